@@ -1,0 +1,109 @@
+//! The options both apps accept (DESIGN.md's command-line contract), parsed by
+//! one clap struct so that `twinray-vk` and `twinray-gl` can never drift apart.
+
+use crate::error::bad_input;
+use clap::Parser;
+use std::path::PathBuf;
+
+#[derive(Parser, Debug, Clone)]
+pub struct RenderArgs {
+    /// Built-in scene (teapot, box, spherelist) or a path to a scene file (.toml).
+    #[arg(long, default_value = "box")]
+    pub scene: String,
+    /// Image size as WxH.
+    #[arg(long, default_value = "800x600", value_parser = parse_size)]
+    pub size: Size,
+    /// Render offscreen, without a window.
+    #[arg(long)]
+    pub headless: bool,
+    /// Frames to render, then exit (headless default: 1).
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=100_000))]
+    pub frames: Option<u32>,
+    /// Save the last frame as PNG (top row first, same orientation in both APIs).
+    #[arg(long)]
+    pub out: Option<PathBuf>,
+    /// Print one JSON object describing the run on stdout.
+    #[arg(long)]
+    pub json: bool,
+    /// Scene parameter override KEY=VALUE (repeatable), e.g. extra_spheres=2500, max_depth=3.
+    #[arg(long = "set", value_name = "KEY=VALUE")]
+    pub set: Vec<String>,
+    /// Vulkan: require validation layers and fail on any message. OpenGL: debug context, fail on any error.
+    #[arg(long)]
+    pub validate: bool,
+    /// Render with the all-features shader instead of the scene's own variant.
+    #[arg(long)]
+    pub generic: bool,
+}
+
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Size {
+    pub width: u32,
+    pub height: u32,
+}
+
+impl std::fmt::Display for Size {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "{}x{}", self.width, self.height)
+    }
+}
+
+/// The largest size accepted before asking the device: 16384² covers every GPU's
+/// framebuffer limit; apps then check their device's own limit.
+pub const MAX_SIZE: u32 = 16384;
+
+pub fn parse_size(s: &str) -> Result<Size, String> {
+    let (w, h) = s
+        .split_once(['x', 'X'])
+        .ok_or_else(|| format!("'{s}' is not WxH (for example 800x600)"))?;
+    let parse = |v: &str, what: &str| -> Result<u32, String> {
+        v.trim().parse::<u32>().map_err(|_| format!("the {what} in '{s}' is not a whole number"))
+    };
+    let (width, height) = (parse(w, "width")?, parse(h, "height")?);
+    if width == 0 || height == 0 {
+        return Err(format!("'{s}' has a zero dimension; width and height must be at least 1"));
+    }
+    if width > MAX_SIZE || height > MAX_SIZE {
+        return Err(format!("'{s}' is larger than {MAX_SIZE} in one dimension"));
+    }
+    Ok(Size { width, height })
+}
+
+impl RenderArgs {
+    /// Parses argv, mapping clap's usage errors to exit code 2 (clap already
+    /// prints one clear line naming the option).
+    pub fn parse_or_exit() -> Self {
+        match Self::try_parse() {
+            Ok(a) => a,
+            Err(e) => {
+                let code = match e.kind() {
+                    clap::error::ErrorKind::DisplayHelp | clap::error::ErrorKind::DisplayVersion => 0,
+                    _ => 2,
+                };
+                let _ = e.print();
+                std::process::exit(code);
+            }
+        }
+    }
+
+    pub fn frame_count(&self) -> u32 {
+        self.frames.unwrap_or(1)
+    }
+
+    /// The `--set` pairs split into (key, value).
+    pub fn overrides(&self) -> anyhow::Result<Vec<(String, String)>> {
+        self.set
+            .iter()
+            .map(|kv| {
+                kv.split_once('=')
+                    .map(|(k, v)| (k.trim().to_string(), v.trim().to_string()))
+                    .ok_or_else(|| bad_input(format!("--set '{kv}' is not KEY=VALUE")))
+            })
+            .collect()
+    }
+
+    /// Loads the scene named by `--scene` with the `--set` overrides applied.
+    pub fn load_scene(&self) -> anyhow::Result<crate::scene::Scene> {
+        crate::scene::Scene::load(&self.scene, &self.overrides()?)
+    }
+}

@@ -1,0 +1,218 @@
+//! GPU buffer layouts: the one Rust mirror of every struct in shaders/trace.glsl
+//! (`#[repr(C)]` + bytemuck), and the conversion of a `Scene` into the exact bytes
+//! both apps upload. A test checks these layouts against naga's view of the GLSL.
+
+use crate::camera::RayFrame;
+use crate::scene::Scene;
+use bytemuck::{Pod, Zeroable};
+
+/// Uniform block `Frame` (std140, binding 0).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, Pod, Zeroable, PartialEq)]
+pub struct GpuFrame {
+    pub eye: [f32; 3],
+    pub min_weight: f32,
+    pub top_left: [f32; 3],
+    pub epsilon: f32,
+    pub step_x: [f32; 3],
+    pub max_depth: u32,
+    pub step_y: [f32; 3],
+    pub sphere_count: u32,
+    pub background: [f32; 3],
+    pub triangle_count: u32,
+    pub light_count: u32,
+    pub pad: [u32; 3],
+}
+
+/// `Sphere` (std430 array element, binding 1).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, Pod, Zeroable, PartialEq)]
+pub struct GpuSphere {
+    pub center: [f32; 3],
+    pub radius: f32,
+    pub material: u32,
+    pub pad: [u32; 3],
+}
+
+/// `Triangle` (std430 array element, binding 2): vertices, then per-vertex normals.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, Pod, Zeroable, PartialEq)]
+pub struct GpuTriangle {
+    pub p0: [f32; 3],
+    pub material: u32,
+    pub p1: [f32; 3],
+    pub pad0: u32,
+    pub p2: [f32; 3],
+    pub pad1: u32,
+    pub n0: [f32; 3],
+    pub pad2: u32,
+    pub n1: [f32; 3],
+    pub pad3: u32,
+    pub n2: [f32; 3],
+    pub pad4: u32,
+}
+
+/// `Material` (std430 array element, binding 3).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, Pod, Zeroable, PartialEq)]
+pub struct GpuMaterial {
+    pub ambient: [f32; 3],
+    pub reflectivity: f32,
+    pub diffuse: [f32; 3],
+    pub transparency: f32,
+    pub specular: [f32; 3],
+    pub shininess: f32,
+    pub ior: f32,
+    pub pad: [u32; 3],
+}
+
+/// `Light` (std430 array element, binding 4).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, Pod, Zeroable, PartialEq)]
+pub struct GpuLight {
+    pub position: [f32; 3],
+    pub pad0: f32,
+    pub color: [f32; 3],
+    pub pad1: f32,
+}
+
+/// Binding numbers, shared by the shader build (GLSL binding map) and both apps.
+pub mod binding {
+    pub const FRAME: u32 = 0;
+    pub const SPHERES: u32 = 1;
+    pub const TRIANGLES: u32 = 2;
+    pub const MATERIALS: u32 = 3;
+    pub const LIGHTS: u32 = 4;
+    /// The storage buffers in binding order.
+    pub const STORAGE: [u32; 4] = [SPHERES, TRIANGLES, MATERIALS, LIGHTS];
+}
+
+/// Everything a frame needs on the GPU, as bytes. Both apps upload exactly these.
+#[derive(Clone, Debug)]
+pub struct GpuScene {
+    pub frame: GpuFrame,
+    pub spheres: Vec<GpuSphere>,
+    pub triangles: Vec<GpuTriangle>,
+    pub materials: Vec<GpuMaterial>,
+    pub lights: Vec<GpuLight>,
+}
+
+fn v3(v: glam::DVec3) -> [f32; 3] {
+    v.as_vec3().to_array()
+}
+
+impl GpuScene {
+    pub fn new(scene: &Scene, width: u32, height: u32) -> GpuScene {
+        let rf = RayFrame::new(&scene.camera, width, height);
+        let frame = GpuFrame {
+            eye: v3(rf.eye),
+            min_weight: scene.min_weight as f32,
+            top_left: v3(rf.top_left),
+            epsilon: scene.epsilon as f32,
+            step_x: v3(rf.step_x),
+            max_depth: scene.max_depth,
+            step_y: v3(rf.step_y),
+            sphere_count: scene.spheres.len() as u32,
+            background: v3(scene.background),
+            triangle_count: scene.triangles.len() as u32,
+            light_count: scene.lights.len() as u32,
+            pad: [0; 3],
+        };
+        GpuScene {
+            frame,
+            spheres: scene
+                .spheres
+                .iter()
+                .map(|s| GpuSphere { center: v3(s.center), radius: s.radius as f32, material: s.material, pad: [0; 3] })
+                .collect(),
+            triangles: scene
+                .triangles
+                .iter()
+                .map(|t| GpuTriangle {
+                    p0: v3(t.p[0]),
+                    material: t.material,
+                    p1: v3(t.p[1]),
+                    p2: v3(t.p[2]),
+                    n0: v3(t.n[0]),
+                    n1: v3(t.n[1]),
+                    n2: v3(t.n[2]),
+                    ..Default::default()
+                })
+                .collect(),
+            materials: scene
+                .materials
+                .iter()
+                .map(|m| GpuMaterial {
+                    ambient: v3(m.ambient),
+                    reflectivity: m.reflectivity as f32,
+                    diffuse: v3(m.diffuse),
+                    transparency: m.transparency as f32,
+                    specular: v3(m.specular),
+                    shininess: m.shininess as f32,
+                    ior: m.ior as f32,
+                    pad: [0; 3],
+                })
+                .collect(),
+            lights: scene
+                .lights
+                .iter()
+                .map(|l| GpuLight { position: v3(l.position), color: v3(l.color), ..Default::default() })
+                .collect(),
+        }
+    }
+
+    pub fn frame_bytes(&self) -> &[u8] {
+        bytemuck::bytes_of(&self.frame)
+    }
+
+    /// The bytes of a storage buffer by binding number. An empty array still gets
+    /// one zeroed element: neither API accepts a zero-sized buffer binding, and the
+    /// counts in `Frame` keep the shader from reading it.
+    pub fn storage_bytes(&self, binding: u32) -> Vec<u8> {
+        fn bytes<T: Pod + Default>(v: &[T]) -> Vec<u8> {
+            if v.is_empty() {
+                bytemuck::bytes_of(&T::default()).to_vec()
+            } else {
+                bytemuck::cast_slice(v).to_vec()
+            }
+        }
+        match binding {
+            binding::SPHERES => bytes(&self.spheres),
+            binding::TRIANGLES => bytes(&self.triangles),
+            binding::MATERIALS => bytes(&self.materials),
+            binding::LIGHTS => bytes(&self.lights),
+            _ => panic!("binding {binding} is not a storage buffer"),
+        }
+    }
+
+    /// The largest storage buffer, to check against the device's limit.
+    pub fn largest_storage(&self) -> (u32, usize) {
+        binding::STORAGE
+            .iter()
+            .map(|&b| (b, self.storage_bytes(b).len()))
+            .max_by_key(|(_, n)| *n)
+            .unwrap_or((0, 0))
+    }
+}
+
+pub fn storage_name(binding: u32) -> &'static str {
+    match binding {
+        binding::SPHERES => "spheres",
+        binding::TRIANGLES => "triangles",
+        binding::MATERIALS => "materials",
+        binding::LIGHTS => "lights",
+        _ => "frame",
+    }
+}
+
+/// A clear bad-input error when the scene's largest buffer exceeds the device limit.
+pub fn check_storage_limit(gpu: &GpuScene, limit: u64, limit_name: &str) -> anyhow::Result<()> {
+    let (b, n) = gpu.largest_storage();
+    if n as u64 > limit {
+        return Err(crate::error::bad_input(format!(
+            "the scene's {} buffer needs {n} bytes, more than this device's {limit_name} of {limit} bytes; use fewer primitives",
+            storage_name(b)
+        )));
+    }
+    Ok(())
+}

@@ -1,0 +1,18 @@
+//! twinray-common: everything both apps share so that they differ only where
+//! Vulkan and OpenGL differ — scene loading, camera, GPU buffer layouts, the
+//! naga shader build, the f64 CPU reference, image metrics, CLI and statistics.
+
+pub mod camera;
+pub mod cli;
+pub mod error;
+pub mod gpu;
+pub mod image_io;
+pub mod metrics;
+pub mod reference;
+pub mod report;
+pub mod scene;
+pub mod shader;
+pub mod stats;
+pub mod teapot;
+
+pub use error::{Failure, FailureKind};

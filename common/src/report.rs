@@ -1,0 +1,64 @@
+//! The JSON object each app prints with `--json`: the contract between the apps
+//! and the `twinray` orchestrator (which reads it back with the same struct).
+
+use crate::scene::SceneStats;
+use crate::stats::{summarize, Summary};
+use serde::{Deserialize, Serialize};
+
+#[derive(Debug, Clone, Serialize, Deserialize)]
+pub struct FrameTime {
+    /// GPU time of the draw, from timestamps / timer queries (None where unreliable or unsupported).
+    pub gpu_ms: Option<f64>,
+    /// One loop iteration: submit + wait, as the 2018 study measured.
+    pub wall_ms: f64,
+}
+
+#[derive(Debug, Clone, Serialize, Deserialize)]
+pub struct RunReport {
+    /// "vulkan" or "opengl".
+    pub api: String,
+    pub device: String,
+    pub driver: String,
+    pub api_version: String,
+    pub os: String,
+    pub scene: SceneStats,
+    pub variant: String,
+    pub width: u32,
+    pub height: u32,
+    pub frames: Vec<FrameTime>,
+    pub gpu_ms: Option<Summary>,
+    pub wall_ms: Option<Summary>,
+    /// Pixels of the last frame with a NaN or infinite channel before quantisation.
+    pub nonfinite_pixels: u64,
+    /// Milliseconds from process start to the first frame (setup cost).
+    pub setup_ms: f64,
+    /// Messages from the validation layer / GL debug output (errors and warnings).
+    pub validation_messages: u64,
+}
+
+impl RunReport {
+    /// Fills the summaries from `frames`.
+    pub fn summarise(&mut self) {
+        let wall: Vec<f64> = self.frames.iter().map(|f| f.wall_ms).collect();
+        self.wall_ms = summarize(&wall);
+        let gpu: Option<Vec<f64>> = self.frames.iter().map(|f| f.gpu_ms).collect();
+        self.gpu_ms = gpu.and_then(|g| summarize(&g));
+    }
+}
+
+/// "Debian GNU/Linux 12 (bookworm), Linux 6.1" — for reports.
+pub fn os_description() -> String {
+    let pretty = std::fs::read_to_string("/etc/os-release")
+        .ok()
+        .and_then(|t| {
+            t.lines()
+                .find_map(|l| l.strip_prefix("PRETTY_NAME=").map(|v| v.trim_matches('"').to_string()))
+        })
+        .unwrap_or_else(|| std::env::consts::OS.to_string());
+    let kernel = std::fs::read_to_string("/proc/sys/kernel/osrelease").map(|s| s.trim().to_string()).unwrap_or_default();
+    if kernel.is_empty() {
+        pretty
+    } else {
+        format!("{pretty}, Linux {kernel}")
+    }
+}

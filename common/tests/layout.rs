@@ -1,0 +1,120 @@
+//! Proves that naga's layout of every struct in shaders/trace.glsl equals the
+//! Rust mirror in common/src/gpu.rs: member offsets, struct sizes, array strides.
+
+use std::mem::{offset_of, size_of};
+use twinray_common::gpu::*;
+use twinray_common::shader::{fragment_source, parse, Variant};
+
+/// (name, offset) of every member, in declaration order.
+fn naga_members(module: &naga::Module, ty: naga::Handle<naga::Type>) -> (Vec<(String, u32)>, u32) {
+    match &module.types[ty].inner {
+        naga::TypeInner::Struct { members, span } => (
+            members.iter().map(|m| (m.name.clone().unwrap_or_default(), m.offset)).collect(),
+            *span,
+        ),
+        other => panic!("expected a struct, found {other:?}"),
+    }
+}
+
+/// The block bound at `binding` and, for storage buffers, its runtime-array element type and stride.
+fn block(module: &naga::Module, binding: u32) -> (naga::Handle<naga::Type>, Option<(naga::Handle<naga::Type>, u32)>) {
+    let (_, var) = module
+        .global_variables
+        .iter()
+        .find(|(_, v)| v.binding.as_ref().map(|b| (b.group, b.binding)) == Some((0, binding)))
+        .unwrap_or_else(|| panic!("no resource at binding {binding}"));
+    let elem = match &module.types[var.ty].inner {
+        naga::TypeInner::Struct { members, .. } if members.len() == 1 => match &module.types[members[0].ty].inner {
+            naga::TypeInner::Array { base, stride, .. } => Some((*base, *stride)),
+            _ => None,
+        },
+        _ => None,
+    };
+    (var.ty, elem)
+}
+
+macro_rules! rust_offsets {
+    ($t:ty { $($field:tt $( [$idx:expr] )?),* $(,)? }) => {
+        vec![$( offset_of!($t, $field) as u32 $( + $idx * 4 )? ),*]
+    };
+}
+
+fn check(name: &str, naga: (Vec<(String, u32)>, u32), rust_offsets: Vec<u32>, rust_size: usize) {
+    let (members, span) = naga;
+    let offsets: Vec<u32> = members.iter().map(|m| m.1).collect();
+    assert_eq!(offsets, rust_offsets, "{name}: member offsets differ (naga members {members:?})");
+    assert_eq!(span as usize, rust_size, "{name}: size differs");
+}
+
+#[test]
+fn naga_layout_matches_rust_for_every_shader_struct() {
+    let (module, _) = parse(&fragment_source(), naga::ShaderStage::Fragment, &Variant::generic()).unwrap();
+
+    let (frame_ty, _) = block(&module, binding::FRAME);
+    check(
+        "Frame",
+        naga_members(&module, frame_ty),
+        rust_offsets!(GpuFrame {
+            eye, min_weight, top_left, epsilon, step_x, max_depth, step_y, sphere_count, background,
+            triangle_count, light_count, pad[0], pad[1], pad[2]
+        }),
+        size_of::<GpuFrame>(),
+    );
+
+    let (_, sphere) = block(&module, binding::SPHERES);
+    let (ty, stride) = sphere.expect("spheres is a runtime array");
+    assert_eq!(stride as usize, size_of::<GpuSphere>(), "Sphere stride");
+    check(
+        "Sphere",
+        naga_members(&module, ty),
+        rust_offsets!(GpuSphere { center, radius, material, pad[0], pad[1], pad[2] }),
+        size_of::<GpuSphere>(),
+    );
+
+    let (_, tri) = block(&module, binding::TRIANGLES);
+    let (ty, stride) = tri.expect("triangles is a runtime array");
+    assert_eq!(stride as usize, size_of::<GpuTriangle>(), "Triangle stride");
+    check(
+        "Triangle",
+        naga_members(&module, ty),
+        rust_offsets!(GpuTriangle { p0, material, p1, pad0, p2, pad1, n0, pad2, n1, pad3, n2, pad4 }),
+        size_of::<GpuTriangle>(),
+    );
+
+    let (_, mat) = block(&module, binding::MATERIALS);
+    let (ty, stride) = mat.expect("materials is a runtime array");
+    assert_eq!(stride as usize, size_of::<GpuMaterial>(), "Material stride");
+    check(
+        "Material",
+        naga_members(&module, ty),
+        rust_offsets!(GpuMaterial {
+            ambient, reflectivity, diffuse, transparency, specular, shininess, ior, pad[0], pad[1], pad[2]
+        }),
+        size_of::<GpuMaterial>(),
+    );
+
+    let (_, light) = block(&module, binding::LIGHTS);
+    let (ty, stride) = light.expect("lights is a runtime array");
+    assert_eq!(stride as usize, size_of::<GpuLight>(), "Light stride");
+    check(
+        "Light",
+        naga_members(&module, ty),
+        rust_offsets!(GpuLight { position, pad0, color, pad1 }),
+        size_of::<GpuLight>(),
+    );
+}
+
+#[test]
+fn every_builtin_variant_and_the_generic_one_compile_for_both_apis() {
+    let mut variants = vec![Variant::generic()];
+    for (name, _) in twinray_common::scene::BUILTIN_SCENES {
+        let scene = twinray_common::scene::Scene::load(name, &[]).unwrap();
+        variants.push(Variant::for_scene(&scene));
+    }
+    for v in variants {
+        let s = twinray_common::shader::build(&v).unwrap_or_else(|e| panic!("{}: {e:#}", v.label()));
+        assert_eq!(s.fragment_spirv[0], 0x0723_0203, "SPIR-V magic");
+        assert!(s.fragment_glsl.starts_with("#version 450 core"), "{}", &s.fragment_glsl[..40]);
+        assert!(s.fragment_glsl.contains("layout(std140, binding = 0) uniform"), "{}: UBO bound by number", v.label());
+    }
+}

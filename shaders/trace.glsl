@@ -1,0 +1,341 @@
+// trace.glsl — the one Whitted-style tracer shared by every entry point.
+//
+// Rust concatenates: a `#version` line, this file, then an entry point (trace.frag).
+// naga has no #include. Every struct here is mirrored by a #[repr(C)] struct in
+// common/src/gpu.rs and a test checks that naga's layout equals the Rust one.
+//
+// Features a scene lacks are compiled out through defines chosen in
+// common/src/shader.rs: HAS_SPHERES, HAS_TRIANGLES, HAS_MIRROR, HAS_GLASS,
+// and STACK_SIZE (the ray stack, >= max_depth + 1).
+//
+// The CPU reference (common/src/reference.rs) follows this file step by step in
+// f64; change both together.
+
+#ifndef STACK_SIZE
+#define STACK_SIZE 17
+#endif
+
+struct Material {
+    vec3 ambient;
+    float reflectivity;
+    vec3 diffuse;
+    float transparency;
+    vec3 specular;
+    float shininess;
+    float ior;
+    uint pad0;
+    uint pad1;
+    uint pad2;
+};
+
+struct Sphere {
+    vec3 center;
+    float radius;
+    uint material;
+    uint pad0;
+    uint pad1;
+    uint pad2;
+};
+
+// Vertices and per-vertex normals; the material index rides in p0's spare slot.
+struct Triangle {
+    vec3 p0;
+    uint material;
+    vec3 p1;
+    uint pad0;
+    vec3 p2;
+    uint pad1;
+    vec3 n0;
+    uint pad2;
+    vec3 n1;
+    uint pad3;
+    vec3 n2;
+    uint pad4;
+};
+
+struct Light {
+    vec3 position;
+    float pad0;
+    vec3 color;
+    float pad1;
+};
+
+// The camera is an eye plus the centre of the top-left pixel and per-pixel steps:
+// the y step points down the image, so both APIs produce the same upright image.
+layout(std140, set = 0, binding = 0) uniform Frame {
+    vec3 eye;
+    float min_weight;
+    vec3 top_left;
+    float epsilon;
+    vec3 step_x;
+    uint max_depth;
+    vec3 step_y;
+    uint sphere_count;
+    vec3 background;
+    uint triangle_count;
+    uint light_count;
+    uint pad0;
+    uint pad1;
+    uint pad2;
+} frame;
+
+layout(std430, set = 0, binding = 1) readonly buffer Spheres {
+    Sphere spheres[];
+} sphere_buf;
+
+layout(std430, set = 0, binding = 2) readonly buffer Triangles {
+    Triangle triangles[];
+} triangle_buf;
+
+layout(std430, set = 0, binding = 3) readonly buffer Materials {
+    Material materials[];
+} material_buf;
+
+layout(std430, set = 0, binding = 4) readonly buffer Lights {
+    Light lights[];
+} light_buf;
+
+const float T_MAX = 1.0e30;
+
+// Stable ray-sphere test (Haines et al., Ray Tracing Gems ch. 7): the discriminant
+// is formed from the distance of the centre to the ray, and the two roots as c/q
+// and q, which avoids cancellation for small or far spheres. `dir` is unit length.
+float hit_sphere(vec3 origin, vec3 dir, Sphere s, float t_min, float t_max) {
+    vec3 f = origin - s.center;
+    float b = dot(f, dir);
+    vec3 l = f - b * dir;
+    float r2 = s.radius * s.radius;
+    float disc = r2 - dot(l, l);
+    if (!(disc >= 0.0)) {
+        return -1.0;
+    }
+    float c = dot(f, f) - r2;
+    float q = -b - (b >= 0.0 ? 1.0 : -1.0) * sqrt(disc);
+    float t0 = c / q;
+    float t1 = q;
+    float lo = min(t0, t1);
+    float hi = max(t0, t1);
+    if (lo > t_min && lo < t_max) {
+        return lo;
+    }
+    if (hi > t_min && hi < t_max) {
+        return hi;
+    }
+    return -1.0;
+}
+
+// Moller-Trumbore. Conditions are written so that NaN (degenerate triangles give
+// det == 0 or a tiny det) fails them: a degenerate triangle is never hit.
+vec3 hit_triangle(vec3 origin, vec3 dir, Triangle tri, float t_min, float t_max) {
+    vec3 e1 = tri.p1 - tri.p0;
+    vec3 e2 = tri.p2 - tri.p0;
+    vec3 pv = cross(dir, e2);
+    float det = dot(e1, pv);
+    vec3 miss = vec3(-1.0, 0.0, 0.0);
+    if (det == 0.0) {
+        return miss;
+    }
+    float inv = 1.0 / det;
+    vec3 tv = origin - tri.p0;
+    float u = dot(tv, pv) * inv;
+    if (!(u >= 0.0 && u <= 1.0)) {
+        return miss;
+    }
+    vec3 qv = cross(tv, e1);
+    float v = dot(dir, qv) * inv;
+    if (!(v >= 0.0 && u + v <= 1.0)) {
+        return miss;
+    }
+    float t = dot(e2, qv) * inv;
+    if (!(t > t_min && t < t_max)) {
+        return miss;
+    }
+    return vec3(t, u, v);
+}
+
+struct Hit {
+    float t;
+    uint kind;  // 0 none, 1 sphere, 2 triangle
+    uint index;
+    float u;
+    float v;
+};
+
+Hit closest_hit(vec3 origin, vec3 dir) {
+    Hit h;
+    h.t = T_MAX;
+    h.kind = 0u;
+    h.index = 0u;
+    h.u = 0.0;
+    h.v = 0.0;
+#ifdef HAS_SPHERES
+    for (uint i = 0u; i < frame.sphere_count; i++) {
+        float t = hit_sphere(origin, dir, sphere_buf.spheres[i], 0.0, h.t);
+        if (t > 0.0) {
+            h.t = t;
+            h.kind = 1u;
+            h.index = i;
+        }
+    }
+#endif
+#ifdef HAS_TRIANGLES
+    for (uint i = 0u; i < frame.triangle_count; i++) {
+        vec3 r = hit_triangle(origin, dir, triangle_buf.triangles[i], 0.0, h.t);
+        if (r.x > 0.0) {
+            h.t = r.x;
+            h.kind = 2u;
+            h.index = i;
+            h.u = r.y;
+            h.v = r.z;
+        }
+    }
+#endif
+    return h;
+}
+
+// Shadow rays need any hit before the light, not the closest one.
+bool occluded(vec3 origin, vec3 dir, float dist) {
+#ifdef HAS_SPHERES
+    for (uint i = 0u; i < frame.sphere_count; i++) {
+        if (hit_sphere(origin, dir, sphere_buf.spheres[i], 0.0, dist) > 0.0) {
+            return true;
+        }
+    }
+#endif
+#ifdef HAS_TRIANGLES
+    for (uint i = 0u; i < frame.triangle_count; i++) {
+        if (hit_triangle(origin, dir, triangle_buf.triangles[i], 0.0, dist).x > 0.0) {
+            return true;
+        }
+    }
+#endif
+    return false;
+}
+
+// Secondary rays start a small, scale-aware distance off the surface, along the
+// geometric normal on the side the new ray leaves from.
+vec3 offset_point(vec3 p, vec3 n) {
+    float scale = max(1.0, max(abs(p.x), max(abs(p.y), abs(p.z))));
+    return p + n * (frame.epsilon * scale);
+}
+
+// Unpolarised Fresnel reflectance of a dielectric boundary.
+float fresnel(float cos_i, float cos_t, float eta) {
+    float rs = (eta * cos_i - cos_t) / (eta * cos_i + cos_t);
+    float rp = (cos_i - eta * cos_t) / (cos_i + eta * cos_t);
+    return 0.5 * (rs * rs + rp * rp);
+}
+
+vec3 trace(vec3 origin, vec3 dir) {
+    vec3 st_origin[STACK_SIZE];
+    vec3 st_dir[STACK_SIZE];
+    float st_weight[STACK_SIZE];
+    uint st_depth[STACK_SIZE];
+    uint max_depth = min(frame.max_depth, uint(STACK_SIZE - 1));
+
+    vec3 color = vec3(0.0);
+    int sp = 0;
+    st_origin[0] = origin;
+    st_dir[0] = dir;
+    st_weight[0] = 1.0;
+    st_depth[0] = 0u;
+    sp = 1;
+
+    while (sp > 0) {
+        sp -= 1;
+        vec3 o = st_origin[sp];
+        vec3 d = st_dir[sp];
+        float w = st_weight[sp];
+        uint depth = st_depth[sp];
+
+        Hit h = closest_hit(o, d);
+        if (h.kind == 0u) {
+            color += w * frame.background;
+            continue;
+        }
+
+        vec3 p = o + h.t * d;
+        vec3 ng;
+        vec3 ns;
+        uint mat_index;
+        if (h.kind == 1u) {
+            Sphere s = sphere_buf.spheres[h.index];
+            ng = (p - s.center) / s.radius;
+            ns = ng;
+            mat_index = s.material;
+        } else {
+            Triangle tri = triangle_buf.triangles[h.index];
+            ng = normalize(cross(tri.p1 - tri.p0, tri.p2 - tri.p0));
+            ns = normalize((1.0 - h.u - h.v) * tri.n0 + h.u * tri.n1 + h.v * tri.n2);
+            mat_index = tri.material;
+        }
+        // Face both normals towards the incoming ray; `inside` tells glass which way it goes.
+        bool inside = dot(d, ng) > 0.0;
+        if (inside) {
+            ng = -ng;
+        }
+        if (dot(ns, ng) < 0.0) {
+            ns = -ns;
+        }
+        Material m = material_buf.materials[mat_index];
+
+        vec3 local = m.ambient;
+        vec3 p_out = offset_point(p, ng);
+        for (uint li = 0u; li < frame.light_count; li++) {
+            Light light = light_buf.lights[li];
+            vec3 to_light = light.position - p_out;
+            float dist = length(to_light);
+            vec3 l = to_light / dist;
+            float ndl = dot(ns, l);
+            if (ndl > 0.0 && dot(ng, l) > 0.0 && !occluded(p_out, l, dist)) {
+                vec3 r = reflect(-l, ns);
+                float spec = pow(max(dot(r, -d), 0.0), m.shininess);
+                local += light.color * (m.diffuse * ndl + m.specular * spec);
+            }
+        }
+        color += w * local;
+
+#if defined(HAS_MIRROR) || defined(HAS_GLASS)
+        if (depth + 1u < max_depth) {
+            float kr = m.reflectivity;
+#ifdef HAS_GLASS
+            float kt = m.transparency;
+            if (kt > 0.0) {
+                float eta = inside ? m.ior : 1.0 / m.ior;
+                float cos_i = -dot(d, ns);
+                float k = 1.0 - eta * eta * (1.0 - cos_i * cos_i);
+                if (k < 0.0) {
+                    kr += kt;  // total internal reflection
+                } else {
+                    float cos_t = sqrt(k);
+                    float f = fresnel(cos_i, cos_t, eta);
+                    kr += kt * f;
+                    float wt = w * kt * (1.0 - f);
+                    if (wt >= frame.min_weight && sp < STACK_SIZE) {
+                        st_origin[sp] = offset_point(p, -ng);
+                        st_dir[sp] = normalize(eta * d + (eta * cos_i - cos_t) * ns);
+                        st_weight[sp] = wt;
+                        st_depth[sp] = depth + 1u;
+                        sp += 1;
+                    }
+                }
+            }
+#endif
+            float wr = w * kr;
+            if (wr >= frame.min_weight && sp < STACK_SIZE) {
+                st_origin[sp] = p_out;
+                st_dir[sp] = reflect(d, ns);
+                st_weight[sp] = wr;
+                st_depth[sp] = depth + 1u;
+                sp += 1;
+            }
+        }
+#endif
+    }
+    return color;
+}
+
+vec3 primary_dir(vec2 frag_xy) {
+    vec3 target = frame.top_left + (frag_xy.x - 0.5) * frame.step_x + (frag_xy.y - 0.5) * frame.step_y;
+    return normalize(target - frame.eye);
+}
