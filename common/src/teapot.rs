@@ -165,10 +165,16 @@ pub fn parse_bpt(text: &str) -> anyhow::Result<Vec<[[f64; 3]; 16]>> {
 /// # Panics
 /// If `nu` or `nv` is zero, or the vertex count does not fit in `u32`.
 pub fn tessellate(patches: &[[[f64; 3]; 16]], nu: u32, nv: u32) -> TeapotMesh {
-    assert!(nu >= 1 && nv >= 1, "tessellate: nu and nv must be at least 1 (got {nu} x {nv})");
+    assert!(
+        nu >= 1 && nv >= 1,
+        "tessellate: nu and nv must be at least 1 (got {nu} x {nv})"
+    );
     let per_patch = (nu as u64 + 1) * (nv as u64 + 1);
     let total = per_patch * patches.len() as u64;
-    assert!(total <= u32::MAX as u64, "tessellate: {total} vertices do not fit in u32 indices");
+    assert!(
+        total <= u32::MAX as u64,
+        "tessellate: {total} vertices do not fit in u32 indices"
+    );
 
     let flips = inward_facing_patches(patches);
     let mut mesh = TeapotMesh {
@@ -220,7 +226,9 @@ pub fn tessellate(patches: &[[[f64; 3]; 16]], nu: u32, nv: u32) -> TeapotMesh {
 /// `0.000000`) and `f a//a b//b c//c` faces (1-based indices).
 pub fn to_obj(mesh: &TeapotMesh, header: &str) -> String {
     let mut out = String::with_capacity(
-        64 + header.len() + (mesh.positions.len() + mesh.normals.len()) * 36 + mesh.triangles.len() * 36,
+        64 + header.len()
+            + (mesh.positions.len() + mesh.normals.len()) * 36
+            + mesh.triangles.len() * 36,
     );
     for line in header.lines() {
         if line.is_empty() {
@@ -330,7 +338,10 @@ fn eval_patch(cp: &[V3; 16], u: f64, v: f64) -> (V3, V3, V3) {
 /// Squared size of a patch's control net, used to make the "vanishing cross
 /// product" threshold scale-invariant.
 fn patch_size_sq(cp: &[V3; 16]) -> f64 {
-    let s = cp.iter().map(|c| dot(sub(*c, cp[0]), sub(*c, cp[0]))).fold(0.0, f64::max);
+    let s = cp
+        .iter()
+        .map(|c| dot(sub(*c, cp[0]), sub(*c, cp[0])))
+        .fold(0.0, f64::max);
     if s > 0.0 {
         s
     } else {
@@ -374,7 +385,11 @@ fn surface_normal(cp: &[V3; 16], u: f64, v: f64) -> V3 {
 
 /// Any unit vector orthonormal frame (t1, t2) completing unit `n`.
 fn tangent_frame(n: V3) -> (V3, V3) {
-    let helper = if n[0].abs() < 0.6 { [1.0, 0.0, 0.0] } else { [0.0, 1.0, 0.0] };
+    let helper = if n[0].abs() < 0.6 {
+        [1.0, 0.0, 0.0]
+    } else {
+        [0.0, 1.0, 0.0]
+    };
     let t1 = cross(n, helper);
     let t1 = scale(t1, 1.0 / length(t1));
     let t2 = cross(n, t1);
@@ -432,7 +447,13 @@ const VOTE_GRID: usize = 6;
 /// Rays per hemisphere per sample point in the orientation vote.
 const VOTE_RAYS: usize = 16;
 /// Sample points (u, v) on each patch for the orientation vote.
-const VOTE_SAMPLES: [(f64, f64); 5] = [(0.5, 0.5), (0.25, 0.25), (0.75, 0.25), (0.25, 0.75), (0.75, 0.75)];
+const VOTE_SAMPLES: [(f64, f64); 5] = [
+    (0.5, 0.5),
+    (0.25, 0.25),
+    (0.75, 0.25),
+    (0.25, 0.75),
+    (0.75, 0.75),
+];
 
 /// Number of rays escaping to infinity from each side of a patch:
 /// `(along +∂P/∂u × ∂P/∂v, along its opposite)`, occluded only by the other
@@ -523,7 +544,10 @@ fn escape_votes(patches: &[[V3; 16]]) -> Vec<(usize, usize)> {
 /// For each patch, whether its `∂P/∂u × ∂P/∂v` faces inward (more rays escape
 /// from the opposite side), so that normals and winding must be flipped.
 fn inward_facing_patches(patches: &[[V3; 16]]) -> Vec<bool> {
-    escape_votes(patches).into_iter().map(|(out, inn)| inn > out).collect()
+    escape_votes(patches)
+        .into_iter()
+        .map(|(out, inn)| inn > out)
+        .collect()
 }
 
 #[cfg(test)]
@@ -570,15 +594,27 @@ mod tests {
             // Non-bicubic degree line.
             ("1\n2 3\n".to_string() + &"0 0 0\n".repeat(16), "line 2:"),
             // Non-numeric coordinate on line 7 (5th control point).
-            ("1\n3 3\n".to_string() + &"0 0 0\n".repeat(4) + "0 zero 0\n" + &"0 0 0\n".repeat(11), "line 7:"),
+            (
+                "1\n3 3\n".to_string()
+                    + &"0 0 0\n".repeat(4)
+                    + "0 zero 0\n"
+                    + &"0 0 0\n".repeat(11),
+                "line 7:",
+            ),
             // Too few fields on line 4.
-            ("1\n3 3\n0 0 0\n0 0\n".to_string() + &"0 0 0\n".repeat(14), "line 4:"),
+            (
+                "1\n3 3\n0 0 0\n0 0\n".to_string() + &"0 0 0\n".repeat(14),
+                "line 4:",
+            ),
             // Truncated input: 2 patches declared, 1 given (18 lines) -> EOF is line 19.
             ("2\n".to_string() + &good[2..], "line 19:"),
             // Extra content after the declared patches.
             (good.clone() + "1 2 3\n", "line 19:"),
             // Non-finite coordinate.
-            ("1\n3 3\nNaN 0 0\n".to_string() + &"0 0 0\n".repeat(15), "line 3:"),
+            (
+                "1\n3 3\nNaN 0 0\n".to_string() + &"0 0 0\n".repeat(15),
+                "line 3:",
+            ),
         ];
         for (text, want) in cases {
             let err = parse_bpt(&text).expect_err("malformed input must be rejected");
@@ -586,7 +622,8 @@ mod tests {
             assert!(msg.contains(want), "error {msg:?} should name {want:?}");
         }
         // Blank lines do not shift the reported line numbers.
-        let text = "\n1\n\n3 3\n".to_string() + &"0 0 0\n".repeat(3) + "bad\n" + &"0 0 0\n".repeat(12);
+        let text =
+            "\n1\n\n3 3\n".to_string() + &"0 0 0\n".repeat(3) + "bad\n" + &"0 0 0\n".repeat(12);
         let msg = format!("{:#}", parse_bpt(&text).unwrap_err());
         assert!(msg.contains("line 8:"), "{msg}");
     }
@@ -595,14 +632,25 @@ mod tests {
     fn study_tessellation_has_19200_triangles() {
         let mesh = study_mesh();
         assert_eq!(mesh.triangles.len(), 19_200);
-        assert_eq!(mesh.triangles.len(), 32 * STUDY_NU as usize * STUDY_NV as usize * 2);
+        assert_eq!(
+            mesh.triangles.len(),
+            32 * STUDY_NU as usize * STUDY_NV as usize * 2
+        );
         let verts = 32 * (STUDY_NU as usize + 1) * (STUDY_NV as usize + 1);
         assert_eq!(mesh.positions.len(), verts);
         assert_eq!(mesh.normals.len(), verts);
-        assert!(mesh.triangles.iter().flatten().all(|&i| (i as usize) < verts));
+        assert!(mesh
+            .triangles
+            .iter()
+            .flatten()
+            .all(|&i| (i as usize) < verts));
         // The only degenerate triangles are those of the collapsed first rows
         // of the 4 lid-knob and 4 bottom patches: one per quad of that row.
-        let degenerate = mesh.triangles.iter().filter(|t| is_degenerate(&mesh, t)).count();
+        let degenerate = mesh
+            .triangles
+            .iter()
+            .filter(|t| is_degenerate(&mesh, t))
+            .count();
         assert_eq!(degenerate, 8 * STUDY_NU as usize);
     }
 
@@ -613,7 +661,10 @@ mod tests {
             assert!(mesh.positions.iter().flatten().all(|x| x.is_finite()));
             assert!(mesh.normals.iter().flatten().all(|x| x.is_finite()));
             for n in &mesh.normals {
-                assert!((length(*n) - 1.0).abs() < 1e-9, "normal {n:?} is not unit length");
+                assert!(
+                    (length(*n) - 1.0).abs() < 1e-9,
+                    "normal {n:?} is not unit length"
+                );
             }
         }
     }
@@ -630,7 +681,10 @@ mod tests {
                     assert!(n[1] > 0.999, "knob-top normal {n:?} should point up");
                 } else if p[1].abs() < 1e-12 {
                     bottom += 1;
-                    assert!(n[1] < -0.999, "bottom-centre normal {n:?} should point down");
+                    assert!(
+                        n[1] < -0.999,
+                        "bottom-centre normal {n:?} should point down"
+                    );
                 }
             }
         }
@@ -652,9 +706,18 @@ mod tests {
         // y-up: sits on y = 0, knob top at 3.15; spout tip toward +x (~3.43),
         // handle toward -x (-3.0); radius 2 (bottom of the body) in z.
         let close = |a: f64, b: f64, tol: f64| (a - b).abs() < tol;
-        assert!(close(lo[1], 0.0, 1e-9) && close(hi[1], 3.15, 1e-9), "y range {lo:?} {hi:?}");
-        assert!(close(lo[0], -3.0, 1e-2) && close(hi[0], 3.434, 2e-2), "x range {lo:?} {hi:?}");
-        assert!(close(lo[2], -2.0, 1e-2) && close(hi[2], 2.0, 1e-2), "z range {lo:?} {hi:?}");
+        assert!(
+            close(lo[1], 0.0, 1e-9) && close(hi[1], 3.15, 1e-9),
+            "y range {lo:?} {hi:?}"
+        );
+        assert!(
+            close(lo[0], -3.0, 1e-2) && close(hi[0], 3.434, 2e-2),
+            "x range {lo:?} {hi:?}"
+        );
+        assert!(
+            close(lo[2], -2.0, 1e-2) && close(hi[2], 2.0, 1e-2),
+            "z range {lo:?} {hi:?}"
+        );
         // Symmetric about the x-y plane (the data's x-z plane).
         assert!(close(lo[2], -hi[2], 1e-9));
     }
@@ -668,7 +731,10 @@ mod tests {
         for k in 4 * per..12 * per {
             let (p, n) = (mesh.positions[k], mesh.normals[k]);
             let radial = [p[0], 0.0, p[2]];
-            assert!(dot(n, radial) > 0.0, "body vertex {p:?} has inward normal {n:?}");
+            assert!(
+                dot(n, radial) > 0.0,
+                "body vertex {p:?} has inward normal {n:?}"
+            );
             checked += 1;
         }
         assert_eq!(checked, 8 * per);
@@ -679,17 +745,33 @@ mod tests {
             mesh.normals[patch * per + b * (STUDY_NU as usize + 1) + a]
         };
         for patch in 24..28 {
-            assert!(centre(patch)[1] > 0.5, "lid patch {} normal {:?}", patch + 1, centre(patch));
+            assert!(
+                centre(patch)[1] > 0.5,
+                "lid patch {} normal {:?}",
+                patch + 1,
+                centre(patch)
+            );
         }
         for patch in 28..32 {
-            assert!(centre(patch)[1] < -0.5, "bottom patch {} normal {:?}", patch + 1, centre(patch));
+            assert!(
+                centre(patch)[1] < -0.5,
+                "bottom patch {} normal {:?}",
+                patch + 1,
+                centre(patch)
+            );
         }
         // Handle (13..16) and spout (17..20): each patch is half a tube split at
         // the symmetry plane; its middle points away from that plane.
         for patch in 12..20 {
-            let k = patch * per + (STUDY_NV as usize / 2) * (STUDY_NU as usize + 1) + STUDY_NU as usize / 2;
+            let k = patch * per
+                + (STUDY_NV as usize / 2) * (STUDY_NU as usize + 1)
+                + STUDY_NU as usize / 2;
             let (p, n) = (mesh.positions[k], mesh.normals[k]);
-            assert!(p[2] * n[2] > 0.0, "patch {} at {p:?}: normal {n:?} faces the symmetry plane", patch + 1);
+            assert!(
+                p[2] * n[2] > 0.0,
+                "patch {} at {p:?}: normal {n:?} faces the symmetry plane",
+                patch + 1
+            );
         }
     }
 
@@ -704,7 +786,9 @@ mod tests {
             }
             non_degenerate += 1;
             let g = tri_cross(&mesh, t);
-            let avg = t.iter().fold([0.0; 3], |acc, &i| add(acc, mesh.normals[i as usize]));
+            let avg = t
+                .iter()
+                .fold([0.0; 3], |acc, &i| add(acc, mesh.normals[i as usize]));
             if dot(g, avg) > 0.0 {
                 agree += 1;
             }
@@ -721,7 +805,11 @@ mod tests {
         let patches = reference();
         let votes = escape_votes(&patches);
         for (i, &(out, inn)) in votes.iter().enumerate() {
-            assert!(out > inn + 8, "patch {}: outward side escapes {out}, inward {inn}", i + 1);
+            assert!(
+                out > inn + 8,
+                "patch {}: outward side escapes {out}, inward {inn}",
+                i + 1
+            );
         }
         assert!(inward_facing_patches(&patches).iter().all(|f| !f));
     }
@@ -756,13 +844,19 @@ mod tests {
                     let ka = patch * per + bb * (nu as usize + 1) + aa;
                     let kb = patch * per + bb * (nu as usize + 1) + (nu as usize - aa);
                     let (na, nb) = (a.normals[ka], b.normals[kb]);
-                    assert!(length(sub(na, nb)) < 1e-9, "patch {}: {na:?} vs {nb:?}", patch + 1);
+                    assert!(
+                        length(sub(na, nb)) < 1e-9,
+                        "patch {}: {na:?} vs {nb:?}",
+                        patch + 1
+                    );
                 }
             }
         }
         for t in &b.triangles {
             if length(tri_cross(&b, t)) > 1e-12 {
-                let avg = t.iter().fold([0.0; 3], |acc, &i| add(acc, b.normals[i as usize]));
+                let avg = t
+                    .iter()
+                    .fold([0.0; 3], |acc, &i| add(acc, b.normals[i as usize]));
                 assert!(dot(tri_cross(&b, t), avg) > 0.0);
             }
         }
@@ -788,7 +882,10 @@ mod tests {
     #[test]
     fn committed_obj_matches_generator() {
         let committed = include_str!("../../scenes/teapot.obj").replace("\r\n", "\n");
-        let fresh = to_obj(&tessellate(&parse_bpt(BPT).unwrap(), STUDY_NU, STUDY_NV), HEADER);
+        let fresh = to_obj(
+            &tessellate(&parse_bpt(BPT).unwrap(), STUDY_NU, STUDY_NV),
+            HEADER,
+        );
         assert!(
             committed == fresh,
             "scenes/teapot.obj is stale: regenerate with `cargo run -p twinray-common --bin twinray-gen-teapot`"

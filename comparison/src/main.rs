@@ -1,1 +1,55 @@
-fn main(){}
+//! `twinray`: the orchestrator. It never links Vulkan or OpenGL: it runs the
+//! apps as child processes (one API per process) and reads their JSON, renders
+//! the f64 reference itself, and compares images.
+
+mod apps;
+mod diff;
+
+use clap::{Parser, Subcommand};
+use twinray_common::cli::RenderArgs;
+use twinray_common::error::exit_with;
+
+#[derive(Parser)]
+#[command(name = "twinray", about = "One GLSL ray tracer, two front doors: Vulkan vs OpenGL, checked against an f64 reference")]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Subcommand)]
+enum Command {
+    /// Render one scene with one API (or the CPU reference); the app options pass through.
+    Render {
+        /// vulkan, opengl or reference.
+        #[arg(long, value_enum)]
+        api: apps::Api,
+        #[command(flatten)]
+        args: RenderArgs,
+    },
+    /// Compare two PNGs: RMSE, PSNR, max abs error, share of pixels above 1/255 and 8/255.
+    Diff {
+        a: std::path::PathBuf,
+        b: std::path::PathBuf,
+        /// Print the metrics as one JSON object.
+        #[arg(long)]
+        json: bool,
+    },
+}
+
+fn main() {
+    let cli = match Cli::try_parse() {
+        Ok(c) => c,
+        Err(e) => {
+            let code = if e.use_stderr() { 2 } else { 0 };
+            let _ = e.print();
+            std::process::exit(code);
+        }
+    };
+    let result = match cli.command {
+        Command::Render { api, args } => apps::render(api, &args),
+        Command::Diff { a, b, json } => diff::run(&a, &b, json),
+    };
+    if let Err(e) = result {
+        exit_with("twinray", e);
+    }
+}

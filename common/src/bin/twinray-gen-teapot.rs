@@ -36,7 +36,9 @@ enum Parsed {
 fn parse_count(flag: &str, value: &str) -> Result<u32, String> {
     match value.parse::<u32>() {
         Ok(n) if (1..=1000).contains(&n) => Ok(n),
-        _ => Err(format!("{flag} expects an integer from 1 to 1000, got {value:?}.")),
+        _ => Err(format!(
+            "{flag} expects an integer from 1 to 1000, got {value:?}."
+        )),
     }
 }
 
@@ -74,9 +76,16 @@ fn parse_args(mut it: impl Iterator<Item = String>) -> Result<Parsed, String> {
         }
     }
     let out = out.unwrap_or_else(|| {
-        PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("..").join("scenes").join("teapot.obj")
+        PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+            .join("..")
+            .join("scenes")
+            .join("teapot.obj")
     });
-    Ok(Parsed::Run(Args { nu: nu.unwrap_or(STUDY_NU), nv: nv.unwrap_or(STUDY_NV), out }))
+    Ok(Parsed::Run(Args {
+        nu: nu.unwrap_or(STUDY_NU),
+        nv: nv.unwrap_or(STUDY_NV),
+        out,
+    }))
 }
 
 fn main() -> ExitCode {
@@ -106,13 +115,19 @@ fn main() -> ExitCode {
         // Keep the header truthful for non-study resolutions.
         HEADER.replacen(
             &format!("tessellated {STUDY_NU} x {STUDY_NV} quads per patch"),
-            &format!("tessellated {} x {} quads per patch (NOT the study resolution)", args.nu, args.nv),
+            &format!(
+                "tessellated {} x {} quads per patch (NOT the study resolution)",
+                args.nu, args.nv
+            ),
             1,
         )
     };
     let obj = to_obj(&mesh, &header);
     if let Err(e) = std::fs::write(&args.out, &obj) {
-        eprintln!("twinray-gen-teapot: cannot write {}: {e}", args.out.display());
+        eprintln!(
+            "twinray-gen-teapot: cannot write {}: {e}",
+            args.out.display()
+        );
         return ExitCode::FAILURE;
     }
     let shown = args.out.canonicalize().unwrap_or(args.out.clone());

@@ -1,0 +1,155 @@
+//! Scene loading: the built-in scenes have the study's counts, and every kind of
+//! bad scene input is refused with one sentence that names the culprit (exit 2).
+
+use twinray_common::camera::{Frustum, RayFrame};
+use twinray_common::error::exit_code_of;
+use twinray_common::scene::Scene;
+
+fn set(kv: &[(&str, &str)]) -> Vec<(String, String)> {
+    kv.iter().map(|(k, v)| (k.to_string(), v.to_string())).collect()
+}
+
+#[test]
+fn teapot_has_the_study_counts_and_its_sphere_is_out_of_view() {
+    let s = Scene::load("teapot", &[]).unwrap();
+    assert_eq!(s.triangles.len(), 19_200);
+    assert_eq!(s.spheres.len(), 1);
+    assert_eq!(s.lights.len(), 3);
+    let f = Frustum::new(&RayFrame::new(&s.camera, 800, 600), 800, 600);
+    let sp = &s.spheres[0];
+    assert!(!f.sees_sphere(sp.center, sp.radius), "the teapot scene's sphere must be outside the view");
+}
+
+#[test]
+fn box_has_30_triangles_a_mirror_and_a_glass_sphere_and_one_light() {
+    let s = Scene::load("box", &[]).unwrap();
+    assert_eq!(s.triangles.len(), 30);
+    assert_eq!(s.spheres.len(), 2);
+    assert_eq!(s.lights.len(), 1);
+    let mats: Vec<_> = s.spheres.iter().map(|sp| &s.materials[sp.material as usize]).collect();
+    assert!(mats.iter().any(|m| m.reflectivity > 0.5 && m.transparency == 0.0), "a mirror sphere");
+    assert!(mats.iter().any(|m| m.transparency > 0.5), "a glass sphere");
+}
+
+#[test]
+fn spherelist_has_6_triangles_one_visible_sphere_and_n_hidden_ones() {
+    for n in [1u32, 10, 50, 100, 500, 1000, 2500, 5000, 10000] {
+        let s = Scene::load("spherelist", &set(&[("extra_spheres", &n.to_string())])).unwrap();
+        assert_eq!(s.triangles.len(), 6);
+        assert_eq!(s.spheres.len(), 1 + n as usize);
+        let visible = &s.spheres[0];
+        for hidden in &s.spheres[1..] {
+            let inside = (hidden.center - visible.center).length() + hidden.radius < visible.radius;
+            assert!(inside, "extra spheres are hidden inside the visible one");
+        }
+    }
+}
+
+fn err_of(text: &str) -> (i32, String) {
+    let dir = std::env::temp_dir();
+    let e = Scene::from_toml("bad", text, &dir, &[]).unwrap_err();
+    (exit_code_of(&e), format!("{e}"))
+}
+
+const OK: &str = r#"
+[camera]
+eye = [0.0, 0.0, 5.0]
+look_at = [0.0, 0.0, 0.0]
+[[materials]]
+name = "m"
+diffuse = [0.5, 0.5, 0.5]
+[[lights]]
+position = [0.0, 5.0, 5.0]
+"#;
+
+#[test]
+fn a_minimal_scene_loads() {
+    let s = Scene::from_toml("ok", &format!("{OK}[[spheres]]\ncenter=[0.0,0.0,0.0]\nradius=1.0\nmaterial=\"m\"\n"), std::path::Path::new("."), &[]).unwrap();
+    assert_eq!(s.spheres.len(), 1);
+}
+
+#[test]
+fn malformed_toml_names_line_and_column() {
+    let (code, msg) = err_of("[camera]\neye = [0.0, 0.0\n");
+    assert_eq!(code, 2);
+    assert!(msg.contains("line 2, column"), "{msg}");
+}
+
+#[test]
+fn unknown_key_is_named_with_its_line() {
+    let (code, msg) = err_of(&format!("{OK}[[spheres]]\ncenter=[0.0,0.0,0.0]\nradius=1.0\nmaterial=\"m\"\ncolour=1\n"));
+    assert_eq!(code, 2);
+    assert!(msg.contains("colour") && msg.contains("line 14"), "{msg}");
+}
+
+#[test]
+fn nan_value_is_refused() {
+    let (code, msg) = err_of(&format!("{OK}[[spheres]]\ncenter=[nan,0.0,0.0]\nradius=1.0\nmaterial=\"m\"\n"));
+    assert_eq!(code, 2);
+    assert!(msg.contains("spheres[0].center") && msg.contains("not finite"), "{msg}");
+}
+
+#[test]
+fn negative_radius_is_refused() {
+    let (code, msg) = err_of(&format!("{OK}[[spheres]]\ncenter=[0.0,0.0,0.0]\nradius=-1.0\nmaterial=\"m\"\n"));
+    assert_eq!(code, 2);
+    assert!(msg.contains("spheres[0].radius = -1") && msg.contains("positive"), "{msg}");
+}
+
+#[test]
+fn zero_length_normal_is_refused() {
+    let (code, msg) = err_of(&format!(
+        "{OK}[[triangles]]\nvertices=[[0.0,0.0,0.0],[1.0,0.0,0.0],[0.0,1.0,0.0]]\nnormals=[[0.0,0.0,1.0],[0.0,0.0,0.0],[0.0,0.0,1.0]]\nmaterial=\"m\"\n"
+    ));
+    assert_eq!(code, 2);
+    assert!(msg.contains("triangles[0].normals[1]") && msg.contains("zero length"), "{msg}");
+}
+
+#[test]
+fn unknown_material_is_named() {
+    let (code, msg) = err_of(&format!("{OK}[[spheres]]\ncenter=[0.0,0.0,0.0]\nradius=1.0\nmaterial=\"gold\"\n"));
+    assert_eq!(code, 2);
+    assert!(msg.contains("'gold'") && msg.contains("not a defined material"), "{msg}");
+}
+
+#[test]
+fn missing_and_broken_obj_files_are_named() {
+    let dir = std::env::temp_dir().join(format!("twinray-obj-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let text = format!("{OK}[[meshes]]\nobj=\"thing.obj\"\nmaterial=\"m\"\n");
+    let e = Scene::from_toml("s", &text, &dir, &[]).unwrap_err();
+    assert_eq!(exit_code_of(&e), 2);
+    assert!(format!("{e}").contains("thing.obj") && format!("{e}").contains("cannot be read"), "{e}");
+
+    std::fs::write(dir.join("thing.obj"), "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 9\n").unwrap();
+    let e = Scene::from_toml("s", &text, &dir, &[]).unwrap_err();
+    assert_eq!(exit_code_of(&e), 2);
+    assert!(format!("{e}").contains("thing.obj"), "{e}");
+
+    std::fs::write(dir.join("thing.obj"), "v 0 0 zero\nf 1 1 1\n").unwrap();
+    let e = Scene::from_toml("s", &text, &dir, &[]).unwrap_err();
+    assert!(format!("{e}").contains("not a valid OBJ"), "{e}");
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+#[test]
+fn unknown_scene_name_and_missing_file() {
+    let e = Scene::load("kettle", &[]).unwrap_err();
+    assert_eq!(exit_code_of(&e), 2);
+    assert!(format!("{e}").contains("'kettle'") && format!("{e}").contains("teapot, box, spherelist"), "{e}");
+    let e = Scene::load("nowhere/scene.toml", &[]).unwrap_err();
+    assert!(format!("{e}").contains("does not exist"), "{e}");
+}
+
+#[test]
+fn overrides_are_checked() {
+    let e = Scene::load("box", &set(&[("speed", "3")])).unwrap_err();
+    assert_eq!(exit_code_of(&e), 2);
+    assert!(format!("{e}").contains("unknown key 'speed'"), "{e}");
+    let e = Scene::load("box", &set(&[("max_depth", "-2")])).unwrap_err();
+    assert!(format!("{e}").contains("max_depth"), "{e}");
+    let e = Scene::load("box", &set(&[("extra_spheres", "5")])).unwrap_err();
+    assert!(format!("{e}").contains("no [extra_spheres]"), "{e}");
+    let s = Scene::load("box", &set(&[("max_depth", "2")])).unwrap();
+    assert_eq!(s.max_depth, 2);
+}

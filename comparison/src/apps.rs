@@ -1,0 +1,151 @@
+//! Running the two apps as child processes (never in-process, so each API gets
+//! a clean process, as in the study), and the CPU reference in-process.
+
+use anyhow::Context;
+use std::path::PathBuf;
+use std::process::Command;
+use std::time::Instant;
+use twinray_common::cli::RenderArgs;
+use twinray_common::error::{bad_input, Failure, FailureKind};
+use twinray_common::report::{FrameTime, RunReport};
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum Api {
+    Vulkan,
+    Opengl,
+    Reference,
+}
+
+impl Api {
+    pub fn binary(self) -> Option<&'static str> {
+        match self {
+            Api::Vulkan => Some("twinray-vk"),
+            Api::Opengl => Some("twinray-gl"),
+            Api::Reference => None,
+        }
+    }
+}
+
+/// Where the app binaries live: `TWINRAY_BIN_DIR`, else next to this executable.
+pub fn app_path(name: &str) -> anyhow::Result<PathBuf> {
+    let dir = match std::env::var_os("TWINRAY_BIN_DIR") {
+        Some(d) => PathBuf::from(d),
+        None => std::env::current_exe()?.parent().map(PathBuf::from).unwrap_or_default(),
+    };
+    let path = dir.join(name);
+    if !path.exists() {
+        return Err(anyhow::anyhow!(
+            "{name} was not found in '{}'; build the whole workspace (cargo build --release --workspace) or set TWINRAY_BIN_DIR",
+            dir.display()
+        ));
+    }
+    Ok(path)
+}
+
+/// The app's command line for `args` (always headless: the orchestrator never opens windows).
+pub fn app_args(args: &RenderArgs) -> Vec<String> {
+    let mut v = vec!["--headless".to_string(), "--scene".into(), args.scene.clone(), "--size".into(), args.size.to_string()];
+    if let Some(f) = args.frames {
+        v.extend(["--frames".into(), f.to_string()]);
+    }
+    if let Some(o) = &args.out {
+        v.extend(["--out".into(), o.display().to_string()]);
+    }
+    for s in &args.set {
+        v.extend(["--set".into(), s.clone()]);
+    }
+    if args.json {
+        v.push("--json".into());
+    }
+    if args.validate {
+        v.push("--validate".into());
+    }
+    if args.generic {
+        v.push("--generic".into());
+    }
+    v
+}
+
+/// Runs an app, passing its output through, and exits with its exit code on failure.
+pub fn render(api: Api, args: &RenderArgs) -> anyhow::Result<()> {
+    match api.binary() {
+        Some(bin) => {
+            let status = Command::new(app_path(bin)?)
+                .args(app_args(args))
+                .status()
+                .with_context(|| format!("starting {bin}"))?;
+            if !status.success() {
+                // The app already printed its one-line error; keep its exit code.
+                std::process::exit(status.code().unwrap_or(1));
+            }
+            Ok(())
+        }
+        None => render_reference(args),
+    }
+}
+
+/// Runs an app with `--json` and returns its report; a failure carries the app's own message and exit code.
+pub fn run_json(api: Api, args: &RenderArgs) -> anyhow::Result<RunReport> {
+    let bin = api.binary().expect("an app");
+    let mut args = args.clone();
+    args.json = true;
+    let out = Command::new(app_path(bin)?).args(app_args(&args)).output().with_context(|| format!("starting {bin}"))?;
+    if !out.status.success() {
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        let line = stderr.lines().rev().find(|l| !l.trim().is_empty()).unwrap_or("no message").to_string();
+        let kind = match out.status.code() {
+            Some(2) => Some(FailureKind::BadInput),
+            Some(3) => Some(FailureKind::NoDevice),
+            _ => None,
+        };
+        return Err(match kind {
+            Some(kind) => Failure { kind, message: line }.into(),
+            None => anyhow::anyhow!("{bin} failed ({}): {line}", out.status),
+        });
+    }
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    let json = stdout.lines().rev().find(|l| l.starts_with('{')).unwrap_or("");
+    serde_json::from_str(json).with_context(|| format!("reading {bin}'s JSON report"))
+}
+
+/// The f64 CPU reference, in-process. With `--json` it prints a report in the
+/// apps' format (api "reference", CPU time as wall time).
+pub fn render_reference(args: &RenderArgs) -> anyhow::Result<()> {
+    let start = Instant::now();
+    let scene = args.load_scene()?;
+    let (w, h) = (args.size.width, args.size.height);
+    let t = Instant::now();
+    let img = twinray_common::reference::render(&scene, w, h);
+    let ms = t.elapsed().as_secs_f64() * 1e3;
+    if let Some(out) = &args.out {
+        img.save_png(out)?;
+    }
+    if args.json {
+        let mut report = RunReport {
+            api: "reference".into(),
+            device: format!("CPU, {} threads", rayon_threads()),
+            driver: "twinray f64 reference".into(),
+            api_version: String::new(),
+            os: twinray_common::report::os_description(),
+            scene: scene.stats(),
+            variant: "f64".into(),
+            width: w,
+            height: h,
+            frames: vec![FrameTime { gpu_ms: None, wall_ms: ms }],
+            gpu_ms: None,
+            wall_ms: None,
+            nonfinite_pixels: img.nonfinite_pixels(),
+            setup_ms: (t - start).as_secs_f64() * 1e3,
+            validation_messages: 0,
+        };
+        report.summarise();
+        println!("{}", serde_json::to_string(&report)?);
+    } else if args.out.is_none() {
+        return Err(bad_input("render --api reference needs --out FILE.png or --json"));
+    }
+    Ok(())
+}
+
+fn rayon_threads() -> usize {
+    rayon::current_num_threads()
+}

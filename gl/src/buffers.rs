@@ -1,0 +1,48 @@
+//! The scene on the GPU: the `Frame` uniform buffer and the four storage
+//! buffers, uploaded once from the bytes `common` builds for both APIs.
+
+use anyhow::{anyhow, Context as _};
+use glow::HasContext;
+use twinray_common::gpu::{binding, GpuScene};
+
+pub struct SceneBuffers<'gl> {
+    gl: &'gl glow::Context,
+    /// UBO first, then the SSBOs in binding order.
+    buffers: Vec<glow::Buffer>,
+}
+
+impl<'gl> SceneBuffers<'gl> {
+    /// Uploads and binds everything. Bound by number because naga renames
+    /// the blocks; UBO and SSBO binding points are separate spaces in GL, so
+    /// the numbers are the Vulkan descriptor bindings unchanged.
+    pub fn new(gl: &'gl glow::Context, scene: &GpuScene) -> anyhow::Result<SceneBuffers<'gl>> {
+        let mut this = SceneBuffers { gl, buffers: Vec::with_capacity(1 + binding::STORAGE.len()) };
+        this.upload(glow::UNIFORM_BUFFER, binding::FRAME, scene.frame_bytes())?;
+        for b in binding::STORAGE {
+            this.upload(glow::SHADER_STORAGE_BUFFER, b, &scene.storage_bytes(b))?;
+        }
+        Ok(this)
+    }
+
+    fn upload(&mut self, target: u32, index: u32, bytes: &[u8]) -> anyhow::Result<()> {
+        // SAFETY: a fresh buffer on the current context; `bytes` is copied by the driver.
+        unsafe {
+            let buf = self.gl.create_buffer().map_err(|e| anyhow!(e)).with_context(|| format!("glCreateBuffer (binding {index})"))?;
+            self.buffers.push(buf);
+            self.gl.bind_buffer(target, Some(buf));
+            // Written once, read every frame: STATIC_DRAW.
+            self.gl.buffer_data_u8_slice(target, bytes, glow::STATIC_DRAW);
+            self.gl.bind_buffer_base(target, index, Some(buf));
+        }
+        Ok(())
+    }
+}
+
+impl Drop for SceneBuffers<'_> {
+    fn drop(&mut self) {
+        // SAFETY: these buffers were created on this context, which outlives them.
+        for &b in self.buffers.iter().rev() {
+            unsafe { self.gl.delete_buffer(b) }
+        }
+    }
+}

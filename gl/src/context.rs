@@ -1,0 +1,100 @@
+//! The headless OpenGL context: EGL device platform, surfaceless 4.5 core
+//! context, and the glow function table loaded from it. Owns device choice.
+
+use anyhow::Context as _;
+use glutin::api::egl::{context::PossiblyCurrentContext, device::Device, display::Display};
+use glutin::config::{Api, ConfigSurfaceTypes, ConfigTemplateBuilder};
+use glutin::context::{ContextApi, ContextAttributesBuilder, GlProfile, Version};
+use glutin::prelude::*;
+use twinray_common::error::{bad_input, no_device};
+
+const NO_DEVICE: &str =
+    "no EGL device found: install libegl1 and libegl-mesa0 + libgl1-mesa-dri (or a GPU driver)";
+
+/// Mesa's llvmpipe device carries this extension; a hardware device does not.
+const SOFTWARE_EXT: &str = "EGL_MESA_device_software";
+
+/// Field order is drop order: the function table goes before the context it
+/// came from, and the context before its display.
+pub struct Gl {
+    pub gl: glow::Context,
+    _context: PossiblyCurrentContext,
+    _display: Display,
+}
+
+impl Gl {
+    /// Creates the context on the preferred device; `debug` asks for a debug
+    /// context so that KHR_debug reports everything the driver checks.
+    pub fn headless(debug: bool) -> anyhow::Result<Gl> {
+        // No libEGL, or one without the device extensions, is a missing driver
+        // for the user, not a bug: glutin's error alone would not say what to install.
+        let devices: Vec<Device> = Device::query_devices()
+            .map_err(|e| no_device(format!("{NO_DEVICE} ({e})")))?
+            .collect();
+        if devices.is_empty() {
+            return Err(no_device(NO_DEVICE));
+        }
+        let mut last_err = None;
+        for device in candidates(&devices)? {
+            match create(device, debug) {
+                Ok(gl) => return Ok(gl),
+                Err(e) => last_err = Some(e),
+            }
+        }
+        let e = last_err.expect("at least one candidate");
+        Err(no_device(format!("no EGL device offers an OpenGL 4.5 core context: {e:#}")))
+    }
+}
+
+/// Devices to try in order. Hardware first: the software rasteriser would
+/// silently turn a GPU benchmark into a CPU one.
+fn candidates(devices: &[Device]) -> anyhow::Result<Vec<&Device>> {
+    if let Ok(v) = std::env::var("TWINRAY_GL_DEVICE") {
+        let i: usize = v
+            .trim()
+            .parse()
+            .ok()
+            .filter(|&i| i < devices.len())
+            .ok_or_else(|| {
+                bad_input(format!(
+                    "TWINRAY_GL_DEVICE='{v}' is not a device index; this machine has {} EGL device(s), 0..{}",
+                    devices.len(),
+                    devices.len() - 1
+                ))
+            })?;
+        return Ok(vec![&devices[i]]);
+    }
+    let (soft, hard): (Vec<&Device>, Vec<&Device>) =
+        devices.iter().partition(|d| d.extensions().contains(SOFTWARE_EXT));
+    Ok(hard.into_iter().chain(soft).collect())
+}
+
+fn create(device: &Device, debug: bool) -> anyhow::Result<Gl> {
+    let what = device.name().unwrap_or("EGL device");
+    // SAFETY: no native display handle is passed, only the device.
+    let display = unsafe { Display::with_device(device, None) }
+        .with_context(|| format!("opening an EGL display on {what}"))?;
+    // No surface types: the context renders into our own FBO only.
+    let template = ConfigTemplateBuilder::new()
+        .with_surface_type(ConfigSurfaceTypes::empty())
+        .with_api(Api::OPENGL)
+        .build();
+    // SAFETY: the display outlives the configs iterator (same scope).
+    let config = unsafe { display.find_configs(template) }
+        .with_context(|| format!("listing EGL configs on {what}"))?
+        .next()
+        .with_context(|| format!("{what} has no OpenGL EGL config"))?;
+    let attributes = ContextAttributesBuilder::new()
+        .with_debug(debug)
+        .with_profile(GlProfile::Core)
+        .with_context_api(ContextApi::OpenGl(Some(Version::new(4, 5))))
+        .build(None);
+    // SAFETY: config belongs to display.
+    let context = unsafe { display.create_context(&config, &attributes) }
+        .with_context(|| format!("creating an OpenGL 4.5 core context on {what}"))?
+        .make_current_surfaceless()
+        .with_context(|| format!("making the context current without a surface on {what}"))?;
+    // SAFETY: the context is current on this thread, which glow requires.
+    let gl = unsafe { glow::Context::from_loader_function_cstr(|s| display.get_proc_address(s)) };
+    Ok(Gl { gl, _context: context, _display: display })
+}

@@ -1,0 +1,13 @@
+//! twinray-gl: the OpenGL twin of twinray-vk. Modules in the order a reader
+//! meets the setup: context, debug output, program, buffers, target, timer,
+//! and the run that strings them together.
+
+pub mod context;
+pub mod debug;
+pub mod program;
+pub mod buffers;
+pub mod target;
+pub mod timer;
+pub mod app;
+
+pub use app::run;

@@ -1,0 +1,51 @@
+//! GPU time of one draw through a GL_TIME_ELAPSED query, and the decision of
+//! whether that time can be trusted on this driver.
+
+use anyhow::anyhow;
+use glow::HasContext;
+
+pub struct Timer<'gl> {
+    gl: &'gl glow::Context,
+    query: glow::Query,
+    /// False where the driver's numbers do not mean GPU time.
+    reliable: bool,
+}
+
+impl<'gl> Timer<'gl> {
+    pub fn new(gl: &'gl glow::Context, renderer: &str) -> anyhow::Result<Timer<'gl>> {
+        // SAFETY: a fresh query object on the current context.
+        let query = unsafe { gl.create_query() }.map_err(|e| anyhow!(e).context("glGenQueries"))?;
+        // llvmpipe has no GPU clock: its TIME_ELAPSED comes from CPU clock reads
+        // in the driver's own threads, which do not bracket the draw the way a
+        // GPU's do, and DESIGN.md found the values unreliable. The query still
+        // runs there so that the loop is the same on every driver; only its
+        // result is dropped, and wall time is the measure.
+        let reliable = !renderer.contains("llvmpipe");
+        Ok(Timer { gl, query, reliable })
+    }
+
+    pub fn begin(&self) {
+        // SAFETY: one query, never nested, on the current context.
+        unsafe { self.gl.begin_query(glow::TIME_ELAPSED, self.query) }
+    }
+
+    pub fn end(&self) {
+        // SAFETY: matches `begin`.
+        unsafe { self.gl.end_query(glow::TIME_ELAPSED) }
+    }
+
+    /// Milliseconds of the last begin/end pair; waits for the result, which
+    /// after glFinish is already there.
+    pub fn result_ms(&self) -> Option<f64> {
+        // SAFETY: the query has ended; GL_QUERY_RESULT is 64-bit nanoseconds.
+        let ns = unsafe { self.gl.get_query_parameter_u64(self.query, glow::QUERY_RESULT) };
+        self.reliable.then(|| ns as f64 / 1e6)
+    }
+}
+
+impl Drop for Timer<'_> {
+    fn drop(&mut self) {
+        // SAFETY: query of this context, not active any more.
+        unsafe { self.gl.delete_query(self.query) }
+    }
+}

@@ -1,0 +1,185 @@
+//! Choosing a GPU (the *physical device*) and opening it (the *logical device*)
+//! with one queue.
+//!
+//! Vulkan separates the two because choosing is the app's job: a physical device
+//! is only a description (name, type, limits, memory types, queue families) that
+//! the app inspects. The logical device is the open connection every later object
+//! is created on; it enables only the queues and features the app asks for, so
+//! the driver sets up nothing else. Work reaches the GPU only through *queues*,
+//! which come in families with different abilities: we need one that can draw.
+
+use crate::instance::Instance;
+use anyhow::{Context, Result};
+use ash::vk;
+use twinray_common::error::{bad_input, no_device};
+
+pub struct Device {
+    pub physical: vk::PhysicalDevice,
+    pub properties: vk::PhysicalDeviceProperties,
+    pub memory_properties: vk::PhysicalDeviceMemoryProperties,
+    pub name: String,
+    /// "driverName driverInfo" where Vulkan 1.2 can tell us, else the raw driverVersion.
+    pub driver: String,
+    pub queue_family: u32,
+    /// The queue family's timestampValidBits: 0 means no timestamps on this queue.
+    pub timestamp_valid_bits: u32,
+    pub device: ash::Device,
+    pub queue: vk::Queue,
+}
+
+/// One physical device as the chooser sees it.
+struct Candidate {
+    physical: vk::PhysicalDevice,
+    properties: vk::PhysicalDeviceProperties,
+    name: String,
+    /// The first queue family that can draw, with its timestampValidBits.
+    graphics_family: Option<(u32, u32)>,
+}
+
+impl Device {
+    pub fn new(instance: &Instance) -> Result<Device> {
+        let vk_instance = &instance.instance;
+        let physicals = unsafe { vk_instance.enumerate_physical_devices() }.context("listing Vulkan devices")?;
+        if physicals.is_empty() {
+            return Err(no_device(
+                "no Vulkan device found: install mesa-vulkan-drivers (lavapipe, on the CPU) or a GPU driver",
+            ));
+        }
+        let candidates: Vec<Candidate> = physicals
+            .into_iter()
+            .map(|physical| {
+                let properties = unsafe { vk_instance.get_physical_device_properties(physical) };
+                let families = unsafe { vk_instance.get_physical_device_queue_family_properties(physical) };
+                let graphics_family = (0u32..)
+                    .zip(&families)
+                    .find(|(_, f)| f.queue_flags.contains(vk::QueueFlags::GRAPHICS))
+                    .map(|(i, f)| (i, f.timestamp_valid_bits));
+                let name = properties.device_name_as_c_str().unwrap_or(c"?").to_string_lossy().into_owned();
+                Candidate { physical, properties, name, graphics_family }
+            })
+            .collect();
+        let chosen = choose(&candidates)?;
+        let (queue_family, timestamp_valid_bits) = chosen.graphics_family.expect("choose() checks this");
+
+        // One queue is enough: every frame is submitted and waited for in turn.
+        let priorities = [1.0];
+        let queue_infos =
+            [vk::DeviceQueueCreateInfo::default().queue_family_index(queue_family).queue_priorities(&priorities)];
+        let info = vk::DeviceCreateInfo::default().queue_create_infos(&queue_infos);
+        let device = unsafe { vk_instance.create_device(chosen.physical, &info, None) }
+            .with_context(|| format!("opening the Vulkan device '{}'", chosen.name))?;
+        let queue = unsafe { device.get_device_queue(queue_family, 0) };
+        Ok(Device {
+            physical: chosen.physical,
+            properties: chosen.properties,
+            memory_properties: unsafe { vk_instance.get_physical_device_memory_properties(chosen.physical) },
+            name: chosen.name.clone(),
+            driver: driver_description(instance, chosen),
+            queue_family,
+            timestamp_valid_bits,
+            device,
+            queue,
+        })
+    }
+
+    /// "Vulkan 1.3.230": the version the device (not the loader) supports.
+    pub fn api_version(&self) -> String {
+        let v = self.properties.api_version;
+        format!("Vulkan {}.{}.{}", vk::api_version_major(v), vk::api_version_minor(v), vk::api_version_patch(v))
+    }
+
+    /// Image and framebuffer sizes are bounded per device; say which limit a size breaks.
+    pub fn check_size(&self, width: u32, height: u32) -> Result<()> {
+        let l = &self.properties.limits;
+        let checks = [
+            (width, l.max_image_dimension2_d, "maxImageDimension2D"),
+            (height, l.max_image_dimension2_d, "maxImageDimension2D"),
+            (width, l.max_framebuffer_width, "maxFramebufferWidth"),
+            (height, l.max_framebuffer_height, "maxFramebufferHeight"),
+            (width, l.max_viewport_dimensions[0], "maxViewportDimensions[0]"),
+            (height, l.max_viewport_dimensions[1], "maxViewportDimensions[1]"),
+        ];
+        match checks.iter().find(|(value, limit, _)| value > limit) {
+            Some((_, limit, name)) => Err(bad_input(format!(
+                "--size {width}x{height} exceeds this device's limit of {limit} ({name})"
+            ))),
+            None => Ok(()),
+        }
+    }
+
+    /// Records commands into a throwaway command buffer, runs them and waits.
+    /// For setup and readback copies only; the timed frames use commands.rs.
+    pub fn run_once(&self, what: &str, record: impl FnOnce(vk::CommandBuffer)) -> Result<()> {
+        let d = &self.device;
+        let info = vk::CommandPoolCreateInfo::default()
+            .queue_family_index(self.queue_family)
+            .flags(vk::CommandPoolCreateFlags::TRANSIENT);
+        let pool = unsafe { d.create_command_pool(&info, None) }.with_context(|| format!("creating a command pool for {what}"))?;
+        let result = (|| -> ash::prelude::VkResult<()> {
+            let alloc = vk::CommandBufferAllocateInfo::default().command_pool(pool).command_buffer_count(1);
+            let cmd = unsafe { d.allocate_command_buffers(&alloc) }?[0];
+            let begin = vk::CommandBufferBeginInfo::default().flags(vk::CommandBufferUsageFlags::ONE_TIME_SUBMIT);
+            unsafe { d.begin_command_buffer(cmd, &begin) }?;
+            record(cmd);
+            unsafe { d.end_command_buffer(cmd) }?;
+            let cmds = [cmd];
+            let submit = vk::SubmitInfo::default().command_buffers(&cmds);
+            unsafe { d.queue_submit(self.queue, &[submit], vk::Fence::null()) }?;
+            // Setup only, so waiting for the whole queue is simpler than a fence.
+            unsafe { d.queue_wait_idle(self.queue) }
+        })();
+        // Destroying the pool frees its command buffer too.
+        unsafe { d.destroy_command_pool(pool, None) };
+        result.with_context(|| format!("running the commands for {what}"))
+    }
+}
+
+/// `TWINRAY_VK_DEVICE` (an index or part of a name) wins; otherwise the kind of
+/// device most likely to be fast: discrete, integrated, virtual, then CPU.
+fn choose(candidates: &[Candidate]) -> Result<&Candidate> {
+    if let Some(wanted) = std::env::var("TWINRAY_VK_DEVICE").ok().filter(|v| !v.trim().is_empty()) {
+        let needle = wanted.trim().to_lowercase();
+        let by_index = needle.parse::<usize>().ok().and_then(|i| candidates.get(i));
+        let found = by_index.or_else(|| candidates.iter().find(|c| c.name.to_lowercase().contains(&needle)));
+        let list: Vec<String> = candidates.iter().enumerate().map(|(i, c)| format!("{i}: {}", c.name)).collect();
+        let c = found.ok_or_else(|| {
+            bad_input(format!("TWINRAY_VK_DEVICE='{wanted}' matches no Vulkan device; the devices are {}", list.join(", ")))
+        })?;
+        if c.graphics_family.is_none() {
+            return Err(bad_input(format!("TWINRAY_VK_DEVICE='{wanted}' picks '{}', which cannot draw (no graphics queue)", c.name)));
+        }
+        return Ok(c);
+    }
+    let rank = |t: vk::PhysicalDeviceType| match t {
+        vk::PhysicalDeviceType::DISCRETE_GPU => 0,
+        vk::PhysicalDeviceType::INTEGRATED_GPU => 1,
+        vk::PhysicalDeviceType::VIRTUAL_GPU => 2,
+        vk::PhysicalDeviceType::CPU => 3,
+        _ => 4,
+    };
+    candidates
+        .iter()
+        .filter(|c| c.graphics_family.is_some())
+        .min_by_key(|c| rank(c.properties.device_type))
+        .ok_or_else(|| no_device("no Vulkan device can draw (no graphics queue): install mesa-vulkan-drivers or a GPU driver"))
+}
+
+/// The driver's own name ("llvmpipe Mesa 22.3.6 ...") needs Vulkan 1.2 on both
+/// the instance and the device; before that there is only a vendor-coded number.
+fn driver_description(instance: &Instance, c: &Candidate) -> String {
+    if instance.api_version < vk::API_VERSION_1_2 || c.properties.api_version < vk::API_VERSION_1_2 {
+        return format!("driverVersion {:#x}", c.properties.driver_version);
+    }
+    let mut driver = vk::PhysicalDeviceDriverProperties::default();
+    let mut props2 = vk::PhysicalDeviceProperties2::default().push_next(&mut driver);
+    unsafe { instance.instance.get_physical_device_properties2(c.physical, &mut props2) };
+    let text = |s: Result<&std::ffi::CStr, _>| s.unwrap_or(c"?").to_string_lossy().into_owned();
+    format!("{} {}", text(driver.driver_name_as_c_str()), text(driver.driver_info_as_c_str()))
+}
+
+impl Drop for Device {
+    fn drop(&mut self) {
+        // SAFETY: every object made on this device was dropped before it (see app.rs).
+        unsafe { self.device.destroy_device(None) };
+    }
+}

@@ -1,0 +1,139 @@
+//! The loader and the instance, plus the optional validation layer.
+//!
+//! Vulkan is not a library the app links against but a *loader* (libvulkan.so.1)
+//! that finds the installed drivers at run time; `ash::Entry` opens it. The
+//! `VkInstance` is this application's connection to the loader: it is where the
+//! app states the Vulkan version it targets and the layers and extensions it
+//! wants, and it is the only way to list the GPUs.
+//!
+//! Drivers do almost no error checking (that is part of why Vulkan is fast), so
+//! correctness checking is an opt-in *layer* between the app and the driver:
+//! VK_LAYER_KHRONOS_validation, which reports through a VK_EXT_debug_utils
+//! messenger, a callback we provide.
+
+use anyhow::{Context, Result};
+use ash::{ext::debug_utils, vk};
+use std::ffi::{c_void, CStr};
+use std::sync::atomic::{AtomicU64, Ordering};
+use twinray_common::error::no_device;
+
+const VALIDATION_LAYER: &CStr = c"VK_LAYER_KHRONOS_validation";
+
+/// Warnings and errors the layer reported. The app reads it after every Vulkan
+/// object is destroyed, so mistakes in teardown count too.
+pub static VALIDATION_MESSAGES: AtomicU64 = AtomicU64::new(0);
+
+pub struct Instance {
+    pub entry: ash::Entry,
+    pub instance: ash::Instance,
+    /// The Vulkan version this app asked the loader for.
+    pub api_version: u32,
+    messenger: Option<(debug_utils::Instance, vk::DebugUtilsMessengerEXT)>,
+}
+
+impl Instance {
+    /// `validate` is `--validate`: the layer is then required, not optional.
+    pub fn new(validate: bool) -> Result<Instance> {
+        // SAFETY: loads the system's Vulkan loader; nothing else runs meanwhile.
+        let entry = unsafe { ash::Entry::load() }.map_err(|e| {
+            no_device(format!(
+                "no Vulkan loader found (libvulkan.so.1: {e}): install libvulkan1 and a Vulkan driver, e.g. mesa-vulkan-drivers"
+            ))
+        })?;
+
+        // The layer checks every call, which costs CPU time on every submit, and a
+        // timing run must not pay for it. So it is on only when asked for:
+        // --validate (required) or TWINRAY_VK_VALIDATION=1 (best effort).
+        let from_env = std::env::var("TWINRAY_VK_VALIDATION").is_ok_and(|v| v == "1");
+        let layers = unsafe { entry.enumerate_instance_layer_properties() }.context("listing Vulkan layers")?;
+        let installed = layers.iter().any(|l| l.layer_name_as_c_str() == Ok(VALIDATION_LAYER));
+        if validate && !installed {
+            return Err(no_device(
+                "--validate needs VK_LAYER_KHRONOS_validation, which is not installed: install vulkan-validationlayers",
+            ));
+        }
+        if from_env && !installed {
+            eprintln!("twinray-vk: TWINRAY_VK_VALIDATION=1 but the validation layer is not installed; running without it");
+        }
+        let validation = installed && (validate || from_env);
+
+        // Vulkan 1.2 is asked for only to read VkPhysicalDeviceDriverProperties (the
+        // driver's name for the report). A 1.0 loader rejects any higher version.
+        let loader_version = unsafe { entry.try_enumerate_instance_version() }
+            .context("asking the loader for its Vulkan version")?
+            .unwrap_or(vk::API_VERSION_1_0);
+        let api_version = loader_version.min(vk::API_VERSION_1_2);
+        let app = vk::ApplicationInfo::default()
+            .application_name(c"twinray-vk")
+            .engine_name(c"twinray")
+            .api_version(api_version);
+        let layer_names = [VALIDATION_LAYER.as_ptr()];
+        let extension_names = [debug_utils::NAME.as_ptr()];
+        let mut early_messenger = messenger_info();
+        let mut info = vk::InstanceCreateInfo::default().application_info(&app);
+        if validation {
+            // Chained here, the messenger also hears about vkCreateInstance and
+            // vkDestroyInstance, when the real messenger does not exist yet or any more.
+            info = info
+                .enabled_layer_names(&layer_names)
+                .enabled_extension_names(&extension_names)
+                .push_next(&mut early_messenger);
+        }
+        let instance = unsafe { entry.create_instance(&info, None) }.map_err(|e| match e {
+            vk::Result::ERROR_INCOMPATIBLE_DRIVER => no_device(
+                "the Vulkan loader found no usable driver: install mesa-vulkan-drivers or a GPU driver",
+            ),
+            e => anyhow::Error::new(e).context("creating the Vulkan instance"),
+        })?;
+
+        // From here on, `Drop` cleans up whatever was created, even on error.
+        let mut this = Instance { entry, instance, api_version, messenger: None };
+        if validation {
+            let functions = debug_utils::Instance::new(&this.entry, &this.instance);
+            let messenger = unsafe { functions.create_debug_utils_messenger(&messenger_info(), None) }
+                .context("creating the debug messenger")?;
+            this.messenger = Some((functions, messenger));
+        }
+        Ok(this)
+    }
+}
+
+/// Warnings and errors only: "info" and "verbose" are chatter, not mistakes.
+fn messenger_info() -> vk::DebugUtilsMessengerCreateInfoEXT<'static> {
+    vk::DebugUtilsMessengerCreateInfoEXT::default()
+        .message_severity(vk::DebugUtilsMessageSeverityFlagsEXT::WARNING | vk::DebugUtilsMessageSeverityFlagsEXT::ERROR)
+        .message_type(
+            vk::DebugUtilsMessageTypeFlagsEXT::GENERAL
+                | vk::DebugUtilsMessageTypeFlagsEXT::VALIDATION
+                | vk::DebugUtilsMessageTypeFlagsEXT::PERFORMANCE,
+        )
+        .pfn_user_callback(Some(on_message))
+}
+
+/// Called by the layer, on whichever thread made the faulty call.
+unsafe extern "system" fn on_message(
+    severity: vk::DebugUtilsMessageSeverityFlagsEXT,
+    kind: vk::DebugUtilsMessageTypeFlagsEXT,
+    data: *const vk::DebugUtilsMessengerCallbackDataEXT<'_>,
+    _user_data: *mut c_void,
+) -> vk::Bool32 {
+    VALIDATION_MESSAGES.fetch_add(1, Ordering::Relaxed);
+    // SAFETY: the layer passes a valid struct (or null) for the duration of the call.
+    let text = unsafe { data.as_ref().and_then(|d| d.message_as_c_str()) };
+    let text = text.map(CStr::to_string_lossy).unwrap_or_default();
+    eprintln!("twinray-vk: validation {severity:?} {kind:?}: {text}");
+    // FALSE = let the call go ahead; we count and carry on to see every message.
+    vk::FALSE
+}
+
+impl Drop for Instance {
+    fn drop(&mut self) {
+        // SAFETY: every device object was dropped before the instance (see app.rs).
+        unsafe {
+            if let Some((functions, messenger)) = self.messenger.take() {
+                functions.destroy_debug_utils_messenger(messenger, None);
+            }
+            self.instance.destroy_instance(None);
+        }
+    }
+}
