@@ -48,9 +48,9 @@ impl std::fmt::Display for Size {
     }
 }
 
-/// The largest size accepted before asking the device: 16384² covers every GPU's
-/// framebuffer limit; apps then check their device's own limit.
-pub const MAX_SIZE: u32 = 16384;
+/// The largest size the parser accepts (beyond any GPU's framebuffer); each app
+/// then checks its device's own limit.
+pub const MAX_SIZE: u32 = 65536;
 
 pub fn parse_size(s: &str) -> Result<Size, String> {
     let (w, h) = s

@@ -168,12 +168,14 @@ impl GpuScene {
     /// The bytes of a storage buffer by binding number. An empty array still gets
     /// one zeroed element: neither API accepts a zero-sized buffer binding, and the
     /// counts in `Frame` keep the shader from reading it.
-    pub fn storage_bytes(&self, binding: u32) -> Vec<u8> {
-        fn bytes<T: Pod + Default>(v: &[T]) -> Vec<u8> {
+    pub fn storage_bytes(&self, binding: u32) -> &[u8] {
+        // Zeroes for the one element of an empty array (the largest struct is 96 bytes).
+        static ZEROES: [u8; std::mem::size_of::<GpuTriangle>()] = [0; std::mem::size_of::<GpuTriangle>()];
+        fn bytes<T: Pod>(v: &[T]) -> &[u8] {
             if v.is_empty() {
-                bytemuck::bytes_of(&T::default()).to_vec()
+                &ZEROES[..std::mem::size_of::<T>()]
             } else {
-                bytemuck::cast_slice(v).to_vec()
+                bytemuck::cast_slice(v)
             }
         }
         match binding {

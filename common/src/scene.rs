@@ -23,6 +23,10 @@ const BUILTIN_FILES: &[(&str, &str)] = &[
 /// Keys accepted by `--set`.
 pub const OVERRIDE_KEYS: &[&str] = &["max_depth", "min_weight", "epsilon", "extra_spheres", "fov_y"];
 
+/// More hidden spheres than any storage buffer needs to hold for the study (10,000),
+/// yet enough to exceed a device's storage-buffer limit on purpose.
+pub const MAX_EXTRA_SPHERES: u32 = 10_000_000;
+
 /// The largest `max_depth` a scene may ask for; the shader's generic ray stack holds this + 1.
 pub const MAX_DEPTH_LIMIT: u32 = 16;
 
@@ -360,7 +364,7 @@ fn apply_overrides(def: &mut SceneFile, overrides: &[(String, String)]) -> anyho
             "epsilon" => def.render.epsilon = num()?,
             "fov_y" => def.camera.fov_y = num()?,
             "extra_spheres" => {
-                let n = int(1_000_000)?;
+                let n = int(MAX_EXTRA_SPHERES)?;
                 match def.extra_spheres.as_mut() {
                     Some(e) => e.count = n,
                     None => {

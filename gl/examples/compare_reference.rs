@@ -15,7 +15,17 @@ fn main() -> anyhow::Result<()> {
     let reference = reference::render(&scene, size.width, size.height).to_rgb8();
     let ref_path = Path::new(&a[2]).with_extension("ref.png");
     twinray_common::image_io::save_png(&reference, &ref_path)?;
-    let m = compare(&load_png(Path::new(&a[2]))?, &reference)?;
+    let gl = load_png(Path::new(&a[2]))?;
+    let m = compare(&gl, &reference)?;
+    // Where they differ by more than 1/255: white; else the reference, dimmed.
+    let mut mask = reference.clone();
+    for (p, q) in mask.pixels_mut().zip(gl.pixels()) {
+        let off = (0..3).any(|c| p.0[c].abs_diff(q.0[c]) > 1);
+        for c in 0..3 {
+            p.0[c] = if off { 255 } else { p.0[c] / 3 };
+        }
+    }
+    twinray_common::image_io::save_png(&mask, &Path::new(&a[2]).with_extension("diff.png"))?;
     println!(
         "{} {}: within 1/255 {:.4}%, above 8/255 {:.4}%, max {} , psnr {:.1} dB (reference: {})",
         a[0],

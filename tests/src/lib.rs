@@ -1,1 +1,86 @@
-//! End-to-end tests live in tests/tests/.
+//! Helpers for the end-to-end tests in tests/tests/: locating the built apps,
+//! running them the way a user does, and reading back their PNG + JSON.
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+use twinray_common::report::RunReport;
+
+/// target/<profile>/, found from this test executable (target/<profile>/deps/…).
+pub fn bin_dir() -> PathBuf {
+    let exe = std::env::current_exe().expect("test executable path");
+    let dir = exe.parent().and_then(Path::parent).expect("target/<profile>").to_path_buf();
+    for name in ["twinray-vk", "twinray-gl", "twinray"] {
+        assert!(
+            dir.join(name).exists(),
+            "{name} is not built in {}: run `cargo build --workspace` with the same profile first (tests/run.sh does)",
+            dir.display()
+        );
+    }
+    dir
+}
+
+pub fn bin(name: &str) -> PathBuf {
+    bin_dir().join(name)
+}
+
+/// A fresh scratch folder for one test.
+pub fn scratch(test: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("twinray-test-{}-{test}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    dir
+}
+
+/// Runs a command with a writable Mesa shader cache (lavapipe/llvmpipe recompile
+/// every frame without one) and returns its output.
+pub fn run(program: &Path, args: &[&str], env: &[(&str, &str)]) -> Output {
+    let cache = std::env::temp_dir().join("twinray-mesa-cache");
+    let mut cmd = Command::new(program);
+    cmd.args(args).env("MESA_SHADER_CACHE_DIR", &cache);
+    for (k, v) in env {
+        cmd.env(k, v);
+    }
+    cmd.output().unwrap_or_else(|e| panic!("starting {}: {e}", program.display()))
+}
+
+/// Which app to run.
+#[derive(Clone, Copy, Debug)]
+pub enum App {
+    Vulkan,
+    OpenGl,
+}
+
+impl App {
+    pub const BOTH: [App; 2] = [App::Vulkan, App::OpenGl];
+
+    pub fn exe(self) -> PathBuf {
+        bin(match self {
+            App::Vulkan => "twinray-vk",
+            App::OpenGl => "twinray-gl",
+        })
+    }
+}
+
+/// A successful validated headless render: its report and its 8-bit image.
+pub fn render(app: App, scene: &str, size: &str, extra: &[&str], out: &Path) -> (RunReport, image::RgbImage) {
+    let mut args = vec!["--headless", "--validate", "--json", "--scene", scene, "--size", size, "--out"];
+    let out_s = out.to_str().unwrap();
+    args.push(out_s);
+    args.extend_from_slice(extra);
+    let o = run(&app.exe(), &args, &[]);
+    let stderr = String::from_utf8_lossy(&o.stderr);
+    assert!(o.status.success(), "{app:?} {args:?} failed ({}): {stderr}", o.status);
+    let stdout = String::from_utf8_lossy(&o.stdout);
+    let report: RunReport = serde_json::from_str(stdout.trim())
+        .unwrap_or_else(|e| panic!("{app:?}: stdout is not one JSON report ({e}): {stdout}"));
+    let img = twinray_common::image_io::load_png(out).unwrap();
+    (report, img)
+}
+
+/// The exit code and stderr of a run that is expected to fail.
+pub fn fail(program: &Path, args: &[&str], env: &[(&str, &str)]) -> (i32, String) {
+    let o = run(program, args, env);
+    let stderr = String::from_utf8_lossy(&o.stderr).to_string();
+    assert!(!stderr.contains("panicked"), "{} {args:?} panicked: {stderr}", program.display());
+    (o.status.code().unwrap_or(-1), stderr)
+}

@@ -1,0 +1,22 @@
+# Sourced by tests/run.sh, comparison/run.sh and .ci/run: installs what twinray
+# needs on Debian/Ubuntu (Vulkan loader + Mesa lavapipe, EGL + Mesa llvmpipe, the
+# Khronos validation layer, a C++ compiler) and gives Mesa a writable shader cache.
+twinray_packages=(libvulkan1 mesa-vulkan-drivers vulkan-validationlayers libegl1 libegl-mesa0 libgl1-mesa-dri g++ pkg-config)
+twinray_missing=()
+for p in "${twinray_packages[@]}"; do
+    dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || twinray_missing+=("$p")
+done
+if [ ${#twinray_missing[@]} -gt 0 ]; then
+    echo "twinray: installing ${twinray_missing[*]}" >&2
+    sudo_cmd=""
+    [ "$(id -u)" -ne 0 ] && sudo_cmd="sudo"
+    $sudo_cmd apt-get update -qq
+    DEBIAN_FRONTEND=noninteractive $sudo_cmd apt-get install -y -qq --no-install-recommends "${twinray_missing[@]}" >/dev/null
+fi
+if ! command -v cargo >/dev/null; then
+    [ -f "$HOME/.cargo/env" ] && source "$HOME/.cargo/env"
+fi
+command -v cargo >/dev/null || { echo "twinray: cargo not found; install Rust from https://rustup.rs" >&2; exit 1; }
+# lavapipe and llvmpipe recompile the shader every frame without a writable cache.
+export MESA_SHADER_CACHE_DIR="${MESA_SHADER_CACHE_DIR:-$PWD/target/mesa-shader-cache}"
+mkdir -p "$MESA_SHADER_CACHE_DIR"

@@ -1,0 +1,110 @@
+//! The frame's command buffer and its fence.
+//!
+//! Vulkan does nothing when the app "draws": commands are *recorded* into a
+//! command buffer (allocated from a *pool*, which owns their memory), and the
+//! GPU runs them only when the buffer is *submitted* to a queue. A *fence* is
+//! how the CPU learns that a submission has finished.
+//!
+//! Every frame here is identical, so the buffer is recorded once and resubmitted.
+//! That is deliberate, for a fair comparison with OpenGL: the per-frame CPU cost
+//! measured is exactly submit + wait, the same loop the original study timed,
+//! not the cost of re-recording (which real apps often do, and OpenGL cannot skip).
+
+use crate::descriptors::Descriptors;
+use crate::device::Device;
+use crate::pipeline::Pipeline;
+use crate::target::Target;
+use crate::timestamps::Timestamps;
+use anyhow::{Context, Result};
+use ash::vk;
+
+pub struct Commands {
+    device: ash::Device,
+    queue: vk::Queue,
+    pool: vk::CommandPool,
+    cmd: vk::CommandBuffer,
+    fence: vk::Fence,
+}
+
+impl Commands {
+    pub fn record(
+        device: &Device,
+        pipeline: &Pipeline,
+        descriptors: &Descriptors,
+        target: &Target,
+        timestamps: Option<&Timestamps>,
+    ) -> Result<Commands> {
+        let d = &device.device;
+        let mut this = Commands {
+            device: d.clone(),
+            queue: device.queue,
+            pool: vk::CommandPool::null(),
+            cmd: vk::CommandBuffer::null(),
+            fence: vk::Fence::null(),
+        };
+        let info = vk::CommandPoolCreateInfo::default().queue_family_index(device.queue_family);
+        this.pool = unsafe { d.create_command_pool(&info, None) }.context("creating the command pool")?;
+        let info = vk::CommandBufferAllocateInfo::default()
+            .command_pool(this.pool)
+            .level(vk::CommandBufferLevel::PRIMARY)
+            .command_buffer_count(1);
+        this.cmd = unsafe { d.allocate_command_buffers(&info) }.context("allocating the command buffer")?[0];
+        // Unsignalled: the first wait is for the first frame.
+        this.fence = unsafe { d.create_fence(&vk::FenceCreateInfo::default(), None) }.context("creating the fence")?;
+
+        // No ONE_TIME_SUBMIT flag: the buffer is resubmitted every frame.
+        let cmd = this.cmd;
+        unsafe { d.begin_command_buffer(cmd, &vk::CommandBufferBeginInfo::default()) }.context("recording the frame")?;
+        if let Some(t) = timestamps {
+            t.record_reset(cmd);
+            t.record(cmd, 0);
+        }
+        let begin = vk::RenderPassBeginInfo::default()
+            .render_pass(pipeline.render_pass)
+            .framebuffer(target.framebuffer)
+            .render_area(vk::Rect2D { offset: vk::Offset2D::default(), extent: vk::Extent2D { width: target.width, height: target.height } });
+        unsafe {
+            d.cmd_begin_render_pass(cmd, &begin, vk::SubpassContents::INLINE);
+            d.cmd_bind_pipeline(cmd, vk::PipelineBindPoint::GRAPHICS, pipeline.pipeline);
+            d.cmd_bind_descriptor_sets(cmd, vk::PipelineBindPoint::GRAPHICS, pipeline.layout, 0, &[descriptors.set], &[]);
+            // Three vertices, no vertex buffer: the fullscreen triangle.
+            d.cmd_draw(cmd, 3, 1, 0, 0);
+            d.cmd_end_render_pass(cmd);
+        }
+        if let Some(t) = timestamps {
+            t.record(cmd, 1);
+        }
+        unsafe { d.end_command_buffer(cmd) }.context("recording the frame")?;
+        Ok(this)
+    }
+
+    /// Hands the frame to the GPU; the fence signals when it is done.
+    pub fn submit(&self) -> Result<()> {
+        let cmds = [self.cmd];
+        let submit = vk::SubmitInfo::default().command_buffers(&cmds);
+        unsafe { self.device.queue_submit(self.queue, &[submit], self.fence) }.context("submitting a frame")
+    }
+
+    /// Blocks until the GPU has finished the frame.
+    pub fn wait(&self) -> Result<()> {
+        unsafe { self.device.wait_for_fences(&[self.fence], true, u64::MAX) }.context("waiting for a frame")
+    }
+
+    /// A fence stays signalled until reset; the next submit needs it unsignalled.
+    pub fn reset_fence(&self) -> Result<()> {
+        unsafe { self.device.reset_fences(&[self.fence]) }.context("resetting the fence")
+    }
+}
+
+impl Drop for Commands {
+    fn drop(&mut self) {
+        // This is the last object created, so it is dropped first. When the app
+        // unwinds from an error the GPU may still be running a frame: wait for it
+        // before anything the frame uses is destroyed.
+        unsafe {
+            let _ = self.device.device_wait_idle();
+            self.device.destroy_fence(self.fence, None);
+            self.device.destroy_command_pool(self.pool, None);
+        }
+    }
+}

@@ -1,0 +1,84 @@
+//! Descriptors: how the shader's `layout(set = 0, binding = N)` blocks find our buffers.
+//!
+//! Vulkan splits this in three. The *set layout* is the shape (binding 0 is a
+//! uniform buffer, 1–4 are storage buffers, all read by the fragment stage); it
+//! exists on its own because the pipeline is compiled against it, before any
+//! buffer is chosen. Sets are allocated from a *pool*, so the driver can manage
+//! their memory in bulk. The *set* is then written once to point at the buffers.
+//! Nothing changes between frames, so it is bound once, in the recorded commands.
+
+use crate::device::Device;
+use crate::memory::Buffer;
+use anyhow::{Context, Result};
+use ash::vk;
+use twinray_common::gpu::binding;
+
+pub struct Descriptors {
+    device: ash::Device,
+    pub set_layout: vk::DescriptorSetLayout,
+    pool: vk::DescriptorPool,
+    pub set: vk::DescriptorSet,
+}
+
+impl Descriptors {
+    /// `frame` is the uniform buffer; `storage` pairs each storage binding with its buffer.
+    pub fn new(device: &Device, frame: &Buffer, storage: &[(u32, Buffer)]) -> Result<Descriptors> {
+        let d = &device.device;
+        let mut this = Descriptors {
+            device: d.clone(),
+            set_layout: vk::DescriptorSetLayout::null(),
+            pool: vk::DescriptorPool::null(),
+            set: vk::DescriptorSet::null(),
+        };
+        let all: Vec<(u32, vk::DescriptorType, &Buffer)> = std::iter::once((binding::FRAME, vk::DescriptorType::UNIFORM_BUFFER, frame))
+            .chain(storage.iter().map(|(b, buf)| (*b, vk::DescriptorType::STORAGE_BUFFER, buf)))
+            .collect();
+
+        let bindings: Vec<_> = all
+            .iter()
+            .map(|&(b, ty, _)| {
+                vk::DescriptorSetLayoutBinding::default()
+                    .binding(b)
+                    .descriptor_type(ty)
+                    .descriptor_count(1)
+                    .stage_flags(vk::ShaderStageFlags::FRAGMENT)
+            })
+            .collect();
+        let info = vk::DescriptorSetLayoutCreateInfo::default().bindings(&bindings);
+        this.set_layout = unsafe { d.create_descriptor_set_layout(&info, None) }.context("creating the descriptor set layout")?;
+
+        let sizes = [
+            vk::DescriptorPoolSize { ty: vk::DescriptorType::UNIFORM_BUFFER, descriptor_count: 1 },
+            vk::DescriptorPoolSize { ty: vk::DescriptorType::STORAGE_BUFFER, descriptor_count: storage.len() as u32 },
+        ];
+        let info = vk::DescriptorPoolCreateInfo::default().max_sets(1).pool_sizes(&sizes);
+        this.pool = unsafe { d.create_descriptor_pool(&info, None) }.context("creating the descriptor pool")?;
+
+        let layouts = [this.set_layout];
+        let info = vk::DescriptorSetAllocateInfo::default().descriptor_pool(this.pool).set_layouts(&layouts);
+        this.set = unsafe { d.allocate_descriptor_sets(&info) }.context("allocating the descriptor set")?[0];
+
+        let infos: Vec<[vk::DescriptorBufferInfo; 1]> =
+            all.iter().map(|(_, _, buf)| [vk::DescriptorBufferInfo { buffer: buf.buffer, offset: 0, range: buf.size }]).collect();
+        let writes: Vec<_> = all
+            .iter()
+            .zip(&infos)
+            .map(|(&(b, ty, _), info)| {
+                vk::WriteDescriptorSet::default().dst_set(this.set).dst_binding(b).descriptor_type(ty).buffer_info(info)
+            })
+            .collect();
+        unsafe { d.update_descriptor_sets(&writes, &[]) };
+        Ok(this)
+    }
+}
+
+impl Drop for Descriptors {
+    fn drop(&mut self) {
+        // SAFETY: no command buffer using the set is pending (see Commands::drop).
+        // Destroying the pool frees the set allocated from it.
+        unsafe {
+            self.device.destroy_descriptor_pool(self.pool, None);
+            self.device.destroy_descriptor_set_layout(self.set_layout, None);
+        }
+    }
+}

@@ -1,0 +1,164 @@
+//! Memory and buffers, allocated by hand.
+//!
+//! Vulkan never allocates behind the app's back. A device offers a few memory
+//! *types* (fast device-local memory, memory the CPU can map, cached or not);
+//! each buffer or image reports which types it may live in, and the app picks one
+//! with the properties it needs, allocates, and binds. (Large apps sub-allocate
+//! from big blocks, e.g. with VMA; this app has seven allocations, so one each.)
+//!
+//! The GPU reads scene data fastest from device-local memory, which on a
+//! discrete GPU the CPU cannot map. So scene buffers are filled by writing into a
+//! host-visible *staging* buffer and letting the GPU copy it across.
+
+use crate::device::Device;
+use anyhow::{anyhow, Context, Result};
+use ash::vk;
+
+/// Property wishes, best first; an empty set accepts any type the resource allows.
+pub const DEVICE_LOCAL: &[vk::MemoryPropertyFlags] =
+    &[vk::MemoryPropertyFlags::DEVICE_LOCAL, vk::MemoryPropertyFlags::empty()];
+/// Written once by the CPU: coherent saves a flush, but we can flush if we must.
+const UPLOAD: &[vk::MemoryPropertyFlags] = &[
+    both(vk::MemoryPropertyFlags::HOST_VISIBLE, vk::MemoryPropertyFlags::HOST_COHERENT),
+    vk::MemoryPropertyFlags::HOST_VISIBLE,
+];
+/// Read by the CPU: uncached reads of mapped memory are very slow, so prefer cached.
+pub const READBACK: &[vk::MemoryPropertyFlags] = &[
+    both(vk::MemoryPropertyFlags::HOST_VISIBLE, vk::MemoryPropertyFlags::HOST_CACHED),
+    vk::MemoryPropertyFlags::HOST_VISIBLE,
+];
+
+/// `a | b` for use in constants.
+const fn both(a: vk::MemoryPropertyFlags, b: vk::MemoryPropertyFlags) -> vk::MemoryPropertyFlags {
+    vk::MemoryPropertyFlags::from_raw(a.as_raw() | b.as_raw())
+}
+
+/// Allocates memory for `needs` from the first type that has every property of
+/// the earliest possible wish. Returns the memory and the chosen type's properties.
+pub fn allocate(
+    device: &Device,
+    needs: vk::MemoryRequirements,
+    wishes: &[vk::MemoryPropertyFlags],
+    what: &str,
+) -> Result<(vk::DeviceMemory, vk::MemoryPropertyFlags)> {
+    let props = &device.memory_properties;
+    let types = &props.memory_types[..props.memory_type_count as usize];
+    // Bit i of memory_type_bits set = the resource may live in memory type i.
+    let allowed = |i: usize| needs.memory_type_bits & (1 << i) != 0;
+    let (index, flags) = wishes
+        .iter()
+        .find_map(|&wish| {
+            (0..types.len()).find(|&i| allowed(i) && types[i].property_flags.contains(wish)).map(|i| (i, types[i].property_flags))
+        })
+        .ok_or_else(|| anyhow!("no memory type suits the {what} ({wishes:?})"))?;
+    let info = vk::MemoryAllocateInfo::default().allocation_size(needs.size).memory_type_index(index as u32);
+    let memory = unsafe { device.device.allocate_memory(&info, None) }
+        .with_context(|| format!("allocating {} KiB of memory for the {what}", needs.size.div_ceil(1024)))?;
+    Ok((memory, flags))
+}
+
+/// A buffer and the memory behind it.
+pub struct Buffer {
+    device: ash::Device,
+    pub buffer: vk::Buffer,
+    memory: vk::DeviceMemory,
+    pub size: u64,
+    /// Host-visible but not coherent: CPU writes need a flush, CPU reads an invalidate.
+    needs_flush: bool,
+}
+
+impl Buffer {
+    pub fn new(
+        device: &Device,
+        size: u64,
+        usage: vk::BufferUsageFlags,
+        wishes: &[vk::MemoryPropertyFlags],
+        what: &str,
+    ) -> Result<Buffer> {
+        // Destroy functions accept null handles, so a half-built Buffer drops cleanly.
+        let mut b = Buffer {
+            device: device.device.clone(),
+            buffer: vk::Buffer::null(),
+            memory: vk::DeviceMemory::null(),
+            size,
+            needs_flush: false,
+        };
+        let info = vk::BufferCreateInfo::default().size(size).usage(usage).sharing_mode(vk::SharingMode::EXCLUSIVE);
+        b.buffer = unsafe { b.device.create_buffer(&info, None) }.with_context(|| format!("creating the {what}"))?;
+        let needs = unsafe { b.device.get_buffer_memory_requirements(b.buffer) };
+        let (memory, flags) = allocate(device, needs, wishes, what)?;
+        b.memory = memory;
+        b.needs_flush = flags.contains(vk::MemoryPropertyFlags::HOST_VISIBLE)
+            && !flags.contains(vk::MemoryPropertyFlags::HOST_COHERENT);
+        unsafe { b.device.bind_buffer_memory(b.buffer, b.memory, 0) }.with_context(|| format!("binding the {what}"))?;
+        Ok(b)
+    }
+
+    /// A device-local buffer holding `bytes`, filled through a staging buffer.
+    pub fn device_local_with(device: &Device, bytes: &[u8], usage: vk::BufferUsageFlags, what: &str) -> Result<Buffer> {
+        let size = bytes.len() as u64;
+        let staging = Buffer::new(device, size, vk::BufferUsageFlags::TRANSFER_SRC, UPLOAD, &format!("staging buffer for {what}"))?;
+        staging.write(bytes)?;
+        let buffer = Buffer::new(device, size, usage | vk::BufferUsageFlags::TRANSFER_DST, DEVICE_LOCAL, what)?;
+        device.run_once(&format!("uploading the {what}"), |cmd| {
+            let region = vk::BufferCopy::default().size(size);
+            // The barrier makes the copied bytes visible to the fragment shader of
+            // every later submission: queue order alone does not order memory.
+            let barrier = vk::BufferMemoryBarrier::default()
+                .src_access_mask(vk::AccessFlags::TRANSFER_WRITE)
+                .dst_access_mask(vk::AccessFlags::UNIFORM_READ | vk::AccessFlags::SHADER_READ)
+                .src_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
+                .dst_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
+                .buffer(buffer.buffer)
+                .size(vk::WHOLE_SIZE);
+            unsafe {
+                device.device.cmd_copy_buffer(cmd, staging.buffer, buffer.buffer, &[region]);
+                device.device.cmd_pipeline_barrier(
+                    cmd,
+                    vk::PipelineStageFlags::TRANSFER,
+                    vk::PipelineStageFlags::FRAGMENT_SHADER,
+                    vk::DependencyFlags::empty(),
+                    &[],
+                    &[barrier],
+                    &[],
+                );
+            }
+        })?;
+        Ok(buffer) // `staging` is dropped here: the copy has finished.
+    }
+
+    /// Copies `bytes` into a host-visible buffer.
+    pub fn write(&self, bytes: &[u8]) -> Result<()> {
+        let d = &self.device;
+        let ptr = unsafe { d.map_memory(self.memory, 0, vk::WHOLE_SIZE, vk::MemoryMapFlags::empty()) }.context("mapping memory")?;
+        // SAFETY: the mapping covers the whole buffer, which is bytes.len() long.
+        unsafe { std::ptr::copy_nonoverlapping(bytes.as_ptr(), ptr.cast::<u8>(), bytes.len()) };
+        let range = vk::MappedMemoryRange::default().memory(self.memory).size(vk::WHOLE_SIZE);
+        let flushed = if self.needs_flush { unsafe { d.flush_mapped_memory_ranges(&[range]) } } else { Ok(()) };
+        unsafe { d.unmap_memory(self.memory) };
+        flushed.context("flushing mapped memory")
+    }
+
+    /// Copies a host-visible buffer's bytes out.
+    pub fn read(&self) -> Result<Vec<u8>> {
+        let d = &self.device;
+        let ptr = unsafe { d.map_memory(self.memory, 0, vk::WHOLE_SIZE, vk::MemoryMapFlags::empty()) }.context("mapping memory")?;
+        let range = vk::MappedMemoryRange::default().memory(self.memory).size(vk::WHOLE_SIZE);
+        let fresh = if self.needs_flush { unsafe { d.invalidate_mapped_memory_ranges(&[range]) } } else { Ok(()) };
+        // SAFETY: the mapping covers the whole buffer, `size` bytes.
+        let bytes = unsafe { std::slice::from_raw_parts(ptr.cast::<u8>(), self.size as usize) }.to_vec();
+        unsafe { d.unmap_memory(self.memory) };
+        fresh.context("invalidating mapped memory")?;
+        Ok(bytes)
+    }
+}
+
+impl Drop for Buffer {
+    fn drop(&mut self) {
+        // SAFETY: the GPU has finished with the buffer (see Commands::drop).
+        unsafe {
+            self.device.destroy_buffer(self.buffer, None);
+            self.device.free_memory(self.memory, None);
+        }
+    }
+}

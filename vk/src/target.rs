@@ -1,0 +1,140 @@
+//! The offscreen render target and its readback.
+//!
+//! Without a window there is no swapchain to draw into, so the app makes its own
+//! *image*: memory laid out in the GPU's private (OPTIMAL) tiling. Pipelines do
+//! not see images directly but through an *image view* (which format, which mip
+//! levels and layers), and a render pass sees views through a *framebuffer*,
+//! which fills its attachment slots for one size.
+//!
+//! An OPTIMAL-tiled image cannot be mapped, so after the last frame the GPU
+//! copies it into a host-visible *readback* buffer as plain rows, top row first.
+
+use crate::device::Device;
+use crate::memory::{self, Buffer};
+use crate::pipeline::COLOR_FORMAT;
+use anyhow::{Context, Result};
+use ash::vk;
+use twinray_common::image_io::FloatImage;
+
+pub struct Target {
+    device: ash::Device,
+    pub image: vk::Image,
+    memory: vk::DeviceMemory,
+    view: vk::ImageView,
+    pub framebuffer: vk::Framebuffer,
+    pub width: u32,
+    pub height: u32,
+    readback: Buffer,
+}
+
+const COLOR: vk::ImageSubresourceRange = vk::ImageSubresourceRange {
+    aspect_mask: vk::ImageAspectFlags::COLOR,
+    base_mip_level: 0,
+    level_count: 1,
+    base_array_layer: 0,
+    layer_count: 1,
+};
+
+impl Target {
+    pub fn new(device: &Device, render_pass: vk::RenderPass, width: u32, height: u32) -> Result<Target> {
+        let d = &device.device;
+        // RGBA32F: 16 bytes a pixel, rows packed tightly in the readback buffer.
+        let bytes = width as u64 * height as u64 * 16;
+        let readback = Buffer::new(device, bytes, vk::BufferUsageFlags::TRANSFER_DST, memory::READBACK, "readback buffer")?;
+        let mut this = Target {
+            device: d.clone(),
+            image: vk::Image::null(),
+            memory: vk::DeviceMemory::null(),
+            view: vk::ImageView::null(),
+            framebuffer: vk::Framebuffer::null(),
+            width,
+            height,
+            readback,
+        };
+        let info = vk::ImageCreateInfo::default()
+            .image_type(vk::ImageType::TYPE_2D)
+            .format(COLOR_FORMAT)
+            .extent(vk::Extent3D { width, height, depth: 1 })
+            .mip_levels(1)
+            .array_layers(1)
+            .samples(vk::SampleCountFlags::TYPE_1)
+            .tiling(vk::ImageTiling::OPTIMAL)
+            .usage(vk::ImageUsageFlags::COLOR_ATTACHMENT | vk::ImageUsageFlags::TRANSFER_SRC)
+            .initial_layout(vk::ImageLayout::UNDEFINED);
+        this.image = unsafe { d.create_image(&info, None) }.context("creating the colour image")?;
+        let needs = unsafe { d.get_image_memory_requirements(this.image) };
+        this.memory = memory::allocate(device, needs, memory::DEVICE_LOCAL, "colour image")?.0;
+        unsafe { d.bind_image_memory(this.image, this.memory, 0) }.context("binding the colour image's memory")?;
+
+        let info = vk::ImageViewCreateInfo::default()
+            .image(this.image)
+            .view_type(vk::ImageViewType::TYPE_2D)
+            .format(COLOR_FORMAT)
+            .subresource_range(COLOR);
+        this.view = unsafe { d.create_image_view(&info, None) }.context("creating the colour image view")?;
+
+        let views = [this.view];
+        let info = vk::FramebufferCreateInfo::default()
+            .render_pass(render_pass)
+            .attachments(&views)
+            .width(width)
+            .height(height)
+            .layers(1);
+        this.framebuffer = unsafe { d.create_framebuffer(&info, None) }.context("creating the framebuffer")?;
+        Ok(this)
+    }
+
+    /// Copies the last frame to the CPU. The render pass left the image in
+    /// TRANSFER_SRC_OPTIMAL and its outgoing dependency orders the copy after the draw.
+    pub fn read_back(&self, device: &Device) -> Result<FloatImage> {
+        device.run_once("reading the image back", |cmd| {
+            let region = vk::BufferImageCopy::default()
+                .image_subresource(vk::ImageSubresourceLayers {
+                    aspect_mask: vk::ImageAspectFlags::COLOR,
+                    mip_level: 0,
+                    base_array_layer: 0,
+                    layer_count: 1,
+                })
+                .image_extent(vk::Extent3D { width: self.width, height: self.height, depth: 1 });
+            // The copy's writes become visible to the CPU's reads only through a
+            // barrier to the HOST stage; waiting for the queue orders, but does not flush.
+            let to_host = vk::BufferMemoryBarrier::default()
+                .src_access_mask(vk::AccessFlags::TRANSFER_WRITE)
+                .dst_access_mask(vk::AccessFlags::HOST_READ)
+                .src_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
+                .dst_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
+                .buffer(self.readback.buffer)
+                .size(vk::WHOLE_SIZE);
+            unsafe {
+                let d = &device.device;
+                d.cmd_copy_image_to_buffer(cmd, self.image, vk::ImageLayout::TRANSFER_SRC_OPTIMAL, self.readback.buffer, &[region]);
+                d.cmd_pipeline_barrier(
+                    cmd,
+                    vk::PipelineStageFlags::TRANSFER,
+                    vk::PipelineStageFlags::HOST,
+                    vk::DependencyFlags::empty(),
+                    &[],
+                    &[to_host],
+                    &[],
+                );
+            }
+        })?;
+        let bytes = self.readback.read().context("reading the readback buffer")?;
+        // Copied into f32s rather than cast in place: a Vec<u8> need not be 4-aligned.
+        let rgba: Vec<f32> = bytemuck::pod_collect_to_vec(&bytes);
+        Ok(FloatImage::from_rgba(self.width, self.height, &rgba))
+    }
+}
+
+impl Drop for Target {
+    fn drop(&mut self) {
+        // SAFETY: no command buffer using them is pending (see Commands::drop).
+        // The readback buffer drops itself after this.
+        unsafe {
+            self.device.destroy_framebuffer(self.framebuffer, None);
+            self.device.destroy_image_view(self.view, None);
+            self.device.destroy_image(self.image, None);
+            self.device.free_memory(self.memory, None);
+        }
+    }
+}
