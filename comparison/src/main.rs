@@ -3,7 +3,10 @@
 //! the f64 reference itself, and compares images.
 
 mod apps;
+mod compare;
 mod diff;
+mod report;
+mod study;
 
 use clap::{Parser, Subcommand};
 use twinray_common::cli::RenderArgs;
@@ -26,6 +29,8 @@ enum Command {
         #[command(flatten)]
         args: RenderArgs,
     },
+    /// Side-by-side Vulkan vs OpenGL on the study's three experiments: results.csv, report.md, plots.
+    Compare(compare::CompareArgs),
     /// Compare two PNGs: RMSE, PSNR, max abs error, share of pixels above 1/255 and 8/255.
     Diff {
         a: std::path::PathBuf,
@@ -48,6 +53,7 @@ fn main() {
     let result = match cli.command {
         Command::Render { api, args } => apps::render(api, &args),
         Command::Diff { a, b, json } => diff::run(&a, &b, json),
+        Command::Compare(args) => compare::run(&args),
     };
     if let Err(e) = result {
         exit_with("twinray", e);

@@ -1,0 +1,211 @@
+//! `twinray compare`: the study's three experiments (teapot and box resolution
+//! sweeps, the sphere-list count sweep) with both apps, each point in fresh
+//! processes with the API order alternating, then results.csv, report.md and plots.
+
+use crate::apps::{run_json, Api};
+use anyhow::Context;
+use std::path::PathBuf;
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::Arc;
+use twinray_common::cli::{parse_size, RenderArgs, Size};
+use twinray_common::report::RunReport;
+
+#[derive(clap::Args, Debug, Clone)]
+pub struct CompareArgs {
+    /// Small sizes, counts and frame numbers: minutes on software drivers.
+    #[arg(long)]
+    pub quick: bool,
+    /// Output folder.
+    #[arg(long, default_value = "comparison-out")]
+    pub out: PathBuf,
+    /// Frames per point (the study: 60; statistics over the last 30).
+    #[arg(long)]
+    pub frames: Option<u32>,
+    /// Fewer frames for slow points so that one app spends at most about this long on one point.
+    #[arg(long)]
+    pub seconds_per_point: Option<f64>,
+    /// Only these experiments (teapot, box, spherelist), comma-separated.
+    #[arg(long, value_delimiter = ',')]
+    pub only: Vec<String>,
+}
+
+#[derive(Debug, Clone)]
+pub struct Point {
+    pub experiment: &'static str,
+    pub param_name: &'static str,
+    pub param_value: String,
+    pub scene: &'static str,
+    pub size: Size,
+    pub set: Vec<String>,
+    /// Work relative to the sweep's first point (pixels or primitives), to predict frame time.
+    pub work: f64,
+}
+
+pub struct Plan {
+    pub points: Vec<Point>,
+    pub frames: u32,
+    pub seconds_per_point: f64,
+    pub preset: &'static str,
+}
+
+pub const EXPERIMENTS: [&str; 3] = ["teapot", "box", "spherelist"];
+
+pub fn plan(args: &CompareArgs) -> anyhow::Result<Plan> {
+    for e in &args.only {
+        if !EXPERIMENTS.contains(&e.as_str()) {
+            return Err(twinray_common::error::bad_input(format!(
+                "--only '{e}' is not an experiment (teapot, box, spherelist)"
+            )));
+        }
+    }
+    let (res_teapot, res_box, counts, sl_size, frames, secs, preset): (Vec<u32>, Vec<u32>, Vec<u32>, u32, u32, f64, _) =
+        if args.quick {
+            (vec![40, 80], vec![100, 200, 300], vec![1, 10, 100, 1000], 100, 8, 8.0, "quick")
+        } else {
+            (
+                (1..=10).map(|i| i * 100).collect(),
+                (1..=10).map(|i| i * 100).collect(),
+                vec![1, 10, 50, 100, 500, 1000, 2500, 5000, 10000],
+                300,
+                60,
+                30.0,
+                "full",
+            )
+        };
+    let mut points = Vec::new();
+    let wanted = |e: &str| args.only.is_empty() || args.only.iter().any(|o| o == e);
+    for (exp, sizes) in [("teapot", &res_teapot), ("box", &res_box)] {
+        if !wanted(exp) {
+            continue;
+        }
+        for &r in sizes {
+            points.push(Point {
+                experiment: exp,
+                param_name: "resolution",
+                param_value: format!("{r}x{r}"),
+                scene: exp,
+                size: Size { width: r, height: r },
+                set: vec![],
+                work: (r as f64 / sizes[0] as f64).powi(2),
+            });
+        }
+    }
+    if wanted("spherelist") {
+        for &n in &counts {
+            points.push(Point {
+                experiment: "spherelist",
+                param_name: "extra_spheres",
+                param_value: n.to_string(),
+                scene: "spherelist",
+                size: parse_size(&format!("{sl_size}x{sl_size}")).expect("valid size"),
+                set: vec![format!("extra_spheres={n}")],
+                work: (n as f64 + 8.0) / (counts[0] as f64 + 8.0),
+            });
+        }
+    }
+    Ok(Plan {
+        points,
+        frames: args.frames.unwrap_or(frames),
+        seconds_per_point: args.seconds_per_point.unwrap_or(secs),
+        preset,
+    })
+}
+
+/// One API at one point: its report, or why it failed.
+#[derive(Debug, Clone)]
+pub struct Outcome {
+    pub point: Point,
+    pub api: Api,
+    pub result: Result<RunReport, String>,
+}
+
+pub fn api_name(api: Api) -> &'static str {
+    match api {
+        Api::Vulkan => "vulkan",
+        Api::Opengl => "opengl",
+        Api::Reference => "reference",
+    }
+}
+
+pub fn run(args: &CompareArgs) -> anyhow::Result<()> {
+    let plan = plan(args)?;
+    std::fs::create_dir_all(&args.out).with_context(|| format!("creating --out folder '{}'", args.out.display()))?;
+    let stop = Arc::new(AtomicBool::new(false));
+    {
+        let stop = stop.clone();
+        ctrlc::set_handler(move || stop.store(true, Ordering::SeqCst)).context("installing the Ctrl-C handler")?;
+    }
+    eprintln!(
+        "twinray compare: {} preset, {} points x 2 APIs, up to {} frames each (about {} s per app per point at most) -> {}",
+        plan.preset,
+        plan.points.len(),
+        plan.frames,
+        plan.seconds_per_point,
+        args.out.display()
+    );
+    let bar = indicatif::ProgressBar::new(plan.points.len() as u64 * 2);
+    bar.set_style(
+        indicatif::ProgressStyle::with_template("{bar:40} {pos}/{len} [{elapsed_precise} elapsed, ETA {eta}] {msg}")
+            .expect("valid template"),
+    );
+    let mut outcomes: Vec<Outcome> = Vec::new();
+    let mut interrupted = false;
+    // Frame-time prediction per experiment: (work, wall ms) of the last finished point.
+    let mut last: std::collections::HashMap<&str, (f64, f64)> = Default::default();
+    'points: for (i, point) in plan.points.iter().enumerate() {
+        let order = if i % 2 == 0 { [Api::Vulkan, Api::Opengl] } else { [Api::Opengl, Api::Vulkan] };
+        let frames = match last.get(point.experiment) {
+            Some(&(work, ms)) if ms > 0.0 => {
+                let predicted = ms * point.work / work;
+                ((plan.seconds_per_point * 1e3 / predicted).floor() as u32).clamp(4, plan.frames)
+            }
+            _ => plan.frames,
+        };
+        for api in order {
+            if stop.load(Ordering::SeqCst) {
+                interrupted = true;
+                break 'points;
+            }
+            bar.set_message(format!("{} {} {}", point.experiment, point.param_value, api_name(api)));
+            let ra = RenderArgs {
+                scene: point.scene.to_string(),
+                size: point.size,
+                headless: true,
+                frames: Some(frames),
+                out: None,
+                json: true,
+                set: point.set.clone(),
+                validate: false,
+                generic: false,
+            };
+            let result = run_json(api, &ra).map_err(|e| format!("{e:#}"));
+            if stop.load(Ordering::SeqCst) {
+                // The child got the Ctrl-C too: this point did not finish.
+                interrupted = true;
+                break 'points;
+            }
+            if let Ok(r) = &result {
+                if let Some(w) = r.wall_ms {
+                    last.insert(point.experiment, (point.work, w.median));
+                }
+            } else if let Err(e) = &result {
+                bar.println(format!("  {} {} {}: FAILED: {e}", point.experiment, point.param_value, api_name(api)));
+            }
+            outcomes.push(Outcome { point: point.clone(), api, result });
+            bar.inc(1);
+        }
+    }
+    bar.finish_and_clear();
+    crate::report::write_all(&args.out, &plan, &outcomes, interrupted)?;
+    eprintln!(
+        "twinray compare: {} of {} runs done{}; report: {}",
+        outcomes.iter().filter(|o| o.result.is_ok()).count(),
+        plan.points.len() * 2,
+        if interrupted { " (interrupted: the finished points are kept)" } else { "" },
+        args.out.join("report.md").display()
+    );
+    if interrupted {
+        std::process::exit(130);
+    }
+    Ok(())
+}

@@ -1,0 +1,339 @@
+//! The comparison's outputs: results.csv (one row per API × experiment × point),
+//! report.md (the study's tables with ours beside them, ratios, machine info,
+//! a summary derived from the numbers) and one SVG plot per experiment.
+
+use crate::compare::{api_name, Outcome, Plan, EXPERIMENTS};
+use crate::apps::Api;
+use crate::study::{self, StudyRow};
+use anyhow::Context;
+use plotters::prelude::*;
+use std::fmt::Write as _;
+use std::path::Path;
+use twinray_common::report::RunReport;
+
+pub fn cpu_model() -> String {
+    std::fs::read_to_string("/proc/cpuinfo")
+        .ok()
+        .and_then(|t| t.lines().find_map(|l| l.strip_prefix("model name").map(|v| v.trim_start_matches([' ', '\t', ':']).to_string())))
+        .map(|m| format!("{m} ({} threads)", std::thread::available_parallelism().map(|n| n.get()).unwrap_or(1)))
+        .unwrap_or_else(|| "unknown CPU".into())
+}
+
+pub fn write_all(out: &Path, plan: &Plan, outcomes: &[Outcome], interrupted: bool) -> anyhow::Result<()> {
+    let cpu = cpu_model();
+    std::fs::write(out.join("results.csv"), csv(outcomes, &cpu)).context("writing results.csv")?;
+    let study = study::rows();
+    let mut plots = Vec::new();
+    for exp in EXPERIMENTS {
+        let rows: Vec<&Outcome> = outcomes.iter().filter(|o| o.point.experiment == exp).collect();
+        if rows.is_empty() {
+            continue;
+        }
+        let file = format!("{exp}.svg");
+        plot(&out.join(&file), exp, &rows, &study).with_context(|| format!("plotting {file}"))?;
+        plots.push(file);
+    }
+    std::fs::write(out.join("report.md"), markdown(plan, outcomes, &study, &cpu, &plots, interrupted))
+        .context("writing report.md")?;
+    Ok(())
+}
+
+const CSV_HEADER: &str = "experiment,param_name,param_value,api,status,frames,wall_mean_ms,wall_median_ms,wall_min_ms,wall_max_ms,gpu_mean_ms,gpu_median_ms,gpu_min_ms,gpu_max_ms,setup_ms,nonfinite_pixels,variant,width,height,device,driver,api_version,os,cpu";
+
+fn q(s: &str) -> String {
+    if s.contains([',', '"', '\n']) {
+        format!("\"{}\"", s.replace('"', "\"\""))
+    } else {
+        s.to_string()
+    }
+}
+
+pub fn csv(outcomes: &[Outcome], cpu: &str) -> String {
+    let mut s = String::from(CSV_HEADER);
+    s.push('\n');
+    for o in outcomes {
+        let p = &o.point;
+        let head = format!("{},{},{},{}", p.experiment, p.param_name, p.param_value, api_name(o.api));
+        match &o.result {
+            Ok(r) => {
+                let st = |x: Option<twinray_common::stats::Summary>| match x {
+                    Some(x) => format!("{:.6},{:.6},{:.6},{:.6}", x.mean, x.median, x.min, x.max),
+                    None => ",,,".into(),
+                };
+                let _ = writeln!(
+                    s,
+                    "{head},ok,{},{},{},{:.3},{},{},{},{},{},{},{},{},{}",
+                    r.frames.len(),
+                    st(r.wall_ms),
+                    st(r.gpu_ms),
+                    r.setup_ms,
+                    r.nonfinite_pixels,
+                    q(&r.variant),
+                    r.width,
+                    r.height,
+                    q(&r.device),
+                    q(&r.driver),
+                    q(&r.api_version),
+                    q(&r.os),
+                    q(cpu)
+                );
+            }
+            Err(e) => {
+                let _ = writeln!(s, "{head},{},0,,,,,,,,,,,,{},{},,,,,{}", q(&format!("failed: {e}")), p.size.width, p.size.height, q(cpu));
+            }
+        }
+    }
+    s
+}
+
+fn report_of<'a>(outcomes: &'a [&Outcome], value: &str, api: Api) -> Option<&'a RunReport> {
+    outcomes.iter().find(|o| o.point.param_value == value && o.api == api).and_then(|o| o.result.as_ref().ok())
+}
+
+fn ratio(a: Option<f64>, b: Option<f64>) -> Option<f64> {
+    match (a, b) {
+        (Some(a), Some(b)) if b > 0.0 => Some(a / b),
+        _ => None,
+    }
+}
+
+fn f(v: Option<f64>, digits: usize) -> String {
+    v.map(|v| format!("{v:.digits$}")).unwrap_or_else(|| "–".into())
+}
+
+fn range(v: &[f64]) -> Option<(f64, f64, f64)> {
+    if v.is_empty() {
+        return None;
+    }
+    let mut s = v.to_vec();
+    s.sort_by(|a, b| a.total_cmp(b));
+    Some((s[0], s[s.len() / 2], s[s.len() - 1]))
+}
+
+struct ExpRatios {
+    wall: Vec<f64>,
+    gpu: Vec<f64>,
+    study: Vec<f64>,
+}
+
+fn ratios(exp: &str, outcomes: &[Outcome], study: &[StudyRow]) -> ExpRatios {
+    let rows: Vec<&Outcome> = outcomes.iter().filter(|o| o.point.experiment == exp).collect();
+    let mut values: Vec<String> = rows.iter().map(|o| o.point.param_value.clone()).collect();
+    values.dedup();
+    let mut r = ExpRatios { wall: vec![], gpu: vec![], study: vec![] };
+    for v in &values {
+        let vk = report_of(&rows, v, Api::Vulkan);
+        let gl = report_of(&rows, v, Api::Opengl);
+        if let Some(x) = ratio(vk.and_then(|r| r.wall_ms).map(|s| s.median), gl.and_then(|r| r.wall_ms).map(|s| s.median)) {
+            r.wall.push(x);
+        }
+        if let Some(x) = ratio(vk.and_then(|r| r.gpu_ms).map(|s| s.median), gl.and_then(|r| r.gpu_ms).map(|s| s.median)) {
+            r.gpu.push(x);
+        }
+        if let Some(s) = study::find(study, exp, v) {
+            r.study.push(s.vulkan_median_s / s.opengl_median_s);
+        }
+    }
+    r
+}
+
+fn describe(label: &str, v: &[f64]) -> String {
+    match range(v) {
+        Some((lo, med, hi)) => {
+            let who = if med > 1.02 {
+                "OpenGL faster"
+            } else if med < 0.98 {
+                "Vulkan faster"
+            } else {
+                "a tie"
+            };
+            format!("{label} {lo:.2}–{hi:.2}× (median {med:.2}×, {who})")
+        }
+        None => format!("{label} –"),
+    }
+}
+
+pub fn markdown(plan: &Plan, outcomes: &[Outcome], study: &[StudyRow], cpu: &str, plots: &[String], interrupted: bool) -> String {
+    let mut s = String::new();
+    let any = |api: Api| outcomes.iter().find(|o| o.api == api).and_then(|o| o.result.as_ref().ok());
+    let device = any(Api::Vulkan).or(any(Api::Opengl)).map(|r| r.device.clone()).unwrap_or_else(|| "no device".into());
+    let _ = writeln!(s, "# twinray compare — {device}\n");
+
+    // The summary: one line per experiment, computed from the rows below.
+    for exp in EXPERIMENTS {
+        let r = ratios(exp, outcomes, study);
+        if r.wall.is_empty() && r.gpu.is_empty() {
+            continue;
+        }
+        let why = match (range(&r.wall), range(&r.gpu)) {
+            (Some((_, w, _)), Some((_, g, _))) if (w - g).abs() < 0.05 => {
+                "wall and GPU ratios agree, so the gap (if any) is in executing the shader, not in API overhead"
+            }
+            (Some((_, w, _)), Some((_, g, _))) if w > g => "Vulkan's wall ratio exceeds its GPU ratio: per-frame overhead outside the draw",
+            (Some(_), Some(_)) => "OpenGL's per-frame overhead outside the draw exceeds Vulkan's",
+            _ => "GPU timers unavailable on this driver: wall time only",
+        };
+        let _ = writeln!(
+            s,
+            "- **{exp}**: Vulkan/OpenGL {}; {}; study {}. {why}.",
+            describe("wall", &r.wall),
+            describe("GPU", &r.gpu),
+            describe("", &r.study).trim_start()
+        );
+    }
+    let _ = writeln!(s);
+    if interrupted {
+        let _ = writeln!(s, "> Interrupted with Ctrl-C: only the points that finished are below.\n");
+    }
+    let _ = writeln!(
+        s,
+        "Ratios are Vulkan time / OpenGL time (above 1: OpenGL faster). Wall time is one render-loop iteration \
+         (submit + wait), as the study measured; GPU time comes from Vulkan timestamps and GL_TIME_ELAPSED queries \
+         around the draw. Preset: {}; up to {} frames per point (fewer for slow points, about {} s per app per point), \
+         statistics over the last 30 (or the last half of shorter runs). Each API runs in its own process, the order \
+         alternating from point to point. The study's times are seconds per frame; ours are milliseconds.\n",
+        plan.preset, plan.frames, plan.seconds_per_point
+    );
+
+    let _ = writeln!(s, "## Machine\n\n| | Vulkan | OpenGL |\n|---|---|---|");
+    let field = |api: Api, g: &dyn Fn(&RunReport) -> String| any(api).map(g).unwrap_or_else(|| "–".into());
+    for (name, g) in [
+        ("device", &(|r: &RunReport| r.device.clone()) as &dyn Fn(&RunReport) -> String),
+        ("driver", &|r: &RunReport| r.driver.clone()),
+        ("API version", &|r: &RunReport| r.api_version.clone()),
+        ("OS", &|r: &RunReport| r.os.clone()),
+    ] {
+        let _ = writeln!(s, "| {name} | {} | {} |", field(Api::Vulkan, g), field(Api::Opengl, g));
+    }
+    let _ = writeln!(s, "| CPU | {cpu} | {cpu} |\n");
+
+    for exp in EXPERIMENTS {
+        let rows: Vec<&Outcome> = outcomes.iter().filter(|o| o.point.experiment == exp).collect();
+        if rows.is_empty() {
+            continue;
+        }
+        let first = &rows[0].point;
+        let title = match exp {
+            "teapot" => "Teapot: 19,200 triangles, resolution sweep".to_string(),
+            "box" => "Box: 30 triangles, mirror + glass sphere, resolution sweep".to_string(),
+            _ => format!("Sphere list: extra spheres sweep at {}", first.size),
+        };
+        let _ = writeln!(s, "## {title}\n");
+        if plots.contains(&format!("{exp}.svg")) {
+            let _ = writeln!(s, "![{exp}]({exp}.svg)\n");
+        }
+        let _ = writeln!(
+            s,
+            "| {} | study VK mean / median (s) | study GL mean / median (s) | study VK/GL | VK wall (ms) | GL wall (ms) | VK/GL wall | VK GPU (ms) | GL GPU (ms) | VK/GL GPU | frames VK/GL |",
+            first.param_name
+        );
+        let _ = writeln!(s, "|---|---|---|---|---|---|---|---|---|---|---|");
+        let mut values: Vec<String> = rows.iter().map(|o| o.point.param_value.clone()).collect();
+        values.dedup();
+        for v in &values {
+            let st = study::find(study, exp, v);
+            let vk = report_of(&rows, v, Api::Vulkan);
+            let gl = report_of(&rows, v, Api::Opengl);
+            let med = |r: Option<&RunReport>, gpu: bool| r.and_then(|r| if gpu { r.gpu_ms } else { r.wall_ms }).map(|x| x.median);
+            let frames = |r: Option<&RunReport>| r.map(|r| r.frames.len().to_string()).unwrap_or_else(|| "failed".into());
+            let _ = writeln!(
+                s,
+                "| {v} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {}/{} |",
+                st.map(|x| format!("{:.5} / {:.5}", x.vulkan_mean_s, x.vulkan_median_s)).unwrap_or_else(|| "–".into()),
+                st.map(|x| format!("{:.5} / {:.5}", x.opengl_mean_s, x.opengl_median_s)).unwrap_or_else(|| "–".into()),
+                f(st.map(|x| x.vulkan_median_s / x.opengl_median_s), 2),
+                f(med(vk, false), 3),
+                f(med(gl, false), 3),
+                f(ratio(med(vk, false), med(gl, false)), 2),
+                f(med(vk, true), 3),
+                f(med(gl, true), 3),
+                f(ratio(med(vk, true), med(gl, true)), 2),
+                frames(vk),
+                frames(gl)
+            );
+        }
+        let _ = writeln!(s);
+    }
+
+    let failures: Vec<&Outcome> = outcomes.iter().filter(|o| o.result.is_err()).collect();
+    if !failures.is_empty() {
+        let _ = writeln!(s, "## Failed points\n");
+        for o in failures {
+            let _ = writeln!(
+                s,
+                "- {} {} {}: {}",
+                o.point.experiment,
+                o.point.param_value,
+                api_name(o.api),
+                o.result.as_ref().err().map(String::as_str).unwrap_or("")
+            );
+        }
+        let _ = writeln!(s);
+    }
+    let _ = writeln!(s, "Full statistics (mean, median, min, max of wall and GPU time) are in `results.csv`.");
+    s
+}
+
+fn x_of(exp: &str, value: &str) -> f64 {
+    if exp == "spherelist" {
+        value.parse().unwrap_or(1.0)
+    } else {
+        value.split('x').next().and_then(|w| w.parse().ok()).unwrap_or(1.0)
+    }
+}
+
+fn plot(path: &Path, exp: &str, rows: &[&Outcome], study: &[StudyRow]) -> anyhow::Result<()> {
+    let mut series: Vec<(String, RGBColor, Vec<(f64, f64)>)> = Vec::new();
+    let colours = [(Api::Vulkan, RGBColor(200, 30, 30)), (Api::Opengl, RGBColor(30, 80, 200))];
+    for (api, colour) in colours {
+        for gpu in [false, true] {
+            let pts: Vec<(f64, f64)> = rows
+                .iter()
+                .filter(|o| o.api == api)
+                .filter_map(|o| {
+                    let r = o.result.as_ref().ok()?;
+                    let v = if gpu { r.gpu_ms } else { r.wall_ms }?.median;
+                    Some((x_of(exp, &o.point.param_value), v))
+                })
+                .collect();
+            if !pts.is_empty() {
+                series.push((format!("ours {} {}", api_name(api), if gpu { "GPU" } else { "wall" }), colour, pts));
+            }
+        }
+    }
+    let st: Vec<&StudyRow> = study.iter().filter(|r| r.experiment == exp).collect();
+    series.push(("study vulkan".into(), RGBColor(240, 140, 40), st.iter().map(|r| (x_of(exp, &r.param_value), r.vulkan_median_s * 1e3)).collect()));
+    series.push(("study opengl".into(), RGBColor(40, 170, 170), st.iter().map(|r| (x_of(exp, &r.param_value), r.opengl_median_s * 1e3)).collect()));
+
+    let all: Vec<(f64, f64)> = series.iter().flat_map(|s| s.2.iter().copied()).filter(|p| p.0 > 0.0 && p.1 > 0.0).collect();
+    let (xmin, xmax) = all.iter().fold((f64::MAX, f64::MIN), |a, p| (a.0.min(p.0), a.1.max(p.0)));
+    let (ymin, ymax) = all.iter().fold((f64::MAX, f64::MIN), |a, p| (a.0.min(p.1), a.1.max(p.1)));
+    let root = SVGBackend::new(path, (900, 560)).into_drawing_area();
+    root.fill(&WHITE)?;
+    let xlabel = if exp == "spherelist" { "extra spheres" } else { "image width = height (pixels)" };
+    let mut chart = ChartBuilder::on(&root)
+        .caption(format!("{exp}: time per frame (log scale)"), ("sans-serif", 22))
+        .margin(12)
+        .x_label_area_size(45)
+        .y_label_area_size(70)
+        .build_cartesian_2d((xmin * 0.8..xmax * 1.25).log_scale(), (ymin * 0.5..ymax * 2.0).log_scale())?;
+    chart.configure_mesh().x_desc(xlabel).y_desc("milliseconds").draw()?;
+    for (name, colour, pts) in series {
+        let dashed = name.contains("GPU");
+        let style = if name.starts_with("study") { colour.stroke_width(1) } else { colour.stroke_width(2) };
+        let mut pts = pts;
+        pts.sort_by(|a, b| a.0.total_cmp(&b.0));
+        chart
+            .draw_series(LineSeries::new(pts.clone(), style))?
+            .label(name.clone())
+            .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], colour.stroke_width(2)));
+        if dashed {
+            chart.draw_series(pts.iter().map(|p| Cross::new(*p, 4, colour.stroke_width(1))))?;
+        } else {
+            chart.draw_series(pts.iter().map(|p| Circle::new(*p, 3, colour.filled())))?;
+        }
+    }
+    chart.configure_series_labels().background_style(WHITE.mix(0.8)).border_style(BLACK).position(SeriesLabelPosition::UpperLeft).draw()?;
+    root.present()?;
+    Ok(())
+}
