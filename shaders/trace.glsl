@@ -195,21 +195,18 @@ Hit closest_hit(vec3 origin, vec3 dir) {
 
 // Shadow rays need any hit before the light, not the closest one.
 bool occluded(vec3 origin, vec3 dir, float dist) {
+    bool blocked = false;
 #ifdef HAS_SPHERES
-    for (uint i = 0u; i < frame.sphere_count; i++) {
-        if (hit_sphere(origin, dir, sphere_buf.spheres[i], 0.0, dist) > 0.0) {
-            return true;
-        }
+    for (uint i = 0u; i < frame.sphere_count && !blocked; i++) {
+        blocked = hit_sphere(origin, dir, sphere_buf.spheres[i], 0.0, dist) > 0.0;
     }
 #endif
 #ifdef HAS_TRIANGLES
-    for (uint i = 0u; i < frame.triangle_count; i++) {
-        if (hit_triangle(origin, dir, triangle_buf.triangles[i], 0.0, dist).x > 0.0) {
-            return true;
-        }
+    for (uint i = 0u; i < frame.triangle_count && !blocked; i++) {
+        blocked = hit_triangle(origin, dir, triangle_buf.triangles[i], 0.0, dist).x > 0.0;
     }
 #endif
-    return false;
+    return blocked;
 }
 
 // Secondary rays start a small, scale-aware distance off the surface, along the
@@ -287,7 +284,11 @@ vec3 trace(vec3 origin, vec3 dir) {
             float dist = length(to_light);
             vec3 l = to_light / dist;
             float ndl = dot(ns, l);
-            if (ndl > 0.0 && dot(ng, l) > 0.0 && !occluded(p_out, l, dist)) {
+            bool lit = ndl > 0.0 && dot(ng, l) > 0.0;
+            if (lit) {
+                lit = !occluded(p_out, l, dist);
+            }
+            if (lit) {
                 vec3 r = reflect(-l, ns);
                 float spec = pow(max(dot(r, -d), 0.0), m.shininess);
                 local += light.color * (m.diffuse * ndl + m.specular * spec);

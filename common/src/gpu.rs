@@ -212,7 +212,7 @@ pub fn check_storage_limit(gpu: &GpuScene, limit: u64, limit_name: &str) -> anyh
     let (b, n) = gpu.largest_storage();
     if n as u64 > limit {
         return Err(crate::error::bad_input(format!(
-            "the scene's {} buffer needs {n} bytes, more than this device's {limit_name} of {limit} bytes; use fewer primitives",
+            "the scene's {} buffer needs {n} bytes, more than this device's {limit_name} limit of {limit} bytes; use fewer primitives",
             storage_name(b)
         )));
     }

@@ -13,8 +13,12 @@ use twinray_common::report::RunReport;
 #[derive(clap::Args, Debug, Clone)]
 pub struct CompareArgs {
     /// Small sizes, counts and frame numbers: minutes on software drivers.
-    #[arg(long)]
+    /// Without --quick or --full the preset follows the device: quick on a software driver.
+    #[arg(long, conflicts_with = "full")]
     pub quick: bool,
+    /// The study's full sweeps even on a software driver (hours there).
+    #[arg(long)]
+    pub full: bool,
     /// Output folder.
     #[arg(long, default_value = "comparison-out")]
     pub out: PathBuf,
@@ -127,7 +131,35 @@ pub fn api_name(api: Api) -> &'static str {
     }
 }
 
+/// Software rasterisers (Mesa's lavapipe/llvmpipe, SwiftShader) get the quick preset.
+fn is_software(device: &str) -> bool {
+    let d = device.to_lowercase();
+    ["llvmpipe", "lavapipe", "softpipe", "swiftshader"].iter().any(|s| d.contains(s))
+}
+
 pub fn run(args: &CompareArgs) -> anyhow::Result<()> {
+    let mut args = args.clone();
+    if !args.quick && !args.full {
+        let probe = RenderArgs {
+            scene: "spherelist".into(),
+            size: Size { width: 8, height: 8 },
+            headless: true,
+            frames: Some(1),
+            out: None,
+            json: true,
+            set: vec![],
+            validate: false,
+            generic: false,
+        };
+        let r = run_json(Api::Vulkan, &probe).context("probing the Vulkan device")?;
+        if is_software(&r.device) {
+            eprintln!("twinray compare: '{}' is a software driver: running the quick preset (pass --full for the study's full sweeps)", r.device);
+            args.quick = true;
+        } else {
+            eprintln!("twinray compare: '{}' is a GPU: running the study's full sweeps", r.device);
+        }
+    }
+    let args = &args;
     let plan = plan(args)?;
     std::fs::create_dir_all(&args.out).with_context(|| format!("creating --out folder '{}'", args.out.display()))?;
     let stop = Arc::new(AtomicBool::new(false));
@@ -196,7 +228,8 @@ pub fn run(args: &CompareArgs) -> anyhow::Result<()> {
         }
     }
     bar.finish_and_clear();
-    crate::report::write_all(&args.out, &plan, &outcomes, interrupted)?;
+    let agreement = if interrupted { Vec::new() } else { agreement(&args.out, &plan, &stop) };
+    crate::report::write_all(&args.out, &plan, &outcomes, &agreement, interrupted)?;
     eprintln!(
         "twinray compare: {} of {} runs done{}; report: {}",
         outcomes.iter().filter(|o| o.result.is_ok()).count(),
@@ -208,4 +241,78 @@ pub fn run(args: &CompareArgs) -> anyhow::Result<()> {
         std::process::exit(130);
     }
     Ok(())
+}
+
+/// Image agreement of one scene: both APIs against each other and the f64 reference.
+#[derive(Debug, Clone)]
+pub struct Agreement {
+    pub scene: &'static str,
+    pub size: Size,
+    pub result: Result<[twinray_common::metrics::Metrics; 3], String>,
+}
+
+/// Renders each built-in scene once with both apps and the reference, keeps the
+/// PNGs under images/, and measures how far apart they are.
+pub fn agreement(out: &std::path::Path, plan: &Plan, stop: &AtomicBool) -> Vec<Agreement> {
+    let dir = out.join("images");
+    let mut rows = Vec::new();
+    if std::fs::create_dir_all(&dir).is_err() {
+        return rows;
+    }
+    let size = if plan.preset == "quick" { Size { width: 160, height: 120 } } else { Size { width: 400, height: 300 } };
+    eprintln!("twinray compare: checking image agreement at {size} (Vulkan, OpenGL, f64 reference)");
+    for scene in EXPERIMENTS {
+        if stop.load(Ordering::SeqCst) {
+            break;
+        }
+        let set = if scene == "spherelist" { vec!["extra_spheres=100".to_string()] } else { vec![] };
+        let result = (|| -> anyhow::Result<[twinray_common::metrics::Metrics; 3]> {
+            let mut imgs = Vec::new();
+            let mut nan = Vec::new();
+            for api in [Api::Vulkan, Api::Opengl] {
+                let png = dir.join(format!("{scene}-{}.png", api_name(api)));
+                let ra = RenderArgs {
+                    scene: scene.into(),
+                    size,
+                    headless: true,
+                    frames: Some(1),
+                    out: Some(png.clone()),
+                    json: true,
+                    set: set.clone(),
+                    validate: false,
+                    generic: false,
+                };
+                let r = run_json(api, &ra)?;
+                nan.push(r.nonfinite_pixels);
+                imgs.push(twinray_common::image_io::load_png(&png)?);
+            }
+            let overrides: Vec<(String, String)> =
+                set.iter().filter_map(|kv| kv.split_once('=')).map(|(k, v)| (k.into(), v.into())).collect();
+            let sc = twinray_common::scene::Scene::load(scene, &overrides)?;
+            let reference = twinray_common::reference::render(&sc, size.width, size.height);
+            let ref_png = dir.join(format!("{scene}-reference.png"));
+            reference.save_png(&ref_png)?;
+            let reference = reference.to_rgb8();
+            let mut vk_gl = twinray_common::metrics::compare(&imgs[0], &imgs[1])?;
+            vk_gl.nan_pixels = nan[0] + nan[1];
+            let mut vk_ref = twinray_common::metrics::compare(&imgs[0], &reference)?;
+            vk_ref.nan_pixels = nan[0];
+            let mut gl_ref = twinray_common::metrics::compare(&imgs[1], &reference)?;
+            gl_ref.nan_pixels = nan[1];
+            Ok([vk_gl, vk_ref, gl_ref])
+        })()
+        .map_err(|e| format!("{e:#}"));
+        if let Ok(m) = &result {
+            let label = |w: &str| format!("{scene} {w}");
+            crate::diff::print_table(&[
+                (&label("vulkan vs opengl"), m[0]),
+                (&label("vulkan vs reference"), m[1]),
+                (&label("opengl vs reference"), m[2]),
+            ]);
+        } else if let Err(e) = &result {
+            eprintln!("  {scene}: agreement check failed: {e}");
+        }
+        rows.push(Agreement { scene, size, result });
+    }
+    rows
 }

@@ -4,10 +4,21 @@ use std::path::Path;
 use twinray_common::image_io::load_png;
 use twinray_common::metrics::{compare, Metrics};
 
-pub fn run(a: &Path, b: &Path, json: bool) -> anyhow::Result<()> {
-    let m = compare(&load_png(a)?, &load_png(b)?).map_err(|e| {
+pub fn run(a: &Path, b: &Path, json: bool, heatmap: Option<&Path>) -> anyhow::Result<()> {
+    let (ia, ib) = (load_png(a)?, load_png(b)?);
+    let m = compare(&ia, &ib).map_err(|e| {
         twinray_common::error::bad_input(format!("'{}' vs '{}': {e}", a.display(), b.display()))
     })?;
+    if let Some(path) = heatmap {
+        let mut out = image::RgbImage::new(ia.width(), ia.height());
+        for (x, y, p) in out.enumerate_pixels_mut() {
+            let (pa, pb) = (ia.get_pixel(x, y), ib.get_pixel(x, y));
+            let worst = (0..3).map(|c| pa[c].abs_diff(pb[c])).max().unwrap_or(0);
+            let grey = ((pa[0] as u32 + pa[1] as u32 + pa[2] as u32) / 9) as u8;
+            *p = if worst > 1 { image::Rgb([128u8.saturating_add(worst.saturating_mul(2)), 0, 0]) } else { image::Rgb([grey; 3]) };
+        }
+        twinray_common::image_io::save_png(&out, path)?;
+    }
     if json {
         println!("{}", serde_json::to_string(&m)?);
     } else {

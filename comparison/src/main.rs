@@ -38,6 +38,9 @@ enum Command {
         /// Print the metrics as one JSON object.
         #[arg(long)]
         json: bool,
+        /// Also write a PNG that shows A dimmed to grey and every pixel off by more than 1/255 in red.
+        #[arg(long)]
+        heatmap: Option<std::path::PathBuf>,
     },
 }
 
@@ -52,7 +55,7 @@ fn main() {
     };
     let result = match cli.command {
         Command::Render { api, args } => apps::render(api, &args),
-        Command::Diff { a, b, json } => diff::run(&a, &b, json),
+        Command::Diff { a, b, json, heatmap } => diff::run(&a, &b, json, heatmap.as_deref()),
         Command::Compare(args) => compare::run(&args),
     };
     if let Err(e) = result {

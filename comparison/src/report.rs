@@ -2,7 +2,7 @@
 //! report.md (the study's tables with ours beside them, ratios, machine info,
 //! a summary derived from the numbers) and one SVG plot per experiment.
 
-use crate::compare::{api_name, Outcome, Plan, EXPERIMENTS};
+use crate::compare::{api_name, Agreement, Outcome, Plan, EXPERIMENTS};
 use crate::apps::Api;
 use crate::study::{self, StudyRow};
 use anyhow::Context;
@@ -19,7 +19,7 @@ pub fn cpu_model() -> String {
         .unwrap_or_else(|| "unknown CPU".into())
 }
 
-pub fn write_all(out: &Path, plan: &Plan, outcomes: &[Outcome], interrupted: bool) -> anyhow::Result<()> {
+pub fn write_all(out: &Path, plan: &Plan, outcomes: &[Outcome], agreement: &[Agreement], interrupted: bool) -> anyhow::Result<()> {
     let cpu = cpu_model();
     std::fs::write(out.join("results.csv"), csv(outcomes, &cpu)).context("writing results.csv")?;
     let study = study::rows();
@@ -33,7 +33,7 @@ pub fn write_all(out: &Path, plan: &Plan, outcomes: &[Outcome], interrupted: boo
         plot(&out.join(&file), exp, &rows, &study).with_context(|| format!("plotting {file}"))?;
         plots.push(file);
     }
-    std::fs::write(out.join("report.md"), markdown(plan, outcomes, &study, &cpu, &plots, interrupted))
+    std::fs::write(out.join("report.md"), markdown(plan, outcomes, agreement, &study, &cpu, &plots, interrupted))
         .context("writing report.md")?;
     Ok(())
 }
@@ -153,7 +153,7 @@ fn describe(label: &str, v: &[f64]) -> String {
     }
 }
 
-pub fn markdown(plan: &Plan, outcomes: &[Outcome], study: &[StudyRow], cpu: &str, plots: &[String], interrupted: bool) -> String {
+pub fn markdown(plan: &Plan, outcomes: &[Outcome], agreement: &[Agreement], study: &[StudyRow], cpu: &str, plots: &[String], interrupted: bool) -> String {
     let mut s = String::new();
     let any = |api: Api| outcomes.iter().find(|o| o.api == api).and_then(|o| o.result.as_ref().ok());
     let device = any(Api::Vulkan).or(any(Api::Opengl)).map(|r| r.device.clone()).unwrap_or_else(|| "no device".into());
@@ -251,6 +251,39 @@ pub fn markdown(plan: &Plan, outcomes: &[Outcome], study: &[StudyRow], cpu: &str
                 frames(vk),
                 frames(gl)
             );
+        }
+        let _ = writeln!(s);
+    }
+
+    if !agreement.is_empty() {
+        let _ = writeln!(
+            s,
+            "## Image agreement\n\nOne frame per scene from each app (PNGs in `images/`) against each other and the f64 CPU \
+             reference (spherelist with 100 extra spheres). Share of pixels within 1/255 on every channel, the largest \
+             channel difference in 1/255 steps, and pixels that were NaN/Inf before quantisation.\n"
+        );
+        let _ = writeln!(s, "| scene | size | VK vs GL | VK vs reference | GL vs reference | max abs VK/GL/ref | NaN |\n|---|---|---|---|---|---|---|");
+        for a in agreement {
+            match &a.result {
+                Ok(m) => {
+                    let _ = writeln!(
+                        s,
+                        "| {} | {} | {:.4}% | {:.4}% | {:.4}% | {} / {} / {} | {} |",
+                        a.scene,
+                        a.size,
+                        100.0 * m[0].within_1(),
+                        100.0 * m[1].within_1(),
+                        100.0 * m[2].within_1(),
+                        m[0].max_abs,
+                        m[1].max_abs,
+                        m[2].max_abs,
+                        m[0].nan_pixels
+                    );
+                }
+                Err(e) => {
+                    let _ = writeln!(s, "| {} | {} | failed: {} | | | | |", a.scene, a.size, e.replace('|', "/"));
+                }
+            }
         }
         let _ = writeln!(s);
     }

@@ -106,6 +106,7 @@ fn frame_loop(gl: &glow::Context, timer: &Timer, count: u32, started: Instant) -
         unsafe { gl.draw_arrays(glow::TRIANGLES, 0, 3) };
         timer.end();
         // glFinish, not a fence: the wait is part of what the study timed.
+        // SAFETY: no arguments; the context is current.
         unsafe { gl.finish() };
         let wall_ms = ms(t0.elapsed());
         frames.push(FrameTime { gpu_ms: timer.result_ms(), wall_ms });

@@ -19,7 +19,7 @@ impl<'gl> SceneBuffers<'gl> {
         let mut this = SceneBuffers { gl, buffers: Vec::with_capacity(1 + binding::STORAGE.len()) };
         this.upload(glow::UNIFORM_BUFFER, binding::FRAME, scene.frame_bytes())?;
         for b in binding::STORAGE {
-            this.upload(glow::SHADER_STORAGE_BUFFER, b, &scene.storage_bytes(b))?;
+            this.upload(glow::SHADER_STORAGE_BUFFER, b, scene.storage_bytes(b))?;
         }
         Ok(this)
     }
@@ -27,7 +27,11 @@ impl<'gl> SceneBuffers<'gl> {
     fn upload(&mut self, target: u32, index: u32, bytes: &[u8]) -> anyhow::Result<()> {
         // SAFETY: a fresh buffer on the current context; `bytes` is copied by the driver.
         unsafe {
-            let buf = self.gl.create_buffer().map_err(|e| anyhow!(e)).with_context(|| format!("glCreateBuffer (binding {index})"))?;
+            let buf = self
+                .gl
+                .create_buffer()
+                .map_err(|e| anyhow!(e))
+                .with_context(|| format!("glCreateBuffer (binding {index})"))?;
             self.buffers.push(buf);
             self.gl.bind_buffer(target, Some(buf));
             // Written once, read every frame: STATIC_DRAW.

@@ -8,8 +8,7 @@ use glutin::context::{ContextApi, ContextAttributesBuilder, GlProfile, Version};
 use glutin::prelude::*;
 use twinray_common::error::{bad_input, no_device};
 
-const NO_DEVICE: &str =
-    "no EGL device found: install libegl1 and libegl-mesa0 + libgl1-mesa-dri (or a GPU driver)";
+const NO_DEVICE: &str = "no EGL device found: install libegl1 and libegl-mesa0 + libgl1-mesa-dri (or a GPU driver)";
 
 /// Mesa's llvmpipe device carries this extension; a hardware device does not.
 const SOFTWARE_EXT: &str = "EGL_MESA_device_software";
@@ -28,57 +27,55 @@ impl Gl {
     pub fn headless(debug: bool) -> anyhow::Result<Gl> {
         // No libEGL, or one without the device extensions, is a missing driver
         // for the user, not a bug: glutin's error alone would not say what to install.
-        let devices: Vec<Device> = Device::query_devices()
-            .map_err(|e| no_device(format!("{NO_DEVICE} ({e})")))?
-            .collect();
+        let devices: Vec<Device> =
+            Device::query_devices().map_err(|e| no_device(format!("{NO_DEVICE} ({e})")))?.collect();
         if devices.is_empty() {
             return Err(no_device(NO_DEVICE));
         }
-        let mut last_err = None;
-        for device in candidates(&devices)? {
-            match create(device, debug) {
-                Ok(gl) => return Ok(gl),
-                Err(e) => last_err = Some(e),
+        let mut failures = Vec::new();
+        for (index, device) in candidates(&devices)? {
+            match create(index, device, debug) {
+                Ok(gl) => {
+                    // A run that fell back to another device must say so: its
+                    // timings would otherwise pass for the skipped device's.
+                    for f in &failures {
+                        eprintln!("twinray-gl: note: skipped {f}");
+                    }
+                    return Ok(gl);
+                }
+                Err(e) => failures.push(format!("{e:#}")),
             }
         }
-        let e = last_err.expect("at least one candidate");
-        Err(no_device(format!("no EGL device offers an OpenGL 4.5 core context: {e:#}")))
+        Err(no_device(format!("no EGL device offers an OpenGL 4.5 core context: {}", failures.join("; "))))
     }
 }
 
 /// Devices to try in order. Hardware first: the software rasteriser would
 /// silently turn a GPU benchmark into a CPU one.
-fn candidates(devices: &[Device]) -> anyhow::Result<Vec<&Device>> {
+fn candidates(devices: &[Device]) -> anyhow::Result<Vec<(usize, &Device)>> {
     if let Ok(v) = std::env::var("TWINRAY_GL_DEVICE") {
-        let i: usize = v
-            .trim()
-            .parse()
-            .ok()
-            .filter(|&i| i < devices.len())
-            .ok_or_else(|| {
-                bad_input(format!(
-                    "TWINRAY_GL_DEVICE='{v}' is not a device index; this machine has {} EGL device(s), 0..{}",
-                    devices.len(),
-                    devices.len() - 1
-                ))
-            })?;
-        return Ok(vec![&devices[i]]);
+        let i: usize = v.trim().parse().ok().filter(|&i| i < devices.len()).ok_or_else(|| {
+            bad_input(format!(
+                "TWINRAY_GL_DEVICE='{v}' is not a device index; this machine has {} EGL device(s), 0..{}",
+                devices.len(),
+                devices.len() - 1
+            ))
+        })?;
+        return Ok(vec![(i, &devices[i])]);
     }
-    let (soft, hard): (Vec<&Device>, Vec<&Device>) =
-        devices.iter().partition(|d| d.extensions().contains(SOFTWARE_EXT));
+    let (soft, hard): (Vec<_>, Vec<_>) =
+        devices.iter().enumerate().partition(|(_, d)| d.extensions().contains(SOFTWARE_EXT));
     Ok(hard.into_iter().chain(soft).collect())
 }
 
-fn create(device: &Device, debug: bool) -> anyhow::Result<Gl> {
-    let what = device.name().unwrap_or("EGL device");
+fn create(index: usize, device: &Device, debug: bool) -> anyhow::Result<Gl> {
+    let what = format!("EGL device {index} ({})", device.name().unwrap_or("unnamed"));
     // SAFETY: no native display handle is passed, only the device.
-    let display = unsafe { Display::with_device(device, None) }
-        .with_context(|| format!("opening an EGL display on {what}"))?;
+    let display =
+        unsafe { Display::with_device(device, None) }.with_context(|| format!("opening an EGL display on {what}"))?;
     // No surface types: the context renders into our own FBO only.
-    let template = ConfigTemplateBuilder::new()
-        .with_surface_type(ConfigSurfaceTypes::empty())
-        .with_api(Api::OPENGL)
-        .build();
+    let template =
+        ConfigTemplateBuilder::new().with_surface_type(ConfigSurfaceTypes::empty()).with_api(Api::OPENGL).build();
     // SAFETY: the display outlives the configs iterator (same scope).
     let config = unsafe { display.find_configs(template) }
         .with_context(|| format!("listing EGL configs on {what}"))?

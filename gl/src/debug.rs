@@ -6,7 +6,8 @@ use std::sync::atomic::{AtomicU64, Ordering};
 use std::sync::Arc;
 
 /// Errors seen so far. The callback may be called from any driver thread,
-/// hence the shared atomic.
+/// hence the shared atomic. One fault can count twice (callback and
+/// glGetError): the count decides pass or fail, it is not a tally.
 #[derive(Clone, Default)]
 pub struct DebugLog {
     errors: Arc<AtomicU64>,

@@ -2,12 +2,12 @@
 //! meets the setup: context, debug output, program, buffers, target, timer,
 //! and the run that strings them together.
 
+pub mod app;
+pub mod buffers;
 pub mod context;
 pub mod debug;
 pub mod program;
-pub mod buffers;
 pub mod target;
 pub mod timer;
-pub mod app;
 
 pub use app::run;

@@ -12,7 +12,7 @@ pub struct Program<'gl> {
 impl<'gl> Program<'gl> {
     pub fn new(gl: &'gl glow::Context, vertex: &str, fragment: &str) -> anyhow::Result<Program<'gl>> {
         // SAFETY: objects are created and deleted on the current context; the
-        // shaders are detached and deleted once linked (the program keeps them).
+        // shaders are detached and deleted once linked (the linked program no longer needs them).
         unsafe {
             let raw = gl.create_program().map_err(|e| anyhow!(e)).context("glCreateProgram")?;
             let program = Program { gl, raw };

@@ -24,81 +24,61 @@ use twinray_common::error::bad_input;
 use twinray_common::gpu::{binding, check_storage_limit, storage_name, GpuScene};
 use twinray_common::image_io::FloatImage;
 use twinray_common::report::{os_description, FrameTime, RunReport};
-use twinray_common::shader::{self, Shaders, Variant};
-
-/// What the Vulkan part of the run hands back once every Vulkan object is gone.
-struct Rendered {
-    device: String,
-    driver: String,
-    api_version: String,
-    frames: Vec<FrameTime>,
-    setup_ms: f64,
-    image: FloatImage,
-}
+use twinray_common::scene::Scene;
+use twinray_common::shader::{self, Variant};
 
 pub fn run(args: RenderArgs, process_start: Instant) -> Result<()> {
     if !args.headless {
-        return Err(bad_input("twinray-vk: windowed mode is not available yet; run with --headless"));
+        return Err(bad_input("windowed mode is not available yet; run with --headless"));
     }
     let scene = args.load_scene()?;
     let variant = if args.generic { Variant::generic() } else { Variant::for_scene(&scene) };
-    let shaders = shader::build(&variant)?;
-    let (width, height) = (args.size.width, args.size.height);
-    let gpu_scene = GpuScene::new(&scene, width, height);
+    let (mut report, image) = render(&args, &scene, &variant, process_start)?;
 
-    let rendered = render(&args, &shaders, &gpu_scene, process_start)?;
-    // Read only now: teardown mistakes (e.g. a leaked object) are reported too.
-    let validation_messages = VALIDATION_MESSAGES.load(Ordering::SeqCst);
-
+    // Counted only now that every Vulkan object is gone, so teardown mistakes count too.
+    report.validation_messages = VALIDATION_MESSAGES.load(Ordering::SeqCst);
     if let Some(path) = &args.out {
-        rendered.image.save_png(path)?;
+        image.save_png(path)?;
     }
-    let mut report = RunReport {
-        api: "vulkan".into(),
-        device: rendered.device,
-        driver: rendered.driver,
-        api_version: rendered.api_version,
-        os: os_description(),
-        scene: scene.stats(),
-        variant: variant.label(),
-        width,
-        height,
-        frames: rendered.frames,
-        gpu_ms: None,
-        wall_ms: None,
-        nonfinite_pixels: rendered.image.nonfinite_pixels(),
-        setup_ms: rendered.setup_ms,
-        validation_messages,
-    };
-    report.summarise();
     if args.json {
         println!("{}", serde_json::to_string(&report)?);
     }
-    if args.validate && validation_messages > 0 {
-        bail!("{validation_messages} validation messages (see above)");
+    if args.validate && report.validation_messages > 0 {
+        bail!("{} validation messages (see above)", report.validation_messages);
     }
     Ok(())
 }
 
-fn render(args: &RenderArgs, shaders: &Shaders, gpu_scene: &GpuScene, process_start: Instant) -> Result<Rendered> {
+/// Everything Vulkan, from the instance to the readback. Returns the report
+/// (without the validation count) and the last frame.
+fn render(
+    args: &RenderArgs,
+    scene: &Scene,
+    variant: &Variant,
+    process_start: Instant,
+) -> Result<(RunReport, FloatImage)> {
     let (width, height) = (args.size.width, args.size.height);
+    let shaders = shader::build(variant)?;
+    let gpu_scene = GpuScene::new(scene, width, height);
+
     let instance = Instance::new(args.validate)?;
     let device = Device::new(&instance)?;
     device.check_size(width, height)?;
     let limit = device.properties.limits.max_storage_buffer_range as u64;
-    check_storage_limit(gpu_scene, limit, "maxStorageBufferRange")?;
+    check_storage_limit(&gpu_scene, limit, "maxStorageBufferRange")?;
 
-    let frame = Buffer::device_local_with(&device, gpu_scene.frame_bytes(), vk::BufferUsageFlags::UNIFORM_BUFFER, "frame uniform buffer")?;
+    let uniform = vk::BufferUsageFlags::UNIFORM_BUFFER;
+    let frame = Buffer::device_local_with(&device, gpu_scene.frame_bytes(), uniform, "frame uniform buffer")?;
     let storage = binding::STORAGE
         .iter()
         .map(|&b| {
             let what = format!("{} storage buffer", storage_name(b));
-            let bytes = gpu_scene.storage_bytes(b);
-            Ok((b, Buffer::device_local_with(&device, &bytes, vk::BufferUsageFlags::STORAGE_BUFFER, &what)?))
+            let usage = vk::BufferUsageFlags::STORAGE_BUFFER;
+            Ok((b, Buffer::device_local_with(&device, gpu_scene.storage_bytes(b), usage, &what)?))
         })
         .collect::<Result<Vec<_>>>()?;
     let descriptors = Descriptors::new(&device, &frame, &storage)?;
-    let pipeline = Pipeline::new(&device, descriptors.set_layout, shaders, width, height)?;
+    let pipeline = Pipeline::new(&device, descriptors.set_layout, &shaders, width, height)?;
     let target = Target::new(&device, pipeline.render_pass, width, height)?;
     let timestamps = Timestamps::new(&device)?;
     let commands = Commands::record(&device, &pipeline, &descriptors, &target, timestamps.as_ref())?;
@@ -120,13 +100,24 @@ fn render(args: &RenderArgs, shaders: &Shaders, gpu_scene: &GpuScene, process_st
     }
 
     let image = target.read_back(&device)?;
-    Ok(Rendered {
+    let mut report = RunReport {
+        api: "vulkan".into(),
         device: device.name.clone(),
         driver: device.driver.clone(),
         api_version: device.api_version(),
+        os: os_description(),
+        scene: scene.stats(),
+        variant: variant.label(),
+        width,
+        height,
         frames,
+        gpu_ms: None,
+        wall_ms: None,
+        nonfinite_pixels: image.nonfinite_pixels(),
         setup_ms,
-        image,
-    })
-    // Every Vulkan object is dropped here, newest first: commands ... device, instance.
+        validation_messages: 0,
+    };
+    report.summarise();
+    Ok((report, image))
+    // Every Vulkan object is dropped here, newest first: commands, ..., device, instance.
 }

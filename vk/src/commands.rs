@@ -54,7 +54,8 @@ impl Commands {
 
         // No ONE_TIME_SUBMIT flag: the buffer is resubmitted every frame.
         let cmd = this.cmd;
-        unsafe { d.begin_command_buffer(cmd, &vk::CommandBufferBeginInfo::default()) }.context("recording the frame")?;
+        unsafe { d.begin_command_buffer(cmd, &vk::CommandBufferBeginInfo::default()) }
+            .context("recording the frame")?;
         if let Some(t) = timestamps {
             t.record_reset(cmd);
             t.record(cmd, 0);
@@ -62,11 +63,21 @@ impl Commands {
         let begin = vk::RenderPassBeginInfo::default()
             .render_pass(pipeline.render_pass)
             .framebuffer(target.framebuffer)
-            .render_area(vk::Rect2D { offset: vk::Offset2D::default(), extent: vk::Extent2D { width: target.width, height: target.height } });
+            .render_area(vk::Rect2D {
+                offset: vk::Offset2D::default(),
+                extent: vk::Extent2D { width: target.width, height: target.height },
+            });
         unsafe {
             d.cmd_begin_render_pass(cmd, &begin, vk::SubpassContents::INLINE);
             d.cmd_bind_pipeline(cmd, vk::PipelineBindPoint::GRAPHICS, pipeline.pipeline);
-            d.cmd_bind_descriptor_sets(cmd, vk::PipelineBindPoint::GRAPHICS, pipeline.layout, 0, &[descriptors.set], &[]);
+            d.cmd_bind_descriptor_sets(
+                cmd,
+                vk::PipelineBindPoint::GRAPHICS,
+                pipeline.layout,
+                0,
+                &[descriptors.set],
+                &[],
+            );
             // Three vertices, no vertex buffer: the fullscreen triangle.
             d.cmd_draw(cmd, 3, 1, 0, 0);
             d.cmd_end_render_pass(cmd);

@@ -30,9 +30,10 @@ impl Descriptors {
             pool: vk::DescriptorPool::null(),
             set: vk::DescriptorSet::null(),
         };
-        let all: Vec<(u32, vk::DescriptorType, &Buffer)> = std::iter::once((binding::FRAME, vk::DescriptorType::UNIFORM_BUFFER, frame))
-            .chain(storage.iter().map(|(b, buf)| (*b, vk::DescriptorType::STORAGE_BUFFER, buf)))
-            .collect();
+        let all: Vec<(u32, vk::DescriptorType, &Buffer)> =
+            std::iter::once((binding::FRAME, vk::DescriptorType::UNIFORM_BUFFER, frame))
+                .chain(storage.iter().map(|(b, buf)| (*b, vk::DescriptorType::STORAGE_BUFFER, buf)))
+                .collect();
 
         let bindings: Vec<_> = all
             .iter()
@@ -45,7 +46,8 @@ impl Descriptors {
             })
             .collect();
         let info = vk::DescriptorSetLayoutCreateInfo::default().bindings(&bindings);
-        this.set_layout = unsafe { d.create_descriptor_set_layout(&info, None) }.context("creating the descriptor set layout")?;
+        this.set_layout =
+            unsafe { d.create_descriptor_set_layout(&info, None) }.context("creating the descriptor set layout")?;
 
         let sizes = [
             vk::DescriptorPoolSize { ty: vk::DescriptorType::UNIFORM_BUFFER, descriptor_count: 1 },
@@ -58,8 +60,10 @@ impl Descriptors {
         let info = vk::DescriptorSetAllocateInfo::default().descriptor_pool(this.pool).set_layouts(&layouts);
         this.set = unsafe { d.allocate_descriptor_sets(&info) }.context("allocating the descriptor set")?[0];
 
-        let infos: Vec<[vk::DescriptorBufferInfo; 1]> =
-            all.iter().map(|(_, _, buf)| [vk::DescriptorBufferInfo { buffer: buf.buffer, offset: 0, range: buf.size }]).collect();
+        let infos: Vec<[vk::DescriptorBufferInfo; 1]> = all
+            .iter()
+            .map(|(_, _, buf)| [vk::DescriptorBufferInfo { buffer: buf.buffer, offset: 0, range: buf.size }])
+            .collect();
         let writes: Vec<_> = all
             .iter()
             .zip(&infos)

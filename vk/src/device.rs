@@ -14,7 +14,6 @@ use ash::vk;
 use twinray_common::error::{bad_input, no_device};
 
 pub struct Device {
-    pub physical: vk::PhysicalDevice,
     pub properties: vk::PhysicalDeviceProperties,
     pub memory_properties: vk::PhysicalDeviceMemoryProperties,
     pub name: String,
@@ -70,7 +69,6 @@ impl Device {
             .with_context(|| format!("opening the Vulkan device '{}'", chosen.name))?;
         let queue = unsafe { device.get_device_queue(queue_family, 0) };
         Ok(Device {
-            physical: chosen.physical,
             properties: chosen.properties,
             memory_properties: unsafe { vk_instance.get_physical_device_memory_properties(chosen.physical) },
             name: chosen.name.clone(),
@@ -100,9 +98,9 @@ impl Device {
             (height, l.max_viewport_dimensions[1], "maxViewportDimensions[1]"),
         ];
         match checks.iter().find(|(value, limit, _)| value > limit) {
-            Some((_, limit, name)) => Err(bad_input(format!(
-                "--size {width}x{height} exceeds this device's limit of {limit} ({name})"
-            ))),
+            Some((_, limit, name)) => {
+                Err(bad_input(format!("--size {width}x{height} exceeds this device's limit of {limit} ({name})")))
+            }
             None => Ok(()),
         }
     }
@@ -114,7 +112,8 @@ impl Device {
         let info = vk::CommandPoolCreateInfo::default()
             .queue_family_index(self.queue_family)
             .flags(vk::CommandPoolCreateFlags::TRANSIENT);
-        let pool = unsafe { d.create_command_pool(&info, None) }.with_context(|| format!("creating a command pool for {what}"))?;
+        let pool = unsafe { d.create_command_pool(&info, None) }
+            .with_context(|| format!("creating a command pool for {what}"))?;
         let result = (|| -> ash::prelude::VkResult<()> {
             let alloc = vk::CommandBufferAllocateInfo::default().command_pool(pool).command_buffer_count(1);
             let cmd = unsafe { d.allocate_command_buffers(&alloc) }?[0];
@@ -139,14 +138,23 @@ impl Device {
 fn choose(candidates: &[Candidate]) -> Result<&Candidate> {
     if let Some(wanted) = std::env::var("TWINRAY_VK_DEVICE").ok().filter(|v| !v.trim().is_empty()) {
         let needle = wanted.trim().to_lowercase();
-        let by_index = needle.parse::<usize>().ok().and_then(|i| candidates.get(i));
-        let found = by_index.or_else(|| candidates.iter().find(|c| c.name.to_lowercase().contains(&needle)));
+        // A number is an index, never part of a name ("1" is in "LLVM 15.0.6").
+        let found = match needle.parse::<usize>() {
+            Ok(i) => candidates.get(i),
+            Err(_) => candidates.iter().find(|c| c.name.to_lowercase().contains(&needle)),
+        };
         let list: Vec<String> = candidates.iter().enumerate().map(|(i, c)| format!("{i}: {}", c.name)).collect();
         let c = found.ok_or_else(|| {
-            bad_input(format!("TWINRAY_VK_DEVICE='{wanted}' matches no Vulkan device; the devices are {}", list.join(", ")))
+            bad_input(format!(
+                "TWINRAY_VK_DEVICE='{wanted}' matches no Vulkan device; the devices are {}",
+                list.join(", ")
+            ))
         })?;
         if c.graphics_family.is_none() {
-            return Err(bad_input(format!("TWINRAY_VK_DEVICE='{wanted}' picks '{}', which cannot draw (no graphics queue)", c.name)));
+            return Err(bad_input(format!(
+                "TWINRAY_VK_DEVICE='{wanted}' picks '{}', which cannot draw (no graphics queue)",
+                c.name
+            )));
         }
         return Ok(c);
     }
@@ -157,11 +165,10 @@ fn choose(candidates: &[Candidate]) -> Result<&Candidate> {
         vk::PhysicalDeviceType::CPU => 3,
         _ => 4,
     };
-    candidates
-        .iter()
-        .filter(|c| c.graphics_family.is_some())
-        .min_by_key(|c| rank(c.properties.device_type))
-        .ok_or_else(|| no_device("no Vulkan device can draw (no graphics queue): install mesa-vulkan-drivers or a GPU driver"))
+    let drawable = candidates.iter().filter(|c| c.graphics_family.is_some());
+    drawable.min_by_key(|c| rank(c.properties.device_type)).ok_or_else(|| {
+        no_device("no Vulkan device can draw (no graphics queue): install mesa-vulkan-drivers or a GPU driver")
+    })
 }
 
 /// The driver's own name ("llvmpipe Mesa 22.3.6 ...") needs Vulkan 1.2 on both

@@ -35,10 +35,10 @@ impl Instance {
     /// `validate` is `--validate`: the layer is then required, not optional.
     pub fn new(validate: bool) -> Result<Instance> {
         // SAFETY: loads the system's Vulkan loader; nothing else runs meanwhile.
-        let entry = unsafe { ash::Entry::load() }.map_err(|e| {
-            no_device(format!(
-                "no Vulkan loader found (libvulkan.so.1: {e}): install libvulkan1 and a Vulkan driver, e.g. mesa-vulkan-drivers"
-            ))
+        let entry = unsafe { ash::Entry::load() }.map_err(|_| {
+            no_device(
+                "no Vulkan loader found (libvulkan.so.1): install libvulkan1 and a Vulkan driver, e.g. mesa-vulkan-drivers",
+            )
         })?;
 
         // The layer checks every call, which costs CPU time on every submit, and a
@@ -53,7 +53,9 @@ impl Instance {
             ));
         }
         if from_env && !installed {
-            eprintln!("twinray-vk: TWINRAY_VK_VALIDATION=1 but the validation layer is not installed; running without it");
+            eprintln!(
+                "twinray-vk: TWINRAY_VK_VALIDATION=1 but the validation layer is not installed; running without it"
+            );
         }
         let validation = installed && (validate || from_env);
 
@@ -80,9 +82,9 @@ impl Instance {
                 .push_next(&mut early_messenger);
         }
         let instance = unsafe { entry.create_instance(&info, None) }.map_err(|e| match e {
-            vk::Result::ERROR_INCOMPATIBLE_DRIVER => no_device(
-                "the Vulkan loader found no usable driver: install mesa-vulkan-drivers or a GPU driver",
-            ),
+            vk::Result::ERROR_INCOMPATIBLE_DRIVER => {
+                no_device("the Vulkan loader found no usable driver: install mesa-vulkan-drivers or a GPU driver")
+            }
             e => anyhow::Error::new(e).context("creating the Vulkan instance"),
         })?;
 

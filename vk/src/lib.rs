@@ -4,12 +4,12 @@
 //! The modules are listed in the order a reader meets the setup; `app.rs` ties
 //! them together and is the best place to start for the big picture.
 
-pub mod instance;
-pub mod device;
-pub mod memory;
+pub mod app;
+pub mod commands;
 pub mod descriptors;
+pub mod device;
+pub mod instance;
+pub mod memory;
 pub mod pipeline;
 pub mod target;
 pub mod timestamps;
-pub mod commands;
-pub mod app;

@@ -13,34 +13,17 @@
 use crate::device::Device;
 use anyhow::{anyhow, Context, Result};
 use ash::vk;
+use ash::vk::MemoryPropertyFlags as Flags;
 
-/// Property wishes, best first; an empty set accepts any type the resource allows.
-pub const DEVICE_LOCAL: &[vk::MemoryPropertyFlags] =
-    &[vk::MemoryPropertyFlags::DEVICE_LOCAL, vk::MemoryPropertyFlags::empty()];
-/// Written once by the CPU: coherent saves a flush, but we can flush if we must.
-const UPLOAD: &[vk::MemoryPropertyFlags] = &[
-    both(vk::MemoryPropertyFlags::HOST_VISIBLE, vk::MemoryPropertyFlags::HOST_COHERENT),
-    vk::MemoryPropertyFlags::HOST_VISIBLE,
-];
-/// Read by the CPU: uncached reads of mapped memory are very slow, so prefer cached.
-pub const READBACK: &[vk::MemoryPropertyFlags] = &[
-    both(vk::MemoryPropertyFlags::HOST_VISIBLE, vk::MemoryPropertyFlags::HOST_CACHED),
-    vk::MemoryPropertyFlags::HOST_VISIBLE,
-];
-
-/// `a | b` for use in constants.
-const fn both(a: vk::MemoryPropertyFlags, b: vk::MemoryPropertyFlags) -> vk::MemoryPropertyFlags {
-    vk::MemoryPropertyFlags::from_raw(a.as_raw() | b.as_raw())
-}
-
-/// Allocates memory for `needs` from the first type that has every property of
-/// the earliest possible wish. Returns the memory and the chosen type's properties.
+/// Allocates memory for `needs` from the first allowed type that has every property
+/// of the earliest wish it can meet (an empty wish accepts any allowed type).
+/// Returns the memory and the chosen type's properties.
 pub fn allocate(
     device: &Device,
     needs: vk::MemoryRequirements,
-    wishes: &[vk::MemoryPropertyFlags],
+    wishes: &[Flags],
     what: &str,
-) -> Result<(vk::DeviceMemory, vk::MemoryPropertyFlags)> {
+) -> Result<(vk::DeviceMemory, Flags)> {
     let props = &device.memory_properties;
     let types = &props.memory_types[..props.memory_type_count as usize];
     // Bit i of memory_type_bits set = the resource may live in memory type i.
@@ -48,7 +31,9 @@ pub fn allocate(
     let (index, flags) = wishes
         .iter()
         .find_map(|&wish| {
-            (0..types.len()).find(|&i| allowed(i) && types[i].property_flags.contains(wish)).map(|i| (i, types[i].property_flags))
+            (0..types.len())
+                .find(|&i| allowed(i) && types[i].property_flags.contains(wish))
+                .map(|i| (i, types[i].property_flags))
         })
         .ok_or_else(|| anyhow!("no memory type suits the {what} ({wishes:?})"))?;
     let info = vk::MemoryAllocateInfo::default().allocation_size(needs.size).memory_type_index(index as u32);
@@ -72,7 +57,7 @@ impl Buffer {
         device: &Device,
         size: u64,
         usage: vk::BufferUsageFlags,
-        wishes: &[vk::MemoryPropertyFlags],
+        wishes: &[Flags],
         what: &str,
     ) -> Result<Buffer> {
         // Destroy functions accept null handles, so a half-built Buffer drops cleanly.
@@ -88,8 +73,7 @@ impl Buffer {
         let needs = unsafe { b.device.get_buffer_memory_requirements(b.buffer) };
         let (memory, flags) = allocate(device, needs, wishes, what)?;
         b.memory = memory;
-        b.needs_flush = flags.contains(vk::MemoryPropertyFlags::HOST_VISIBLE)
-            && !flags.contains(vk::MemoryPropertyFlags::HOST_COHERENT);
+        b.needs_flush = flags.contains(Flags::HOST_VISIBLE) && !flags.contains(Flags::HOST_COHERENT);
         unsafe { b.device.bind_buffer_memory(b.buffer, b.memory, 0) }.with_context(|| format!("binding the {what}"))?;
         Ok(b)
     }
@@ -97,9 +81,18 @@ impl Buffer {
     /// A device-local buffer holding `bytes`, filled through a staging buffer.
     pub fn device_local_with(device: &Device, bytes: &[u8], usage: vk::BufferUsageFlags, what: &str) -> Result<Buffer> {
         let size = bytes.len() as u64;
-        let staging = Buffer::new(device, size, vk::BufferUsageFlags::TRANSFER_SRC, UPLOAD, &format!("staging buffer for {what}"))?;
+        // Coherent memory needs no flush after writing, but any mappable type will do.
+        let upload = [Flags::HOST_VISIBLE | Flags::HOST_COHERENT, Flags::HOST_VISIBLE];
+        let staging = Buffer::new(
+            device,
+            size,
+            vk::BufferUsageFlags::TRANSFER_SRC,
+            &upload,
+            &format!("staging buffer for {what}"),
+        )?;
         staging.write(bytes)?;
-        let buffer = Buffer::new(device, size, usage | vk::BufferUsageFlags::TRANSFER_DST, DEVICE_LOCAL, what)?;
+        let usage = usage | vk::BufferUsageFlags::TRANSFER_DST;
+        let buffer = Buffer::new(device, size, usage, &[Flags::DEVICE_LOCAL, Flags::empty()], what)?;
         device.run_once(&format!("uploading the {what}"), |cmd| {
             let region = vk::BufferCopy::default().size(size);
             // The barrier makes the copied bytes visible to the fragment shader of
@@ -130,7 +123,8 @@ impl Buffer {
     /// Copies `bytes` into a host-visible buffer.
     pub fn write(&self, bytes: &[u8]) -> Result<()> {
         let d = &self.device;
-        let ptr = unsafe { d.map_memory(self.memory, 0, vk::WHOLE_SIZE, vk::MemoryMapFlags::empty()) }.context("mapping memory")?;
+        let ptr = unsafe { d.map_memory(self.memory, 0, vk::WHOLE_SIZE, vk::MemoryMapFlags::empty()) }
+            .context("mapping memory")?;
         // SAFETY: the mapping covers the whole buffer, which is bytes.len() long.
         unsafe { std::ptr::copy_nonoverlapping(bytes.as_ptr(), ptr.cast::<u8>(), bytes.len()) };
         let range = vk::MappedMemoryRange::default().memory(self.memory).size(vk::WHOLE_SIZE);
@@ -139,17 +133,20 @@ impl Buffer {
         flushed.context("flushing mapped memory")
     }
 
-    /// Copies a host-visible buffer's bytes out.
-    pub fn read(&self) -> Result<Vec<u8>> {
+    /// Copies a host-visible buffer's contents out, as `T`s. (Copied rather than
+    /// cast in place: the mapping is aligned, a Vec<u8> copy of it need not be.)
+    pub fn read<T: bytemuck::Pod>(&self) -> Result<Vec<T>> {
         let d = &self.device;
-        let ptr = unsafe { d.map_memory(self.memory, 0, vk::WHOLE_SIZE, vk::MemoryMapFlags::empty()) }.context("mapping memory")?;
+        let ptr = unsafe { d.map_memory(self.memory, 0, vk::WHOLE_SIZE, vk::MemoryMapFlags::empty()) }
+            .context("mapping memory")?;
         let range = vk::MappedMemoryRange::default().memory(self.memory).size(vk::WHOLE_SIZE);
         let fresh = if self.needs_flush { unsafe { d.invalidate_mapped_memory_ranges(&[range]) } } else { Ok(()) };
         // SAFETY: the mapping covers the whole buffer, `size` bytes.
-        let bytes = unsafe { std::slice::from_raw_parts(ptr.cast::<u8>(), self.size as usize) }.to_vec();
+        let bytes = unsafe { std::slice::from_raw_parts(ptr.cast::<u8>(), self.size as usize) };
+        let data = bytemuck::pod_collect_to_vec(bytes);
         unsafe { d.unmap_memory(self.memory) };
         fresh.context("invalidating mapped memory")?;
-        Ok(bytes)
+        Ok(data)
     }
 }
 

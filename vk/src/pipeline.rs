@@ -38,12 +38,19 @@ impl Drop for Module {
 
 fn module(d: &ash::Device, spirv: &[u32], stage: &str) -> Result<Module> {
     let info = vk::ShaderModuleCreateInfo::default().code(spirv);
-    let m = unsafe { d.create_shader_module(&info, None) }.with_context(|| format!("creating the {stage} shader module"))?;
+    let m = unsafe { d.create_shader_module(&info, None) }
+        .with_context(|| format!("creating the {stage} shader module"))?;
     Ok(Module(d.clone(), m))
 }
 
 impl Pipeline {
-    pub fn new(device: &Device, set_layout: vk::DescriptorSetLayout, shaders: &Shaders, width: u32, height: u32) -> Result<Pipeline> {
+    pub fn new(
+        device: &Device,
+        set_layout: vk::DescriptorSetLayout,
+        shaders: &Shaders,
+        width: u32,
+        height: u32,
+    ) -> Result<Pipeline> {
         let d = &device.device;
         let mut this = Pipeline {
             device: d.clone(),
@@ -98,15 +105,29 @@ impl Pipeline {
         let vertex = module(d, &shaders.vertex_spirv, "vertex")?;
         let fragment = module(d, &shaders.fragment_spirv, "fragment")?;
         let stages = [
-            vk::PipelineShaderStageCreateInfo::default().stage(vk::ShaderStageFlags::VERTEX).module(vertex.1).name(c"main"),
-            vk::PipelineShaderStageCreateInfo::default().stage(vk::ShaderStageFlags::FRAGMENT).module(fragment.1).name(c"main"),
+            vk::PipelineShaderStageCreateInfo::default()
+                .stage(vk::ShaderStageFlags::VERTEX)
+                .module(vertex.1)
+                .name(c"main"),
+            vk::PipelineShaderStageCreateInfo::default()
+                .stage(vk::ShaderStageFlags::FRAGMENT)
+                .module(fragment.1)
+                .name(c"main"),
         ];
         // No vertex buffers: the vertex shader makes the triangle from gl_VertexIndex.
         let vertex_input = vk::PipelineVertexInputStateCreateInfo::default();
-        let assembly = vk::PipelineInputAssemblyStateCreateInfo::default().topology(vk::PrimitiveTopology::TRIANGLE_LIST);
+        let assembly =
+            vk::PipelineInputAssemblyStateCreateInfo::default().topology(vk::PrimitiveTopology::TRIANGLE_LIST);
         // A normal viewport (positive height): Vulkan's row 0 is the top, and the
         // shader builds rays with +y down, so rows go to the PNG unflipped.
-        let viewports = [vk::Viewport { x: 0.0, y: 0.0, width: width as f32, height: height as f32, min_depth: 0.0, max_depth: 1.0 }];
+        let viewports = [vk::Viewport {
+            x: 0.0,
+            y: 0.0,
+            width: width as f32,
+            height: height as f32,
+            min_depth: 0.0,
+            max_depth: 1.0,
+        }];
         let scissors = [vk::Rect2D { offset: vk::Offset2D::default(), extent: vk::Extent2D { width, height } }];
         let viewport = vk::PipelineViewportStateCreateInfo::default().viewports(&viewports).scissors(&scissors);
         // No culling: the one triangle must be drawn whichever way it winds.
@@ -114,8 +135,10 @@ impl Pipeline {
             .polygon_mode(vk::PolygonMode::FILL)
             .cull_mode(vk::CullModeFlags::NONE)
             .line_width(1.0);
-        let multisample = vk::PipelineMultisampleStateCreateInfo::default().rasterization_samples(vk::SampleCountFlags::TYPE_1);
-        let blend_attachments = [vk::PipelineColorBlendAttachmentState::default().color_write_mask(vk::ColorComponentFlags::RGBA)];
+        let multisample =
+            vk::PipelineMultisampleStateCreateInfo::default().rasterization_samples(vk::SampleCountFlags::TYPE_1);
+        let blend_attachments =
+            [vk::PipelineColorBlendAttachmentState::default().color_write_mask(vk::ColorComponentFlags::RGBA)];
         let blend = vk::PipelineColorBlendStateCreateInfo::default().attachments(&blend_attachments);
         let info = vk::GraphicsPipelineCreateInfo::default()
             .stages(&stages)

@@ -14,6 +14,7 @@ use crate::memory::{self, Buffer};
 use crate::pipeline::COLOR_FORMAT;
 use anyhow::{Context, Result};
 use ash::vk;
+use ash::vk::MemoryPropertyFlags as Flags;
 use twinray_common::image_io::FloatImage;
 
 pub struct Target {
@@ -27,20 +28,14 @@ pub struct Target {
     readback: Buffer,
 }
 
-const COLOR: vk::ImageSubresourceRange = vk::ImageSubresourceRange {
-    aspect_mask: vk::ImageAspectFlags::COLOR,
-    base_mip_level: 0,
-    level_count: 1,
-    base_array_layer: 0,
-    layer_count: 1,
-};
-
 impl Target {
     pub fn new(device: &Device, render_pass: vk::RenderPass, width: u32, height: u32) -> Result<Target> {
         let d = &device.device;
         // RGBA32F: 16 bytes a pixel, rows packed tightly in the readback buffer.
         let bytes = width as u64 * height as u64 * 16;
-        let readback = Buffer::new(device, bytes, vk::BufferUsageFlags::TRANSFER_DST, memory::READBACK, "readback buffer")?;
+        // The CPU reads this one, and uncached reads of mapped memory are very slow.
+        let wishes = [Flags::HOST_VISIBLE | Flags::HOST_CACHED, Flags::HOST_VISIBLE];
+        let readback = Buffer::new(device, bytes, vk::BufferUsageFlags::TRANSFER_DST, &wishes, "readback buffer")?;
         let mut this = Target {
             device: d.clone(),
             image: vk::Image::null(),
@@ -63,14 +58,19 @@ impl Target {
             .initial_layout(vk::ImageLayout::UNDEFINED);
         this.image = unsafe { d.create_image(&info, None) }.context("creating the colour image")?;
         let needs = unsafe { d.get_image_memory_requirements(this.image) };
-        this.memory = memory::allocate(device, needs, memory::DEVICE_LOCAL, "colour image")?.0;
+        this.memory = memory::allocate(device, needs, &[Flags::DEVICE_LOCAL, Flags::empty()], "colour image")?.0;
         unsafe { d.bind_image_memory(this.image, this.memory, 0) }.context("binding the colour image's memory")?;
 
         let info = vk::ImageViewCreateInfo::default()
             .image(this.image)
             .view_type(vk::ImageViewType::TYPE_2D)
             .format(COLOR_FORMAT)
-            .subresource_range(COLOR);
+            .subresource_range(
+                vk::ImageSubresourceRange::default()
+                    .aspect_mask(vk::ImageAspectFlags::COLOR)
+                    .level_count(1)
+                    .layer_count(1),
+            );
         this.view = unsafe { d.create_image_view(&info, None) }.context("creating the colour image view")?;
 
         let views = [this.view];
@@ -96,8 +96,8 @@ impl Target {
                     layer_count: 1,
                 })
                 .image_extent(vk::Extent3D { width: self.width, height: self.height, depth: 1 });
-            // The copy's writes become visible to the CPU's reads only through a
-            // barrier to the HOST stage; waiting for the queue orders, but does not flush.
+            // A queue or fence wait covers only the GPU's side: the copy's writes
+            // become visible to the CPU's reads only through a barrier to HOST.
             let to_host = vk::BufferMemoryBarrier::default()
                 .src_access_mask(vk::AccessFlags::TRANSFER_WRITE)
                 .dst_access_mask(vk::AccessFlags::HOST_READ)
@@ -107,7 +107,13 @@ impl Target {
                 .size(vk::WHOLE_SIZE);
             unsafe {
                 let d = &device.device;
-                d.cmd_copy_image_to_buffer(cmd, self.image, vk::ImageLayout::TRANSFER_SRC_OPTIMAL, self.readback.buffer, &[region]);
+                d.cmd_copy_image_to_buffer(
+                    cmd,
+                    self.image,
+                    vk::ImageLayout::TRANSFER_SRC_OPTIMAL,
+                    self.readback.buffer,
+                    &[region],
+                );
                 d.cmd_pipeline_barrier(
                     cmd,
                     vk::PipelineStageFlags::TRANSFER,
@@ -119,9 +125,7 @@ impl Target {
                 );
             }
         })?;
-        let bytes = self.readback.read().context("reading the readback buffer")?;
-        // Copied into f32s rather than cast in place: a Vec<u8> need not be 4-aligned.
-        let rgba: Vec<f32> = bytemuck::pod_collect_to_vec(&bytes);
+        let rgba: Vec<f32> = self.readback.read().context("reading the readback buffer")?;
         Ok(FloatImage::from_rgba(self.width, self.height, &rgba))
     }
 }
