@@ -34,6 +34,10 @@ pub struct RenderArgs {
     /// Render with the all-features shader instead of the scene's own variant.
     #[arg(long)]
     pub generic: bool,
+    /// OpenGL only: load naga's SPIR-V through GL_ARB_gl_spirv instead of naga's GLSL,
+    /// so that both APIs run the very same shader binary (isolates the compiler path).
+    #[arg(long)]
+    pub gl_spirv: bool,
 }
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -70,6 +74,22 @@ pub fn parse_size(s: &str) -> Result<Size, String> {
 }
 
 impl RenderArgs {
+    /// A headless run of `scene` at `size` with every other option at its default.
+    pub fn headless(scene: &str, size: Size) -> RenderArgs {
+        RenderArgs {
+            scene: scene.to_string(),
+            size,
+            headless: true,
+            frames: None,
+            out: None,
+            json: false,
+            set: Vec::new(),
+            validate: false,
+            generic: false,
+            gl_spirv: false,
+        }
+    }
+
     /// Parses argv, mapping clap's usage errors to exit code 2 (clap already
     /// prints one clear line naming the option).
     pub fn parse_or_exit() -> Self {

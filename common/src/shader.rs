@@ -133,3 +133,66 @@ pub fn to_glsl(module: &Module, info: &ModuleInfo, stage: ShaderStage) -> anyhow
     writer.write().with_context(|| format!("writing {stage:?} GLSL"))?;
     Ok(out)
 }
+
+/// naga's Vulkan SPIR-V made loadable by OpenGL (GL_ARB_gl_spirv), so both APIs
+/// can run the very same binary: GL has no descriptor sets, so the
+/// `DescriptorSet` decorations go, and GL's window origin is the lower left, so
+/// `OriginUpperLeft` becomes `OriginLowerLeft` (with glReadPixels' bottom-up rows
+/// this gives the same upright image as the GLSL path). Nothing else changes.
+pub fn spirv_for_opengl(words: &[u32]) -> Vec<u32> {
+    const OP_EXECUTION_MODE: u32 = 16;
+    const OP_DECORATE: u32 = 71;
+    const DECORATION_DESCRIPTOR_SET: u32 = 34;
+    const ORIGIN_UPPER_LEFT: u32 = 7;
+    const ORIGIN_LOWER_LEFT: u32 = 8;
+    let mut out = words[..5.min(words.len())].to_vec();
+    let mut i = 5;
+    while i < words.len() {
+        let count = (words[i] >> 16) as usize;
+        let op = words[i] & 0xffff;
+        if count == 0 || i + count > words.len() {
+            // Malformed; keep the rest untouched and let the driver report it.
+            out.extend_from_slice(&words[i..]);
+            break;
+        }
+        let inst = &words[i..i + count];
+        if op == OP_DECORATE && count >= 3 && inst[2] == DECORATION_DESCRIPTOR_SET {
+            // dropped
+        } else if op == OP_EXECUTION_MODE && count >= 3 && inst[2] == ORIGIN_UPPER_LEFT {
+            out.extend_from_slice(&[inst[0], inst[1], ORIGIN_LOWER_LEFT]);
+            out.extend_from_slice(&inst[3..]);
+        } else {
+            out.extend_from_slice(inst);
+        }
+        i += count;
+    }
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn spirv_for_opengl_drops_sets_and_flips_origin_only() {
+        let s = build(&Variant::generic()).unwrap();
+        let gl = spirv_for_opengl(&s.fragment_spirv);
+        let count = |w: &[u32], op: u32, arg2: u32| {
+            let mut i = 5;
+            let mut n = 0;
+            while i < w.len() {
+                let c = (w[i] >> 16) as usize;
+                if w[i] & 0xffff == op && c >= 3 && w[i + 2] == arg2 {
+                    n += 1;
+                }
+                i += c;
+            }
+            n
+        };
+        assert_eq!(count(&s.fragment_spirv, 71, 34), 5, "five resources in set 0");
+        assert_eq!(count(&gl, 71, 34), 0);
+        assert_eq!(count(&s.fragment_spirv, 16, 7), 1);
+        assert_eq!(count(&gl, 16, 8), 1);
+        assert_eq!(gl.len(), s.fragment_spirv.len() - 5 * 4, "only the five 4-word decorations go");
+    }
+}

@@ -13,6 +13,9 @@ use twinray_common::report::{FrameTime, RunReport};
 pub enum Api {
     Vulkan,
     Opengl,
+    /// OpenGL running naga's SPIR-V (GL_ARB_gl_spirv): the very binary Vulkan runs.
+    #[value(name = "opengl-spirv")]
+    OpenglSpirv,
     Reference,
 }
 
@@ -20,7 +23,7 @@ impl Api {
     pub fn binary(self) -> Option<&'static str> {
         match self {
             Api::Vulkan => Some("twinray-vk"),
-            Api::Opengl => Some("twinray-gl"),
+            Api::Opengl | Api::OpenglSpirv => Some("twinray-gl"),
             Api::Reference => None,
         }
     }
@@ -63,6 +66,9 @@ pub fn app_args(args: &RenderArgs) -> Vec<String> {
     if args.generic {
         v.push("--generic".into());
     }
+    if args.gl_spirv {
+        v.push("--gl-spirv".into());
+    }
     v
 }
 
@@ -70,8 +76,10 @@ pub fn app_args(args: &RenderArgs) -> Vec<String> {
 pub fn render(api: Api, args: &RenderArgs) -> anyhow::Result<()> {
     match api.binary() {
         Some(bin) => {
+            let mut args = args.clone();
+            args.gl_spirv |= api == Api::OpenglSpirv;
             let status = Command::new(app_path(bin)?)
-                .args(app_args(args))
+                .args(app_args(&args))
                 .status()
                 .with_context(|| format!("starting {bin}"))?;
             if !status.success() {
@@ -89,6 +97,7 @@ pub fn run_json(api: Api, args: &RenderArgs) -> anyhow::Result<RunReport> {
     let bin = api.binary().expect("an app");
     let mut args = args.clone();
     args.json = true;
+    args.gl_spirv |= api == Api::OpenglSpirv;
     let out = Command::new(app_path(bin)?).args(app_args(&args)).output().with_context(|| format!("starting {bin}"))?;
     if !out.status.success() {
         let stderr = String::from_utf8_lossy(&out.stderr);

@@ -28,6 +28,10 @@ pub struct CompareArgs {
     /// Fewer frames for slow points so that one app spends at most about this long on one point.
     #[arg(long)]
     pub seconds_per_point: Option<f64>,
+    /// Also run OpenGL on naga's SPIR-V (GL_ARB_gl_spirv): the same binary as Vulkan,
+    /// which separates the API from the shader-compiler path.
+    #[arg(long)]
+    pub gl_spirv: bool,
     /// Only these experiments (teapot, box, spherelist), comma-separated.
     #[arg(long, value_delimiter = ',')]
     pub only: Vec<String>,
@@ -127,6 +131,7 @@ pub fn api_name(api: Api) -> &'static str {
     match api {
         Api::Vulkan => "vulkan",
         Api::Opengl => "opengl",
+        Api::OpenglSpirv => "opengl-spirv",
         Api::Reference => "reference",
     }
 }
@@ -141,15 +146,11 @@ pub fn run(args: &CompareArgs) -> anyhow::Result<()> {
     let mut args = args.clone();
     if !args.quick && !args.full {
         let probe = RenderArgs {
-            scene: "spherelist".into(),
-            size: Size { width: 8, height: 8 },
-            headless: true,
             frames: Some(1),
             out: None,
             json: true,
             set: vec![],
-            validate: false,
-            generic: false,
+            ..RenderArgs::headless("spherelist", Size { width: 8, height: 8 })
         };
         let r = run_json(Api::Vulkan, &probe).context("probing the Vulkan device")?;
         if is_software(&r.device) {
@@ -167,15 +168,16 @@ pub fn run(args: &CompareArgs) -> anyhow::Result<()> {
         let stop = stop.clone();
         ctrlc::set_handler(move || stop.store(true, Ordering::SeqCst)).context("installing the Ctrl-C handler")?;
     }
+    let apis = if args.gl_spirv { 3 } else { 2 };
     eprintln!(
-        "twinray compare: {} preset, {} points x 2 APIs, up to {} frames each (about {} s per app per point at most) -> {}",
+        "twinray compare: {} preset, {} points x {apis} APIs, up to {} frames each (about {} s per app per point at most) -> {}",
         plan.preset,
         plan.points.len(),
         plan.frames,
         plan.seconds_per_point,
         args.out.display()
     );
-    let bar = indicatif::ProgressBar::new(plan.points.len() as u64 * 2);
+    let bar = indicatif::ProgressBar::new((plan.points.len() * apis) as u64);
     bar.set_style(
         indicatif::ProgressStyle::with_template("{bar:40} {pos}/{len} [{elapsed_precise} elapsed, ETA {eta}] {msg}")
             .expect("valid template"),
@@ -185,7 +187,13 @@ pub fn run(args: &CompareArgs) -> anyhow::Result<()> {
     // Frame-time prediction per experiment: (work, wall ms) of the last finished point.
     let mut last: std::collections::HashMap<&str, (f64, f64)> = Default::default();
     'points: for (i, point) in plan.points.iter().enumerate() {
-        let order = if i % 2 == 0 { [Api::Vulkan, Api::Opengl] } else { [Api::Opengl, Api::Vulkan] };
+        let mut order = vec![Api::Vulkan, Api::Opengl];
+        if args.gl_spirv {
+            order.push(Api::OpenglSpirv);
+        }
+        if i % 2 == 1 {
+            order.reverse();
+        }
         let frames = match last.get(point.experiment) {
             Some(&(work, ms)) if ms > 0.0 => {
                 let predicted = ms * point.work / work;
@@ -200,15 +208,11 @@ pub fn run(args: &CompareArgs) -> anyhow::Result<()> {
             }
             bar.set_message(format!("{} {} {}", point.experiment, point.param_value, api_name(api)));
             let ra = RenderArgs {
-                scene: point.scene.to_string(),
-                size: point.size,
-                headless: true,
                 frames: Some(frames),
                 out: None,
                 json: true,
                 set: point.set.clone(),
-                validate: false,
-                generic: false,
+                ..RenderArgs::headless(point.scene, point.size)
             };
             let result = run_json(api, &ra).map_err(|e| format!("{e:#}"));
             if stop.load(Ordering::SeqCst) {
@@ -233,7 +237,7 @@ pub fn run(args: &CompareArgs) -> anyhow::Result<()> {
     eprintln!(
         "twinray compare: {} of {} runs done{}; report: {}",
         outcomes.iter().filter(|o| o.result.is_ok()).count(),
-        plan.points.len() * 2,
+        plan.points.len() * apis,
         if interrupted { " (interrupted: the finished points are kept)" } else { "" },
         args.out.join("report.md").display()
     );
@@ -272,15 +276,11 @@ pub fn agreement(out: &std::path::Path, plan: &Plan, stop: &AtomicBool) -> Vec<A
             for api in [Api::Vulkan, Api::Opengl] {
                 let png = dir.join(format!("{scene}-{}.png", api_name(api)));
                 let ra = RenderArgs {
-                    scene: scene.into(),
-                    size,
-                    headless: true,
                     frames: Some(1),
                     out: Some(png.clone()),
                     json: true,
                     set: set.clone(),
-                    validate: false,
-                    generic: false,
+                    ..RenderArgs::headless(scene, size)
                 };
                 let r = run_json(api, &ra)?;
                 nan.push(r.nonfinite_pixels);

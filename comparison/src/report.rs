@@ -114,13 +114,15 @@ struct ExpRatios {
     wall: Vec<f64>,
     gpu: Vec<f64>,
     study: Vec<f64>,
+    /// Vulkan GPU time / OpenGL-on-the-same-SPIR-V GPU time.
+    spirv: Vec<f64>,
 }
 
 fn ratios(exp: &str, outcomes: &[Outcome], study: &[StudyRow]) -> ExpRatios {
     let rows: Vec<&Outcome> = outcomes.iter().filter(|o| o.point.experiment == exp).collect();
     let mut values: Vec<String> = rows.iter().map(|o| o.point.param_value.clone()).collect();
     values.dedup();
-    let mut r = ExpRatios { wall: vec![], gpu: vec![], study: vec![] };
+    let mut r = ExpRatios { wall: vec![], gpu: vec![], study: vec![], spirv: vec![] };
     for v in &values {
         let vk = report_of(&rows, v, Api::Vulkan);
         let gl = report_of(&rows, v, Api::Opengl);
@@ -129,6 +131,10 @@ fn ratios(exp: &str, outcomes: &[Outcome], study: &[StudyRow]) -> ExpRatios {
         }
         if let Some(x) = ratio(vk.and_then(|r| r.gpu_ms).map(|s| s.median), gl.and_then(|r| r.gpu_ms).map(|s| s.median)) {
             r.gpu.push(x);
+        }
+        let glspv = report_of(&rows, v, Api::OpenglSpirv);
+        if let Some(x) = ratio(vk.and_then(|r| r.gpu_ms).map(|s| s.median), glspv.and_then(|r| r.gpu_ms).map(|s| s.median)) {
+            r.spirv.push(x);
         }
         if let Some(s) = study::find(study, exp, v) {
             r.study.push(s.vulkan_median_s / s.opengl_median_s);
@@ -173,9 +179,22 @@ pub fn markdown(plan: &Plan, outcomes: &[Outcome], agreement: &[Agreement], stud
             (Some(_), Some(_)) => "OpenGL's per-frame overhead outside the draw exceeds Vulkan's",
             _ => "GPU timers unavailable on this driver: wall time only",
         };
+        let spirv = match (range(&r.gpu), range(&r.spirv)) {
+            (Some((_, g, _)), Some((_, sp, _))) => {
+                let verdict = if (sp - 1.0).abs() < 0.03 && (g - 1.0).abs() >= 0.03 {
+                    "so the gap comes with naga's SPIR-V through the driver's SPIR-V compiler, not with the Vulkan API"
+                } else if (sp - g).abs() < 0.03 {
+                    "so the gap is not the shader binary: it stays with the API"
+                } else {
+                    "so part of the gap is the shader path and part the API"
+                };
+                format!(" With OpenGL running the very same SPIR-V, {}, {verdict}.", describe("Vulkan/OpenGL-SPIR-V GPU", &r.spirv))
+            }
+            _ => String::new(),
+        };
         let _ = writeln!(
             s,
-            "- **{exp}**: Vulkan/OpenGL {}; {}; study {}. {why}.",
+            "- **{exp}**: Vulkan/OpenGL {}; {}; study {}. {why}.{spirv}",
             describe("wall", &r.wall),
             describe("GPU", &r.gpu),
             describe("", &r.study).trim_start()
@@ -222,12 +241,14 @@ pub fn markdown(plan: &Plan, outcomes: &[Outcome], agreement: &[Agreement], stud
         if plots.contains(&format!("{exp}.svg")) {
             let _ = writeln!(s, "![{exp}]({exp}.svg)\n");
         }
+        let has_spirv = rows.iter().any(|o| o.api == Api::OpenglSpirv);
         let _ = writeln!(
             s,
-            "| {} | study VK mean / median (s) | study GL mean / median (s) | study VK/GL | VK wall (ms) | GL wall (ms) | VK/GL wall | VK GPU (ms) | GL GPU (ms) | VK/GL GPU | frames VK/GL |",
-            first.param_name
+            "| {} | study VK mean / median (s) | study GL mean / median (s) | study VK/GL | VK wall (ms) | GL wall (ms) | VK/GL wall | VK GPU (ms) | GL GPU (ms) | VK/GL GPU | frames VK/GL |{}",
+            first.param_name,
+            if has_spirv { " GL SPIR-V GPU (ms) | VK/GL-SPIR-V GPU |" } else { "" }
         );
-        let _ = writeln!(s, "|---|---|---|---|---|---|---|---|---|---|---|");
+        let _ = writeln!(s, "|---|---|---|---|---|---|---|---|---|---|---|{}", if has_spirv { "---|---|" } else { "" });
         let mut values: Vec<String> = rows.iter().map(|o| o.point.param_value.clone()).collect();
         values.dedup();
         for v in &values {
@@ -236,9 +257,15 @@ pub fn markdown(plan: &Plan, outcomes: &[Outcome], agreement: &[Agreement], stud
             let gl = report_of(&rows, v, Api::Opengl);
             let med = |r: Option<&RunReport>, gpu: bool| r.and_then(|r| if gpu { r.gpu_ms } else { r.wall_ms }).map(|x| x.median);
             let frames = |r: Option<&RunReport>| r.map(|r| r.frames.len().to_string()).unwrap_or_else(|| "failed".into());
+            let glspv = report_of(&rows, v, Api::OpenglSpirv);
+            let extra = if has_spirv {
+                format!(" {} | {} |", f(med(glspv, true), 3), f(ratio(med(vk, true), med(glspv, true)), 2))
+            } else {
+                String::new()
+            };
             let _ = writeln!(
                 s,
-                "| {v} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {}/{} |",
+                "| {v} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {}/{} |{extra}",
                 st.map(|x| format!("{:.5} / {:.5}", x.vulkan_mean_s, x.vulkan_median_s)).unwrap_or_else(|| "–".into()),
                 st.map(|x| format!("{:.5} / {:.5}", x.opengl_mean_s, x.opengl_median_s)).unwrap_or_else(|| "–".into()),
                 f(st.map(|x| x.vulkan_median_s / x.opengl_median_s), 2),
@@ -317,7 +344,7 @@ fn x_of(exp: &str, value: &str) -> f64 {
 
 fn plot(path: &Path, exp: &str, rows: &[&Outcome], study: &[StudyRow]) -> anyhow::Result<()> {
     let mut series: Vec<(String, RGBColor, Vec<(f64, f64)>)> = Vec::new();
-    let colours = [(Api::Vulkan, RGBColor(200, 30, 30)), (Api::Opengl, RGBColor(30, 80, 200))];
+    let colours = [(Api::Vulkan, RGBColor(200, 30, 30)), (Api::Opengl, RGBColor(30, 80, 200)), (Api::OpenglSpirv, RGBColor(120, 60, 160))];
     for (api, colour) in colours {
         for gpu in [false, true] {
             let pts: Vec<(f64, f64)> = rows

@@ -48,7 +48,13 @@ pub fn run(args: RenderArgs, started: Instant) -> anyhow::Result<()> {
 
     // Declaration order is creation order; Rust drops locals in reverse, so GL
     // objects are deleted in reverse order on success and on every error path.
-    let program = Program::new(gl, &shaders.vertex_glsl, &shaders.fragment_glsl)?;
+    let program = if args.gl_spirv {
+        let vs = shader::spirv_for_opengl(&shaders.vertex_spirv);
+        let fs = shader::spirv_for_opengl(&shaders.fragment_spirv);
+        Program::from_spirv(gl, &|name| ctx.proc_address(name), &vs, &fs)?
+    } else {
+        Program::new(gl, &shaders.vertex_glsl, &shaders.fragment_glsl)?
+    };
     let _buffers = SceneBuffers::new(gl, &gpu_scene)?;
     let target = Target::new(gl, width, height)?;
     let vao = EmptyVertexArray::new(gl)?;
@@ -72,7 +78,7 @@ pub fn run(args: RenderArgs, started: Instant) -> anyhow::Result<()> {
             api_version: format!("OpenGL {version}"),
             os: os_description(),
             scene: scene.stats(),
-            variant: variant.label(),
+            variant: if args.gl_spirv { format!("{} (SPIR-V)", variant.label()) } else { variant.label() },
             width,
             height,
             frames,

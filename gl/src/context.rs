@@ -22,6 +22,11 @@ pub struct Gl {
 }
 
 impl Gl {
+    /// An entry point glow does not wrap (glShaderBinary, glSpecializeShader).
+    pub fn proc_address(&self, name: &std::ffi::CStr) -> *const std::ffi::c_void {
+        self._display.get_proc_address(name)
+    }
+
     /// Creates the context on the preferred device; `debug` asks for a debug
     /// context so that KHR_debug reports everything the driver checks.
     pub fn headless(debug: bool) -> anyhow::Result<Gl> {

@@ -1,5 +1,7 @@
-//! The tracer program: compiles and links naga's GLSL 450 core output. Blocks
-//! are bound by the explicit `binding` numbers naga writes, never by name.
+//! The tracer program: compiles and links naga's GLSL 450 core output, or, with
+//! `--gl-spirv`, loads naga's SPIR-V through GL_ARB_gl_spirv (the same binary
+//! Vulkan runs). Blocks are bound by the explicit `binding` numbers naga writes,
+//! never by name.
 
 use anyhow::{anyhow, Context as _};
 use glow::HasContext;
@@ -34,6 +36,64 @@ impl<'gl> Program<'gl> {
             }
             if !linked {
                 return Err(anyhow!("linking the tracer program failed:\n{}", gl.get_program_info_log(raw)));
+            }
+            Ok(program)
+        }
+    }
+
+    /// Loads SPIR-V modules (already adapted by `shader::spirv_for_opengl`).
+    /// glow wraps neither glShaderBinary nor glSpecializeShader, so they are
+    /// looked up directly.
+    pub fn from_spirv(
+        gl: &'gl glow::Context,
+        proc_address: &dyn Fn(&std::ffi::CStr) -> *const std::ffi::c_void,
+        vertex: &[u32],
+        fragment: &[u32],
+    ) -> anyhow::Result<Program<'gl>> {
+        type ShaderBinary = unsafe extern "system" fn(i32, *const u32, u32, *const std::ffi::c_void, i32);
+        type SpecializeShader = unsafe extern "system" fn(u32, *const std::ffi::c_char, u32, *const u32, *const u32);
+        if !gl.supported_extensions().contains("GL_ARB_gl_spirv") {
+            return Err(twinray_common::error::no_device(
+                "--gl-spirv: this OpenGL driver does not support GL_ARB_gl_spirv (Mesa 22.3's llvmpipe does not; NVIDIA does)",
+            ));
+        }
+        let binary = proc_address(c"glShaderBinary");
+        let specialize = proc_address(c"glSpecializeShader");
+        if binary.is_null() || specialize.is_null() {
+            return Err(anyhow!("the driver lists GL_ARB_gl_spirv but has no glShaderBinary/glSpecializeShader"));
+        }
+        // SAFETY: both pointers are the driver's entry points with these C signatures (GL 4.6 core).
+        let (binary, specialize): (ShaderBinary, SpecializeShader) =
+            unsafe { (std::mem::transmute(binary), std::mem::transmute(specialize)) };
+        // SAFETY: objects are created and used on the current context; the word
+        // slices outlive the calls; the entry point name is NUL-terminated.
+        unsafe {
+            let raw = gl.create_program().map_err(|e| anyhow!(e)).context("glCreateProgram")?;
+            let program = Program { gl, raw };
+            let mut shaders = Vec::new();
+            for (stage, words, name) in [(glow::VERTEX_SHADER, vertex, "vertex"), (glow::FRAGMENT_SHADER, fragment, "fragment")] {
+                let s = gl.create_shader(stage).map_err(|e| anyhow!(e)).with_context(|| format!("glCreateShader({name})"))?;
+                shaders.push(s);
+                let id = s.0.get();
+                binary(1, &id, glow::SHADER_BINARY_FORMAT_SPIR_V, words.as_ptr().cast(), (words.len() * 4) as i32);
+                specialize(id, c"main".as_ptr(), 0, std::ptr::null(), std::ptr::null());
+                if !gl.get_shader_compile_status(s) {
+                    let log = gl.get_shader_info_log(s);
+                    for s in &shaders {
+                        gl.delete_shader(*s);
+                    }
+                    return Err(anyhow!("the driver rejected naga's {name} SPIR-V:\n{log}"));
+                }
+                gl.attach_shader(raw, s);
+            }
+            gl.link_program(raw);
+            let linked = gl.get_program_link_status(raw);
+            for s in shaders {
+                gl.detach_shader(raw, s);
+                gl.delete_shader(s);
+            }
+            if !linked {
+                return Err(anyhow!("linking the SPIR-V tracer program failed:\n{}", gl.get_program_info_log(raw)));
             }
             Ok(program)
         }

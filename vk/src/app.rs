@@ -31,6 +31,9 @@ pub fn run(args: RenderArgs, process_start: Instant) -> Result<()> {
     if !args.headless {
         return Err(bad_input("windowed mode is not available yet; run with --headless"));
     }
+    if args.gl_spirv {
+        return Err(bad_input("--gl-spirv is an OpenGL option: Vulkan always runs naga's SPIR-V"));
+    }
     let scene = args.load_scene()?;
     let variant = if args.generic { Variant::generic() } else { Variant::for_scene(&scene) };
     let (mut report, image) = render(&args, &scene, &variant, process_start)?;
