@@ -100,11 +100,13 @@ const float T_MAX = 1.0e30;
 // Stable ray-sphere test (Haines et al., Ray Tracing Gems ch. 7): the discriminant
 // is formed from the distance of the centre to the ray, and the two roots as c/q
 // and q, which avoids cancellation for small or far spheres. `dir` is unit length.
-float hit_sphere(vec3 origin, vec3 dir, Sphere s, float t_min, float t_max) {
-    vec3 f = origin - s.center;
+// It takes the fields it needs, not a `Sphere`: naga turns a struct argument into
+// a load of the whole struct from the storage buffer (see the Performance notes).
+float hit_sphere(vec3 origin, vec3 dir, vec3 center, float radius, float t_min, float t_max) {
+    vec3 f = origin - center;
     float b = dot(f, dir);
     vec3 l = f - b * dir;
-    float r2 = s.radius * s.radius;
+    float r2 = radius * radius;
     float disc = r2 - dot(l, l);
     if (!(disc >= 0.0)) {
         return -1.0;
@@ -126,9 +128,9 @@ float hit_sphere(vec3 origin, vec3 dir, Sphere s, float t_min, float t_max) {
 
 // Moller-Trumbore. Conditions are written so that NaN (degenerate triangles give
 // det == 0 or a tiny det) fails them: a degenerate triangle is never hit.
-vec3 hit_triangle(vec3 origin, vec3 dir, Triangle tri, float t_min, float t_max) {
-    vec3 e1 = tri.p1 - tri.p0;
-    vec3 e2 = tri.p2 - tri.p0;
+vec3 hit_triangle(vec3 origin, vec3 dir, vec3 p0, vec3 p1, vec3 p2, float t_min, float t_max) {
+    vec3 e1 = p1 - p0;
+    vec3 e2 = p2 - p0;
     vec3 pv = cross(dir, e2);
     float det = dot(e1, pv);
     vec3 miss = vec3(-1.0, 0.0, 0.0);
@@ -136,7 +138,7 @@ vec3 hit_triangle(vec3 origin, vec3 dir, Triangle tri, float t_min, float t_max)
         return miss;
     }
     float inv = 1.0 / det;
-    vec3 tv = origin - tri.p0;
+    vec3 tv = origin - p0;
     float u = dot(tv, pv) * inv;
     if (!(u >= 0.0 && u <= 1.0)) {
         return miss;
@@ -151,6 +153,15 @@ vec3 hit_triangle(vec3 origin, vec3 dir, Triangle tri, float t_min, float t_max)
         return miss;
     }
     return vec3(t, u, v);
+}
+
+float sphere_t(vec3 origin, vec3 dir, uint i, float t_max) {
+    return hit_sphere(origin, dir, sphere_buf.spheres[i].center, sphere_buf.spheres[i].radius, 0.0, t_max);
+}
+
+vec3 triangle_tuv(vec3 origin, vec3 dir, uint i, float t_max) {
+    return hit_triangle(origin, dir, triangle_buf.triangles[i].p0, triangle_buf.triangles[i].p1,
+                        triangle_buf.triangles[i].p2, 0.0, t_max);
 }
 
 struct Hit {
@@ -168,9 +179,9 @@ struct Hit {
 // The order of the tests is unchanged, so the result equals the plain loop's.
 #define PRIMS_PER_ITERATION 4u
 
-void closest_sphere(inout Hit h, vec3 origin, vec3 dir, uint i) {
-    if (i < frame.sphere_count) {
-        float t = hit_sphere(origin, dir, sphere_buf.spheres[i], 0.0, h.t);
+void closest_sphere(inout Hit h, vec3 origin, vec3 dir, uint i, uint n) {
+    if (i < n) {
+        float t = sphere_t(origin, dir, i, h.t);
         if (t > 0.0) {
             h.t = t;
             h.kind = 1u;
@@ -179,9 +190,9 @@ void closest_sphere(inout Hit h, vec3 origin, vec3 dir, uint i) {
     }
 }
 
-void closest_triangle(inout Hit h, vec3 origin, vec3 dir, uint i) {
-    if (i < frame.triangle_count) {
-        vec3 r = hit_triangle(origin, dir, triangle_buf.triangles[i], 0.0, h.t);
+void closest_triangle(inout Hit h, vec3 origin, vec3 dir, uint i, uint n) {
+    if (i < n) {
+        vec3 r = triangle_tuv(origin, dir, i, h.t);
         if (r.x > 0.0) {
             h.t = r.x;
             h.kind = 2u;
@@ -200,46 +211,50 @@ Hit closest_hit(vec3 origin, vec3 dir) {
     h.u = 0.0;
     h.v = 0.0;
 #ifdef HAS_SPHERES
-    for (uint i = 0u; i < frame.sphere_count; i += PRIMS_PER_ITERATION) {
-        closest_sphere(h, origin, dir, i);
-        closest_sphere(h, origin, dir, i + 1u);
-        closest_sphere(h, origin, dir, i + 2u);
-        closest_sphere(h, origin, dir, i + 3u);
+    uint spheres = frame.sphere_count;
+    for (uint i = 0u; i < spheres; i += PRIMS_PER_ITERATION) {
+        closest_sphere(h, origin, dir, i, spheres);
+        closest_sphere(h, origin, dir, i + 1u, spheres);
+        closest_sphere(h, origin, dir, i + 2u, spheres);
+        closest_sphere(h, origin, dir, i + 3u, spheres);
     }
 #endif
 #ifdef HAS_TRIANGLES
-    for (uint i = 0u; i < frame.triangle_count; i += PRIMS_PER_ITERATION) {
-        closest_triangle(h, origin, dir, i);
-        closest_triangle(h, origin, dir, i + 1u);
-        closest_triangle(h, origin, dir, i + 2u);
-        closest_triangle(h, origin, dir, i + 3u);
+    uint triangles = frame.triangle_count;
+    for (uint i = 0u; i < triangles; i += PRIMS_PER_ITERATION) {
+        closest_triangle(h, origin, dir, i, triangles);
+        closest_triangle(h, origin, dir, i + 1u, triangles);
+        closest_triangle(h, origin, dir, i + 2u, triangles);
+        closest_triangle(h, origin, dir, i + 3u, triangles);
     }
 #endif
     return h;
 }
 
-bool sphere_blocks(vec3 origin, vec3 dir, float dist, uint i) {
-    return i < frame.sphere_count && hit_sphere(origin, dir, sphere_buf.spheres[i], 0.0, dist) > 0.0;
+bool sphere_blocks(vec3 origin, vec3 dir, float dist, uint i, uint n) {
+    return i < n && sphere_t(origin, dir, i, dist) > 0.0;
 }
 
-bool triangle_blocks(vec3 origin, vec3 dir, float dist, uint i) {
-    return i < frame.triangle_count && hit_triangle(origin, dir, triangle_buf.triangles[i], 0.0, dist).x > 0.0;
+bool triangle_blocks(vec3 origin, vec3 dir, float dist, uint i, uint n) {
+    return i < n && triangle_tuv(origin, dir, i, dist).x > 0.0;
 }
 
 // Shadow rays need any hit before the light, not the closest one.
 bool occluded(vec3 origin, vec3 dir, float dist) {
 #ifdef HAS_SPHERES
-    for (uint i = 0u; i < frame.sphere_count; i += PRIMS_PER_ITERATION) {
-        if (sphere_blocks(origin, dir, dist, i) || sphere_blocks(origin, dir, dist, i + 1u)
-            || sphere_blocks(origin, dir, dist, i + 2u) || sphere_blocks(origin, dir, dist, i + 3u)) {
+    uint spheres = frame.sphere_count;
+    for (uint i = 0u; i < spheres; i += PRIMS_PER_ITERATION) {
+        if (sphere_blocks(origin, dir, dist, i, spheres) || sphere_blocks(origin, dir, dist, i + 1u, spheres)
+            || sphere_blocks(origin, dir, dist, i + 2u, spheres) || sphere_blocks(origin, dir, dist, i + 3u, spheres)) {
             return true;
         }
     }
 #endif
 #ifdef HAS_TRIANGLES
-    for (uint i = 0u; i < frame.triangle_count; i += PRIMS_PER_ITERATION) {
-        if (triangle_blocks(origin, dir, dist, i) || triangle_blocks(origin, dir, dist, i + 1u)
-            || triangle_blocks(origin, dir, dist, i + 2u) || triangle_blocks(origin, dir, dist, i + 3u)) {
+    uint triangles = frame.triangle_count;
+    for (uint i = 0u; i < triangles; i += PRIMS_PER_ITERATION) {
+        if (triangle_blocks(origin, dir, dist, i, triangles) || triangle_blocks(origin, dir, dist, i + 1u, triangles)
+            || triangle_blocks(origin, dir, dist, i + 2u, triangles) || triangle_blocks(origin, dir, dist, i + 3u, triangles)) {
             return true;
         }
     }
@@ -316,7 +331,8 @@ vec3 trace(vec3 origin, vec3 dir) {
 
         vec3 local = m.ambient;
         vec3 p_out = offset_point(p, ng);
-        for (uint li = 0u; li < frame.light_count; li++) {
+        uint light_count = frame.light_count;
+        for (uint li = 0u; li < light_count; li++) {
             Light light = light_buf.lights[li];
             vec3 to_light = light.position - p_out;
             float dist = length(to_light);

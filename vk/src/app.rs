@@ -70,14 +70,38 @@ fn render(
     let limit = device.properties.limits.max_storage_buffer_range as u64;
     check_storage_limit(&gpu_scene, limit, "maxStorageBufferRange")?;
 
+    // Device-local memory, filled once through a staging buffer, is the careful
+    // choice. TWINRAY_VK_MEMORY=host keeps the scene in host memory instead, so
+    // the comparison can show what a naive placement costs.
+    let host_memory = match std::env::var("TWINRAY_VK_MEMORY").as_deref() {
+        Ok("host") => true,
+        Ok("device") | Err(_) => false,
+        Ok(other) => {
+            return Err(bad_input(format!("TWINRAY_VK_MEMORY='{other}' is not 'device' or 'host'")));
+        }
+    };
+    // TWINRAY_VK_WAIT=idle waits for each frame with vkQueueWaitIdle +
+    // vkDeviceWaitIdle, as the 2018 study did, instead of the frame's fence.
+    let idle_wait = match std::env::var("TWINRAY_VK_WAIT").as_deref() {
+        Ok("idle") => true,
+        Ok("fence") | Err(_) => false,
+        Ok(other) => return Err(bad_input(format!("TWINRAY_VK_WAIT='{other}' is not 'fence' or 'idle'"))),
+    };
+    let place = |bytes: &[u8], usage: vk::BufferUsageFlags, what: &str| {
+        if host_memory {
+            Buffer::host_visible_with(&device, bytes, usage, what)
+        } else {
+            Buffer::device_local_with(&device, bytes, usage, what)
+        }
+    };
     let uniform = vk::BufferUsageFlags::UNIFORM_BUFFER;
-    let frame = Buffer::device_local_with(&device, gpu_scene.frame_bytes(), uniform, "frame uniform buffer")?;
+    let frame = place(gpu_scene.frame_bytes(), uniform, "frame uniform buffer")?;
     let storage = binding::STORAGE
         .iter()
         .map(|&b| {
             let what = format!("{} storage buffer", storage_name(b));
             let usage = vk::BufferUsageFlags::STORAGE_BUFFER;
-            Ok((b, Buffer::device_local_with(&device, gpu_scene.storage_bytes(b), usage, &what)?))
+            Ok((b, place(gpu_scene.storage_bytes(b), usage, &what)?))
         })
         .collect::<Result<Vec<_>>>()?;
     let descriptors = Descriptors::new(&device, &frame, &storage)?;
@@ -95,7 +119,7 @@ fn render(
             setup_ms = (start - process_start).as_secs_f64() * 1e3;
         }
         commands.submit()?;
-        commands.wait()?;
+        commands.wait(idle_wait)?;
         let wall_ms = start.elapsed().as_secs_f64() * 1e3;
         let gpu_ms = timestamps.as_ref().map(Timestamps::read_ms).transpose()?;
         commands.reset_fence()?;
@@ -110,7 +134,12 @@ fn render(
         api_version: device.api_version(),
         os: os_description(),
         scene: scene.stats(),
-        variant: variant.label(),
+        variant: format!(
+            "{}{}{}",
+            variant.label(),
+            if host_memory { " (host-visible buffers)" } else { "" },
+            if idle_wait { " (idle wait)" } else { "" }
+        ),
         width,
         height,
         frames,

@@ -96,8 +96,14 @@ impl Commands {
         unsafe { self.device.queue_submit(self.queue, &[submit], self.fence) }.context("submitting a frame")
     }
 
-    /// Blocks until the GPU has finished the frame.
-    pub fn wait(&self) -> Result<()> {
+    /// Blocks until the GPU has finished the frame. A fence waits for exactly
+    /// this submission; `idle` instead waits as the 2018 study did
+    /// (vkQueueWaitIdle + vkDeviceWaitIdle), kept to measure whether that costs.
+    pub fn wait(&self, idle: bool) -> Result<()> {
+        if idle {
+            unsafe { self.device.queue_wait_idle(self.queue) }.context("waiting for the queue to idle")?;
+            unsafe { self.device.device_wait_idle() }.context("waiting for the device to idle")?;
+        }
         unsafe { self.device.wait_for_fences(&[self.fence], true, u64::MAX) }.context("waiting for a frame")
     }
 

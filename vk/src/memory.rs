@@ -78,6 +78,17 @@ impl Buffer {
         Ok(b)
     }
 
+    /// A buffer in host-visible, coherent memory (system RAM on a discrete GPU),
+    /// written directly by the CPU: what a naive app does. The GPU then reads the
+    /// scene across the bus on every access; `TWINRAY_VK_MEMORY=host` selects it
+    /// to measure that cost.
+    pub fn host_visible_with(device: &Device, bytes: &[u8], usage: vk::BufferUsageFlags, what: &str) -> Result<Buffer> {
+        let wishes = [Flags::HOST_VISIBLE | Flags::HOST_COHERENT, Flags::HOST_VISIBLE];
+        let buffer = Buffer::new(device, bytes.len() as u64, usage, &wishes, what)?;
+        buffer.write(bytes)?;
+        Ok(buffer)
+    }
+
     /// A device-local buffer holding `bytes`, filled through a staging buffer.
     pub fn device_local_with(device: &Device, bytes: &[u8], usage: vk::BufferUsageFlags, what: &str) -> Result<Buffer> {
         let size = bytes.len() as u64;
