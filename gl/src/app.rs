@@ -49,9 +49,8 @@ pub fn run(args: RenderArgs, started: Instant) -> anyhow::Result<()> {
     // Declaration order is creation order; Rust drops locals in reverse, so GL
     // objects are deleted in reverse order on success and on every error path.
     let program = if args.gl_spirv {
-        let vs = shader::spirv_for_opengl(&shaders.vertex_spirv);
         let fs = shader::spirv_for_opengl(&shaders.fragment_spirv);
-        Program::from_spirv(gl, &|name| ctx.proc_address(name), &vs, &fs)?
+        Program::from_spirv(gl, &|name| ctx.proc_address(name), &shaders.vertex_glsl, &fs)?
     } else {
         Program::new(gl, &shaders.vertex_glsl, &shaders.fragment_glsl)?
     };

@@ -9,6 +9,76 @@ use glow::HasContext;
 pub struct Program<'gl> {
     gl: &'gl glow::Context,
     raw: glow::Program,
+    /// Set for the `--gl-spirv` path: `raw` holds the SPIR-V fragment stage.
+    pipeline: Option<SeparablePipeline>,
+}
+
+/// A program pipeline joining a GLSL vertex program and the SPIR-V tracer.
+struct SeparablePipeline {
+    fns: PipelineFns,
+    pipeline: u32,
+    vertex: glow::Program,
+}
+
+/// GL 4.1/4.6 entry points glow does not wrap.
+#[derive(Clone, Copy)]
+struct PipelineFns {
+    shader_binary: unsafe extern "system" fn(i32, *const u32, u32, *const std::ffi::c_void, i32),
+    specialize_shader: unsafe extern "system" fn(u32, *const std::ffi::c_char, u32, *const u32, *const u32),
+    program_parameteri: unsafe extern "system" fn(u32, u32, i32),
+    gen_program_pipelines: unsafe extern "system" fn(i32, *mut u32),
+    delete_program_pipelines: unsafe extern "system" fn(i32, *const u32),
+    bind_program_pipeline: unsafe extern "system" fn(u32),
+    use_program_stages: unsafe extern "system" fn(u32, u32, u32),
+}
+
+impl PipelineFns {
+    fn load(proc_address: &dyn Fn(&std::ffi::CStr) -> *const std::ffi::c_void) -> anyhow::Result<PipelineFns> {
+        let get = |name: &std::ffi::CStr| {
+            let p = proc_address(name);
+            if p.is_null() {
+                Err(anyhow!("the OpenGL driver has no {}", name.to_string_lossy()))
+            } else {
+                Ok(p)
+            }
+        };
+        // SAFETY: each pointer is the driver's entry point of that name, whose C
+        // signature (GL 4.6 core) the field types spell out.
+        unsafe {
+            Ok(PipelineFns {
+                shader_binary: std::mem::transmute::<*const std::ffi::c_void, _>(get(c"glShaderBinary")?),
+                specialize_shader: std::mem::transmute::<*const std::ffi::c_void, _>(get(c"glSpecializeShader")?),
+                program_parameteri: std::mem::transmute::<*const std::ffi::c_void, _>(get(c"glProgramParameteri")?),
+                gen_program_pipelines: std::mem::transmute::<*const std::ffi::c_void, _>(get(c"glGenProgramPipelines")?),
+                delete_program_pipelines: std::mem::transmute::<*const std::ffi::c_void, _>(get(c"glDeleteProgramPipelines")?),
+                bind_program_pipeline: std::mem::transmute::<*const std::ffi::c_void, _>(get(c"glBindProgramPipeline")?),
+                use_program_stages: std::mem::transmute::<*const std::ffi::c_void, _>(get(c"glUseProgramStages")?),
+            })
+        }
+    }
+}
+
+/// # Safety
+/// Needs a current context; `shader` is compiled and is deleted here.
+unsafe fn link_separable(
+    gl: &glow::Context,
+    fns: &PipelineFns,
+    program: glow::Program,
+    shader: glow::Shader,
+    what: &str,
+) -> anyhow::Result<()> {
+    // SAFETY: forwarded from the caller.
+    unsafe {
+        (fns.program_parameteri)(program.0.get(), glow::PROGRAM_SEPARABLE, 1);
+        gl.attach_shader(program, shader);
+        gl.link_program(program);
+        gl.detach_shader(program, shader);
+        gl.delete_shader(shader);
+        if !gl.get_program_link_status(program) {
+            return Err(anyhow!("linking the {what} program failed:\n{}", gl.get_program_info_log(program)));
+        }
+        Ok(())
+    }
 }
 
 impl<'gl> Program<'gl> {
@@ -17,7 +87,7 @@ impl<'gl> Program<'gl> {
         // shaders are detached and deleted once linked (the linked program no longer needs them).
         unsafe {
             let raw = gl.create_program().map_err(|e| anyhow!(e)).context("glCreateProgram")?;
-            let program = Program { gl, raw };
+            let program = Program { gl, raw, pipeline: None };
             let vs = compile(gl, glow::VERTEX_SHADER, vertex, "vertex")?;
             let fs = match compile(gl, glow::FRAGMENT_SHADER, fragment, "fragment") {
                 Ok(fs) => fs,
@@ -41,60 +111,51 @@ impl<'gl> Program<'gl> {
         }
     }
 
-    /// Loads SPIR-V modules (already adapted by `shader::spirv_for_opengl`).
-    /// glow wraps neither glShaderBinary nor glSpecializeShader, so they are
-    /// looked up directly.
+    /// The tracer as SPIR-V (already adapted by `shader::spirv_for_opengl`) in a
+    /// separable program, behind naga's GLSL vertex shader in a second one, joined
+    /// by a program pipeline. Only the fragment shader (the whole tracer) needs to
+    /// be the very binary Vulkan runs; NVIDIA's GL draws nothing with naga's SPIR-V
+    /// vertex shader (its VertexIndex input is declared `uint`, and gl_Position is
+    /// not in a gl_PerVertex block), so the trivial vertex stage stays GLSL.
+    /// glow wraps none of the entry points needed here, so they are looked up.
     pub fn from_spirv(
         gl: &'gl glow::Context,
         proc_address: &dyn Fn(&std::ffi::CStr) -> *const std::ffi::c_void,
-        vertex: &[u32],
+        vertex_glsl: &str,
         fragment: &[u32],
     ) -> anyhow::Result<Program<'gl>> {
-        type ShaderBinary = unsafe extern "system" fn(i32, *const u32, u32, *const std::ffi::c_void, i32);
-        type SpecializeShader = unsafe extern "system" fn(u32, *const std::ffi::c_char, u32, *const u32, *const u32);
         if !gl.supported_extensions().contains("GL_ARB_gl_spirv") {
             return Err(twinray_common::error::no_device(
-                "--gl-spirv: this OpenGL driver does not support GL_ARB_gl_spirv (Mesa 22.3's llvmpipe does not; NVIDIA does)",
+                "--gl-spirv: this OpenGL driver does not support GL_ARB_gl_spirv",
             ));
         }
-        let binary = proc_address(c"glShaderBinary");
-        let specialize = proc_address(c"glSpecializeShader");
-        if binary.is_null() || specialize.is_null() {
-            return Err(anyhow!("the driver lists GL_ARB_gl_spirv but has no glShaderBinary/glSpecializeShader"));
-        }
-        // SAFETY: both pointers are the driver's entry points with these C signatures (GL 4.6 core).
-        let (binary, specialize): (ShaderBinary, SpecializeShader) =
-            unsafe { (std::mem::transmute(binary), std::mem::transmute(specialize)) };
+        let fns = PipelineFns::load(proc_address)?;
+        // Separable programs must redeclare the built-in output block they write.
+        let vertex_glsl = vertex_glsl.replacen('\n', "\nout gl_PerVertex { vec4 gl_Position; };\n", 1);
         // SAFETY: objects are created and used on the current context; the word
-        // slices outlive the calls; the entry point name is NUL-terminated.
+        // slice outlives the calls; the entry point name is NUL-terminated.
         unsafe {
             let raw = gl.create_program().map_err(|e| anyhow!(e)).context("glCreateProgram")?;
-            let program = Program { gl, raw };
-            let mut shaders = Vec::new();
-            for (stage, words, name) in [(glow::VERTEX_SHADER, vertex, "vertex"), (glow::FRAGMENT_SHADER, fragment, "fragment")] {
-                let s = gl.create_shader(stage).map_err(|e| anyhow!(e)).with_context(|| format!("glCreateShader({name})"))?;
-                shaders.push(s);
-                let id = s.0.get();
-                binary(1, &id, glow::SHADER_BINARY_FORMAT_SPIR_V, words.as_ptr().cast(), (words.len() * 4) as i32);
-                specialize(id, c"main".as_ptr(), 0, std::ptr::null(), std::ptr::null());
-                if !gl.get_shader_compile_status(s) {
-                    let log = gl.get_shader_info_log(s);
-                    for s in &shaders {
-                        gl.delete_shader(*s);
-                    }
-                    return Err(anyhow!("the driver rejected naga's {name} SPIR-V:\n{log}"));
-                }
-                gl.attach_shader(raw, s);
+            let mut program = Program { gl, raw, pipeline: None };
+            let vertex = gl.create_program().map_err(|e| anyhow!(e)).context("glCreateProgram")?;
+            let mut pipeline = 0u32;
+            (fns.gen_program_pipelines)(1, &mut pipeline);
+            program.pipeline = Some(SeparablePipeline { fns, pipeline, vertex });
+
+            let fs = gl.create_shader(glow::FRAGMENT_SHADER).map_err(|e| anyhow!(e)).context("glCreateShader")?;
+            let id = fs.0.get();
+            (fns.shader_binary)(1, &id, glow::SHADER_BINARY_FORMAT_SPIR_V, fragment.as_ptr().cast(), (fragment.len() * 4) as i32);
+            (fns.specialize_shader)(id, c"main".as_ptr(), 0, std::ptr::null(), std::ptr::null());
+            if !gl.get_shader_compile_status(fs) {
+                let log = gl.get_shader_info_log(fs);
+                gl.delete_shader(fs);
+                return Err(anyhow!("the driver rejected naga's fragment SPIR-V:\n{log}"));
             }
-            gl.link_program(raw);
-            let linked = gl.get_program_link_status(raw);
-            for s in shaders {
-                gl.detach_shader(raw, s);
-                gl.delete_shader(s);
-            }
-            if !linked {
-                return Err(anyhow!("linking the SPIR-V tracer program failed:\n{}", gl.get_program_info_log(raw)));
-            }
+            link_separable(gl, &fns, raw, fs, "SPIR-V fragment")?;
+            let vs = compile(gl, glow::VERTEX_SHADER, &vertex_glsl, "vertex")?;
+            link_separable(gl, &fns, vertex, vs, "GLSL vertex")?;
+            (fns.use_program_stages)(pipeline, glow::VERTEX_SHADER_BIT, vertex.0.get());
+            (fns.use_program_stages)(pipeline, glow::FRAGMENT_SHADER_BIT, raw.0.get());
             Ok(program)
         }
     }
@@ -103,7 +164,13 @@ impl<'gl> Program<'gl> {
     pub fn bind(&self, vao: &EmptyVertexArray) {
         // SAFETY: both objects are alive and belong to the current context.
         unsafe {
-            self.gl.use_program(Some(self.raw));
+            match &self.pipeline {
+                Some(p) => {
+                    self.gl.use_program(None);
+                    (p.fns.bind_program_pipeline)(p.pipeline);
+                }
+                None => self.gl.use_program(Some(self.raw)),
+            }
             self.gl.bind_vertex_array(Some(vao.raw));
         }
     }
@@ -129,8 +196,15 @@ unsafe fn compile(gl: &glow::Context, stage: u32, source: &str, name: &str) -> a
 
 impl Drop for Program<'_> {
     fn drop(&mut self) {
-        // SAFETY: the program was created on this context, which outlives it.
-        unsafe { self.gl.delete_program(self.raw) }
+        // SAFETY: the objects were created on this context, which outlives them.
+        unsafe {
+            if let Some(p) = &self.pipeline {
+                (p.fns.bind_program_pipeline)(0);
+                (p.fns.delete_program_pipelines)(1, &p.pipeline);
+                self.gl.delete_program(p.vertex);
+            }
+            self.gl.delete_program(self.raw)
+        }
     }
 }
 
