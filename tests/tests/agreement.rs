@@ -66,3 +66,16 @@ fn generic_shader_renders_the_same_as_the_variant() {
         assert!(m.within_1() >= 0.9999, "{app:?}: generic vs variant {:.4}%", 100.0 * m.within_1());
     }
 }
+
+#[test]
+fn opengl_running_naga_spirv_matches_its_glsl() {
+    // --gl-spirv loads the very SPIR-V Vulkan runs (GL_ARB_gl_spirv); the image must not change.
+    let dir = scratch("gl-spirv");
+    for scene in ["box", "spherelist"] {
+        let (_, glsl) = render(App::OpenGl, scene, "96x72", &[], &dir.join("glsl.png"));
+        let (report, spirv) = render(App::OpenGl, scene, "96x72", &["--gl-spirv"], &dir.join("spirv.png"));
+        assert!(report.variant.ends_with("(SPIR-V)"), "{}", report.variant);
+        let m = compare(&glsl, &spirv).unwrap();
+        assert!(m.within_1() >= 0.9999, "{scene}: SPIR-V vs GLSL {:.4}%", 100.0 * m.within_1());
+    }
+}

@@ -123,6 +123,13 @@ fn too_many_primitives_for_the_storage_buffer_limit() {
 }
 
 #[test]
+fn gl_spirv_is_an_opengl_option_and_the_vulkan_knobs_are_checked() {
+    expect_one(&bin("twinray-vk"), &["--headless", "--gl-spirv"], &[], 2, &["--gl-spirv", "OpenGL"]);
+    expect_one(&bin("twinray-vk"), &["--headless"], &[("TWINRAY_VK_MEMORY", "vram")], 2, &["TWINRAY_VK_MEMORY", "'vram'"]);
+    expect_one(&bin("twinray-vk"), &["--headless"], &[("TWINRAY_VK_WAIT", "spin")], 2, &["TWINRAY_VK_WAIT", "'spin'"]);
+}
+
+#[test]
 fn unknown_override_key() {
     expect_both(&["--headless", "--set", "warp=9"], &[], 2, &["warp"]);
 }
