@@ -76,6 +76,31 @@ pub struct GpuLight {
     pub pad1: f32,
 }
 
+/// `BvhNode` (std430 array element, binding 6). Depth-first layout: an interior
+/// node's left child is the next node and `left_or_first` is its right child;
+/// a leaf (`count > 0`) holds `prims[left_or_first .. left_or_first + count]`.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, Pod, Zeroable, PartialEq)]
+pub struct GpuBvhNode {
+    pub min: [f32; 3],
+    pub left_or_first: u32,
+    pub max: [f32; 3],
+    pub count: u32,
+}
+
+impl GpuBvhNode {
+    pub fn leaf((min, max): ([f32; 3], [f32; 3]), first: u32, count: u32) -> GpuBvhNode {
+        GpuBvhNode { min, left_or_first: first, max, count }
+    }
+
+    pub fn interior((min, max): ([f32; 3], [f32; 3]), right: u32) -> GpuBvhNode {
+        GpuBvhNode { min, left_or_first: right, max, count: 0 }
+    }
+}
+
+/// In the BVH's primitive list (binding 7): set for a sphere index, clear for a triangle index.
+pub const PRIM_SPHERE_BIT: u32 = 1 << 31;
+
 /// Binding numbers, shared by the shader build (GLSL binding map) and both apps.
 pub mod binding {
     pub const FRAME: u32 = 0;

@@ -2,6 +2,7 @@
 //! Vulkan and OpenGL differ — scene loading, camera, GPU buffer layouts, the
 //! naga shader build, the f64 CPU reference, image metrics, CLI and statistics.
 
+pub mod bvh;
 pub mod camera;
 pub mod cli;
 pub mod error;

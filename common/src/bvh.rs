@@ -1,0 +1,290 @@
+//! The bounding volume hierarchy: built on the CPU with binned SAH over spheres
+//! and triangles together, flattened depth-first into the node array the shader
+//! walks (`GpuBvhNode`, mirrored in shaders/trace.glsl and layout-tested), plus
+//! the primitive list its leaves point into.
+
+use crate::gpu::{GpuBvhNode, PRIM_SPHERE_BIT};
+use crate::scene::Scene;
+use glam::DVec3;
+
+/// Primitives per leaf at most; SAH may stop splitting earlier.
+pub const MAX_LEAF: usize = 4;
+const BINS: usize = 16;
+/// Relative cost of one node visit vs one primitive test, for SAH.
+const TRAVERSAL_COST: f64 = 1.0;
+const INTERSECT_COST: f64 = 1.0;
+
+#[derive(Clone, Copy, Debug)]
+struct Aabb {
+    min: DVec3,
+    max: DVec3,
+}
+
+impl Aabb {
+    const EMPTY: Aabb = Aabb { min: DVec3::splat(f64::INFINITY), max: DVec3::splat(f64::NEG_INFINITY) };
+
+    fn grow(&mut self, o: &Aabb) {
+        self.min = self.min.min(o.min);
+        self.max = self.max.max(o.max);
+    }
+
+    fn area(&self) -> f64 {
+        let d = (self.max - self.min).max(DVec3::ZERO);
+        2.0 * (d.x * d.y + d.y * d.z + d.z * d.x)
+    }
+}
+
+#[derive(Clone, Copy)]
+struct PrimRef {
+    bounds: Aabb,
+    centroid: DVec3,
+    /// Index into the shader's primitive list encoding (PRIM_SPHERE_BIT | sphere) or triangle.
+    code: u32,
+}
+
+/// The flattened hierarchy, ready to upload.
+#[derive(Debug, Clone, Default)]
+pub struct Bvh {
+    pub nodes: Vec<GpuBvhNode>,
+    /// Leaf contents: a sphere index with `PRIM_SPHERE_BIT` set, or a triangle index.
+    pub prims: Vec<u32>,
+    pub build_ms: f64,
+    pub depth: u32,
+}
+
+impl Bvh {
+    pub fn build(scene: &Scene) -> Bvh {
+        let start = std::time::Instant::now();
+        let mut refs: Vec<PrimRef> = Vec::with_capacity(scene.spheres.len() + scene.triangles.len());
+        for (i, s) in scene.spheres.iter().enumerate() {
+            let r = DVec3::splat(s.radius);
+            let bounds = Aabb { min: s.center - r, max: s.center + r };
+            refs.push(PrimRef { bounds, centroid: s.center, code: PRIM_SPHERE_BIT | i as u32 });
+        }
+        for (i, t) in scene.triangles.iter().enumerate() {
+            let bounds = Aabb { min: t.p[0].min(t.p[1]).min(t.p[2]), max: t.p[0].max(t.p[1]).max(t.p[2]) };
+            refs.push(PrimRef { bounds, centroid: (bounds.min + bounds.max) * 0.5, code: i as u32 });
+        }
+        let mut bvh = Bvh::default();
+        if !refs.is_empty() {
+            let n = refs.len();
+            bvh.nodes.reserve(2 * n / MAX_LEAF + 1);
+            build_node(&mut bvh, &mut refs, 0, n, 1);
+        }
+        bvh.build_ms = start.elapsed().as_secs_f64() * 1e3;
+        bvh
+    }
+
+    /// Bytes on the GPU: nodes plus the leaf primitive list.
+    pub fn bytes(&self) -> usize {
+        std::mem::size_of_val(self.nodes.as_slice()) + std::mem::size_of_val(self.prims.as_slice())
+    }
+}
+
+fn bounds_of(refs: &[PrimRef]) -> (Aabb, Aabb) {
+    let mut b = Aabb::EMPTY;
+    let mut c = Aabb::EMPTY;
+    for r in refs {
+        b.grow(&r.bounds);
+        c.grow(&Aabb { min: r.centroid, max: r.centroid });
+    }
+    (b, c)
+}
+
+/// Builds the subtree over refs[lo..hi] at the next free node index; returns it.
+/// Depth-first order: an interior node's left child is the next node, its right
+/// child's index is stored in the node.
+fn build_node(bvh: &mut Bvh, refs: &mut [PrimRef], lo: usize, hi: usize, depth: u32) -> usize {
+    bvh.depth = bvh.depth.max(depth);
+    let index = bvh.nodes.len();
+    let (bounds, centroids) = bounds_of(&refs[lo..hi]);
+    bvh.nodes.push(GpuBvhNode::default());
+    let count = hi - lo;
+    let split = if count <= 1 { None } else { sah_split(&refs[lo..hi], &bounds, &centroids) };
+    let split = match split {
+        Some(s) => Some(s),
+        // Too many for a leaf but SAH found no useful split (e.g. identical
+        // centroids): split the list in the middle.
+        None if count > MAX_LEAF => Some((count / 2, None)),
+        None => None,
+    };
+    let node = match split {
+        None => {
+            let first = bvh.prims.len() as u32;
+            bvh.prims.extend(refs[lo..hi].iter().map(|r| r.code));
+            GpuBvhNode::leaf(bounds_f32(&bounds), first, count as u32)
+        }
+        Some((mid, plane)) => {
+            if let Some(plane) = plane {
+                // Partition with the same bin arithmetic that counted the sides.
+                let slice = &mut refs[lo..hi];
+                let mut i = 0;
+                for j in 0..slice.len() {
+                    if plane.left(&slice[j]) {
+                        slice.swap(i, j);
+                        i += 1;
+                    }
+                }
+                debug_assert_eq!(i, mid);
+            }
+            let mid = lo + mid;
+            build_node(bvh, refs, lo, mid, depth + 1);
+            let right = build_node(bvh, refs, mid, hi, depth + 1);
+            GpuBvhNode::interior(bounds_f32(&bounds), right as u32)
+        }
+    };
+    bvh.nodes[index] = node;
+    index
+}
+
+fn bounds_f32(b: &Aabb) -> ([f32; 3], [f32; 3]) {
+    // Round outwards so f32 boxes still contain the f64 primitives.
+    let lo = b.min.to_array().map(|v| next_down(v as f32, v));
+    let hi = b.max.to_array().map(|v| next_up(v as f32, v));
+    (lo, hi)
+}
+
+fn next_down(f: f32, exact: f64) -> f32 {
+    if (f as f64) > exact {
+        f.next_down()
+    } else {
+        f
+    }
+}
+
+fn next_up(f: f32, exact: f64) -> f32 {
+    if (f as f64) < exact {
+        f.next_up()
+    } else {
+        f
+    }
+}
+
+/// A split between centroid bins `..=last_left` and the rest along `axis`.
+#[derive(Clone, Copy)]
+struct Plane {
+    axis: usize,
+    cmin: f64,
+    scale: f64,
+    last_left: usize,
+}
+
+impl Plane {
+    fn bin(&self, r: &PrimRef) -> usize {
+        (((r.centroid[self.axis] - self.cmin) * self.scale) as usize).min(BINS - 1)
+    }
+
+    fn left(&self, r: &PrimRef) -> bool {
+        self.bin(r) <= self.last_left
+    }
+}
+
+/// Binned SAH: the best of BINS-1 planes per axis. Returns (left count, plane)
+/// or None when making a leaf is cheaper.
+fn sah_split(refs: &[PrimRef], bounds: &Aabb, centroids: &Aabb) -> Option<(usize, Option<Plane>)> {
+    let leaf_cost = INTERSECT_COST * refs.len() as f64;
+    let mut best: Option<(f64, usize, Plane)> = None; // cost, left count, plane
+    for axis in 0..3 {
+        let (cmin, cmax) = (centroids.min[axis], centroids.max[axis]);
+        if !(cmax > cmin) {
+            continue;
+        }
+        let scale = BINS as f64 / (cmax - cmin);
+        let mut bins = [(Aabb::EMPTY, 0usize); BINS];
+        for r in refs {
+            let b = Plane { axis, cmin, scale, last_left: 0 }.bin(r);
+            bins[b].0.grow(&r.bounds);
+            bins[b].1 += 1;
+        }
+        // Sweep from the right to get the right side's area and count per plane.
+        let mut right_area = [0.0; BINS];
+        let mut right_count = [0usize; BINS];
+        let mut acc = Aabb::EMPTY;
+        let mut n = 0;
+        for i in (1..BINS).rev() {
+            acc.grow(&bins[i].0);
+            n += bins[i].1;
+            right_area[i] = acc.area();
+            right_count[i] = n;
+        }
+        let mut acc = Aabb::EMPTY;
+        let mut n = 0;
+        for i in 0..BINS - 1 {
+            acc.grow(&bins[i].0);
+            n += bins[i].1;
+            let (nl, nr) = (n, right_count[i + 1]);
+            if nl == 0 || nr == 0 {
+                continue;
+            }
+            let cost = TRAVERSAL_COST
+                + INTERSECT_COST * (acc.area() * nl as f64 + right_area[i + 1] * nr as f64) / bounds.area().max(1e-300);
+            if best.is_none_or(|b| cost < b.0) {
+                best = Some((cost, nl, Plane { axis, cmin, scale, last_left: i }));
+            }
+        }
+    }
+    match best {
+        Some((cost, nl, plane)) if cost < leaf_cost || refs.len() > MAX_LEAF => Some((nl, Some(plane))),
+        _ => None,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn check(scene: &Scene) -> Bvh {
+        let bvh = Bvh::build(scene);
+        let total = scene.spheres.len() + scene.triangles.len();
+        let mut seen = bvh.prims.clone();
+        seen.sort_unstable();
+        seen.dedup();
+        assert_eq!(seen.len(), total, "every primitive is in exactly one leaf");
+        assert_eq!(bvh.prims.len(), total);
+        // Every leaf's box holds its primitives; every child's box lies in its parent's.
+        for (i, n) in bvh.nodes.iter().enumerate() {
+            if n.count > 0 {
+                assert!(n.count as usize <= MAX_LEAF, "leaf {i} holds {}", n.count);
+                for &code in &bvh.prims[n.left_or_first as usize..(n.left_or_first + n.count) as usize] {
+                    let (lo, hi) = if code & PRIM_SPHERE_BIT != 0 {
+                        let s = &scene.spheres[(code & !PRIM_SPHERE_BIT) as usize];
+                        (s.center - s.radius, s.center + s.radius)
+                    } else {
+                        let t = &scene.triangles[code as usize];
+                        (t.p[0].min(t.p[1]).min(t.p[2]), t.p[0].max(t.p[1]).max(t.p[2]))
+                    };
+                    for a in 0..3 {
+                        assert!(n.min[a] as f64 <= lo[a] && n.max[a] as f64 >= hi[a], "leaf {i} box misses a primitive");
+                    }
+                }
+            } else {
+                for child in [i + 1, n.left_or_first as usize] {
+                    let c = &bvh.nodes[child];
+                    for a in 0..3 {
+                        assert!(c.min[a] >= n.min[a] && c.max[a] <= n.max[a], "child {child} outside parent {i}");
+                    }
+                }
+            }
+        }
+        bvh
+    }
+
+    #[test]
+    fn builtin_scenes_give_valid_trees() {
+        for name in ["box", "teapot"] {
+            let b = check(&Scene::load(name, &[]).unwrap());
+            assert!(b.depth < 64, "{name}: depth {}", b.depth);
+        }
+        let many = Scene::load("spherelist", &[("extra_spheres".into(), "1000".into())]).unwrap();
+        // 1000 identical spheres: no SAH plane separates them, the median split must.
+        let b = check(&many);
+        assert!(b.depth < 64, "depth {}", b.depth);
+    }
+
+    #[test]
+    fn teapot_tree_is_shallow_and_compact() {
+        let b = Bvh::build(&Scene::load("teapot", &[]).unwrap());
+        assert!(b.depth <= 32, "depth {}", b.depth);
+        assert!(b.nodes.len() < 2 * 19_201, "{} nodes", b.nodes.len());
+    }
+}
