@@ -34,6 +34,14 @@ pub struct RenderArgs {
     /// Render with the all-features shader instead of the scene's own variant.
     #[arg(long)]
     pub generic: bool,
+    /// Windowed: wait for the display's refresh (Vulkan FIFO, OpenGL swap interval 1).
+    /// Without it the frame rate is uncapped (MAILBOX or IMMEDIATE, swap interval 0).
+    #[arg(long)]
+    pub vsync: bool,
+    /// Print every API object on stderr as it is created, in order, with the
+    /// parameters that matter and the time each step took.
+    #[arg(long)]
+    pub explain: bool,
 }
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]

@@ -5,8 +5,10 @@
 pub mod camera;
 pub mod cli;
 pub mod error;
+pub mod explain;
 pub mod gpu;
 pub mod image_io;
+pub mod interactive;
 pub mod metrics;
 pub mod reference;
 pub mod report;

@@ -150,6 +150,8 @@ pub fn run(args: &CompareArgs) -> anyhow::Result<()> {
             set: vec![],
             validate: false,
             generic: false,
+            vsync: false,
+            explain: false,
         };
         let r = run_json(Api::Vulkan, &probe).context("probing the Vulkan device")?;
         if is_software(&r.device) {
@@ -209,6 +211,8 @@ pub fn run(args: &CompareArgs) -> anyhow::Result<()> {
                 set: point.set.clone(),
                 validate: false,
                 generic: false,
+                vsync: false,
+                explain: false,
             };
             let result = run_json(api, &ra).map_err(|e| format!("{e:#}"));
             if stop.load(Ordering::SeqCst) {
@@ -281,6 +285,8 @@ pub fn agreement(out: &std::path::Path, plan: &Plan, stop: &AtomicBool) -> Vec<A
                     set: set.clone(),
                     validate: false,
                     generic: false,
+                    vsync: false,
+                    explain: false,
                 };
                 let r = run_json(api, &ra)?;
                 nan.push(r.nonfinite_pixels);
