@@ -192,7 +192,7 @@ fn choose(candidates: &[Candidate]) -> Result<&Candidate> {
         })?;
         if c.graphics_family.is_none() {
             return Err(bad_input(format!(
-                "TWINRAY_VK_DEVICE='{wanted}' picks '{}', which cannot draw (no graphics queue)",
+                "TWINRAY_VK_DEVICE='{wanted}' picks '{}', which cannot draw here (no graphics queue, or none that presents to the window)",
                 c.name
             )));
         }
