@@ -1,5 +1,7 @@
-//! Camera → the per-pixel ray frame the shader and the reference both use, and
-//! the view frustum (to check, e.g., that the teapot scene's sphere is out of view).
+//! Camera → the per-pixel ray frame the shader and the reference both use, the
+//! view frustum (to check, e.g., that the teapot scene's sphere is out of view),
+//! and the orbit camera of the windowed apps (drag orbits, wheel zooms, R resets):
+//! one implementation, so both APIs move the camera identically.
 
 use crate::scene::Camera;
 use glam::DVec3;
@@ -65,9 +67,135 @@ impl Frustum {
     }
 }
 
+/// A camera orbiting its look-at point: drag changes yaw (around the scene's
+/// `up`) and pitch, the wheel changes the distance. Angles rather than an
+/// accumulated rotation, so that repeated drags never drift or roll the horizon.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Orbit {
+    home: Camera,
+    /// Unit `up`, and two unit axes spanning the plane at right angles to it;
+    /// yaw 0 is the home eye's direction projected onto that plane.
+    up: DVec3,
+    axis_a: DVec3,
+    axis_b: DVec3,
+    pub yaw: f64,
+    pub pitch: f64,
+    pub distance: f64,
+}
+
+impl Orbit {
+    /// Radians of orbit per window height dragged: a full drag turns half a circle.
+    pub const RADIANS_PER_HEIGHT: f64 = std::f64::consts::PI;
+    /// Each wheel line brings the eye this much closer.
+    pub const ZOOM_PER_LINE: f64 = 0.9;
+    /// Pitch stays this far from the poles, where `up` and the view direction
+    /// would coincide and the ray frame would be undefined.
+    pub const MAX_PITCH: f64 = 89.0 * std::f64::consts::PI / 180.0;
+
+    pub fn new(cam: &Camera) -> Orbit {
+        let up = cam.up.normalize();
+        let offset = cam.eye - cam.look_at;
+        let distance = offset.length();
+        let flat = offset - up * offset.dot(up);
+        // An eye straight above the target has no yaw; any axis at right angles will do.
+        let axis_a = if flat.length() > 1e-9 * distance.max(1.0) { flat.normalize() } else { up.any_orthonormal_vector() };
+        let axis_b = up.cross(axis_a);
+        let pitch = (offset.dot(up) / distance).clamp(-1.0, 1.0).asin();
+        Orbit { home: cam.clone(), up, axis_a, axis_b, yaw: 0.0, pitch, distance }
+    }
+
+    /// The camera these angles describe (same target, up and field of view).
+    pub fn camera(&self) -> Camera {
+        let flat = self.axis_a * self.yaw.cos() + self.axis_b * self.yaw.sin();
+        let dir = flat * self.pitch.cos() + self.up * self.pitch.sin();
+        Camera { eye: self.home.look_at + dir * self.distance, ..self.home.clone() }
+    }
+
+    /// A mouse drag of (dx, dy) pixels in a window `height` pixels tall: right
+    /// turns the scene right (the eye moves left), down tilts it towards the viewer.
+    pub fn drag(&mut self, dx: f64, dy: f64, height: u32) {
+        let k = Self::RADIANS_PER_HEIGHT / height.max(1) as f64;
+        self.yaw = (self.yaw - dx * k).rem_euclid(std::f64::consts::TAU);
+        self.pitch = (self.pitch + dy * k).clamp(-Self::MAX_PITCH, Self::MAX_PITCH);
+    }
+
+    /// `lines` wheel lines (positive = away from the user = closer). Never
+    /// through the target, never further than 100 times the home distance.
+    pub fn zoom(&mut self, lines: f64) {
+        let home = (self.home.eye - self.home.look_at).length();
+        let d = self.distance * Self::ZOOM_PER_LINE.powf(lines);
+        self.distance = d.clamp(home * 0.01, home * 100.0);
+    }
+
+    pub fn reset(&mut self) {
+        *self = Orbit::new(&self.home.clone());
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    fn close(a: DVec3, b: DVec3) -> bool {
+        (a - b).length() < 1e-9
+    }
+
+    #[test]
+    fn orbit_round_trips_the_scene_camera() {
+        let tilted = Camera { eye: DVec3::new(1.0, 2.0, 6.0), look_at: DVec3::new(0.5, -1.0, 0.0), up: DVec3::new(0.0, 2.0, 0.1), fov_y: 40.0 };
+        let above = Camera { eye: DVec3::new(0.0, 5.0, 0.0), look_at: DVec3::ZERO, up: DVec3::Y, fov_y: 60.0 };
+        for c in [cam(), tilted, above] {
+            let o = Orbit::new(&c);
+            let back = o.camera();
+            assert!(close(back.eye, c.eye), "{c:?} -> {back:?}");
+            assert_eq!((back.look_at, back.up, back.fov_y), (c.look_at, c.up, c.fov_y));
+        }
+    }
+
+    #[test]
+    fn drag_orbits_around_the_target_at_constant_distance() {
+        let c = cam();
+        let mut o = Orbit::new(&c);
+        o.drag(150.0, 0.0, 300); // half a window: a quarter turn
+        let e = o.camera().eye;
+        assert!((e.length() - 5.0).abs() < 1e-9);
+        assert!(e.x.abs() > 4.99, "a quarter turn puts the eye on the x axis: {e:?}");
+        assert!(e.x < 0.0, "dragging right moves the eye left");
+        o.drag(-150.0, 0.0, 300);
+        assert!(close(o.camera().eye, c.eye), "dragging back returns");
+        o.drag(0.0, 75.0, 300); // 45 degrees up
+        let e = o.camera().eye;
+        assert!((e.y - 5.0 * std::f64::consts::FRAC_1_SQRT_2).abs() < 1e-9, "{e:?}");
+    }
+
+    #[test]
+    fn pitch_stops_short_of_the_poles() {
+        let mut o = Orbit::new(&cam());
+        o.drag(0.0, 10_000.0, 100);
+        assert_eq!(o.pitch, Orbit::MAX_PITCH);
+        let c = o.camera();
+        let forward = (c.look_at - c.eye).normalize();
+        assert!(forward.cross(c.up).length() > 0.01, "the view never looks along up");
+        o.drag(0.0, -20_000.0, 100);
+        assert_eq!(o.pitch, -Orbit::MAX_PITCH);
+    }
+
+    #[test]
+    fn zoom_is_geometric_clamped_and_reset_restores() {
+        let mut o = Orbit::new(&cam());
+        o.zoom(1.0);
+        assert!((o.distance - 4.5).abs() < 1e-12);
+        o.zoom(-2.0);
+        assert!((o.distance - 5.0 / 0.9).abs() < 1e-12);
+        o.zoom(1e6);
+        assert!((o.distance - 0.05).abs() < 1e-12, "never through the target");
+        o.zoom(-1e6);
+        assert!((o.distance - 500.0).abs() < 1e-9);
+        o.drag(33.0, 17.0, 200);
+        o.reset();
+        assert_eq!(o, Orbit::new(&cam()));
+        assert!(close(o.camera().eye, cam().eye));
+    }
 
     fn cam() -> Camera {
         Camera { eye: DVec3::new(0.0, 0.0, 5.0), look_at: DVec3::ZERO, up: DVec3::Y, fov_y: 90.0 }

@@ -38,6 +38,14 @@ pub struct RenderArgs {
     /// so that both APIs run the very same shader binary (isolates the compiler path).
     #[arg(long)]
     pub gl_spirv: bool,
+    /// Windowed: wait for the display's refresh (Vulkan FIFO, OpenGL swap interval 1).
+    /// Without it the frame rate is uncapped (MAILBOX or IMMEDIATE, swap interval 0).
+    #[arg(long)]
+    pub vsync: bool,
+    /// Print every API object on stderr as it is created, in order, with the
+    /// parameters that matter and the time each step took.
+    #[arg(long)]
+    pub explain: bool,
 }
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -87,6 +95,8 @@ impl RenderArgs {
             validate: false,
             generic: false,
             gl_spirv: false,
+            vsync: false,
+            explain: false,
         }
     }
 

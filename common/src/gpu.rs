@@ -3,7 +3,7 @@
 //! both apps upload. A test checks these layouts against naga's view of the GLSL.
 
 use crate::camera::RayFrame;
-use crate::scene::Scene;
+use crate::scene::{Camera, Scene};
 use bytemuck::{Pod, Zeroable};
 
 /// Uniform block `Frame` (std140, binding 0).
@@ -126,10 +126,12 @@ fn v3(v: glam::DVec3) -> [f32; 3] {
     v.as_vec3().to_array()
 }
 
-impl GpuScene {
-    pub fn new(scene: &Scene, width: u32, height: u32) -> GpuScene {
-        let rf = RayFrame::new(&scene.camera, width, height);
-        let frame = GpuFrame {
+impl GpuFrame {
+    /// The uniform block for `scene` seen through `camera` (the windowed apps
+    /// pass the orbit camera; everything else passes `scene.camera`).
+    pub fn new(scene: &Scene, camera: &Camera, width: u32, height: u32) -> GpuFrame {
+        let rf = RayFrame::new(camera, width, height);
+        GpuFrame {
             eye: v3(rf.eye),
             min_weight: scene.min_weight as f32,
             top_left: v3(rf.top_left),
@@ -142,9 +144,14 @@ impl GpuScene {
             triangle_count: scene.triangles.len() as u32,
             light_count: scene.lights.len() as u32,
             pad: [0; 3],
-        };
+        }
+    }
+}
+
+impl GpuScene {
+    pub fn new(scene: &Scene, width: u32, height: u32) -> GpuScene {
         GpuScene {
-            frame,
+            frame: GpuFrame::new(scene, &scene.camera, width, height),
             spheres: scene
                 .spheres
                 .iter()

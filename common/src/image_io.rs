@@ -20,6 +20,14 @@ impl FloatImage {
         FloatImage { width, height, pixels: rgba.chunks_exact(4).map(|p| [p[0], p[1], p[2]]).collect() }
     }
 
+    /// Reverses the row order: for a readback that came bottom row first.
+    pub fn flip_rows(mut self) -> FloatImage {
+        let w = self.width as usize;
+        let rows: Vec<Vec<[f32; 3]>> = self.pixels.chunks_exact(w).rev().map(<[_]>::to_vec).collect();
+        self.pixels = rows.concat();
+        self
+    }
+
     /// Pixels with any NaN or infinite channel.
     pub fn nonfinite_pixels(&self) -> u64 {
         self.pixels.iter().filter(|p| p.iter().any(|c| !c.is_finite())).count() as u64

@@ -48,6 +48,15 @@ impl Variant {
         Variant::from_features(all, MAX_DEPTH_LIMIT)
     }
 
+    /// Whether this variant can draw everything `needed` can: every feature of
+    /// `needed` compiled in, and a ray stack at least as deep. A windowed app keeps
+    /// its pipeline when `+`/`-` change the depth to one the current variant covers.
+    pub fn covers(&self, needed: &Variant) -> bool {
+        let stack = |v: &Variant| v.defines.get("STACK_SIZE").and_then(|s| s.parse::<u32>().ok()).unwrap_or(0);
+        needed.defines.keys().filter(|k| k.starts_with("HAS_")).all(|k| self.defines.contains_key(k))
+            && stack(self) >= stack(needed)
+    }
+
     /// A short label such as `spheres+triangles+mirror+glass/stack6`.
     pub fn label(&self) -> String {
         let mut parts: Vec<String> = ["HAS_SPHERES", "HAS_TRIANGLES", "HAS_MIRROR", "HAS_GLASS"]

@@ -12,7 +12,7 @@ use anyhow::{anyhow, Context as _};
 use glow::HasContext;
 use std::time::Instant;
 use twinray_common::cli::RenderArgs;
-use twinray_common::error::bad_input;
+use twinray_common::explain;
 use twinray_common::gpu::{check_storage_limit, GpuScene};
 use twinray_common::image_io::FloatImage;
 use twinray_common::report::{os_description, FrameTime, RunReport};
@@ -21,12 +21,21 @@ use twinray_common::shader::{self, Variant};
 /// `started` is taken first thing in main, so `setup_ms` includes process,
 /// driver and shader start-up, as in the Vulkan app.
 pub fn run(args: RenderArgs, started: Instant) -> anyhow::Result<()> {
+    if args.explain {
+        explain::enable("twinray-gl", "OpenGL");
+    }
     if !args.headless {
-        return Err(bad_input("windowed mode is not available yet; run with --headless"));
+        if args.gl_spirv {
+            return Err(twinray_common::error::bad_input("--gl-spirv is a headless measurement option; run it with --headless"));
+        }
+        return run_windowed(&args, started);
     }
     let scene = args.load_scene()?;
     let variant = if args.generic { Variant::generic() } else { Variant::for_scene(&scene) };
     let shaders = shader::build(&variant)?;
+    explain::step("Shaders: GLSL -> naga module -> GLSL 450 core (twinray-common)", || {
+        format!("variant {}", variant.label())
+    });
     let (width, height) = (args.size.width, args.size.height);
     let gpu_scene = GpuScene::new(&scene, width, height);
 
@@ -62,7 +71,11 @@ pub fn run(args: RenderArgs, started: Instant) -> anyhow::Result<()> {
     log.check(gl, "after setup");
 
     let (frames, setup_ms) = frame_loop(gl, &timer, args.frame_count(), started);
+    explain::step("Frames: glDrawArrays + glFinish each", || {
+        format!("{} frame(s); first wall {:.3} ms", frames.len(), frames.first().map_or(0.0, |f| f.wall_ms))
+    });
     let image = FloatImage::from_rgba(width, height, &target.read());
+    explain::step("Readback: glReadPixels", || format!("{width}x{height} RGBA32F, bottom row first = image top"));
     log.check(gl, "after the frame loop");
 
     if let Some(out) = &args.out {
@@ -85,6 +98,37 @@ pub fn run(args: RenderArgs, started: Instant) -> anyhow::Result<()> {
             wall_ms: None,
             nonfinite_pixels: image.nonfinite_pixels(),
             setup_ms,
+            validation_messages: errors,
+        };
+        report.summarise();
+        println!("{}", serde_json::to_string(&report).context("serialising the JSON report")?);
+    }
+    if args.validate && errors > 0 {
+        return Err(anyhow!("{errors} GL debug errors (see above)"));
+    }
+    Ok(())
+}
+
+/// The window: `window::run` owns the loop; the report has the headless shape
+/// (wall time = frame to frame; no NaN count, nothing is read back).
+fn run_windowed(args: &RenderArgs, started: Instant) -> anyhow::Result<()> {
+    let (run, info, errors) = crate::window::run(args, started)?;
+    if args.json {
+        let mut report = RunReport {
+            api: "opengl".into(),
+            device: info.renderer,
+            driver: format!("{} {}", info.vendor, info.version),
+            api_version: format!("OpenGL {}", info.version),
+            os: os_description(),
+            scene: run.scene.stats(),
+            variant: run.variant.label(),
+            width: run.width,
+            height: run.height,
+            frames: run.frames,
+            gpu_ms: None,
+            wall_ms: None,
+            nonfinite_pixels: 0,
+            setup_ms: run.setup_ms,
             validation_messages: errors,
         };
         report.summarise();

@@ -3,6 +3,7 @@
 
 use anyhow::{anyhow, Context as _};
 use glow::HasContext;
+use twinray_common::explain;
 use twinray_common::gpu::{binding, GpuScene};
 
 pub struct SceneBuffers<'gl> {
@@ -38,7 +39,21 @@ impl<'gl> SceneBuffers<'gl> {
             self.gl.buffer_data_u8_slice(target, bytes, glow::STATIC_DRAW);
             self.gl.bind_buffer_base(target, index, Some(buf));
         }
+        explain::step(&format!("glCreateBuffer + glBufferData + glBindBufferBase (binding {index})"), || {
+            let kind = if target == glow::UNIFORM_BUFFER { "UNIFORM_BUFFER" } else { "SHADER_STORAGE_BUFFER" };
+            format!("{} bytes, {kind}, STATIC_DRAW: the driver picks the memory and uploads", bytes.len())
+        });
         Ok(())
+    }
+
+    /// Rewrites the `Frame` uniform block (windowed: the camera moves). The
+    /// driver orders this after the draws that still read the old contents.
+    pub fn update_frame(&self, bytes: &[u8]) {
+        // SAFETY: the buffer holds exactly one Frame, which `bytes` is.
+        unsafe {
+            self.gl.bind_buffer(glow::UNIFORM_BUFFER, Some(self.buffers[0]));
+            self.gl.buffer_sub_data_u8_slice(glow::UNIFORM_BUFFER, 0, bytes);
+        }
     }
 }
 

@@ -7,6 +7,7 @@ use glutin::config::{Api, ConfigSurfaceTypes, ConfigTemplateBuilder};
 use glutin::context::{ContextApi, ContextAttributesBuilder, GlProfile, Version};
 use glutin::prelude::*;
 use twinray_common::error::{bad_input, no_device};
+use twinray_common::explain;
 
 const NO_DEVICE: &str = "no EGL device found: install libegl1 and libegl-mesa0 + libgl1-mesa-dri (or a GPU driver)";
 
@@ -37,6 +38,17 @@ impl Gl {
         if devices.is_empty() {
             return Err(no_device(NO_DEVICE));
         }
+        explain::step("EGL devices (eglQueryDevicesEXT)", || {
+            devices
+                .iter()
+                .enumerate()
+                .map(|(i, d)| {
+                    let soft = if d.extensions().contains(SOFTWARE_EXT) { " (software)" } else { "" };
+                    format!("{i}: {}{soft}\n", d.name().unwrap_or("unnamed"))
+                })
+                .collect::<String>()
+                + "hardware devices are tried first; TWINRAY_GL_DEVICE overrides"
+        });
         let mut failures = Vec::new();
         for (index, device) in candidates(&devices)? {
             match create(index, device, debug) {
@@ -96,6 +108,9 @@ fn create(index: usize, device: &Device, debug: bool) -> anyhow::Result<Gl> {
         .with_context(|| format!("creating an OpenGL 4.5 core context on {what}"))?
         .make_current_surfaceless()
         .with_context(|| format!("making the context current without a surface on {what}"))?;
+    explain::step("EGL display + config + context, made current without a surface", || {
+        format!("{what}: OpenGL 4.5 core{}, surfaceless (renders into our own FBO)", if debug { ", debug" } else { "" })
+    });
     // SAFETY: the context is current on this thread, which glow requires.
     let gl = unsafe { glow::Context::from_loader_function_cstr(|s| display.get_proc_address(s)) };
     Ok(Gl { gl, _context: context, _display: display })

@@ -4,6 +4,7 @@
 use glow::HasContext;
 use std::sync::atomic::{AtomicU64, Ordering};
 use std::sync::Arc;
+use twinray_common::explain;
 
 /// Errors seen so far. The callback may be called from any driver thread,
 /// hence the shared atomic. One fault can count twice (callback and
@@ -34,6 +35,9 @@ impl DebugLog {
                 }
             });
         }
+        explain::step("KHR_debug: glDebugMessageCallback", || {
+            "DEBUG_OUTPUT + DEBUG_OUTPUT_SYNCHRONOUS; errors and high-severity messages are counted".into()
+        });
         log
     }
 

@@ -1,6 +1,6 @@
 //! twinray-gl: the OpenGL twin of twinray-vk. Modules in the order a reader
 //! meets the setup: context, debug output, program, buffers, target, timer,
-//! and the run that strings them together.
+//! the headless run that strings them together, and the windowed run.
 
 pub mod app;
 pub mod buffers;
@@ -9,5 +9,6 @@ pub mod debug;
 pub mod program;
 pub mod target;
 pub mod timer;
+pub mod window;
 
 pub use app::run;

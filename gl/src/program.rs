@@ -5,6 +5,7 @@
 
 use anyhow::{anyhow, Context as _};
 use glow::HasContext;
+use twinray_common::explain;
 
 pub struct Program<'gl> {
     gl: &'gl glow::Context,
@@ -107,6 +108,13 @@ impl<'gl> Program<'gl> {
             if !linked {
                 return Err(anyhow!("linking the tracer program failed:\n{}", gl.get_program_info_log(raw)));
             }
+            explain::step("glCreateShader x2 + glCompileShader + glCreateProgram + glLinkProgram", || {
+                format!(
+                    "vertex {} bytes, fragment {} bytes of naga's GLSL; the driver compiles here, no pipeline state",
+                    vertex.len(),
+                    fragment.len()
+                )
+            });
             Ok(program)
         }
     }
@@ -219,6 +227,7 @@ impl<'gl> EmptyVertexArray<'gl> {
     pub fn new(gl: &'gl glow::Context) -> anyhow::Result<EmptyVertexArray<'gl>> {
         // SAFETY: a fresh object on the current context.
         let raw = unsafe { gl.create_vertex_array() }.map_err(|e| anyhow!(e).context("glGenVertexArrays"))?;
+        explain::step("glGenVertexArrays (empty VAO)", || "the core profile draws nothing without one bound".into());
         Ok(EmptyVertexArray { gl, raw })
     }
 }

@@ -5,6 +5,7 @@
 use anyhow::{anyhow, bail, Context as _};
 use glow::HasContext;
 use twinray_common::error::bad_input;
+use twinray_common::explain;
 
 pub struct Target<'gl> {
     gl: &'gl glow::Context,
@@ -55,6 +56,9 @@ impl<'gl> Target<'gl> {
                 bail!("the RGBA32F {width}x{height} framebuffer is incomplete (status {status:#x})");
             }
             gl.viewport(0, 0, width as i32, height as i32);
+            explain::step("glCreateRenderbuffer + glCreateFramebuffer (RGBA32F target)", || {
+                format!("{width}x{height} RGBA32F renderbuffer as COLOR_ATTACHMENT0; FRAMEBUFFER_COMPLETE; glViewport")
+            });
             Ok(target)
         }
     }

@@ -3,6 +3,7 @@
 
 use anyhow::anyhow;
 use glow::HasContext;
+use twinray_common::explain;
 
 pub struct Timer<'gl> {
     gl: &'gl glow::Context,
@@ -21,6 +22,10 @@ impl<'gl> Timer<'gl> {
         // query still runs, so that the loop is the same on every driver;
         // only its result is dropped.
         let reliable = !renderer.contains("llvmpipe");
+        explain::step("glGenQueries (GL_TIME_ELAPSED)", || {
+            let note = if reliable { "" } else { "; llvmpipe: the result is dropped (not GPU time), wall time is reported" };
+            format!("one query object{note}")
+        });
         Ok(Timer { gl, query, reliable })
     }
 
@@ -40,6 +45,20 @@ impl<'gl> Timer<'gl> {
         // SAFETY: the query has ended; GL_QUERY_RESULT is 64-bit nanoseconds.
         let ns = unsafe { self.gl.get_query_parameter_u64(self.query, glow::QUERY_RESULT) };
         self.reliable.then(|| ns as f64 / 1e6)
+    }
+}
+
+impl Timer<'_> {
+    /// Like `result_ms`, but `None` instead of waiting when the GPU has not
+    /// finished the timed draw yet (the windowed loop never stalls on a query).
+    pub fn try_result_ms(&self) -> Option<f64> {
+        // SAFETY: the query has ended at least once.
+        let ready = unsafe { self.gl.get_query_parameter_u32(self.query, glow::QUERY_RESULT_AVAILABLE) } != 0;
+        if ready {
+            self.result_ms()
+        } else {
+            None
+        }
     }
 }
 

@@ -84,3 +84,49 @@ pub fn fail(program: &Path, args: &[&str], env: &[(&str, &str)]) -> (i32, String
     assert!(!stderr.contains("panicked"), "{} {args:?} panicked: {stderr}", program.display());
     (o.status.code().unwrap_or(-1), stderr)
 }
+
+/// A private X server for one windowed test (Debian's `xvfb`; tests/run.sh
+/// installs it). `-displayfd` lets Xvfb pick a free display number itself, so
+/// tests running in parallel never collide. Killed on drop.
+pub struct Xvfb {
+    child: std::process::Child,
+    pub display: String,
+}
+
+impl Xvfb {
+    pub fn start() -> Xvfb {
+        use std::io::BufRead;
+        let mut child = Command::new("Xvfb")
+            .args(["-displayfd", "1", "-screen", "0", "640x480x24", "-nolisten", "tcp"])
+            .stdout(std::process::Stdio::piped())
+            .stderr(std::process::Stdio::null())
+            .spawn()
+            .unwrap_or_else(|e| panic!("starting Xvfb ({e}): install xvfb (tests/run.sh does)"));
+        let mut line = String::new();
+        std::io::BufReader::new(child.stdout.take().expect("piped")).read_line(&mut line).expect("Xvfb display number");
+        let n: u32 = line.trim().parse().unwrap_or_else(|_| panic!("Xvfb printed '{line}' instead of a display number"));
+        Xvfb { child, display: format!(":{n}") }
+    }
+
+    /// Runs `program` on this display (and nowhere else: WAYLAND_DISPLAY is cleared).
+    pub fn run(&self, program: &Path, args: &[&str], env: &[(&str, &str)], dir: &Path) -> Output {
+        let cache = std::env::temp_dir().join("twinray-mesa-cache");
+        let mut cmd = Command::new(program);
+        cmd.args(args)
+            .current_dir(dir)
+            .env("MESA_SHADER_CACHE_DIR", &cache)
+            .env("DISPLAY", &self.display)
+            .env_remove("WAYLAND_DISPLAY");
+        for (k, v) in env {
+            cmd.env(k, v);
+        }
+        cmd.output().unwrap_or_else(|e| panic!("starting {}: {e}", program.display()))
+    }
+}
+
+impl Drop for Xvfb {
+    fn drop(&mut self) {
+        let _ = self.child.kill();
+        let _ = self.child.wait();
+    }
+}

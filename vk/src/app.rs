@@ -8,31 +8,34 @@
 //! of creation: exactly the order Vulkan needs, on success and on every error path.
 
 use crate::commands::Commands;
-use crate::descriptors::Descriptors;
 use crate::device::Device;
 use crate::instance::{Instance, VALIDATION_MESSAGES};
-use crate::memory::Buffer;
-use crate::pipeline::Pipeline;
+use crate::pipeline::RenderPass;
+use crate::scene::SceneResources;
 use crate::target::Target;
 use crate::timestamps::Timestamps;
+use crate::window;
 use anyhow::{bail, Result};
-use ash::vk;
 use std::sync::atomic::Ordering;
 use std::time::Instant;
 use twinray_common::cli::RenderArgs;
 use twinray_common::error::bad_input;
-use twinray_common::gpu::{binding, check_storage_limit, storage_name, GpuScene};
+use twinray_common::explain;
+use twinray_common::gpu::GpuScene;
 use twinray_common::image_io::FloatImage;
 use twinray_common::report::{os_description, FrameTime, RunReport};
 use twinray_common::scene::Scene;
 use twinray_common::shader::{self, Variant};
 
 pub fn run(args: RenderArgs, process_start: Instant) -> Result<()> {
-    if !args.headless {
-        return Err(bad_input("windowed mode is not available yet; run with --headless"));
+    if args.explain {
+        explain::enable("twinray-vk", "Vulkan");
     }
     if args.gl_spirv {
         return Err(bad_input("--gl-spirv is an OpenGL option: Vulkan always runs naga's SPIR-V"));
+    }
+    if !args.headless {
+        return run_windowed(&args, process_start);
     }
     let scene = args.load_scene()?;
     let variant = if args.generic { Variant::generic() } else { Variant::for_scene(&scene) };
@@ -52,6 +55,39 @@ pub fn run(args: RenderArgs, process_start: Instant) -> Result<()> {
     Ok(())
 }
 
+/// The window: `window::run` owns the loop; the report is the same shape as
+/// headless (wall time = frame to frame; no NaN count, nothing is read back).
+fn run_windowed(args: &RenderArgs, process_start: Instant) -> Result<()> {
+    let (run, device) = window::run(args, process_start)?;
+    // Every Vulkan object is gone by now, so teardown mistakes count too.
+    let messages = VALIDATION_MESSAGES.load(Ordering::SeqCst);
+    if args.json {
+        let mut report = RunReport {
+            api: "vulkan".into(),
+            device: device.name,
+            driver: device.driver,
+            api_version: device.api_version,
+            os: os_description(),
+            scene: run.scene.stats(),
+            variant: run.variant.label(),
+            width: run.width,
+            height: run.height,
+            frames: run.frames,
+            gpu_ms: None,
+            wall_ms: None,
+            nonfinite_pixels: 0,
+            setup_ms: run.setup_ms,
+            validation_messages: messages,
+        };
+        report.summarise();
+        println!("{}", serde_json::to_string(&report)?);
+    }
+    if args.validate && messages > 0 {
+        bail!("{messages} validation messages (see above)");
+    }
+    Ok(())
+}
+
 /// Everything Vulkan, from the instance to the readback. Returns the report
 /// (without the validation count) and the last frame.
 fn render(
@@ -62,24 +98,14 @@ fn render(
 ) -> Result<(RunReport, FloatImage)> {
     let (width, height) = (args.size.width, args.size.height);
     let shaders = shader::build(variant)?;
+    explain::step("Shaders: GLSL -> naga module -> SPIR-V (twinray-common)", || {
+        format!("variant {}", variant.label())
+    });
     let gpu_scene = GpuScene::new(scene, width, height);
 
-    let instance = Instance::new(args.validate)?;
-    let device = Device::new(&instance)?;
+    let instance = Instance::new(args.validate, &[])?;
+    let device = Device::new(&instance, None)?;
     device.check_size(width, height)?;
-    let limit = device.properties.limits.max_storage_buffer_range as u64;
-    check_storage_limit(&gpu_scene, limit, "maxStorageBufferRange")?;
-
-    // Device-local memory, filled once through a staging buffer, is the careful
-    // choice. TWINRAY_VK_MEMORY=host keeps the scene in host memory instead, so
-    // the comparison can show what a naive placement costs.
-    let host_memory = match std::env::var("TWINRAY_VK_MEMORY").as_deref() {
-        Ok("host") => true,
-        Ok("device") | Err(_) => false,
-        Ok(other) => {
-            return Err(bad_input(format!("TWINRAY_VK_MEMORY='{other}' is not 'device' or 'host'")));
-        }
-    };
     // TWINRAY_VK_WAIT=idle waits for each frame with vkQueueWaitIdle +
     // vkDeviceWaitIdle, as the 2018 study did, instead of the frame's fence.
     let idle_wait = match std::env::var("TWINRAY_VK_WAIT").as_deref() {
@@ -87,28 +113,14 @@ fn render(
         Ok("fence") | Err(_) => false,
         Ok(other) => return Err(bad_input(format!("TWINRAY_VK_WAIT='{other}' is not 'fence' or 'idle'"))),
     };
-    let place = |bytes: &[u8], usage: vk::BufferUsageFlags, what: &str| {
-        if host_memory {
-            Buffer::host_visible_with(&device, bytes, usage, what)
-        } else {
-            Buffer::device_local_with(&device, bytes, usage, what)
-        }
-    };
-    let uniform = vk::BufferUsageFlags::UNIFORM_BUFFER;
-    let frame = place(gpu_scene.frame_bytes(), uniform, "frame uniform buffer")?;
-    let storage = binding::STORAGE
-        .iter()
-        .map(|&b| {
-            let what = format!("{} storage buffer", storage_name(b));
-            let usage = vk::BufferUsageFlags::STORAGE_BUFFER;
-            Ok((b, place(gpu_scene.storage_bytes(b), usage, &what)?))
-        })
-        .collect::<Result<Vec<_>>>()?;
-    let descriptors = Descriptors::new(&device, &frame, &storage)?;
-    let pipeline = Pipeline::new(&device, descriptors.set_layout, &shaders, width, height)?;
-    let target = Target::new(&device, pipeline.render_pass, width, height)?;
+    let host_memory = crate::scene::host_memory()?;
+    let render_pass = RenderPass::offscreen(&device)?;
+    let rp = render_pass.render_pass;
+    let resources = SceneResources::new(&device, &gpu_scene, &shaders, rp, Some((width, height)))?;
+    let (pipeline, descriptors) = (&resources.pipeline, &resources.descriptors);
+    let target = Target::new(&device, rp, width, height)?;
     let timestamps = Timestamps::new(&device)?;
-    let commands = Commands::record(&device, &pipeline, &descriptors, &target, timestamps.as_ref())?;
+    let commands = Commands::record(&device, rp, pipeline, descriptors, &target, timestamps.as_ref())?;
 
     // The timed loop: one iteration = submit + wait, as the original study measured.
     let mut frames = Vec::new();
@@ -124,9 +136,18 @@ fn render(
         let gpu_ms = timestamps.as_ref().map(Timestamps::read_ms).transpose()?;
         commands.reset_fence()?;
         frames.push(FrameTime { gpu_ms, wall_ms });
+        if i == 0 {
+            explain::step("Frame 1: vkQueueSubmit + vkWaitForFences + vkResetFences", || {
+                let gpu = gpu_ms.map_or("no timestamps on this queue".into(), |g| format!("GPU {g:.3} ms"));
+                format!("wall {wall_ms:.3} ms, {gpu}; later frames resubmit the same command buffer")
+            });
+        }
     }
 
     let image = target.read_back(&device)?;
+    explain::step("Readback: vkCmdCopyImageToBuffer + HOST barrier, then map", || {
+        format!("{width}x{height} RGBA32F, top row first")
+    });
     let mut report = RunReport {
         api: "vulkan".into(),
         device: device.name.clone(),

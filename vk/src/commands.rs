@@ -17,6 +17,7 @@ use crate::target::Target;
 use crate::timestamps::Timestamps;
 use anyhow::{Context, Result};
 use ash::vk;
+use twinray_common::explain;
 
 pub struct Commands {
     device: ash::Device,
@@ -29,6 +30,7 @@ pub struct Commands {
 impl Commands {
     pub fn record(
         device: &Device,
+        render_pass: vk::RenderPass,
         pipeline: &Pipeline,
         descriptors: &Descriptors,
         target: &Target,
@@ -51,6 +53,9 @@ impl Commands {
         this.cmd = unsafe { d.allocate_command_buffers(&info) }.context("allocating the command buffer")?[0];
         // Unsignalled: the first wait is for the first frame.
         this.fence = unsafe { d.create_fence(&vk::FenceCreateInfo::default(), None) }.context("creating the fence")?;
+        explain::step("VkCommandPool + VkCommandBuffer + VkFence", || {
+            format!("pool on queue family {}; 1 PRIMARY buffer; fence created unsignalled", device.queue_family)
+        });
 
         // No ONE_TIME_SUBMIT flag: the buffer is resubmitted every frame.
         let cmd = this.cmd;
@@ -61,7 +66,7 @@ impl Commands {
             t.record(cmd, 0);
         }
         let begin = vk::RenderPassBeginInfo::default()
-            .render_pass(pipeline.render_pass)
+            .render_pass(render_pass)
             .framebuffer(target.framebuffer)
             .render_area(vk::Rect2D {
                 offset: vk::Offset2D::default(),
@@ -86,6 +91,11 @@ impl Commands {
             t.record(cmd, 1);
         }
         unsafe { d.end_command_buffer(cmd) }.context("recording the frame")?;
+        explain::step("Command buffer recorded once (resubmitted every frame)", || {
+            let ts = if timestamps.is_some() { "reset queries, timestamp TOP_OF_PIPE, " } else { "" };
+            format!("{ts}begin render pass {}x{}, bind pipeline, bind descriptor set 0, draw 3 vertices, end pass{}",
+                target.width, target.height, if timestamps.is_some() { ", timestamp BOTTOM_OF_PIPE" } else { "" })
+        });
         Ok(this)
     }
 

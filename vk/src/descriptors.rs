@@ -11,6 +11,7 @@ use crate::device::Device;
 use crate::memory::Buffer;
 use anyhow::{Context, Result};
 use ash::vk;
+use twinray_common::explain;
 use twinray_common::gpu::binding;
 
 pub struct Descriptors {
@@ -48,6 +49,9 @@ impl Descriptors {
         let info = vk::DescriptorSetLayoutCreateInfo::default().bindings(&bindings);
         this.set_layout =
             unsafe { d.create_descriptor_set_layout(&info, None) }.context("creating the descriptor set layout")?;
+        explain::step("VkDescriptorSetLayout", || {
+            all.iter().map(|(b, ty, _)| format!("binding {b}: {ty:?} x1, FRAGMENT stage\n")).collect()
+        });
 
         let sizes = [
             vk::DescriptorPoolSize { ty: vk::DescriptorType::UNIFORM_BUFFER, descriptor_count: 1 },
@@ -55,6 +59,7 @@ impl Descriptors {
         ];
         let info = vk::DescriptorPoolCreateInfo::default().max_sets(1).pool_sizes(&sizes);
         this.pool = unsafe { d.create_descriptor_pool(&info, None) }.context("creating the descriptor pool")?;
+        explain::step("VkDescriptorPool", || format!("max 1 set; 1 UNIFORM_BUFFER, {} STORAGE_BUFFER", storage.len()));
 
         let layouts = [this.set_layout];
         let info = vk::DescriptorSetAllocateInfo::default().descriptor_pool(this.pool).set_layouts(&layouts);
@@ -72,6 +77,9 @@ impl Descriptors {
             })
             .collect();
         unsafe { d.update_descriptor_sets(&writes, &[]) };
+        explain::step("VkDescriptorSet (allocated, then vkUpdateDescriptorSets)", || {
+            format!("{} writes: each binding points at its whole buffer", writes.len())
+        });
         Ok(this)
     }
 }

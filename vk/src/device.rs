@@ -9,11 +9,14 @@
 //! which come in families with different abilities: we need one that can draw.
 
 use crate::instance::Instance;
+use crate::surface::Surface;
 use anyhow::{Context, Result};
-use ash::vk;
+use ash::{khr, vk};
 use twinray_common::error::{bad_input, no_device};
+use twinray_common::explain;
 
 pub struct Device {
+    pub physical: vk::PhysicalDevice,
     pub properties: vk::PhysicalDeviceProperties,
     pub memory_properties: vk::PhysicalDeviceMemoryProperties,
     pub name: String,
@@ -31,12 +34,15 @@ struct Candidate {
     physical: vk::PhysicalDevice,
     properties: vk::PhysicalDeviceProperties,
     name: String,
-    /// The first queue family that can draw, with its timestampValidBits.
-    graphics_family: Option<(u32, u32)>,
+    /// The first queue family that can draw (and present, for a window), with
+    /// its timestampValidBits and flags.
+    graphics_family: Option<(u32, u32, vk::QueueFlags)>,
 }
 
 impl Device {
-    pub fn new(instance: &Instance) -> Result<Device> {
+    /// `surface` is the window's, in windowed mode: the queue must also present
+    /// to it, and the device must offer VK_KHR_swapchain.
+    pub fn new(instance: &Instance, surface: Option<&Surface>) -> Result<Device> {
         let vk_instance = &instance.instance;
         let physicals = unsafe { vk_instance.enumerate_physical_devices() }.context("listing Vulkan devices")?;
         if physicals.is_empty() {
@@ -49,26 +55,53 @@ impl Device {
             .map(|physical| {
                 let properties = unsafe { vk_instance.get_physical_device_properties(physical) };
                 let families = unsafe { vk_instance.get_physical_device_queue_family_properties(physical) };
+                let presents = |i: u32| surface.is_none_or(|s| s.supports(physical, i));
                 let graphics_family = (0u32..)
                     .zip(&families)
-                    .find(|(_, f)| f.queue_flags.contains(vk::QueueFlags::GRAPHICS))
-                    .map(|(i, f)| (i, f.timestamp_valid_bits));
+                    .find(|&(i, f)| f.queue_flags.contains(vk::QueueFlags::GRAPHICS) && presents(i))
+                    .filter(|_| surface.is_none() || has_swapchain(vk_instance, physical))
+                    .map(|(i, f)| (i, f.timestamp_valid_bits, f.queue_flags));
                 let name = properties.device_name_as_c_str().unwrap_or(c"?").to_string_lossy().into_owned();
                 Candidate { physical, properties, name, graphics_family }
             })
             .collect();
         let chosen = choose(&candidates)?;
-        let (queue_family, timestamp_valid_bits) = chosen.graphics_family.expect("choose() checks this");
+        let (queue_family, timestamp_valid_bits, flags) = chosen.graphics_family.expect("choose() checks this");
+        explain::step("VkPhysicalDevice chosen", || {
+            let mut s = String::new();
+            for (i, c) in candidates.iter().enumerate() {
+                let mark = if c.physical == chosen.physical { "->" } else { "  " };
+                let usable = if c.graphics_family.is_some() { "" } else { " (cannot draw/present here)" };
+                s += &format!("{mark} {i}: {} [{:?}]{usable}
+", c.name, c.properties.device_type);
+            }
+            let why = if std::env::var("TWINRAY_VK_DEVICE").is_ok_and(|v| !v.trim().is_empty()) {
+                "TWINRAY_VK_DEVICE picked it"
+            } else {
+                "the most capable kind present (discrete > integrated > virtual > CPU)"
+            };
+            s + &format!("why: {why}
+queue family {queue_family}: {flags:?}, timestampValidBits {timestamp_valid_bits}{}",
+                if surface.is_some() { ", presents to the surface" } else { "" })
+        });
 
         // One queue is enough: every frame is submitted and waited for in turn.
         let priorities = [1.0];
         let queue_infos =
             [vk::DeviceQueueCreateInfo::default().queue_family_index(queue_family).queue_priorities(&priorities)];
-        let info = vk::DeviceCreateInfo::default().queue_create_infos(&queue_infos);
+        // A window needs the swapchain, a device extension; headless needs none.
+        let extensions = if surface.is_some() { vec![khr::swapchain::NAME.as_ptr()] } else { vec![] };
+        let info =
+            vk::DeviceCreateInfo::default().queue_create_infos(&queue_infos).enabled_extension_names(&extensions);
         let device = unsafe { vk_instance.create_device(chosen.physical, &info, None) }
             .with_context(|| format!("opening the Vulkan device '{}'", chosen.name))?;
         let queue = unsafe { device.get_device_queue(queue_family, 0) };
+        explain::step("VkDevice + VkQueue (vkCreateDevice, vkGetDeviceQueue)", || {
+            let ext = if surface.is_some() { "VK_KHR_swapchain" } else { "none" };
+            format!("1 queue from family {queue_family}, priority 1.0; device extensions: {ext}; no optional features")
+        });
         Ok(Device {
+            physical: chosen.physical,
             properties: chosen.properties,
             memory_properties: unsafe { vk_instance.get_physical_device_memory_properties(chosen.physical) },
             name: chosen.name.clone(),
@@ -133,6 +166,13 @@ impl Device {
     }
 }
 
+/// Whether the device can make swapchains at all.
+fn has_swapchain(instance: &ash::Instance, physical: vk::PhysicalDevice) -> bool {
+    // SAFETY: a valid physical device of this instance.
+    let exts = unsafe { instance.enumerate_device_extension_properties(physical) }.unwrap_or_default();
+    exts.iter().any(|e| e.extension_name_as_c_str() == Ok(khr::swapchain::NAME))
+}
+
 /// `TWINRAY_VK_DEVICE` (an index or part of a name) wins; otherwise the kind of
 /// device most likely to be fast: discrete, integrated, virtual, then CPU.
 fn choose(candidates: &[Candidate]) -> Result<&Candidate> {
@@ -152,7 +192,7 @@ fn choose(candidates: &[Candidate]) -> Result<&Candidate> {
         })?;
         if c.graphics_family.is_none() {
             return Err(bad_input(format!(
-                "TWINRAY_VK_DEVICE='{wanted}' picks '{}', which cannot draw (no graphics queue)",
+                "TWINRAY_VK_DEVICE='{wanted}' picks '{}', which cannot draw here (no graphics queue, or none that presents to the window)",
                 c.name
             )));
         }

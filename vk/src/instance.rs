@@ -13,9 +13,10 @@
 
 use anyhow::{Context, Result};
 use ash::{ext::debug_utils, vk};
-use std::ffi::{c_void, CStr};
+use std::ffi::{c_char, c_void, CStr};
 use std::sync::atomic::{AtomicU64, Ordering};
 use twinray_common::error::no_device;
+use twinray_common::explain;
 
 const VALIDATION_LAYER: &CStr = c"VK_LAYER_KHRONOS_validation";
 
@@ -33,13 +34,17 @@ pub struct Instance {
 
 impl Instance {
     /// `validate` is `--validate`: the layer is then required, not optional.
-    pub fn new(validate: bool) -> Result<Instance> {
+    /// `window_extensions` are the surface extensions a window needs (none headless).
+    pub fn new(validate: bool, window_extensions: &[*const c_char]) -> Result<Instance> {
         // SAFETY: loads the system's Vulkan loader; nothing else runs meanwhile.
         let entry = unsafe { ash::Entry::load() }.map_err(|_| {
             no_device(
                 "no Vulkan loader found (libvulkan.so.1): install libvulkan1 and a Vulkan driver, e.g. mesa-vulkan-drivers",
             )
         })?;
+        explain::step("Loader: libvulkan.so.1 opened (ash::Entry::load)", || {
+            "the loader finds the installed drivers (ICDs) and layers at run time".into()
+        });
 
         // The layer checks every call, which costs CPU time on every submit, and a
         // timing run must not pay for it. So it is on only when asked for:
@@ -70,16 +75,17 @@ impl Instance {
             .engine_name(c"twinray")
             .api_version(api_version);
         let layer_names = [VALIDATION_LAYER.as_ptr()];
-        let extension_names = [debug_utils::NAME.as_ptr()];
+        let mut extension_names = window_extensions.to_vec();
+        if validation {
+            extension_names.push(debug_utils::NAME.as_ptr());
+        }
         let mut early_messenger = messenger_info();
-        let mut info = vk::InstanceCreateInfo::default().application_info(&app);
+        let mut info =
+            vk::InstanceCreateInfo::default().application_info(&app).enabled_extension_names(&extension_names);
         if validation {
             // Chained here, the messenger also hears about vkCreateInstance and
             // vkDestroyInstance, when the real messenger does not exist yet or any more.
-            info = info
-                .enabled_layer_names(&layer_names)
-                .enabled_extension_names(&extension_names)
-                .push_next(&mut early_messenger);
+            info = info.enabled_layer_names(&layer_names).push_next(&mut early_messenger);
         }
         let instance = unsafe { entry.create_instance(&info, None) }.map_err(|e| match e {
             vk::Result::ERROR_INCOMPATIBLE_DRIVER => {
@@ -88,6 +94,23 @@ impl Instance {
             e => anyhow::Error::new(e).context("creating the Vulkan instance"),
         })?;
 
+        explain::step("VkInstance (vkCreateInstance)", || {
+            let v = |v: u32| format!("{}.{}.{}", vk::api_version_major(v), vk::api_version_minor(v), vk::api_version_patch(v));
+            let names: Vec<String> = extension_names
+                .iter()
+                // SAFETY: every pointer comes from a 'static C string (ash or ash-window).
+                .map(|&p| unsafe { CStr::from_ptr(p) }.to_string_lossy().into_owned())
+                .collect();
+            format!(
+                "API version {} requested (loader supports {}; 1.2 only to read the driver's name)\n\
+                 layers: {}\nextensions: {}",
+                v(api_version),
+                v(loader_version),
+                if validation { "VK_LAYER_KHRONOS_validation" } else { "none (no --validate: timings don't pay for checks)" },
+                if names.is_empty() { "none".to_string() } else { names.join(", ") },
+            )
+        });
+
         // From here on, `Drop` cleans up whatever was created, even on error.
         let mut this = Instance { entry, instance, api_version, messenger: None };
         if validation {
@@ -95,6 +118,9 @@ impl Instance {
             let messenger = unsafe { functions.create_debug_utils_messenger(&messenger_info(), None) }
                 .context("creating the debug messenger")?;
             this.messenger = Some((functions, messenger));
+            explain::step("VkDebugUtilsMessengerEXT", || {
+                "severity WARNING|ERROR, types GENERAL|VALIDATION|PERFORMANCE: every message is counted and fails --validate".into()
+            });
         }
         Ok(this)
     }

@@ -1,15 +1,21 @@
 //! twinray-vk: the Vulkan half of twinray. It draws one fullscreen triangle whose
-//! fragment shader is the ray tracer, into an offscreen float image, and times it.
+//! fragment shader is the ray tracer, into an offscreen float image (headless)
+//! or a window's swapchain, and times it.
 //!
 //! The modules are listed in the order a reader meets the setup; `app.rs` ties
-//! them together and is the best place to start for the big picture.
+//! them together for the headless run and `window.rs` for the windowed one.
 
-pub mod app;
-pub mod commands;
-pub mod descriptors;
-pub mod device;
 pub mod instance;
+pub mod surface;
+pub mod device;
 pub mod memory;
+pub mod descriptors;
 pub mod pipeline;
+pub mod scene;
+pub mod swapchain;
 pub mod target;
 pub mod timestamps;
+pub mod commands;
+pub mod frames;
+pub mod app;
+pub mod window;

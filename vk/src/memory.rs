@@ -14,6 +14,7 @@ use crate::device::Device;
 use anyhow::{anyhow, Context, Result};
 use ash::vk;
 use ash::vk::MemoryPropertyFlags as Flags;
+use twinray_common::explain;
 
 /// Allocates memory for `needs` from the first allowed type that has every property
 /// of the earliest wish it can meet (an empty wish accepts any allowed type).
@@ -50,6 +51,8 @@ pub struct Buffer {
     pub size: u64,
     /// Host-visible but not coherent: CPU writes need a flush, CPU reads an invalidate.
     needs_flush: bool,
+    /// The properties of the memory type it landed in.
+    pub memory_flags: Flags,
 }
 
 impl Buffer {
@@ -67,12 +70,14 @@ impl Buffer {
             memory: vk::DeviceMemory::null(),
             size,
             needs_flush: false,
+            memory_flags: Flags::empty(),
         };
         let info = vk::BufferCreateInfo::default().size(size).usage(usage).sharing_mode(vk::SharingMode::EXCLUSIVE);
         b.buffer = unsafe { b.device.create_buffer(&info, None) }.with_context(|| format!("creating the {what}"))?;
         let needs = unsafe { b.device.get_buffer_memory_requirements(b.buffer) };
         let (memory, flags) = allocate(device, needs, wishes, what)?;
         b.memory = memory;
+        b.memory_flags = flags;
         b.needs_flush = flags.contains(Flags::HOST_VISIBLE) && !flags.contains(Flags::HOST_COHERENT);
         unsafe { b.device.bind_buffer_memory(b.buffer, b.memory, 0) }.with_context(|| format!("binding the {what}"))?;
         Ok(b)
@@ -128,6 +133,12 @@ impl Buffer {
                 );
             }
         })?;
+        explain::step(&format!("VkBuffer + VkDeviceMemory: {what}"), || {
+            format!(
+                "{size} bytes, usage {usage:?}, memory {:?}\nfilled from a HOST_VISIBLE staging buffer: vkCmdCopyBuffer, then a TRANSFER -> FRAGMENT_SHADER barrier",
+                buffer.memory_flags
+            )
+        });
         Ok(buffer) // `staging` is dropped here: the copy has finished.
     }
 

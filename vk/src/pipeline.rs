@@ -1,28 +1,109 @@
 //! The render pass and the graphics pipeline.
 //!
-//! The *render pass* declares the attachments a draw writes (one RGBA32F colour
-//! image), what happens to them at the start and end (don't load, store) and
-//! which layout the image ends in; it exists so the driver knows all of that
-//! before recording, which lets tiled GPUs keep the image on-chip.
+//! The *render pass* declares the attachments a draw writes (one colour image),
+//! what happens to them at the start and end (don't load, store) and which
+//! layout the image ends in; it exists so the driver knows all of that before
+//! recording, which lets tiled GPUs keep the image on-chip. Headless, the
+//! attachment is our RGBA32F image and ends ready to be copied out; windowed,
+//! it is a swapchain image and ends ready to be presented. (A classic render
+//! pass rather than dynamic rendering: it is core in Vulkan 1.0, which every
+//! driver here has, while dynamic rendering needs 1.3 or an extension.)
 //!
 //! The *pipeline* bakes every piece of GPU state into one object, compiled once
-//! up front instead of at draw time: the two shaders (naga's SPIR-V), the fixed
+//! up front instead of at draw time: the two shaders (naga's SPIR-V), the
 //! viewport, rasterisation, blending, and through the *pipeline layout* the
-//! descriptor set layout its shaders read. Nothing is left dynamic: the image
-//! size never changes during a run.
+//! descriptor set layout its shaders read. Headless nothing is dynamic (the
+//! size never changes); windowed, the viewport and scissor are *dynamic state*,
+//! set while recording, so that a resize does not recompile the tracer.
 
 use crate::device::Device;
 use anyhow::{Context, Result};
 use ash::vk;
+use twinray_common::explain;
 use twinray_common::shader::Shaders;
 
 /// Float output, so the NaN count and the 8-bit rounding happen on the CPU,
 /// identically for both APIs. Every Vulkan device can render to it.
 pub const COLOR_FORMAT: vk::Format = vk::Format::R32G32B32A32_SFLOAT;
 
-pub struct Pipeline {
+pub struct RenderPass {
     device: ash::Device,
     pub render_pass: vk::RenderPass,
+}
+
+impl RenderPass {
+    /// The headless pass: RGBA32F, left in TRANSFER_SRC_OPTIMAL for the readback.
+    pub fn offscreen(device: &Device) -> Result<RenderPass> {
+        RenderPass::new(device, COLOR_FORMAT, vk::ImageLayout::TRANSFER_SRC_OPTIMAL)
+    }
+
+    /// The windowed pass: the swapchain's format, left in PRESENT_SRC_KHR.
+    pub fn for_swapchain(device: &Device, format: vk::Format) -> Result<RenderPass> {
+        RenderPass::new(device, format, vk::ImageLayout::PRESENT_SRC_KHR)
+    }
+
+    fn new(device: &Device, format: vk::Format, final_layout: vk::ImageLayout) -> Result<RenderPass> {
+        let d = &device.device;
+        // The fullscreen triangle writes every pixel, so the old contents are not
+        // loaded.
+        let attachment = vk::AttachmentDescription::default()
+            .format(format)
+            .samples(vk::SampleCountFlags::TYPE_1)
+            .load_op(vk::AttachmentLoadOp::DONT_CARE)
+            .store_op(vk::AttachmentStoreOp::STORE)
+            .initial_layout(vk::ImageLayout::UNDEFINED)
+            .final_layout(final_layout);
+        let color_ref = [vk::AttachmentReference { attachment: 0, layout: vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL }];
+        let subpass = vk::SubpassDescription::default()
+            .pipeline_bind_point(vk::PipelineBindPoint::GRAPHICS)
+            .color_attachments(&color_ref);
+        // Into the pass: its writes wait for earlier colour output to the same
+        // image (headless: the previous frame; windowed: the acquire semaphore,
+        // which the submit waits on at this same stage).
+        let incoming = vk::SubpassDependency::default()
+            .src_subpass(vk::SUBPASS_EXTERNAL)
+            .dst_subpass(0)
+            .src_stage_mask(vk::PipelineStageFlags::COLOR_ATTACHMENT_OUTPUT)
+            .dst_stage_mask(vk::PipelineStageFlags::COLOR_ATTACHMENT_OUTPUT)
+            .dst_access_mask(vk::AccessFlags::COLOR_ATTACHMENT_WRITE);
+        // Out of the headless pass: the readback copy waits for the writes to land.
+        // (Presenting needs none: the submit's semaphore covers it.)
+        let to_copy = vk::SubpassDependency::default()
+            .src_subpass(0)
+            .dst_subpass(vk::SUBPASS_EXTERNAL)
+            .src_stage_mask(vk::PipelineStageFlags::COLOR_ATTACHMENT_OUTPUT)
+            .src_access_mask(vk::AccessFlags::COLOR_ATTACHMENT_WRITE)
+            .dst_stage_mask(vk::PipelineStageFlags::TRANSFER)
+            .dst_access_mask(vk::AccessFlags::TRANSFER_READ);
+        let dependencies: &[vk::SubpassDependency] =
+            if final_layout == vk::ImageLayout::TRANSFER_SRC_OPTIMAL { &[incoming, to_copy] } else { &[incoming] };
+        let attachments = [attachment];
+        let subpasses = [subpass];
+        let info = vk::RenderPassCreateInfo::default()
+            .attachments(&attachments)
+            .subpasses(&subpasses)
+            .dependencies(dependencies);
+        let render_pass = unsafe { d.create_render_pass(&info, None) }.context("creating the render pass")?;
+        explain::step("VkRenderPass", || {
+            format!(
+                "1 colour attachment {format:?}, load DONT_CARE (every pixel is written), store STORE\n\
+                 layout UNDEFINED -> COLOR_ATTACHMENT_OPTIMAL -> {final_layout:?}; {} subpass dependencies",
+                dependencies.len()
+            )
+        });
+        Ok(RenderPass { device: d.clone(), render_pass })
+    }
+}
+
+impl Drop for RenderPass {
+    fn drop(&mut self) {
+        // SAFETY: the pipelines and framebuffers made for it are gone (drop order).
+        unsafe { self.device.destroy_render_pass(self.render_pass, None) };
+    }
+}
+
+pub struct Pipeline {
+    device: ash::Device,
     pub layout: vk::PipelineLayout,
     pub pipeline: vk::Pipeline,
 }
@@ -48,62 +129,28 @@ impl Pipeline {
         device: &Device,
         set_layout: vk::DescriptorSetLayout,
         shaders: &Shaders,
-        width: u32,
-        height: u32,
+        render_pass: vk::RenderPass,
+        fixed_size: Option<(u32, u32)>,
     ) -> Result<Pipeline> {
         let d = &device.device;
-        let mut this = Pipeline {
-            device: d.clone(),
-            render_pass: vk::RenderPass::null(),
-            layout: vk::PipelineLayout::null(),
-            pipeline: vk::Pipeline::null(),
-        };
-
-        // The fullscreen triangle writes every pixel, so the old contents are not
-        // loaded. The pass ends in TRANSFER_SRC_OPTIMAL, ready for the readback copy.
-        let attachment = vk::AttachmentDescription::default()
-            .format(COLOR_FORMAT)
-            .samples(vk::SampleCountFlags::TYPE_1)
-            .load_op(vk::AttachmentLoadOp::DONT_CARE)
-            .store_op(vk::AttachmentStoreOp::STORE)
-            .initial_layout(vk::ImageLayout::UNDEFINED)
-            .final_layout(vk::ImageLayout::TRANSFER_SRC_OPTIMAL);
-        let color_ref = [vk::AttachmentReference { attachment: 0, layout: vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL }];
-        let subpass = vk::SubpassDescription::default()
-            .pipeline_bind_point(vk::PipelineBindPoint::GRAPHICS)
-            .color_attachments(&color_ref);
-        // Two dependencies with the world outside the pass: a frame's writes wait
-        // for the previous frame's (same image), and the readback copy waits for
-        // the last frame's writes to land.
-        let dependencies = [
-            vk::SubpassDependency::default()
-                .src_subpass(vk::SUBPASS_EXTERNAL)
-                .dst_subpass(0)
-                .src_stage_mask(vk::PipelineStageFlags::COLOR_ATTACHMENT_OUTPUT)
-                .dst_stage_mask(vk::PipelineStageFlags::COLOR_ATTACHMENT_OUTPUT)
-                .dst_access_mask(vk::AccessFlags::COLOR_ATTACHMENT_WRITE),
-            vk::SubpassDependency::default()
-                .src_subpass(0)
-                .dst_subpass(vk::SUBPASS_EXTERNAL)
-                .src_stage_mask(vk::PipelineStageFlags::COLOR_ATTACHMENT_OUTPUT)
-                .src_access_mask(vk::AccessFlags::COLOR_ATTACHMENT_WRITE)
-                .dst_stage_mask(vk::PipelineStageFlags::TRANSFER)
-                .dst_access_mask(vk::AccessFlags::TRANSFER_READ),
-        ];
-        let attachments = [attachment];
-        let subpasses = [subpass];
-        let info = vk::RenderPassCreateInfo::default()
-            .attachments(&attachments)
-            .subpasses(&subpasses)
-            .dependencies(&dependencies);
-        this.render_pass = unsafe { d.create_render_pass(&info, None) }.context("creating the render pass")?;
+        let mut this =
+            Pipeline { device: d.clone(), layout: vk::PipelineLayout::null(), pipeline: vk::Pipeline::null() };
 
         let set_layouts = [set_layout];
         let info = vk::PipelineLayoutCreateInfo::default().set_layouts(&set_layouts);
         this.layout = unsafe { d.create_pipeline_layout(&info, None) }.context("creating the pipeline layout")?;
+        explain::step("VkPipelineLayout", || "1 descriptor set layout (set 0), no push constants".into());
 
         let vertex = module(d, &shaders.vertex_spirv, "vertex")?;
         let fragment = module(d, &shaders.fragment_spirv, "fragment")?;
+        explain::step("VkShaderModule x2 (naga SPIR-V)", || {
+            format!(
+                "vertex {} words, fragment {} words; variant {}",
+                shaders.vertex_spirv.len(),
+                shaders.fragment_spirv.len(),
+                shaders.variant.label()
+            )
+        });
         let stages = [
             vk::PipelineShaderStageCreateInfo::default()
                 .stage(vk::ShaderStageFlags::VERTEX)
@@ -120,6 +167,7 @@ impl Pipeline {
             vk::PipelineInputAssemblyStateCreateInfo::default().topology(vk::PrimitiveTopology::TRIANGLE_LIST);
         // A normal viewport (positive height): Vulkan's row 0 is the top, and the
         // shader builds rays with +y down, so rows go to the PNG unflipped.
+        let (width, height) = fixed_size.unwrap_or((1, 1));
         let viewports = [vk::Viewport {
             x: 0.0,
             y: 0.0,
@@ -130,6 +178,10 @@ impl Pipeline {
         }];
         let scissors = [vk::Rect2D { offset: vk::Offset2D::default(), extent: vk::Extent2D { width, height } }];
         let viewport = vk::PipelineViewportStateCreateInfo::default().viewports(&viewports).scissors(&scissors);
+        // Windowed, the size changes with the window: set while recording instead.
+        let dynamic_states = [vk::DynamicState::VIEWPORT, vk::DynamicState::SCISSOR];
+        let dynamic = vk::PipelineDynamicStateCreateInfo::default()
+            .dynamic_states(if fixed_size.is_some() { &[] } else { &dynamic_states });
         // No culling: the one triangle must be drawn whichever way it winds.
         let raster = vk::PipelineRasterizationStateCreateInfo::default()
             .polygon_mode(vk::PolygonMode::FILL)
@@ -148,13 +200,22 @@ impl Pipeline {
             .rasterization_state(&raster)
             .multisample_state(&multisample)
             .color_blend_state(&blend)
+            .dynamic_state(&dynamic)
             .layout(this.layout)
-            .render_pass(this.render_pass)
+            .render_pass(render_pass)
             .subpass(0);
         let pipelines = unsafe { d.create_graphics_pipelines(vk::PipelineCache::null(), &[info], None) }
             .map_err(|(_, e)| e)
             .context("creating the graphics pipeline")?;
         this.pipeline = pipelines[0];
+        explain::step("VkPipeline (vkCreateGraphicsPipelines: the driver compiles the tracer here)", || {
+            let size = match fixed_size {
+                Some((w, h)) => format!("fixed viewport + scissor {w}x{h}"),
+                None => "dynamic viewport + scissor (resizes don't recompile)".into(),
+            };
+            format!("TRIANGLE_LIST, no vertex input (3 vertices from gl_VertexIndex); {size}\n\
+                     FILL, cull NONE, 1 sample, no blending, write RGBA; subpass 0")
+        });
         Ok(this) // the shader modules are dropped here: the pipeline has its own copy.
     }
 }
@@ -165,7 +226,6 @@ impl Drop for Pipeline {
         unsafe {
             self.device.destroy_pipeline(self.pipeline, None);
             self.device.destroy_pipeline_layout(self.layout, None);
-            self.device.destroy_render_pass(self.render_pass, None);
         }
     }
 }

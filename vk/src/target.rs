@@ -15,6 +15,7 @@ use crate::pipeline::COLOR_FORMAT;
 use anyhow::{Context, Result};
 use ash::vk;
 use ash::vk::MemoryPropertyFlags as Flags;
+use twinray_common::explain;
 use twinray_common::image_io::FloatImage;
 
 pub struct Target {
@@ -36,6 +37,9 @@ impl Target {
         // The CPU reads this one, and uncached reads of mapped memory are very slow.
         let wishes = [Flags::HOST_VISIBLE | Flags::HOST_CACHED, Flags::HOST_VISIBLE];
         let readback = Buffer::new(device, bytes, vk::BufferUsageFlags::TRANSFER_DST, &wishes, "readback buffer")?;
+        explain::step("VkBuffer + VkDeviceMemory: readback buffer", || {
+            format!("{bytes} bytes, TRANSFER_DST, memory {:?} (the CPU reads it)", readback.memory_flags)
+        });
         let mut this = Target {
             device: d.clone(),
             image: vk::Image::null(),
@@ -60,6 +64,9 @@ impl Target {
         let needs = unsafe { d.get_image_memory_requirements(this.image) };
         this.memory = memory::allocate(device, needs, &[Flags::DEVICE_LOCAL, Flags::empty()], "colour image")?.0;
         unsafe { d.bind_image_memory(this.image, this.memory, 0) }.context("binding the colour image's memory")?;
+        explain::step("VkImage + VkDeviceMemory: colour target", || {
+            format!("{width}x{height} {COLOR_FORMAT:?}, OPTIMAL tiling, usage COLOR_ATTACHMENT|TRANSFER_SRC, {} bytes DEVICE_LOCAL", needs.size)
+        });
 
         let info = vk::ImageViewCreateInfo::default()
             .image(this.image)
@@ -72,6 +79,7 @@ impl Target {
                     .layer_count(1),
             );
         this.view = unsafe { d.create_image_view(&info, None) }.context("creating the colour image view")?;
+        explain::step("VkImageView", || "2D, COLOR aspect, 1 mip level, 1 layer".into());
 
         let views = [this.view];
         let info = vk::FramebufferCreateInfo::default()
@@ -81,6 +89,7 @@ impl Target {
             .height(height)
             .layers(1);
         this.framebuffer = unsafe { d.create_framebuffer(&info, None) }.context("creating the framebuffer")?;
+        explain::step("VkFramebuffer", || format!("{width}x{height}, 1 layer, attachment 0 = the view"));
         Ok(this)
     }
 

@@ -10,6 +10,7 @@
 use crate::device::Device;
 use anyhow::{Context, Result};
 use ash::vk;
+use twinray_common::explain;
 
 pub struct Timestamps {
     device: ash::Device,
@@ -30,6 +31,12 @@ impl Timestamps {
         let info = vk::QueryPoolCreateInfo::default().query_type(vk::QueryType::TIMESTAMP).query_count(2);
         let pool =
             unsafe { device.device.create_query_pool(&info, None) }.context("creating the timestamp query pool")?;
+        explain::step("VkQueryPool (2 TIMESTAMP queries)", || {
+            format!(
+                "timestampPeriod {} ns per tick, timestampValidBits {bits}; results read as 64-bit",
+                device.properties.limits.timestamp_period
+            )
+        });
         Ok(Some(Timestamps {
             device: device.device.clone(),
             pool,

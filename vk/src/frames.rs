@@ -1,0 +1,250 @@
+//! Frames in flight (windowed mode only): the per-frame loop of acquire,
+//! record, submit and present, and the fences and semaphores that order it.
+//!
+//! The CPU may prepare frame N+1 while the GPU still draws frame N, so each
+//! frame "slot" has its own command buffer, its own timestamp queries and its
+//! own synchronisation, and there are two slots:
+//!
+//! - an **in-flight fence** (GPU → CPU): the CPU waits on it before reusing the
+//!   slot's command buffer; created signalled so the first wait passes;
+//! - an **image-available semaphore** (presentation → GPU): signalled when the
+//!   acquired swapchain image may be written; the submit waits on it at the
+//!   colour-output stage, so the tracer's fragment work can start before;
+//! - the swapchain's per-image **render-finished semaphore** (GPU → presentation).
+//!
+//! Command buffers are **re-recorded every frame**, not pre-recorded once per
+//! swapchain image: the camera moves (its uniform block is written inside the
+//! command buffer with vkCmdUpdateBuffer), the framebuffer depends on which
+//! image was acquired, and resizes and scene switches would invalidate
+//! pre-recorded buffers anyway. Recording a dozen commands costs microseconds
+//! beside a traced frame, and it is what the OpenGL driver does for every frame
+//! too, so the two windowed loops do the same per-frame work.
+
+use crate::device::Device;
+use crate::scene::SceneResources;
+use crate::swapchain::Swapchain;
+use crate::timestamps::Timestamps;
+use anyhow::{Context, Result};
+use ash::{khr, vk};
+use twinray_common::explain;
+use twinray_common::gpu::GpuFrame;
+
+/// Two: the CPU records one frame while the GPU draws the other. More would
+/// only add latency, since the GPU (the tracer) is the bottleneck.
+pub const FRAMES_IN_FLIGHT: usize = 2;
+
+struct Slot {
+    cmd: vk::CommandBuffer,
+    image_available: vk::Semaphore,
+    in_flight: vk::Fence,
+    timestamps: Option<Timestamps>,
+    /// Whether this slot's queries hold a finished frame's times.
+    submitted: bool,
+}
+
+pub enum FrameResult {
+    /// Drawn and queued for presentation; the GPU time is that of the slot's
+    /// previous frame (the newest one known to be finished).
+    Presented { gpu_ms: Option<f64>, suboptimal: bool },
+    /// The swapchain no longer matches the window: rebuild it, draw nothing.
+    OutOfDate,
+}
+
+pub struct Frames {
+    device: ash::Device,
+    pool: vk::CommandPool,
+    slots: Vec<Slot>,
+    next: usize,
+}
+
+impl Frames {
+    pub fn new(device: &Device) -> Result<Frames> {
+        let d = &device.device;
+        // RESET_COMMAND_BUFFER: each buffer is reset and re-recorded every frame.
+        let info = vk::CommandPoolCreateInfo::default()
+            .queue_family_index(device.queue_family)
+            .flags(vk::CommandPoolCreateFlags::RESET_COMMAND_BUFFER);
+        let pool = unsafe { d.create_command_pool(&info, None) }.context("creating the frame command pool")?;
+        let mut this = Frames { device: d.clone(), pool, slots: Vec::new(), next: 0 };
+        let info = vk::CommandBufferAllocateInfo::default()
+            .command_pool(pool)
+            .level(vk::CommandBufferLevel::PRIMARY)
+            .command_buffer_count(FRAMES_IN_FLIGHT as u32);
+        let cmds = unsafe { d.allocate_command_buffers(&info) }.context("allocating the frame command buffers")?;
+        for cmd in cmds {
+            let image_available = unsafe { d.create_semaphore(&vk::SemaphoreCreateInfo::default(), None) }
+                .context("creating an image-available semaphore")?;
+            let signalled = vk::FenceCreateInfo::default().flags(vk::FenceCreateFlags::SIGNALED);
+            let in_flight = match unsafe { d.create_fence(&signalled, None) } {
+                Ok(f) => f,
+                Err(e) => {
+                    unsafe { d.destroy_semaphore(image_available, None) };
+                    return Err(e).context("creating an in-flight fence");
+                }
+            };
+            this.slots.push(Slot { cmd, image_available, in_flight, timestamps: None, submitted: false });
+            let slot = this.slots.last_mut().expect("just pushed");
+            slot.timestamps = Timestamps::new(device)?;
+        }
+        explain::step("Frames in flight: VkCommandPool, then per frame a VkCommandBuffer, VkSemaphore, VkFence", || {
+            format!(
+                "{FRAMES_IN_FLIGHT} frames; pool flag RESET_COMMAND_BUFFER (re-recorded every frame);\n\
+                 fences created SIGNALED so the first wait returns; image-available semaphores unsignalled"
+            )
+        });
+        Ok(this)
+    }
+
+    /// One frame: wait for the slot, acquire an image, record, submit, present.
+    pub fn draw(
+        &mut self,
+        device: &Device,
+        loader: &khr::swapchain::Device,
+        swapchain: &Swapchain,
+        render_pass: vk::RenderPass,
+        scene: &SceneResources,
+        frame: &GpuFrame,
+    ) -> Result<FrameResult> {
+        let d = &device.device;
+        let slot = &mut self.slots[self.next];
+        // SAFETY: the fence belongs to this device.
+        unsafe { d.wait_for_fences(&[slot.in_flight], true, u64::MAX) }.context("waiting for a frame in flight")?;
+        let gpu_ms = match (&slot.timestamps, slot.submitted) {
+            (Some(t), true) => Some(t.read_ms()?),
+            _ => None,
+        };
+
+        // SAFETY: the semaphore is unsignalled: its last signal was waited on by the slot's last submit.
+        let acquired =
+            unsafe { loader.acquire_next_image(swapchain.swapchain, u64::MAX, slot.image_available, vk::Fence::null()) };
+        let (index, suboptimal) = match acquired {
+            Ok(r) => r,
+            Err(vk::Result::ERROR_OUT_OF_DATE_KHR) => return Ok(FrameResult::OutOfDate),
+            Err(e) => return Err(e).context("acquiring a swapchain image"),
+        };
+        // Reset only now: had the acquire failed, a reset fence would never be signalled.
+        unsafe { d.reset_fences(&[slot.in_flight]) }.context("resetting a frame fence")?;
+
+        record(d, slot, swapchain, index, render_pass, scene, frame)?;
+
+        let waits = [slot.image_available];
+        let wait_stages = [vk::PipelineStageFlags::COLOR_ATTACHMENT_OUTPUT];
+        let cmds = [slot.cmd];
+        let signals = [swapchain.render_finished[index as usize]];
+        let submit = vk::SubmitInfo::default()
+            .wait_semaphores(&waits)
+            .wait_dst_stage_mask(&wait_stages)
+            .command_buffers(&cmds)
+            .signal_semaphores(&signals);
+        unsafe { d.queue_submit(device.queue, &[submit], slot.in_flight) }.context("submitting a frame")?;
+        slot.submitted = true;
+        self.next = (self.next + 1) % FRAMES_IN_FLIGHT;
+
+        let swapchains = [swapchain.swapchain];
+        let indices = [index];
+        let present = vk::PresentInfoKHR::default()
+            .wait_semaphores(&signals)
+            .swapchains(&swapchains)
+            .image_indices(&indices);
+        let presented = unsafe { loader.queue_present(device.queue, &present) };
+        let suboptimal = suboptimal
+            || match presented {
+                Ok(s) => s,
+                Err(vk::Result::ERROR_OUT_OF_DATE_KHR) => true,
+                Err(e) => return Err(e).context("presenting a frame"),
+            };
+        Ok(FrameResult::Presented { gpu_ms, suboptimal })
+    }
+}
+
+/// The frame's commands, recorded afresh (see the module comment).
+fn record(
+    d: &ash::Device,
+    slot: &Slot,
+    swapchain: &Swapchain,
+    index: u32,
+    render_pass: vk::RenderPass,
+    scene: &SceneResources,
+    frame: &GpuFrame,
+) -> Result<()> {
+    let cmd = slot.cmd;
+    let extent = swapchain.extent;
+    unsafe { d.reset_command_buffer(cmd, vk::CommandBufferResetFlags::empty()) }.context("resetting a command buffer")?;
+    let begin = vk::CommandBufferBeginInfo::default().flags(vk::CommandBufferUsageFlags::ONE_TIME_SUBMIT);
+    unsafe { d.begin_command_buffer(cmd, &begin) }.context("recording a frame")?;
+    if let Some(t) = &slot.timestamps {
+        t.record_reset(cmd);
+        t.record(cmd, 0);
+    }
+    // One uniform buffer serves both frames in flight, so the write waits for
+    // the previous frame's fragment shaders to finish reading it (write after
+    // read: an execution dependency is enough), and the draw waits for the write.
+    let to_shader = vk::BufferMemoryBarrier::default()
+        .src_access_mask(vk::AccessFlags::TRANSFER_WRITE)
+        .dst_access_mask(vk::AccessFlags::UNIFORM_READ)
+        .src_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
+        .dst_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
+        .buffer(scene.frame.buffer)
+        .size(vk::WHOLE_SIZE);
+    let begin_pass = vk::RenderPassBeginInfo::default()
+        .render_pass(render_pass)
+        .framebuffer(swapchain.framebuffers[index as usize])
+        .render_area(vk::Rect2D { offset: vk::Offset2D::default(), extent });
+    let viewport = vk::Viewport {
+        x: 0.0,
+        y: 0.0,
+        width: extent.width as f32,
+        height: extent.height as f32,
+        min_depth: 0.0,
+        max_depth: 1.0,
+    };
+    let scissor = vk::Rect2D { offset: vk::Offset2D::default(), extent };
+    // SAFETY: every handle is alive; the command buffer is in the recording state.
+    unsafe {
+        let none = vk::DependencyFlags::empty();
+        d.cmd_pipeline_barrier(cmd, vk::PipelineStageFlags::FRAGMENT_SHADER, vk::PipelineStageFlags::TRANSFER, none, &[], &[], &[]);
+        d.cmd_update_buffer(cmd, scene.frame.buffer, 0, bytemuck::bytes_of(frame));
+        d.cmd_pipeline_barrier(
+            cmd,
+            vk::PipelineStageFlags::TRANSFER,
+            vk::PipelineStageFlags::FRAGMENT_SHADER,
+            none,
+            &[],
+            &[to_shader],
+            &[],
+        );
+        d.cmd_begin_render_pass(cmd, &begin_pass, vk::SubpassContents::INLINE);
+        d.cmd_set_viewport(cmd, 0, &[viewport]);
+        d.cmd_set_scissor(cmd, 0, &[scissor]);
+        d.cmd_bind_pipeline(cmd, vk::PipelineBindPoint::GRAPHICS, scene.pipeline.pipeline);
+        d.cmd_bind_descriptor_sets(
+            cmd,
+            vk::PipelineBindPoint::GRAPHICS,
+            scene.pipeline.layout,
+            0,
+            &[scene.descriptors.set],
+            &[],
+        );
+        d.cmd_draw(cmd, 3, 1, 0, 0);
+        d.cmd_end_render_pass(cmd);
+    }
+    if let Some(t) = &slot.timestamps {
+        t.record(cmd, 1);
+    }
+    unsafe { d.end_command_buffer(cmd) }.context("recording a frame")
+}
+
+impl Drop for Frames {
+    fn drop(&mut self) {
+        // SAFETY: nothing may be destroyed while a frame still uses it. The
+        // timestamp pools drop with the slots, after this.
+        unsafe {
+            let _ = self.device.device_wait_idle();
+            for s in &self.slots {
+                self.device.destroy_semaphore(s.image_available, None);
+                self.device.destroy_fence(s.in_flight, None);
+            }
+            self.device.destroy_command_pool(self.pool, None);
+        }
+    }
+}

@@ -1,0 +1,73 @@
+//! The scene on the GPU: the `Frame` uniform buffer, the four storage buffers,
+//! the descriptor set pointing at them and the pipeline compiled for the
+//! scene's shader variant. Everything here depends on the scene (and nothing
+//! else does), so a scene switch or a new variant in the window rebuilds
+//! exactly this bundle and keeps the device, swapchain and render pass.
+
+use crate::descriptors::Descriptors;
+use crate::device::Device;
+use crate::memory::Buffer;
+use crate::pipeline::Pipeline;
+use anyhow::Result;
+use ash::vk;
+use twinray_common::gpu::{binding, check_storage_limit, storage_name, GpuScene};
+use twinray_common::shader::Shaders;
+
+/// Fields in reverse creation order, so that they drop in the order Vulkan needs:
+/// the pipeline and the set before the buffers they use.
+pub struct SceneResources {
+    pub pipeline: Pipeline,
+    pub descriptors: Descriptors,
+    pub storage: Vec<(u32, Buffer)>,
+    /// Binding 0. Headless it never changes; windowed, each frame's command
+    /// buffer rewrites it (camera, size, depth) with vkCmdUpdateBuffer.
+    pub frame: Buffer,
+}
+
+impl SceneResources {
+    /// `fixed_size` is the headless image size (None: dynamic viewport, windowed).
+    pub fn new(
+        device: &Device,
+        scene: &GpuScene,
+        shaders: &Shaders,
+        render_pass: vk::RenderPass,
+        fixed_size: Option<(u32, u32)>,
+    ) -> Result<SceneResources> {
+        let limit = device.properties.limits.max_storage_buffer_range as u64;
+        check_storage_limit(scene, limit, "maxStorageBufferRange")?;
+        let host = host_memory()?;
+        let place = |bytes: &[u8], usage: vk::BufferUsageFlags, what: &str| {
+            if host {
+                Buffer::host_visible_with(device, bytes, usage, what)
+            } else {
+                Buffer::device_local_with(device, bytes, usage, what)
+            }
+        };
+        let uniform = vk::BufferUsageFlags::UNIFORM_BUFFER;
+        let frame = place(scene.frame_bytes(), uniform, "frame uniform buffer")?;
+        let storage = binding::STORAGE
+            .iter()
+            .map(|&b| {
+                let what = format!("{} storage buffer", storage_name(b));
+                let usage = vk::BufferUsageFlags::STORAGE_BUFFER;
+                Ok((b, place(scene.storage_bytes(b), usage, &what)?))
+            })
+            .collect::<Result<Vec<_>>>()?;
+        let descriptors = Descriptors::new(device, &frame, &storage)?;
+        let pipeline = Pipeline::new(device, descriptors.set_layout, shaders, render_pass, fixed_size)?;
+        Ok(SceneResources { pipeline, descriptors, storage, frame })
+    }
+}
+
+/// Device-local memory, filled once through a staging buffer, is the careful
+/// choice. `TWINRAY_VK_MEMORY=host` keeps the scene in host-visible memory
+/// instead, so the comparison can show what a naive placement costs.
+pub fn host_memory() -> Result<bool> {
+    match std::env::var("TWINRAY_VK_MEMORY").as_deref() {
+        Ok("host") => Ok(true),
+        Ok("device") | Err(_) => Ok(false),
+        Ok(other) => Err(twinray_common::error::bad_input(format!(
+            "TWINRAY_VK_MEMORY='{other}' is not 'device' or 'host'"
+        ))),
+    }
+}
