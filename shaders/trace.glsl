@@ -95,6 +95,25 @@ layout(std430, set = 0, binding = 4) readonly buffer Lights {
     Light lights[];
 } light_buf;
 
+// The BVH (common/src/bvh.rs), depth-first: an interior node's left child is the
+// next node and `left_or_first` its right child; a leaf (count > 0) holds
+// prims[left_or_first .. +count], each a triangle index or a sphere index with
+// the top bit set. Bound always; read only by the USE_BVH variant.
+struct BvhNode {
+    vec3 bmin;
+    uint left_or_first;
+    vec3 bmax;
+    uint count;
+};
+
+layout(std430, set = 0, binding = 6) readonly buffer BvhNodes {
+    BvhNode nodes[];
+} bvh_buf;
+
+layout(std430, set = 0, binding = 7) readonly buffer BvhPrims {
+    uint prims[];
+} prim_buf;
+
 const float T_MAX = 1.0e30;
 
 // Stable ray-sphere test (Haines et al., Ray Tracing Gems ch. 7): the discriminant
@@ -203,7 +222,117 @@ void closest_triangle(inout Hit h, vec3 origin, vec3 dir, uint i, uint n) {
     }
 }
 
-Hit closest_hit(vec3 origin, vec3 dir) {
+#ifdef USE_BVH
+#ifndef BVH_STACK
+#define BVH_STACK 64
+#endif
+const uint SPHERE_BIT = 0x80000000u;
+
+// Where the ray enters the box, or -1 if it misses it before t_max. Zero
+// direction components are nudged so 0 * inf never makes a NaN.
+float enter_box(vec3 origin, vec3 inv_dir, uint node, float t_max) {
+    vec3 t0 = (bvh_buf.nodes[node].bmin - origin) * inv_dir;
+    vec3 t1 = (bvh_buf.nodes[node].bmax - origin) * inv_dir;
+    vec3 tn = min(t0, t1);
+    vec3 tf = max(t0, t1);
+    float enter = max(max(tn.x, tn.y), max(tn.z, 0.0));
+    float leave = min(min(tf.x, tf.y), min(tf.z, t_max));
+    return enter <= leave ? enter : -1.0;
+}
+
+vec3 inverse_dir(vec3 dir) {
+    vec3 d = mix(vec3(1.0e-30), abs(dir), greaterThan(abs(dir), vec3(1.0e-30)));
+    return sign(dir + vec3(1.0e-38)) / d;
+}
+
+// Visits the tree near child first and skips subtrees that start beyond the
+// closest hit so far. With `any_hit` (shadow rays) it stops at the first hit
+// before t_max and reports it with kind != 0.
+Hit traverse(vec3 origin, vec3 dir, float t_max, bool any_hit) {
+    Hit h;
+    h.t = t_max;
+    h.kind = 0u;
+    h.index = 0u;
+    h.u = 0.0;
+    h.v = 0.0;
+    vec3 inv_dir = inverse_dir(dir);
+    uint stack_node[BVH_STACK];
+    float stack_t[BVH_STACK];
+    int sp = 0;
+    if (enter_box(origin, inv_dir, 0u, t_max) < 0.0) {
+        return h;
+    }
+    uint node = 0u;
+    while (true) {
+        uint count = bvh_buf.nodes[node].count;
+        uint first = bvh_buf.nodes[node].left_or_first;
+        if (count > 0u) {
+            for (uint k = 0u; k < count; k++) {
+                uint prim = prim_buf.prims[first + k];
+                if ((prim & SPHERE_BIT) != 0u) {
+                    uint i = prim & ~SPHERE_BIT;
+                    float t = sphere_t(origin, dir, i, h.t);
+                    if (t > 0.0) {
+                        h.t = t;
+                        h.kind = 1u;
+                        h.index = i;
+                    }
+                } else {
+                    vec3 r = triangle_tuv(origin, dir, prim, h.t);
+                    if (r.x > 0.0) {
+                        h.t = r.x;
+                        h.kind = 2u;
+                        h.index = prim;
+                        h.u = r.y;
+                        h.v = r.z;
+                    }
+                }
+                if (any_hit && h.kind != 0u) {
+                    return h;
+                }
+            }
+        } else {
+            uint left = node + 1u;
+            uint right = first;
+            float tl = enter_box(origin, inv_dir, left, h.t);
+            float tr = enter_box(origin, inv_dir, right, h.t);
+            if (tl >= 0.0 && tr >= 0.0) {
+                bool left_first = tl <= tr;
+                node = left_first ? left : right;
+                if (sp < BVH_STACK) {
+                    stack_node[sp] = left_first ? right : left;
+                    stack_t[sp] = left_first ? tr : tl;
+                    sp += 1;
+                }
+                continue;
+            }
+            if (tl >= 0.0) {
+                node = left;
+                continue;
+            }
+            if (tr >= 0.0) {
+                node = right;
+                continue;
+            }
+        }
+        // Pop the nearest pending subtree that can still hold a closer hit.
+        bool found = false;
+        while (sp > 0 && !found) {
+            sp -= 1;
+            if (stack_t[sp] < h.t) {
+                node = stack_node[sp];
+                found = true;
+            }
+        }
+        if (!found) {
+            break;
+        }
+    }
+    return h;
+}
+#endif
+
+Hit closest_hit_brute(vec3 origin, vec3 dir) {
     Hit h;
     h.t = T_MAX;
     h.kind = 0u;
@@ -240,7 +369,7 @@ bool triangle_blocks(vec3 origin, vec3 dir, float dist, uint i, uint n) {
 }
 
 // Shadow rays need any hit before the light, not the closest one.
-bool occluded(vec3 origin, vec3 dir, float dist) {
+bool occluded_brute(vec3 origin, vec3 dir, float dist) {
 #ifdef HAS_SPHERES
     uint spheres = frame.sphere_count;
     for (uint i = 0u; i < spheres; i += PRIMS_PER_ITERATION) {
@@ -260,6 +389,24 @@ bool occluded(vec3 origin, vec3 dir, float dist) {
     }
 #endif
     return false;
+}
+
+// The closest hit and the shadow test, through the BVH where the scene's
+// variant uses one, else by testing every primitive.
+Hit closest_hit(vec3 origin, vec3 dir) {
+#ifdef USE_BVH
+    return traverse(origin, dir, T_MAX, false);
+#else
+    return closest_hit_brute(origin, dir);
+#endif
+}
+
+bool occluded(vec3 origin, vec3 dir, float dist) {
+#ifdef USE_BVH
+    return traverse(origin, dir, dist, true).kind != 0u;
+#else
+    return occluded_brute(origin, dir, dist);
+#endif
 }
 
 // Secondary rays start a small, scale-aware distance off the surface, along the

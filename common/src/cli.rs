@@ -34,6 +34,10 @@ pub struct RenderArgs {
     /// Render with the all-features shader instead of the scene's own variant.
     #[arg(long)]
     pub generic: bool,
+    /// Acceleration structure: auto (a BVH for scenes with many primitives), none (test
+    /// every primitive, as the 2018 study did) or bvh.
+    #[arg(long, value_enum, default_value_t = Accel::Auto)]
+    pub accel: Accel,
     /// OpenGL only: load naga's SPIR-V through GL_ARB_gl_spirv instead of naga's GLSL,
     /// so that both APIs run the very same shader binary (isolates the compiler path).
     #[arg(long)]
@@ -46,6 +50,23 @@ pub struct RenderArgs {
     /// parameters that matter and the time each step took.
     #[arg(long)]
     pub explain: bool,
+}
+
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+pub enum Accel {
+    Auto,
+    None,
+    Bvh,
+}
+
+impl Accel {
+    pub fn name(self) -> &'static str {
+        match self {
+            Accel::Auto => "auto",
+            Accel::None => "none",
+            Accel::Bvh => "bvh",
+        }
+    }
 }
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -94,6 +115,7 @@ impl RenderArgs {
             set: Vec::new(),
             validate: false,
             generic: false,
+            accel: Accel::Auto,
             gl_spirv: false,
             vsync: false,
             explain: false,
@@ -134,6 +156,8 @@ impl RenderArgs {
 
     /// Loads the scene named by `--scene` with the `--set` overrides applied.
     pub fn load_scene(&self) -> anyhow::Result<crate::scene::Scene> {
-        crate::scene::Scene::load(&self.scene, &self.overrides()?)
+        let mut scene = crate::scene::Scene::load(&self.scene, &self.overrides()?)?;
+        scene.set_accel(self.accel);
+        Ok(scene)
     }
 }

@@ -108,8 +108,12 @@ pub mod binding {
     pub const TRIANGLES: u32 = 2;
     pub const MATERIALS: u32 = 3;
     pub const LIGHTS: u32 = 4;
+    /// 5 is the compute path's output image.
+    pub const BVH_NODES: u32 = 6;
+    pub const BVH_PRIMS: u32 = 7;
+    pub const LAST: u32 = BVH_PRIMS;
     /// The storage buffers in binding order.
-    pub const STORAGE: [u32; 4] = [SPHERES, TRIANGLES, MATERIALS, LIGHTS];
+    pub const STORAGE: [u32; 6] = [SPHERES, TRIANGLES, MATERIALS, LIGHTS, BVH_NODES, BVH_PRIMS];
 }
 
 /// Everything a frame needs on the GPU, as bytes. Both apps upload exactly these.
@@ -120,6 +124,9 @@ pub struct GpuScene {
     pub triangles: Vec<GpuTriangle>,
     pub materials: Vec<GpuMaterial>,
     pub lights: Vec<GpuLight>,
+    /// Empty unless the scene traces through a BVH.
+    pub bvh_nodes: Vec<GpuBvhNode>,
+    pub bvh_prims: Vec<u32>,
 }
 
 fn v3(v: glam::DVec3) -> [f32; 3] {
@@ -150,6 +157,7 @@ impl GpuFrame {
 
 impl GpuScene {
     pub fn new(scene: &Scene, width: u32, height: u32) -> GpuScene {
+        let bvh = if scene.bvh { crate::bvh::Bvh::build(scene) } else { crate::bvh::Bvh::default() };
         GpuScene {
             frame: GpuFrame::new(scene, &scene.camera, width, height),
             spheres: scene
@@ -190,6 +198,8 @@ impl GpuScene {
                 .iter()
                 .map(|l| GpuLight { position: v3(l.position), color: v3(l.color), ..Default::default() })
                 .collect(),
+            bvh_nodes: bvh.nodes,
+            bvh_prims: bvh.prims,
         }
     }
 
@@ -215,6 +225,8 @@ impl GpuScene {
             binding::TRIANGLES => bytes(&self.triangles),
             binding::MATERIALS => bytes(&self.materials),
             binding::LIGHTS => bytes(&self.lights),
+            binding::BVH_NODES => bytes(&self.bvh_nodes),
+            binding::BVH_PRIMS => bytes(&self.bvh_prims),
             _ => panic!("binding {binding} is not a storage buffer"),
         }
     }
@@ -235,6 +247,8 @@ pub fn storage_name(binding: u32) -> &'static str {
         binding::TRIANGLES => "triangles",
         binding::MATERIALS => "materials",
         binding::LIGHTS => "lights",
+        binding::BVH_NODES => "BVH node",
+        binding::BVH_PRIMS => "BVH primitive",
         _ => "frame",
     }
 }

@@ -240,7 +240,15 @@ pub struct Scene {
     pub lights: Vec<Light>,
     pub spheres: Vec<Sphere>,
     pub triangles: Vec<Triangle>,
+    /// Trace through a BVH (common/src/bvh.rs) instead of testing every primitive.
+    /// `--accel` decides; `auto` (the default) uses one from `AUTO_BVH_MIN_PRIMITIVES` on.
+    pub bvh: bool,
 }
+
+/// `--accel auto` builds a BVH for scenes with at least this many primitives.
+/// Below it the brute-force loop is as fast or faster: see the comparison
+/// report's acceleration section for the measurements behind the number.
+pub const AUTO_BVH_MIN_PRIMITIVES: usize = 64;
 
 /// What a scene contains, which decides its shader variant.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize)]
@@ -323,6 +331,19 @@ impl Scene {
             mirror: self.max_depth > 1 && used(&|m| m.reflectivity > 0.0),
             glass: self.max_depth > 1 && used(&|m| m.transparency > 0.0),
         }
+    }
+
+    pub fn primitive_count(&self) -> usize {
+        self.spheres.len() + self.triangles.len()
+    }
+
+    /// Applies `--accel` (none: brute force; bvh: a BVH; auto: a BVH from the threshold on).
+    pub fn set_accel(&mut self, accel: crate::cli::Accel) {
+        self.bvh = match accel {
+            crate::cli::Accel::None => false,
+            crate::cli::Accel::Bvh => self.primitive_count() > 0,
+            crate::cli::Accel::Auto => self.primitive_count() >= AUTO_BVH_MIN_PRIMITIVES,
+        };
     }
 
     pub fn stats(&self) -> SceneStats {
@@ -573,6 +594,7 @@ fn resolve(name: &str, def: SceneFile, origin: &str, files: &FileSource) -> anyh
         epsilon,
         materials,
         lights,
+        bvh: spheres.len() + triangles.len() >= AUTO_BVH_MIN_PRIMITIVES,
         spheres,
         triangles,
     })

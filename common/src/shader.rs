@@ -24,7 +24,11 @@ impl Variant {
     /// Only what the scene needs: no triangle loop without triangles, no
     /// refraction code without glass, a ray stack sized to the scene's depth.
     pub fn for_scene(scene: &Scene) -> Variant {
-        Variant::from_features(scene.features(), scene.max_depth)
+        let mut v = Variant::from_features(scene.features(), scene.max_depth);
+        if scene.bvh {
+            v.defines.insert("USE_BVH".into(), "1".into());
+        }
+        v
     }
 
     pub fn from_features(f: Features, max_depth: u32) -> Variant {
@@ -67,7 +71,8 @@ impl Variant {
         if parts.is_empty() {
             parts.push("background".into());
         }
-        format!("{}/stack{}", parts.join("+"), self.defines.get("STACK_SIZE").map(String::as_str).unwrap_or("?"))
+        let bvh = if self.defines.contains_key("USE_BVH") { "/bvh" } else { "" };
+        format!("{}/stack{}{bvh}", parts.join("+"), self.defines.get("STACK_SIZE").map(String::as_str).unwrap_or("?"))
     }
 }
 
@@ -126,7 +131,7 @@ pub fn to_glsl(module: &Module, info: &ModuleInfo, stage: ShaderStage) -> anyhow
     // resource its (set 0) binding explicitly. UBOs and SSBOs have separate
     // binding spaces in GL, so the numbers carry over unchanged.
     let mut binding_map = glsl::BindingMap::default();
-    for b in 0..=crate::gpu::binding::LIGHTS {
+    for b in 0..=crate::gpu::binding::LAST {
         binding_map.insert(naga::ResourceBinding { group: 0, binding: b }, b as u8);
     }
     let options = glsl::Options {

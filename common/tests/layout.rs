@@ -93,6 +93,19 @@ fn naga_layout_matches_rust_for_every_shader_struct() {
         size_of::<GpuMaterial>(),
     );
 
+    let (_, node) = block(&module, binding::BVH_NODES);
+    let (ty, stride) = node.expect("BVH nodes are a runtime array");
+    assert_eq!(stride as usize, size_of::<GpuBvhNode>(), "BvhNode stride");
+    check(
+        "BvhNode",
+        naga_members(&module, ty),
+        rust_offsets!(GpuBvhNode { min, left_or_first, max, count }),
+        size_of::<GpuBvhNode>(),
+    );
+    let (_, prims) = block(&module, binding::BVH_PRIMS);
+    let (_, stride) = prims.expect("BVH primitives are a runtime array");
+    assert_eq!(stride, 4, "BVH primitive stride");
+
     let (_, light) = block(&module, binding::LIGHTS);
     let (ty, stride) = light.expect("lights is a runtime array");
     assert_eq!(stride as usize, size_of::<GpuLight>(), "Light stride");
@@ -107,6 +120,9 @@ fn naga_layout_matches_rust_for_every_shader_struct() {
 #[test]
 fn every_builtin_variant_and_the_generic_one_compile_for_both_apis() {
     let mut variants = vec![Variant::generic()];
+    let mut bvh = twinray_common::scene::Scene::load("box", &[]).unwrap();
+    bvh.bvh = true;
+    variants.push(Variant::for_scene(&bvh));
     for (name, _) in twinray_common::scene::BUILTIN_SCENES {
         let scene = twinray_common::scene::Scene::load(name, &[]).unwrap();
         variants.push(Variant::for_scene(&scene));

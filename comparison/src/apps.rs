@@ -69,6 +69,7 @@ pub fn app_args(args: &RenderArgs) -> Vec<String> {
     if args.gl_spirv {
         v.push("--gl-spirv".into());
     }
+    v.extend(["--accel".into(), args.accel.name().into()]);
     v
 }
 

@@ -7,7 +7,7 @@ use anyhow::Context;
 use std::path::PathBuf;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::Arc;
-use twinray_common::cli::{parse_size, RenderArgs, Size};
+use twinray_common::cli::{parse_size, Accel, RenderArgs, Size};
 use twinray_common::report::RunReport;
 
 #[derive(clap::Args, Debug, Clone)]
@@ -212,6 +212,8 @@ pub fn run(args: &CompareArgs) -> anyhow::Result<()> {
                 out: None,
                 json: true,
                 set: point.set.clone(),
+                // The study's tracer tests every primitive: so do the sweeps.
+                accel: Accel::None,
                 ..RenderArgs::headless(point.scene, point.size)
             };
             let result = run_json(api, &ra).map_err(|e| format!("{e:#}"));
@@ -232,8 +234,9 @@ pub fn run(args: &CompareArgs) -> anyhow::Result<()> {
         }
     }
     bar.finish_and_clear();
-    let agreement = if interrupted { Vec::new() } else { agreement(&args.out, &plan, &stop) };
-    crate::report::write_all(&args.out, &plan, &outcomes, &agreement, interrupted)?;
+    let accel = if interrupted { Vec::new() } else { acceleration(&plan, &stop) };
+    let agreement = if interrupted || stop.load(Ordering::SeqCst) { Vec::new() } else { agreement(&args.out, &plan, &stop) };
+    crate::report::write_all(&args.out, &plan, &outcomes, &accel, &agreement, interrupted)?;
     eprintln!(
         "twinray compare: {} of {} runs done{}; report: {}",
         outcomes.iter().filter(|o| o.result.is_ok()).count(),
@@ -280,6 +283,7 @@ pub fn agreement(out: &std::path::Path, plan: &Plan, stop: &AtomicBool) -> Vec<A
                     out: Some(png.clone()),
                     json: true,
                     set: set.clone(),
+                    accel: Accel::None,
                     ..RenderArgs::headless(scene, size)
                 };
                 let r = run_json(api, &ra)?;
@@ -315,4 +319,68 @@ pub fn agreement(out: &std::path::Path, plan: &Plan, stop: &AtomicBool) -> Vec<A
         rows.push(Agreement { scene, size, result });
     }
     rows
+}
+
+/// One run of "model only what a scene needs": a scene in one configuration.
+#[derive(Debug, Clone)]
+pub struct AccelRun {
+    pub scene: &'static str,
+    pub size: Size,
+    pub set: Vec<String>,
+    /// "generic, brute force", "variant, brute force" or "variant, BVH".
+    pub config: &'static str,
+    pub api: Api,
+    pub result: Result<RunReport, String>,
+    /// BVH nodes, bytes and build milliseconds (built here, as the apps do).
+    pub bvh: Option<(usize, usize, f64)>,
+}
+
+pub const ACCEL_CONFIGS: [&str; 3] = ["generic, brute force", "variant, brute force", "variant, BVH"];
+
+/// Each scene with the all-features brute-force shader, its own variant, and
+/// its variant with a BVH; then the sphere list scaled up with the BVH alone.
+pub fn acceleration(plan: &Plan, stop: &AtomicBool) -> Vec<AccelRun> {
+    let quick = plan.preset == "quick";
+    let big = if quick { Size { width: 100, height: 100 } } else { Size { width: 1000, height: 1000 } };
+    let sl = if quick { Size { width: 100, height: 100 } } else { Size { width: 300, height: 300 } };
+    let mut cases: Vec<(&'static str, Size, Vec<String>, Vec<&'static str>)> = vec![
+        ("teapot", if quick { Size { width: 40, height: 40 } } else { big }, vec![], ACCEL_CONFIGS.to_vec()),
+        ("box", big, vec![], ACCEL_CONFIGS.to_vec()),
+        ("spherelist", sl, vec![format!("extra_spheres={}", if quick { 1000 } else { 10000 })], ACCEL_CONFIGS.to_vec()),
+    ];
+    let scaling: &[u32] = if quick { &[10_000] } else { &[1_000, 10_000, 100_000] };
+    for &n in scaling {
+        cases.push(("spherelist", sl, vec![format!("extra_spheres={n}")], vec!["variant, BVH"]));
+    }
+    eprintln!("twinray compare: measuring shader variants and the BVH ({} runs)", cases.iter().map(|c| c.3.len() * 2).sum::<usize>());
+    let mut runs = Vec::new();
+    for (scene, size, set, configs) in cases {
+        for config in configs {
+            let bvh = config.ends_with("BVH");
+            let stats = bvh.then(|| {
+                let overrides: Vec<(String, String)> =
+                    set.iter().filter_map(|kv| kv.split_once('=')).map(|(k, v)| (k.into(), v.into())).collect();
+                twinray_common::scene::Scene::load(scene, &overrides).ok().map(|sc| {
+                    let b = twinray_common::bvh::Bvh::build(&sc);
+                    (b.nodes.len(), b.bytes(), b.build_ms)
+                })
+            });
+            for api in [Api::Vulkan, Api::Opengl] {
+                if stop.load(Ordering::SeqCst) {
+                    return runs;
+                }
+                let ra = RenderArgs {
+                    frames: Some(if quick { 4 } else { 12 }),
+                    json: true,
+                    set: set.clone(),
+                    generic: config.starts_with("generic"),
+                    accel: if bvh { Accel::Bvh } else { Accel::None },
+                    ..RenderArgs::headless(scene, size)
+                };
+                let result = run_json(api, &ra).map_err(|e| format!("{e:#}"));
+                runs.push(AccelRun { scene, size, set: set.clone(), config, api, result, bvh: stats.flatten() });
+            }
+        }
+    }
+    runs
 }

@@ -2,7 +2,7 @@
 //! report.md (the study's tables with ours beside them, ratios, machine info,
 //! a summary derived from the numbers) and one SVG plot per experiment.
 
-use crate::compare::{api_name, Agreement, Outcome, Plan, EXPERIMENTS};
+use crate::compare::{api_name, AccelRun, Agreement, Outcome, Plan, EXPERIMENTS};
 use crate::apps::Api;
 use crate::study::{self, StudyRow};
 use anyhow::Context;
@@ -19,7 +19,7 @@ pub fn cpu_model() -> String {
         .unwrap_or_else(|| "unknown CPU".into())
 }
 
-pub fn write_all(out: &Path, plan: &Plan, outcomes: &[Outcome], agreement: &[Agreement], interrupted: bool) -> anyhow::Result<()> {
+pub fn write_all(out: &Path, plan: &Plan, outcomes: &[Outcome], accel: &[AccelRun], agreement: &[Agreement], interrupted: bool) -> anyhow::Result<()> {
     let cpu = cpu_model();
     std::fs::write(out.join("results.csv"), csv(outcomes, &cpu)).context("writing results.csv")?;
     let study = study::rows();
@@ -33,7 +33,7 @@ pub fn write_all(out: &Path, plan: &Plan, outcomes: &[Outcome], agreement: &[Agr
         plot(&out.join(&file), exp, &rows, &study).with_context(|| format!("plotting {file}"))?;
         plots.push(file);
     }
-    std::fs::write(out.join("report.md"), markdown(plan, outcomes, agreement, &study, &cpu, &plots, interrupted))
+    std::fs::write(out.join("report.md"), markdown(plan, outcomes, accel, agreement, &study, &cpu, &plots, interrupted))
         .context("writing report.md")?;
     Ok(())
 }
@@ -159,7 +159,7 @@ fn describe(label: &str, v: &[f64]) -> String {
     }
 }
 
-pub fn markdown(plan: &Plan, outcomes: &[Outcome], agreement: &[Agreement], study: &[StudyRow], cpu: &str, plots: &[String], interrupted: bool) -> String {
+pub fn markdown(plan: &Plan, outcomes: &[Outcome], accel: &[AccelRun], agreement: &[Agreement], study: &[StudyRow], cpu: &str, plots: &[String], interrupted: bool) -> String {
     let mut s = String::new();
     let any = |api: Api| outcomes.iter().find(|o| o.api == api).and_then(|o| o.result.as_ref().ok());
     let device = any(Api::Vulkan).or(any(Api::Opengl)).map(|r| r.device.clone()).unwrap_or_else(|| "no device".into());
@@ -278,6 +278,51 @@ pub fn markdown(plan: &Plan, outcomes: &[Outcome], agreement: &[Agreement], stud
                 frames(vk),
                 frames(gl)
             );
+        }
+        let _ = writeln!(s);
+    }
+
+    if !accel.is_empty() {
+        let _ = writeln!(
+            s,
+            "## Model only what a scene needs\n\nThe same scenes with the all-features shader (`--generic`, brute force, as the study's \
+             tracer), with the scene's own shader variant (features it lacks compiled out), and with that variant tracing through \
+             a BVH (`--accel bvh`; binned SAH over spheres and triangles, built on the CPU). Median GPU ms (wall ms where the driver \
+             has no GPU timer); speed-up against the generic brute-force shader of the same API.\n"
+        );
+        let _ = writeln!(s, "| scene | size | configuration | VK (ms) | GL (ms) | VK speed-up | GL speed-up | BVH nodes / bytes / build ms |\n|---|---|---|---|---|---|---|---|");
+        let time = |r: &AccelRun| r.result.as_ref().ok().and_then(|r| r.gpu_ms.or(r.wall_ms)).map(|x| x.median);
+        let mut keys: Vec<(&str, String, String, &str)> = Vec::new();
+        for r in accel {
+            let k = (r.scene, r.size.to_string(), r.set.join(" "), r.config);
+            if !keys.contains(&k) {
+                keys.push(k);
+            }
+        }
+        for (scene, size, set, config) in &keys {
+            let find = |api: Api, cfg: &str| {
+                accel.iter().find(|r| r.scene == *scene && r.size.to_string() == *size && r.set.join(" ") == *set && r.config == cfg && r.api == api)
+            };
+            let vk = find(Api::Vulkan, config).and_then(time);
+            let gl = find(Api::Opengl, config).and_then(time);
+            let base = |api: Api| find(api, "generic, brute force").and_then(time);
+            let bvh = find(Api::Vulkan, config)
+                .and_then(|r| r.bvh)
+                .map(|(n, b, ms)| format!("{n} / {:.1} KiB / {ms:.1}", b as f64 / 1024.0))
+                .unwrap_or_else(|| "–".into());
+            let label = if set.is_empty() { scene.to_string() } else { format!("{scene} ({set})") };
+            let _ = writeln!(
+                s,
+                "| {label} | {size} | {config} | {} | {} | {} | {} | {bvh} |",
+                f(vk, 3),
+                f(gl, 3),
+                ratio(base(Api::Vulkan), vk).map(|x| format!("{x:.1}×")).unwrap_or_else(|| "–".into()),
+                ratio(base(Api::Opengl), gl).map(|x| format!("{x:.1}×")).unwrap_or_else(|| "–".into()),
+            );
+        }
+        let failed: Vec<&AccelRun> = accel.iter().filter(|r| r.result.is_err()).collect();
+        for r in failed {
+            let _ = writeln!(s, "\n- {} {} {} {}: {}", r.scene, r.config, api_name(r.api), r.size, r.result.as_ref().err().map(String::as_str).unwrap_or(""));
         }
         let _ = writeln!(s);
     }
