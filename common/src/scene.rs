@@ -16,12 +16,16 @@ pub const BUILTIN_SCENES: &[(&str, &str)] = &[
 ];
 
 const BUILTIN_FILES: &[(&str, &str)] = &[
-    ("teapot.obj", include_str!("../../scenes/teapot.obj")),
     ("cube.obj", include_str!("../../scenes/cube.obj")),
+    ("teapot.bpt", include_str!("../../scenes/teapot.bpt")),
 ];
 
 /// Keys accepted by `--set`.
-pub const OVERRIDE_KEYS: &[&str] = &["max_depth", "min_weight", "epsilon", "extra_spheres", "fov_y"];
+pub const OVERRIDE_KEYS: &[&str] = &["max_depth", "min_weight", "epsilon", "extra_spheres", "fov_y", "tessellation"];
+
+/// The finest `tessellation` accepted per direction (400 x 400 quads per patch is
+/// 10 million triangles for the 32-patch teapot).
+pub const MAX_TESSELLATION: u32 = 400;
 
 /// More hidden spheres than any storage buffer needs to hold for the study (10,000),
 /// yet enough to exceed a device's storage-buffer limit on purpose.
@@ -154,7 +158,15 @@ struct QuadDef {
 #[derive(Deserialize, Debug, Clone)]
 #[serde(deny_unknown_fields)]
 struct MeshDef {
-    obj: String,
+    /// A triangle mesh in an OBJ file ...
+    #[serde(default)]
+    obj: Option<String>,
+    /// ... or Bezier patches in the classic .bpt format, tessellated at load.
+    #[serde(default)]
+    bpt: Option<String>,
+    /// Quads per patch in u and v for `bpt` (2 triangles each); default 20 x 15.
+    #[serde(default)]
+    tessellation: Option<[u32; 2]>,
     material: String,
     #[serde(default = "one")]
     scale: f64,
@@ -384,6 +396,25 @@ fn apply_overrides(def: &mut SceneFile, overrides: &[(String, String)]) -> anyho
             "min_weight" => def.render.min_weight = num()?,
             "epsilon" => def.render.epsilon = num()?,
             "fov_y" => def.camera.fov_y = num()?,
+            "tessellation" => {
+                let t = value
+                    .split_once(['x', 'X'])
+                    .and_then(|(u, v)| Some([u.trim().parse::<u32>().ok()?, v.trim().parse::<u32>().ok()?]))
+                    .filter(|t| t.iter().all(|n| (1..=MAX_TESSELLATION).contains(n)))
+                    .ok_or_else(|| {
+                        bad_input(format!(
+                            "--set tessellation={value}: give quads per patch as NUxNV, each from 1 to {MAX_TESSELLATION} (the study: 20x15)"
+                        ))
+                    })?;
+                let mut any = false;
+                for m in def.meshes.iter_mut().filter(|m| m.bpt.is_some()) {
+                    m.tessellation = Some(t);
+                    any = true;
+                }
+                if !any {
+                    return Err(bad_input("--set tessellation: this scene has no Bezier-patch mesh (try --scene teapot)"));
+                }
+            }
             "extra_spheres" => {
                 let n = int(MAX_EXTRA_SPHERES)?;
                 match def.extra_spheres.as_mut() {
@@ -569,7 +600,15 @@ fn resolve(name: &str, def: SceneFile, origin: &str, files: &FileSource) -> anyh
         }
         let rot = DMat3::from_rotation_y(finite(origin, &format!("{at}.rotate_y"), m.rotate_y)?.to_radians());
         let translate = finite3(origin, &format!("{at}.translate"), m.translate)?;
-        let obj = load_obj(origin, &at, &m.obj, files)?;
+        let (obj, file) = match (&m.obj, &m.bpt) {
+            (Some(obj), None) if m.tessellation.is_none() => (load_obj(origin, &at, obj, files)?, obj),
+            (None, Some(bpt)) => (load_bpt(origin, &at, bpt, m.tessellation.unwrap_or([20, 15]), files)?, bpt),
+            _ => {
+                return Err(bad_input(format!(
+                    "{origin}: {at} needs either `obj` or `bpt` (with an optional `tessellation`), not both"
+                )))
+            }
+        };
         let before = triangles.len();
         for (p, n) in obj {
             let p = p.map(|v| rot * (v * scale) + translate);
@@ -580,7 +619,7 @@ fn resolve(name: &str, def: SceneFile, origin: &str, files: &FileSource) -> anyh
             triangles.push(Triangle { p, n, material: mat });
         }
         if triangles.len() == before {
-            return Err(bad_input(format!("{origin}: {at}: OBJ file '{}' contains no faces", m.obj)));
+            return Err(bad_input(format!("{origin}: {at}: '{file}' contains no faces")));
         }
     }
 
@@ -617,20 +656,38 @@ fn flat_normal(p: &[DVec3; 3]) -> DVec3 {
 
 type ObjTriangle = ([DVec3; 3], Option<[DVec3; 3]>);
 
-fn load_obj(origin: &str, at: &str, file: &str, files: &FileSource) -> anyhow::Result<Vec<ObjTriangle>> {
-    let text = match files {
+/// The text of a file a scene names: built in, or next to the scene file.
+fn read_text(origin: &str, what: &str, file: &str, files: &FileSource) -> anyhow::Result<String> {
+    match files {
         FileSource::Builtin => BUILTIN_FILES
             .iter()
             .find(|(n, _)| *n == file)
             .map(|(_, t)| t.to_string())
-            .ok_or_else(|| bad_input(format!("{origin}: {at}.obj '{file}' is not a built-in file")))?,
+            .ok_or_else(|| bad_input(format!("{origin}: {what} '{file}' is not a built-in file"))),
         FileSource::Dir(dir) => {
             let path = dir.join(file);
-            std::fs::read_to_string(&path).map_err(|e| {
-                bad_input(format!("{origin}: {at}.obj '{}' cannot be read: {e}", path.display()))
-            })?
+            std::fs::read_to_string(&path)
+                .map_err(|e| bad_input(format!("{origin}: {what} '{}' cannot be read: {e}", path.display())))
         }
-    };
+    }
+}
+
+/// Newell-style Bezier patches, tessellated by the generator that wrote teapot.obj.
+fn load_bpt(origin: &str, at: &str, file: &str, [nu, nv]: [u32; 2], files: &FileSource) -> anyhow::Result<Vec<ObjTriangle>> {
+    if !(1..=MAX_TESSELLATION).contains(&nu) || !(1..=MAX_TESSELLATION).contains(&nv) {
+        return Err(bad_input(format!("{origin}: {at}.tessellation = [{nu}, {nv}]: each must be from 1 to {MAX_TESSELLATION}")));
+    }
+    let text = read_text(origin, &format!("{at}.bpt"), file, files)?;
+    let patches = crate::teapot::parse_bpt(&text)
+        .map_err(|e| bad_input(format!("{origin}: {at}.bpt '{file}' is not a valid patch file: {e}")))?;
+    let mesh = crate::teapot::tessellate(&patches, nu, nv);
+    let v = |i: u32| DVec3::from_array(mesh.positions[i as usize]);
+    let n = |i: u32| DVec3::from_array(mesh.normals[i as usize]);
+    Ok(mesh.triangles.iter().map(|t| ([v(t[0]), v(t[1]), v(t[2])], Some([n(t[0]), n(t[1]), n(t[2])]))).collect())
+}
+
+fn load_obj(origin: &str, at: &str, file: &str, files: &FileSource) -> anyhow::Result<Vec<ObjTriangle>> {
+    let text = read_text(origin, &format!("{at}.obj"), file, files)?;
     let opts = tobj::LoadOptions { triangulate: true, single_index: true, ..Default::default() };
     let (models, _) = tobj::load_obj_buf(&mut text.as_bytes(), &opts, |_| {
         // Materials come from the scene file, never from an OBJ's mtllib.

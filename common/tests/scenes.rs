@@ -153,3 +153,37 @@ fn overrides_are_checked() {
     let s = Scene::load("box", &set(&[("max_depth", "2")])).unwrap();
     assert_eq!(s.max_depth, 2);
 }
+
+#[test]
+fn teapot_tessellation_override_scales_the_triangle_count() {
+    for (t, n) in [("40x30", 76_800), ("80x60", 307_200)] {
+        let s = Scene::load("teapot", &set(&[("tessellation", t)])).unwrap();
+        assert_eq!(s.triangles.len(), n, "tessellation {t}");
+    }
+    let e = Scene::load("teapot", &set(&[("tessellation", "0x5")])).unwrap_err();
+    assert_eq!(exit_code_of(&e), 2);
+    assert!(format!("{e}").contains("tessellation"), "{e}");
+    let e = Scene::load("box", &set(&[("tessellation", "40x30")])).unwrap_err();
+    assert!(format!("{e}").contains("no Bezier-patch mesh"), "{e}");
+}
+
+#[test]
+fn the_built_in_teapot_is_the_committed_obj() {
+    // The scene tessellates teapot.bpt at load; teapot.obj is that generator's
+    // output written with 6 decimals: the same triangles, to rounding.
+    let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../scenes");
+    let from_obj = Scene::from_toml(
+        "obj",
+        &format!("{}[[meshes]]\nobj = \"teapot.obj\"\nmaterial = \"m\"\n", OK),
+        &dir,
+        &[],
+    )
+    .unwrap();
+    let built_in = Scene::load("teapot", &[]).unwrap();
+    assert_eq!(from_obj.triangles.len(), built_in.triangles.len());
+    for (a, b) in from_obj.triangles.iter().zip(&built_in.triangles) {
+        for k in 0..3 {
+            assert!((a.p[k] - b.p[k]).length() < 1e-5, "positions differ");
+        }
+    }
+}

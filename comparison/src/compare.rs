@@ -348,9 +348,20 @@ pub fn acceleration(plan: &Plan, stop: &AtomicBool) -> Vec<AccelRun> {
         ("box", big, vec![], ACCEL_CONFIGS.to_vec()),
         ("spherelist", sl, vec![format!("extra_spheres={}", if quick { 1000 } else { 10000 })], ACCEL_CONFIGS.to_vec()),
     ];
+    // Where the BVH starts to pay: the crossover behind AUTO_BVH_MIN_PRIMITIVES.
+    let crossover: &[u32] = if quick { &[1, 50, 200] } else { &[1, 10, 25, 50, 100, 200, 500] };
+    for &n in crossover {
+        cases.push(("spherelist", sl, vec![format!("extra_spheres={n}")], vec!["variant, brute force", "variant, BVH"]));
+    }
     let scaling: &[u32] = if quick { &[10_000] } else { &[1_000, 10_000, 100_000] };
     for &n in scaling {
         cases.push(("spherelist", sl, vec![format!("extra_spheres={n}")], vec!["variant, BVH"]));
+    }
+    // The teapot from 19.2k to 1.2M triangles: the same generator, finer.
+    let detail: &[&str] = if quick { &["40x30"] } else { &["40x30", "80x60", "160x120"] };
+    let teapot_size = if quick { Size { width: 40, height: 40 } } else { big };
+    for t in detail {
+        cases.push(("teapot", teapot_size, vec![format!("tessellation={t}")], vec!["variant, BVH"]));
     }
     eprintln!("twinray compare: measuring shader variants and the BVH ({} runs)", cases.iter().map(|c| c.3.len() * 2).sum::<usize>());
     let mut runs = Vec::new();

@@ -23,7 +23,7 @@ pub fn write_all(out: &Path, plan: &Plan, outcomes: &[Outcome], accel: &[AccelRu
     let cpu = cpu_model();
     std::fs::write(out.join("results.csv"), csv(outcomes, &cpu)).context("writing results.csv")?;
     let study = study::rows();
-    let mut plots = Vec::new();
+    let mut plots: Vec<String> = Vec::new();
     for exp in EXPERIMENTS {
         let rows: Vec<&Outcome> = outcomes.iter().filter(|o| o.point.experiment == exp).collect();
         if rows.is_empty() {
@@ -32,6 +32,10 @@ pub fn write_all(out: &Path, plan: &Plan, outcomes: &[Outcome], accel: &[AccelRu
         let file = format!("{exp}.svg");
         plot(&out.join(&file), exp, &rows, &study).with_context(|| format!("plotting {file}"))?;
         plots.push(file);
+    }
+    if accel.iter().any(|r| r.result.is_ok()) {
+        plot_scaling(&out.join("scaling.svg"), outcomes, accel).context("plotting scaling.svg")?;
+        plots.push("scaling.svg".to_string());
     }
     std::fs::write(out.join("report.md"), markdown(plan, outcomes, accel, agreement, &study, &cpu, &plots, interrupted))
         .context("writing report.md")?;
@@ -320,6 +324,9 @@ pub fn markdown(plan: &Plan, outcomes: &[Outcome], accel: &[AccelRun], agreement
                 ratio(base(Api::Opengl), gl).map(|x| format!("{x:.1}×")).unwrap_or_else(|| "–".into()),
             );
         }
+        if plots.iter().any(|p| p == "scaling.svg") {
+            let _ = writeln!(s, "\n![frame time against primitive count](scaling.svg)\n");
+        }
         let failed: Vec<&AccelRun> = accel.iter().filter(|r| r.result.is_err()).collect();
         for r in failed {
             let _ = writeln!(s, "\n- {} {} {} {}: {}", r.scene, r.config, api_name(r.api), r.size, r.result.as_ref().err().map(String::as_str).unwrap_or(""));
@@ -437,6 +444,75 @@ fn plot(path: &Path, exp: &str, rows: &[&Outcome], study: &[StudyRow]) -> anyhow
         } else {
             chart.draw_series(pts.iter().map(|p| Circle::new(*p, 3, colour.filled())))?;
         }
+    }
+    chart.configure_series_labels().background_style(WHITE.mix(0.8)).border_style(BLACK).position(SeriesLabelPosition::UpperLeft).draw()?;
+    root.present()?;
+    Ok(())
+}
+
+/// Primitives in a run (spheres + triangles), from its own report.
+fn primitives(r: &RunReport) -> f64 {
+    (r.scene.spheres + r.scene.triangles) as f64
+}
+
+/// Frame time against primitive count on log-log axes, brute force and BVH.
+fn plot_scaling(path: &Path, outcomes: &[Outcome], accel: &[AccelRun]) -> anyhow::Result<()> {
+    let ms = |r: &RunReport| r.gpu_ms.or(r.wall_ms).map(|x| x.median);
+    let mut series: Vec<(String, RGBColor, Vec<(f64, f64)>)> = Vec::new();
+    let palette = [
+        (Api::Vulkan, [RGBColor(200, 30, 30), RGBColor(240, 130, 40), RGBColor(150, 0, 90)]),
+        (Api::Opengl, [RGBColor(30, 80, 200), RGBColor(40, 170, 170), RGBColor(90, 40, 160)]),
+    ];
+    for (api, [colour, sphere_bvh, teapot_bvh]) in palette {
+        // Brute force: the study's sphere-list sweep plus the crossover runs.
+        let mut brute: Vec<(f64, f64)> = outcomes
+            .iter()
+            .filter(|o| o.api == api && o.point.experiment == "spherelist")
+            .filter_map(|o| o.result.as_ref().ok())
+            .filter_map(|r| Some((primitives(r), ms(r)?)))
+            .collect();
+        brute.extend(
+            accel
+                .iter()
+                .filter(|a| a.api == api && a.scene == "spherelist" && a.config == "variant, brute force")
+                .filter_map(|a| a.result.as_ref().ok())
+                .filter_map(|r| Some((primitives(r), ms(r)?))),
+        );
+        let bvh = |scene: &str| -> Vec<(f64, f64)> {
+            accel
+                .iter()
+                .filter(|a| a.api == api && a.scene == scene && a.config == "variant, BVH")
+                .filter_map(|a| a.result.as_ref().ok())
+                .filter_map(|r| Some((primitives(r), ms(r)?)))
+                .collect()
+        };
+        series.push((format!("spherelist brute force, {}", api_name(api)), colour, brute));
+        series.push((format!("spherelist BVH, {}", api_name(api)), sphere_bvh, bvh("spherelist")));
+        series.push((format!("teapot BVH, {}", api_name(api)), teapot_bvh, bvh("teapot")));
+    }
+    series.retain(|s| !s.2.is_empty());
+    let all: Vec<(f64, f64)> = series.iter().flat_map(|s| s.2.iter().copied()).filter(|p| p.0 > 0.0 && p.1 > 0.0).collect();
+    if all.is_empty() {
+        return Ok(());
+    }
+    let (xmin, xmax) = all.iter().fold((f64::MAX, f64::MIN), |a, p| (a.0.min(p.0), a.1.max(p.0)));
+    let (ymin, ymax) = all.iter().fold((f64::MAX, f64::MIN), |a, p| (a.0.min(p.1), a.1.max(p.1)));
+    let root = SVGBackend::new(path, (900, 560)).into_drawing_area();
+    root.fill(&WHITE)?;
+    let mut chart = ChartBuilder::on(&root)
+        .caption("frame time against primitives (log-log)", ("sans-serif", 22))
+        .margin(12)
+        .x_label_area_size(45)
+        .y_label_area_size(70)
+        .build_cartesian_2d((xmin * 0.8..xmax * 1.25).log_scale(), (ymin * 0.5..ymax * 2.0).log_scale())?;
+    chart.configure_mesh().x_desc("spheres + triangles").y_desc("milliseconds").draw()?;
+    for (name, colour, mut pts) in series {
+        pts.sort_by(|a, b| a.0.total_cmp(&b.0));
+        chart
+            .draw_series(LineSeries::new(pts.clone(), colour.stroke_width(2)))?
+            .label(name)
+            .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], colour.stroke_width(2)));
+        chart.draw_series(pts.iter().map(|p| Circle::new(*p, 3, colour.filled())))?;
     }
     chart.configure_series_labels().background_style(WHITE.mix(0.8)).border_style(BLACK).position(SeriesLabelPosition::UpperLeft).draw()?;
     root.present()?;
