@@ -8,6 +8,7 @@
 //! of creation: exactly the order Vulkan needs, on success and on every error path.
 
 use crate::commands::Commands;
+use crate::compute::Compute;
 use crate::descriptors::Descriptors;
 use crate::device::Device;
 use crate::instance::{Instance, VALIDATION_MESSAGES};
@@ -19,7 +20,7 @@ use anyhow::{bail, Result};
 use ash::vk;
 use std::sync::atomic::Ordering;
 use std::time::Instant;
-use twinray_common::cli::RenderArgs;
+use twinray_common::cli::{RenderArgs, RenderPath};
 use twinray_common::error::bad_input;
 use twinray_common::gpu::{binding, check_storage_limit, storage_name, GpuScene};
 use twinray_common::image_io::FloatImage;
@@ -61,7 +62,7 @@ fn render(
     process_start: Instant,
 ) -> Result<(RunReport, FloatImage)> {
     let (width, height) = (args.size.width, args.size.height);
-    let shaders = shader::build(variant)?;
+    let workgroup = args.compute_workgroup()?;
     let gpu_scene = GpuScene::new(scene, width, height);
 
     let instance = Instance::new(args.validate)?;
@@ -104,29 +105,26 @@ fn render(
             Ok((b, place(gpu_scene.storage_bytes(b), usage, &what)?))
         })
         .collect::<Result<Vec<_>>>()?;
-    let descriptors = Descriptors::new(&device, &frame, &storage)?;
-    let pipeline = Pipeline::new(&device, descriptors.set_layout, &shaders, width, height)?;
-    let target = Target::new(&device, pipeline.render_pass, width, height)?;
     let timestamps = Timestamps::new(&device)?;
-    let commands = Commands::record(&device, &pipeline, &descriptors, &target, timestamps.as_ref())?;
-
-    // The timed loop: one iteration = submit + wait, as the original study measured.
-    let mut frames = Vec::new();
-    let mut setup_ms = 0.0;
-    for i in 0..args.frame_count() {
-        let start = Instant::now();
-        if i == 0 {
-            setup_ms = (start - process_start).as_secs_f64() * 1e3;
+    let run_frames = |commands: &Commands| frame_loop(commands, timestamps.as_ref(), args.frame_count(), idle_wait, process_start);
+    let (frames, setup_ms, image) = match args.path {
+        RenderPath::Fragment => {
+            let shaders = shader::build(variant)?;
+            let descriptors = Descriptors::new(&device, &frame, &storage)?;
+            let pipeline = Pipeline::new(&device, descriptors.set_layout, &shaders, width, height)?;
+            let target = Target::new(&device, pipeline.render_pass, width, height)?;
+            let commands = Commands::record(&device, &pipeline, &descriptors, &target, timestamps.as_ref())?;
+            let (frames, setup_ms) = run_frames(&commands)?;
+            (frames, setup_ms, target.read_back(&device)?)
         }
-        commands.submit()?;
-        commands.wait(idle_wait)?;
-        let wall_ms = start.elapsed().as_secs_f64() * 1e3;
-        let gpu_ms = timestamps.as_ref().map(Timestamps::read_ms).transpose()?;
-        commands.reset_fence()?;
-        frames.push(FrameTime { gpu_ms, wall_ms });
-    }
-
-    let image = target.read_back(&device)?;
+        // The same tracer as a compute shader: compute.rs owns its pipeline and storage image.
+        RenderPath::Compute => {
+            let shader = shader::build_compute(variant, workgroup)?;
+            let compute = Compute::new(&device, &frame, &storage, &shader, width, height, timestamps.as_ref())?;
+            let (frames, setup_ms) = run_frames(&compute.commands)?;
+            (frames, setup_ms, compute.read_back(&device)?)
+        }
+    };
     let mut report = RunReport {
         api: "vulkan".into(),
         device: device.name.clone(),
@@ -142,6 +140,8 @@ fn render(
         ),
         width,
         height,
+        path: args.path,
+        workgroup: (args.path == RenderPath::Compute).then(|| workgroup.to_string()),
         frames,
         gpu_ms: None,
         wall_ms: None,
@@ -152,4 +152,30 @@ fn render(
     report.summarise();
     Ok((report, image))
     // Every Vulkan object is dropped here, newest first: commands, ..., device, instance.
+}
+
+/// The timed loop: one iteration = submit + wait, as the original study measured.
+/// Returns the frames and `setup_ms` (process start to the first submit).
+fn frame_loop(
+    commands: &Commands,
+    timestamps: Option<&Timestamps>,
+    count: u32,
+    idle_wait: bool,
+    process_start: Instant,
+) -> Result<(Vec<FrameTime>, f64)> {
+    let mut frames = Vec::new();
+    let mut setup_ms = 0.0;
+    for i in 0..count {
+        let start = Instant::now();
+        if i == 0 {
+            setup_ms = (start - process_start).as_secs_f64() * 1e3;
+        }
+        commands.submit()?;
+        commands.wait(idle_wait)?;
+        let wall_ms = start.elapsed().as_secs_f64() * 1e3;
+        let gpu_ms = timestamps.map(Timestamps::read_ms).transpose()?;
+        commands.reset_fence()?;
+        frames.push(FrameTime { gpu_ms, wall_ms });
+    }
+    Ok((frames, setup_ms))
 }

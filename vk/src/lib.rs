@@ -6,6 +6,7 @@
 
 pub mod app;
 pub mod commands;
+pub mod compute;
 pub mod descriptors;
 pub mod device;
 pub mod instance;
