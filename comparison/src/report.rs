@@ -506,3 +506,55 @@ fn plot(path: &Path, exp: &str, rows: &[&Outcome], study: &[StudyRow]) -> anyhow
     root.present()?;
     Ok(())
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::compare::Point;
+    use twinray_common::cli::Size;
+
+    fn outcome(api: Api, path: RenderPath, ms: f64) -> Outcome {
+        let json = format!(
+            r#"{{"api":"x","device":"d","driver":"v","api_version":"1","os":"o","scene":{{"name":"box","triangles":30,"spheres":2,"lights":1,"materials":3,"max_depth":5}},
+               "variant":"v","width":8,"height":8,{}"frames":[{{"gpu_ms":{ms},"wall_ms":{ms}}}],"gpu_ms":null,"wall_ms":null,
+               "nonfinite_pixels":0,"setup_ms":1.0,"validation_messages":0}}"#,
+            if path == RenderPath::Compute { r#""path":"compute","workgroup":"16x8","# } else { "" }
+        );
+        let mut r: RunReport = serde_json::from_str(&json).expect("a report without `path` still parses");
+        r.summarise();
+        let point = Point {
+            experiment: "box",
+            param_name: "resolution",
+            param_value: "8x8".into(),
+            scene: "box",
+            size: Size { width: 8, height: 8 },
+            set: vec![],
+            work: 1.0,
+        };
+        Outcome { point, api, path, result: Ok(r) }
+    }
+
+    #[test]
+    fn csv_has_a_path_column_and_the_summary_compares_paths() {
+        let rows = [
+            outcome(Api::Vulkan, RenderPath::Fragment, 10.0),
+            outcome(Api::Opengl, RenderPath::Fragment, 10.0),
+            outcome(Api::Vulkan, RenderPath::Compute, 1.0),
+            outcome(Api::Opengl, RenderPath::Compute, 2.0),
+        ];
+        let text = csv(&rows, "cpu");
+        let mut lines = text.lines();
+        let header: Vec<&str> = lines.next().unwrap().split(',').collect();
+        let col = |name: &str| header.iter().position(|h| *h == name).unwrap();
+        let body: Vec<Vec<&str>> = lines.map(|l| l.split(',').collect()).collect();
+        assert_eq!(body.len(), 4);
+        assert_eq!(body.iter().map(|r| r[col("path")]).collect::<Vec<_>>(), ["fragment", "fragment", "compute", "compute"]);
+        assert_eq!(body[2][col("workgroup")], "16x8");
+        assert_eq!(body[0][col("workgroup")], "");
+        assert!(body.iter().all(|r| r.len() == header.len()));
+        let summary = path_summary(&rows, &[]);
+        assert_eq!(summary.len(), 1, "{summary:?}");
+        assert!(summary[0].contains("1.00× on the fragment path, 0.50× on the compute path"), "{}", summary[0]);
+        assert!(summary[0].contains("Vulkan 10.00× faster, OpenGL 5.00× faster"), "{}", summary[0]);
+    }
+}
