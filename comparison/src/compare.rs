@@ -217,7 +217,7 @@ pub fn run(args: &CompareArgs) -> anyhow::Result<()> {
             let frames = match last.get(&(point.experiment, path)) {
                 Some(&(work, ms)) if ms > 0.0 => {
                     let predicted = ms * point.work / work;
-                    ((plan.seconds_per_point * 1e3 / predicted).floor() as u32).clamp(4, plan.frames)
+                    ((plan.seconds_per_point * 1e3 / predicted).floor() as u32).clamp(plan.frames.min(4), plan.frames)
                 }
                 _ => plan.frames,
             };

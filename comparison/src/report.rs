@@ -208,12 +208,40 @@ fn path_summary(outcomes: &[Outcome], study: &[StudyRow]) -> Vec<String> {
         };
         lines.push(format!(
             "- **{exp}, fragment → compute**: Vulkan/OpenGL {what} median {f:.2}× on the fragment path, {c:.2}× on the compute path: {verdict}. \
-             Compute over fragment ({what} time, median): Vulkan {} faster, OpenGL {} faster.",
+             Fragment time / compute time ({what}, median; above 1: compute faster): Vulkan {}, OpenGL {}.",
             speedup(Api::Vulkan),
             speedup(Api::Opengl)
         ));
     }
     lines
+}
+
+/// The four numbers per experiment at its largest point (teapot and box at
+/// 1000² in the full preset): VK-frag, VK-comp, GL-frag, GL-comp, GPU and wall medians.
+fn four_numbers(outcomes: &[Outcome]) -> String {
+    let mut s = String::from(
+        "| experiment | point | VK fragment | VK compute | GL fragment | GL compute |\n|---|---|---|---|---|---|\n",
+    );
+    let mut any = false;
+    for exp in EXPERIMENTS {
+        let rows: Vec<&Outcome> = outcomes.iter().filter(|o| o.point.experiment == exp).collect();
+        let Some(last) = rows.last().map(|o| o.point.param_value.clone()) else { continue };
+        let cell = |api: Api, path: RenderPath| {
+            let r = report_of(&rows, &last, api, path);
+            let med = |gpu: bool| r.and_then(|r| if gpu { r.gpu_ms } else { r.wall_ms }).map(|x| x.median);
+            format!("{} / {}", f(med(true), 3), f(med(false), 3))
+        };
+        any = true;
+        let _ = writeln!(
+            s,
+            "| {exp} | {last} | {} | {} | {} | {} |",
+            cell(Api::Vulkan, RenderPath::Fragment),
+            cell(Api::Vulkan, RenderPath::Compute),
+            cell(Api::Opengl, RenderPath::Fragment),
+            cell(Api::Opengl, RenderPath::Compute)
+        );
+    }
+    if any { s } else { String::new() }
 }
 
 pub fn markdown(plan: &Plan, outcomes: &[Outcome], agreement: &[Agreement], study: &[StudyRow], cpu: &str, plots: &[String], interrupted: bool) -> String {
@@ -265,6 +293,8 @@ pub fn markdown(plan: &Plan, outcomes: &[Outcome], agreement: &[Agreement], stud
         for line in path_summary(outcomes, study) {
             let _ = writeln!(s, "{line}");
         }
+        let _ = writeln!(s, "\nEach experiment's largest point on both paths, median GPU ms / wall ms:\n");
+        let _ = write!(s, "{}", four_numbers(outcomes));
     }
     let _ = writeln!(s);
     if interrupted {
@@ -274,7 +304,7 @@ pub fn markdown(plan: &Plan, outcomes: &[Outcome], agreement: &[Agreement], stud
         s,
         "Ratios are Vulkan time / OpenGL time (above 1: OpenGL faster). Wall time is one render-loop iteration \
          (submit + wait), as the study measured; GPU time comes from Vulkan timestamps and GL_TIME_ELAPSED queries \
-         around the draw. Preset: {}; up to {} frames per point (fewer for slow points, about {} s per app per point), \
+         around the draw (fragment path) or the dispatch (compute path); the study measured the fragment path only. Preset: {}; up to {} frames per point (fewer for slow points, about {} s per app per point), \
          statistics over the last 30 (or the last half of shorter runs). Each API runs in its own process, the order \
          alternating from point to point. The study's times are seconds per frame; ours are milliseconds.\n",
         plan.preset, plan.frames, plan.seconds_per_point
@@ -555,6 +585,8 @@ mod tests {
         let summary = path_summary(&rows, &[]);
         assert_eq!(summary.len(), 1, "{summary:?}");
         assert!(summary[0].contains("1.00× on the fragment path, 0.50× on the compute path"), "{}", summary[0]);
-        assert!(summary[0].contains("Vulkan 10.00× faster, OpenGL 5.00× faster"), "{}", summary[0]);
+        assert!(summary[0].contains("Vulkan 10.00×, OpenGL 5.00×"), "{}", summary[0]);
+        let four = four_numbers(&rows);
+        assert!(four.contains("| box | 8x8 | 10.000 / 10.000 | 1.000 / 1.000 | 10.000 / 10.000 | 2.000 / 2.000 |"), "{four}");
     }
 }
