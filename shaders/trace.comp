@@ -11,7 +11,7 @@
 // so invocations past the right and bottom edges return at once.
 
 #ifndef WG_X
-#define WG_X 8
+#define WG_X 16
 #endif
 #ifndef WG_Y
 #define WG_Y 8
