@@ -1,6 +1,7 @@
 // trace.glsl — the one Whitted-style tracer shared by every entry point.
 //
-// Rust concatenates: a `#version` line, this file, then an entry point (trace.frag).
+// Rust concatenates: a `#version` line, this file, then an entry point (trace.frag
+// or trace.comp).
 // naga has no #include. Every struct here is mirrored by a #[repr(C)] struct in
 // common/src/gpu.rs and a test checks that naga's layout equals the Rust one.
 //
@@ -74,9 +75,9 @@ layout(std140, set = 0, binding = 0) uniform Frame {
     vec3 background;
     uint triangle_count;
     uint light_count;
-    uint pad0;
-    uint pad1;
-    uint pad2;
+    uint width;   // image size in pixels: the compute entry point's bounds check
+    uint height;
+    uint pad;
 } frame;
 
 layout(std430, set = 0, binding = 1) readonly buffer Spheres {

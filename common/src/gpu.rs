@@ -21,7 +21,11 @@ pub struct GpuFrame {
     pub background: [f32; 3],
     pub triangle_count: u32,
     pub light_count: u32,
-    pub pad: [u32; 3],
+    /// The image size, for the compute entry point's bounds check (the fragment
+    /// path's viewport does that job there).
+    pub width: u32,
+    pub height: u32,
+    pub pad: u32,
 }
 
 /// `Sphere` (std430 array element, binding 1).
@@ -108,6 +112,8 @@ pub mod binding {
     pub const TRIANGLES: u32 = 2;
     pub const MATERIALS: u32 = 3;
     pub const LIGHTS: u32 = 4;
+    /// The compute path's RGBA32F storage image (the fragment path has a colour attachment instead).
+    pub const IMAGE: u32 = 5;
     /// 5 is the compute path's output image.
     pub const BVH_NODES: u32 = 6;
     pub const BVH_PRIMS: u32 = 7;
@@ -150,7 +156,9 @@ impl GpuFrame {
             background: v3(scene.background),
             triangle_count: scene.triangles.len() as u32,
             light_count: scene.lights.len() as u32,
-            pad: [0; 3],
+            width,
+            height,
+            pad: 0,
         }
     }
 }

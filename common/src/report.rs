@@ -1,6 +1,7 @@
 //! The JSON object each app prints with `--json`: the contract between the apps
 //! and the `twinray` orchestrator (which reads it back with the same struct).
 
+use crate::cli::RenderPath;
 use crate::scene::SceneStats;
 use crate::stats::{summarize, Summary};
 use serde::{Deserialize, Serialize};
@@ -25,6 +26,13 @@ pub struct RunReport {
     pub variant: String,
     pub width: u32,
     pub height: u32,
+    /// Which entry point traced: fragment or compute (absent in reports from
+    /// before the compute path: those were fragment runs).
+    #[serde(default)]
+    pub path: RenderPath,
+    /// The compute workgroup as "16x8"; None for the fragment path.
+    #[serde(default)]
+    pub workgroup: Option<String>,
     pub frames: Vec<FrameTime>,
     pub gpu_ms: Option<Summary>,
     pub wall_ms: Option<Summary>,

@@ -2,6 +2,7 @@
 //! scene's variant through defines, validates the naga module once, and writes
 //! SPIR-V for Vulkan and GLSL 450 core for OpenGL from that same module.
 
+use crate::cli::Workgroup;
 use crate::scene::{Features, Scene, MAX_DEPTH_LIMIT};
 use anyhow::{anyhow, Context};
 use naga::back::{glsl, spv};
@@ -12,6 +13,7 @@ use std::collections::BTreeMap;
 pub const TRACE_GLSL: &str = include_str!("../../shaders/trace.glsl");
 pub const TRACE_FRAG: &str = include_str!("../../shaders/trace.frag");
 pub const FULLSCREEN_VERT: &str = include_str!("../../shaders/fullscreen.vert");
+pub const TRACE_COMP: &str = include_str!("../../shaders/trace.comp");
 
 /// The defines that select a shader variant. Same map → same module → same code
 /// in both APIs.
@@ -81,6 +83,11 @@ pub fn fragment_source() -> String {
     format!("#version 450\n{TRACE_GLSL}\n{TRACE_FRAG}")
 }
 
+/// The compute source as naga sees it: the same tracer, the compute entry point.
+pub fn compute_source() -> String {
+    format!("#version 450\n{TRACE_GLSL}\n{TRACE_COMP}")
+}
+
 /// Parses and validates one stage.
 pub fn parse(source: &str, stage: ShaderStage, variant: &Variant) -> anyhow::Result<(Module, ModuleInfo)> {
     let mut options = naga::front::glsl::Options::from(stage);
@@ -118,6 +125,31 @@ pub fn build(variant: &Variant) -> anyhow::Result<Shaders> {
     })
 }
 
+/// The tracer as a compute shader, for both APIs.
+#[derive(Debug, Clone)]
+pub struct ComputeShader {
+    pub variant: Variant,
+    pub workgroup: Workgroup,
+    pub spirv: Vec<u32>,
+    pub glsl: String,
+}
+
+/// The scene's variant plus the workgroup size, which reaches the shader as the
+/// WG_X/WG_Y defines: `local_size` must be a constant, and a define keeps it out
+/// of the specialisation-constant path naga's writers handle poorly.
+pub fn build_compute(variant: &Variant, workgroup: Workgroup) -> anyhow::Result<ComputeShader> {
+    let mut v = variant.clone();
+    v.defines.insert("WG_X".into(), workgroup.x.to_string());
+    v.defines.insert("WG_Y".into(), workgroup.y.to_string());
+    let (m, i) = parse(&compute_source(), ShaderStage::Compute, &v)?;
+    Ok(ComputeShader {
+        variant: variant.clone(),
+        workgroup,
+        spirv: to_spirv(&m, &i, ShaderStage::Compute)?,
+        glsl: to_glsl(&m, &i, ShaderStage::Compute)?,
+    })
+}
+
 pub fn to_spirv(module: &Module, info: &ModuleInfo, stage: ShaderStage) -> anyhow::Result<Vec<u32>> {
     // No ADJUST_COORDINATE_SPACE (y stays as written, see trace.frag) and no DEBUG,
     // so debug and release builds emit identical SPIR-V.
@@ -131,6 +163,8 @@ pub fn to_glsl(module: &Module, info: &ModuleInfo, stage: ShaderStage) -> anyhow
     // resource its (set 0) binding explicitly. UBOs and SSBOs have separate
     // binding spaces in GL, so the numbers carry over unchanged.
     let mut binding_map = glsl::BindingMap::default();
+    // The storage image (compute only) is bound to image unit 5, yet another
+    // binding space in GL; 6 and 7 are the BVH's storage buffers.
     for b in 0..=crate::gpu::binding::LAST {
         binding_map.insert(naga::ResourceBinding { group: 0, binding: b }, b as u8);
     }
@@ -208,5 +242,17 @@ mod tests {
         assert_eq!(count(&s.fragment_spirv, 16, 7), 1);
         assert_eq!(count(&gl, 16, 8), 1);
         assert_eq!(gl.len(), s.fragment_spirv.len() - 5 * 4, "only the five 4-word decorations go");
+    }
+
+    #[test]
+    fn compute_shader_builds_with_each_measured_workgroup() {
+        for wg in Workgroup::MEASURED {
+            let c = build_compute(&Variant::generic(), wg).unwrap();
+            assert_eq!(c.spirv[0], 0x0723_0203, "SPIR-V magic");
+            let local = format!("layout(local_size_x = {}, local_size_y = {}, local_size_z = 1) in;", wg.x, wg.y);
+            assert!(c.glsl.contains(&local), "{wg}: {}", &c.glsl[..200]);
+            assert!(c.glsl.contains("binding = 5"), "the storage image is bound by number");
+            assert!(c.glsl.contains("imageStore"));
+        }
     }
 }

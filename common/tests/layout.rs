@@ -56,7 +56,7 @@ fn naga_layout_matches_rust_for_every_shader_struct() {
         naga_members(&module, frame_ty),
         rust_offsets!(GpuFrame {
             eye, min_weight, top_left, epsilon, step_x, max_depth, step_y, sphere_count, background,
-            triangle_count, light_count, pad[0], pad[1], pad[2]
+            triangle_count, light_count, width, height, pad
         }),
         size_of::<GpuFrame>(),
     );

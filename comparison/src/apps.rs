@@ -70,6 +70,10 @@ pub fn app_args(args: &RenderArgs) -> Vec<String> {
         v.push("--gl-spirv".into());
     }
     v.extend(["--accel".into(), args.accel.name().into()]);
+    v.extend(["--path".into(), args.path.to_string()]);
+    if let Some(wg) = args.workgroup {
+        v.extend(["--workgroup".into(), wg.to_string()]);
+    }
     v
 }
 
@@ -141,6 +145,8 @@ pub fn render_reference(args: &RenderArgs) -> anyhow::Result<()> {
             variant: "f64".into(),
             width: w,
             height: h,
+            path: Default::default(),
+            workgroup: None,
             frames: vec![FrameTime { gpu_ms: None, wall_ms: ms }],
             gpu_ms: None,
             wall_ms: None,

@@ -7,7 +7,7 @@ use anyhow::Context;
 use std::path::PathBuf;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::Arc;
-use twinray_common::cli::{parse_size, Accel, RenderArgs, Size};
+use twinray_common::cli::{parse_size, parse_workgroup, Accel, RenderArgs, RenderPath, Size, Workgroup};
 use twinray_common::report::RunReport;
 
 #[derive(clap::Args, Debug, Clone)]
@@ -35,6 +35,13 @@ pub struct CompareArgs {
     /// Only these experiments (teapot, box, spherelist), comma-separated.
     #[arg(long, value_delimiter = ',')]
     pub only: Vec<String>,
+    /// The tracer's entry points to measure, comma-separated: every point runs
+    /// both APIs on each of them.
+    #[arg(long, value_enum, value_delimiter = ',', default_values_t = [RenderPath::Fragment, RenderPath::Compute])]
+    pub paths: Vec<RenderPath>,
+    /// The compute path's workgroup WxH (default: the apps' default).
+    #[arg(long, value_name = "WxH", value_parser = parse_workgroup)]
+    pub workgroup: Option<Workgroup>,
 }
 
 #[derive(Debug, Clone)]
@@ -124,6 +131,7 @@ pub fn plan(args: &CompareArgs) -> anyhow::Result<Plan> {
 pub struct Outcome {
     pub point: Point,
     pub api: Api,
+    pub path: RenderPath,
     pub result: Result<RunReport, String>,
 }
 
@@ -168,45 +176,56 @@ pub fn run(args: &CompareArgs) -> anyhow::Result<()> {
         let stop = stop.clone();
         ctrlc::set_handler(move || stop.store(true, Ordering::SeqCst)).context("installing the Ctrl-C handler")?;
     }
+    let mut paths = args.paths.clone();
+    paths.dedup();
+    if paths.is_empty() {
+        return Err(twinray_common::error::bad_input("--paths names no path; use fragment, compute or both"));
+    }
     let apis = if args.gl_spirv { 3 } else { 2 };
+    let runs = apis * paths.len();
     eprintln!(
-        "twinray compare: {} preset, {} points x {apis} APIs, up to {} frames each (about {} s per app per point at most) -> {}",
+        "twinray compare: {} preset, {} points x {apis} APIs x {} paths ({}), up to {} frames each (about {} s per app per point at most) -> {}",
         plan.preset,
         plan.points.len(),
+        paths.len(),
+        paths.iter().map(|p| p.name()).collect::<Vec<_>>().join(", "),
         plan.frames,
         plan.seconds_per_point,
         args.out.display()
     );
-    let bar = indicatif::ProgressBar::new((plan.points.len() * apis) as u64);
+    let bar = indicatif::ProgressBar::new((plan.points.len() * runs) as u64);
     bar.set_style(
         indicatif::ProgressStyle::with_template("{bar:40} {pos}/{len} [{elapsed_precise} elapsed, ETA {eta}] {msg}")
             .expect("valid template"),
     );
     let mut outcomes: Vec<Outcome> = Vec::new();
     let mut interrupted = false;
-    // Frame-time prediction per experiment: (work, wall ms) of the last finished point.
-    let mut last: std::collections::HashMap<&str, (f64, f64)> = Default::default();
+    // Frame-time prediction per experiment and path (on a GPU the paths differ by
+    // up to 30x): (work, wall ms) of the last finished point.
+    let mut last: std::collections::HashMap<(&str, RenderPath), (f64, f64)> = Default::default();
     'points: for (i, point) in plan.points.iter().enumerate() {
-        let mut order = vec![Api::Vulkan, Api::Opengl];
+        let mut apis = vec![Api::Vulkan, Api::Opengl];
         if args.gl_spirv {
-            order.push(Api::OpenglSpirv);
+            apis.push(Api::OpenglSpirv);
         }
+        let mut order: Vec<(RenderPath, Api)> =
+            paths.iter().flat_map(|&p| apis.iter().map(move |&a| (p, a))).collect();
         if i % 2 == 1 {
             order.reverse();
         }
-        let frames = match last.get(point.experiment) {
-            Some(&(work, ms)) if ms > 0.0 => {
-                let predicted = ms * point.work / work;
-                ((plan.seconds_per_point * 1e3 / predicted).floor() as u32).clamp(4, plan.frames)
-            }
-            _ => plan.frames,
-        };
-        for api in order {
+        for (path, api) in order {
+            let frames = match last.get(&(point.experiment, path)) {
+                Some(&(work, ms)) if ms > 0.0 => {
+                    let predicted = ms * point.work / work;
+                    ((plan.seconds_per_point * 1e3 / predicted).floor() as u32).clamp(plan.frames.min(4), plan.frames)
+                }
+                _ => plan.frames,
+            };
             if stop.load(Ordering::SeqCst) {
                 interrupted = true;
                 break 'points;
             }
-            bar.set_message(format!("{} {} {}", point.experiment, point.param_value, api_name(api)));
+            bar.set_message(format!("{} {} {} {path}", point.experiment, point.param_value, api_name(api)));
             let ra = RenderArgs {
                 frames: Some(frames),
                 out: None,
@@ -214,6 +233,8 @@ pub fn run(args: &CompareArgs) -> anyhow::Result<()> {
                 set: point.set.clone(),
                 // The study's tracer tests every primitive: so do the sweeps.
                 accel: Accel::None,
+                path,
+                workgroup: if path == RenderPath::Compute { args.workgroup } else { None },
                 ..RenderArgs::headless(point.scene, point.size)
             };
             let result = run_json(api, &ra).map_err(|e| format!("{e:#}"));
@@ -224,23 +245,27 @@ pub fn run(args: &CompareArgs) -> anyhow::Result<()> {
             }
             if let Ok(r) = &result {
                 if let Some(w) = r.wall_ms {
-                    last.insert(point.experiment, (point.work, w.median));
+                    last.insert((point.experiment, path), (point.work, w.median));
                 }
             } else if let Err(e) = &result {
-                bar.println(format!("  {} {} {}: FAILED: {e}", point.experiment, point.param_value, api_name(api)));
+                bar.println(format!("  {} {} {} {path}: FAILED: {e}", point.experiment, point.param_value, api_name(api)));
             }
-            outcomes.push(Outcome { point: point.clone(), api, result });
+            outcomes.push(Outcome { point: point.clone(), api, path, result });
             bar.inc(1);
         }
     }
     bar.finish_and_clear();
     let accel = if interrupted { Vec::new() } else { acceleration(&plan, &stop) };
-    let agreement = if interrupted || stop.load(Ordering::SeqCst) { Vec::new() } else { agreement(&args.out, &plan, &stop) };
+    let agreement = if interrupted || stop.load(Ordering::SeqCst) {
+        Vec::new()
+    } else {
+        agreement(&args.out, &plan, &paths, args.workgroup, &stop)
+    };
     crate::report::write_all(&args.out, &plan, &outcomes, &accel, &agreement, interrupted)?;
     eprintln!(
         "twinray compare: {} of {} runs done{}; report: {}",
         outcomes.iter().filter(|o| o.result.is_ok()).count(),
-        plan.points.len() * apis,
+        plan.points.len() * runs,
         if interrupted { " (interrupted: the finished points are kept)" } else { "" },
         args.out.join("report.md").display()
     );
@@ -256,11 +281,19 @@ pub struct Agreement {
     pub scene: &'static str,
     pub size: Size,
     pub result: Result<[twinray_common::metrics::Metrics; 3], String>,
+    /// With the compute path measured: each API's compute image against its fragment image.
+    pub paths: Option<Result<[twinray_common::metrics::Metrics; 2], String>>,
 }
 
 /// Renders each built-in scene once with both apps and the reference, keeps the
 /// PNGs under images/, and measures how far apart they are.
-pub fn agreement(out: &std::path::Path, plan: &Plan, stop: &AtomicBool) -> Vec<Agreement> {
+pub fn agreement(
+    out: &std::path::Path,
+    plan: &Plan,
+    paths: &[RenderPath],
+    workgroup: Option<Workgroup>,
+    stop: &AtomicBool,
+) -> Vec<Agreement> {
     let dir = out.join("images");
     let mut rows = Vec::new();
     if std::fs::create_dir_all(&dir).is_err() {
@@ -316,7 +349,43 @@ pub fn agreement(out: &std::path::Path, plan: &Plan, stop: &AtomicBool) -> Vec<A
         } else if let Err(e) = &result {
             eprintln!("  {scene}: agreement check failed: {e}");
         }
-        rows.push(Agreement { scene, size, result });
+        // The compute path against the fragment path, API by API: the same tracer
+        // through another entry point must give the same image.
+        let compute = paths.contains(&RenderPath::Compute) && result.is_ok();
+        let paths = compute.then(|| {
+            (|| -> anyhow::Result<[twinray_common::metrics::Metrics; 2]> {
+                let mut m = Vec::new();
+                for api in [Api::Vulkan, Api::Opengl] {
+                    let frag = dir.join(format!("{scene}-{}.png", api_name(api)));
+                    let png = dir.join(format!("{scene}-{}-compute.png", api_name(api)));
+                    let ra = RenderArgs {
+                        frames: Some(1),
+                        out: Some(png.clone()),
+                        json: true,
+                        set: set.clone(),
+                        path: RenderPath::Compute,
+                        workgroup,
+                        ..RenderArgs::headless(scene, size)
+                    };
+                    let r = run_json(api, &ra)?;
+                    let mut metrics = twinray_common::metrics::compare(
+                        &twinray_common::image_io::load_png(&png)?,
+                        &twinray_common::image_io::load_png(&frag)?,
+                    )?;
+                    metrics.nan_pixels = r.nonfinite_pixels;
+                    m.push(metrics);
+                }
+                Ok([m[0], m[1]])
+            })()
+            .map_err(|e| format!("{e:#}"))
+        });
+        if let Some(Ok(m)) = &paths {
+            let label = |w: &str| format!("{scene} {w}");
+            crate::diff::print_table(&[(&label("vulkan compute vs fragment"), m[0]), (&label("opengl compute vs fragment"), m[1])]);
+        } else if let Some(Err(e)) = &paths {
+            eprintln!("  {scene}: compute agreement check failed: {e}");
+        }
+        rows.push(Agreement { scene, size, result, paths });
     }
     rows
 }

@@ -9,6 +9,7 @@ use anyhow::Context;
 use plotters::prelude::*;
 use std::fmt::Write as _;
 use std::path::Path;
+use twinray_common::cli::RenderPath;
 use twinray_common::report::RunReport;
 
 pub fn cpu_model() -> String {
@@ -42,7 +43,7 @@ pub fn write_all(out: &Path, plan: &Plan, outcomes: &[Outcome], accel: &[AccelRu
     Ok(())
 }
 
-const CSV_HEADER: &str = "experiment,param_name,param_value,api,status,frames,wall_mean_ms,wall_median_ms,wall_min_ms,wall_max_ms,gpu_mean_ms,gpu_median_ms,gpu_min_ms,gpu_max_ms,setup_ms,nonfinite_pixels,variant,width,height,device,driver,api_version,os,cpu";
+const CSV_HEADER: &str = "experiment,param_name,param_value,api,path,workgroup,status,frames,wall_mean_ms,wall_median_ms,wall_min_ms,wall_max_ms,gpu_mean_ms,gpu_median_ms,gpu_min_ms,gpu_max_ms,setup_ms,nonfinite_pixels,variant,width,height,device,driver,api_version,os,cpu";
 
 fn q(s: &str) -> String {
     if s.contains([',', '"', '\n']) {
@@ -57,7 +58,8 @@ pub fn csv(outcomes: &[Outcome], cpu: &str) -> String {
     s.push('\n');
     for o in outcomes {
         let p = &o.point;
-        let head = format!("{},{},{},{}", p.experiment, p.param_name, p.param_value, api_name(o.api));
+        let workgroup = o.result.as_ref().ok().and_then(|r| r.workgroup.clone()).unwrap_or_default();
+        let head = format!("{},{},{},{},{},{workgroup}", p.experiment, p.param_name, p.param_value, api_name(o.api), o.path);
         match &o.result {
             Ok(r) => {
                 let st = |x: Option<twinray_common::stats::Summary>| match x {
@@ -90,8 +92,16 @@ pub fn csv(outcomes: &[Outcome], cpu: &str) -> String {
     s
 }
 
-fn report_of<'a>(outcomes: &'a [&Outcome], value: &str, api: Api) -> Option<&'a RunReport> {
-    outcomes.iter().find(|o| o.point.param_value == value && o.api == api).and_then(|o| o.result.as_ref().ok())
+fn report_of<'a>(outcomes: &'a [&Outcome], value: &str, api: Api, path: RenderPath) -> Option<&'a RunReport> {
+    outcomes
+        .iter()
+        .find(|o| o.point.param_value == value && o.api == api && o.path == path)
+        .and_then(|o| o.result.as_ref().ok())
+}
+
+/// The paths that have at least one row, fragment first.
+fn paths_in(outcomes: &[Outcome]) -> Vec<RenderPath> {
+    [RenderPath::Fragment, RenderPath::Compute].into_iter().filter(|p| outcomes.iter().any(|o| o.path == *p)).collect()
 }
 
 fn ratio(a: Option<f64>, b: Option<f64>) -> Option<f64> {
@@ -122,21 +132,21 @@ struct ExpRatios {
     spirv: Vec<f64>,
 }
 
-fn ratios(exp: &str, outcomes: &[Outcome], study: &[StudyRow]) -> ExpRatios {
-    let rows: Vec<&Outcome> = outcomes.iter().filter(|o| o.point.experiment == exp).collect();
+fn ratios(exp: &str, path: RenderPath, outcomes: &[Outcome], study: &[StudyRow]) -> ExpRatios {
+    let rows: Vec<&Outcome> = outcomes.iter().filter(|o| o.point.experiment == exp && o.path == path).collect();
     let mut values: Vec<String> = rows.iter().map(|o| o.point.param_value.clone()).collect();
     values.dedup();
     let mut r = ExpRatios { wall: vec![], gpu: vec![], study: vec![], spirv: vec![] };
     for v in &values {
-        let vk = report_of(&rows, v, Api::Vulkan);
-        let gl = report_of(&rows, v, Api::Opengl);
+        let vk = report_of(&rows, v, Api::Vulkan, path);
+        let gl = report_of(&rows, v, Api::Opengl, path);
         if let Some(x) = ratio(vk.and_then(|r| r.wall_ms).map(|s| s.median), gl.and_then(|r| r.wall_ms).map(|s| s.median)) {
             r.wall.push(x);
         }
         if let Some(x) = ratio(vk.and_then(|r| r.gpu_ms).map(|s| s.median), gl.and_then(|r| r.gpu_ms).map(|s| s.median)) {
             r.gpu.push(x);
         }
-        let glspv = report_of(&rows, v, Api::OpenglSpirv);
+        let glspv = report_of(&rows, v, Api::OpenglSpirv, path);
         if let Some(x) = ratio(vk.and_then(|r| r.gpu_ms).map(|s| s.median), glspv.and_then(|r| r.gpu_ms).map(|s| s.median)) {
             r.spirv.push(x);
         }
@@ -163,15 +173,92 @@ fn describe(label: &str, v: &[f64]) -> String {
     }
 }
 
+/// How Vulkan vs OpenGL changes between the paths, one line per experiment:
+/// the median Vulkan/OpenGL ratio on each path (GPU time where both paths have
+/// it, else wall time), and each API's speed-up from fragment to compute.
+fn path_summary(outcomes: &[Outcome], study: &[StudyRow]) -> Vec<String> {
+    let mut lines = Vec::new();
+    for exp in EXPERIMENTS {
+        let frag = ratios(exp, RenderPath::Fragment, outcomes, study);
+        let comp = ratios(exp, RenderPath::Compute, outcomes, study);
+        let (what, f, c) = if !frag.gpu.is_empty() && !comp.gpu.is_empty() {
+            ("GPU", range(&frag.gpu), range(&comp.gpu))
+        } else {
+            ("wall", range(&frag.wall), range(&comp.wall))
+        };
+        let (Some((_, f, _)), Some((_, c, _))) = (f, c) else { continue };
+        let verdict = if (c - f).abs() < 0.03 * f {
+            "the API gap does not depend on the entry point".to_string()
+        } else if c < f {
+            format!("Vulkan gains {:.0} % on OpenGL when the tracer runs as a compute shader", 100.0 * (1.0 - c / f))
+        } else {
+            format!("Vulkan loses {:.0} % to OpenGL when the tracer runs as a compute shader", 100.0 * (c / f - 1.0))
+        };
+        // Each API's fragment time / compute time, median over the points.
+        let rows: Vec<&Outcome> = outcomes.iter().filter(|o| o.point.experiment == exp).collect();
+        let mut values: Vec<String> = rows.iter().map(|o| o.point.param_value.clone()).collect();
+        values.dedup();
+        let speedup = |api: Api| {
+            let v: Vec<f64> = values
+                .iter()
+                .filter_map(|v| {
+                    let t = |path| {
+                        report_of(&rows, v, api, path).and_then(|r| if what == "GPU" { r.gpu_ms } else { r.wall_ms }).map(|x| x.median)
+                    };
+                    ratio(t(RenderPath::Fragment), t(RenderPath::Compute))
+                })
+                .collect();
+            range(&v).map(|(_, m, _)| format!("{m:.2}×")).unwrap_or_else(|| "–".into())
+        };
+        lines.push(format!(
+            "- **{exp}, fragment → compute**: Vulkan/OpenGL {what} median {f:.2}× on the fragment path, {c:.2}× on the compute path: {verdict}. \
+             Fragment time / compute time ({what}, median; above 1: compute faster): Vulkan {}, OpenGL {}.",
+            speedup(Api::Vulkan),
+            speedup(Api::Opengl)
+        ));
+    }
+    lines
+}
+
+/// The four numbers per experiment at its largest point (teapot and box at
+/// 1000² in the full preset): VK-frag, VK-comp, GL-frag, GL-comp, GPU and wall medians.
+fn four_numbers(outcomes: &[Outcome]) -> String {
+    let mut s = String::from(
+        "| experiment | point | VK fragment | VK compute | GL fragment | GL compute |\n|---|---|---|---|---|---|\n",
+    );
+    let mut any = false;
+    for exp in EXPERIMENTS {
+        let rows: Vec<&Outcome> = outcomes.iter().filter(|o| o.point.experiment == exp).collect();
+        let Some(last) = rows.last().map(|o| o.point.param_value.clone()) else { continue };
+        let cell = |api: Api, path: RenderPath| {
+            let r = report_of(&rows, &last, api, path);
+            let med = |gpu: bool| r.and_then(|r| if gpu { r.gpu_ms } else { r.wall_ms }).map(|x| x.median);
+            format!("{} / {}", f(med(true), 3), f(med(false), 3))
+        };
+        any = true;
+        let _ = writeln!(
+            s,
+            "| {exp} | {last} | {} | {} | {} | {} |",
+            cell(Api::Vulkan, RenderPath::Fragment),
+            cell(Api::Vulkan, RenderPath::Compute),
+            cell(Api::Opengl, RenderPath::Fragment),
+            cell(Api::Opengl, RenderPath::Compute)
+        );
+    }
+    if any { s } else { String::new() }
+}
+
 pub fn markdown(plan: &Plan, outcomes: &[Outcome], accel: &[AccelRun], agreement: &[Agreement], study: &[StudyRow], cpu: &str, plots: &[String], interrupted: bool) -> String {
     let mut s = String::new();
     let any = |api: Api| outcomes.iter().find(|o| o.api == api).and_then(|o| o.result.as_ref().ok());
     let device = any(Api::Vulkan).or(any(Api::Opengl)).map(|r| r.device.clone()).unwrap_or_else(|| "no device".into());
     let _ = writeln!(s, "# twinray compare — {device}\n");
 
-    // The summary: one line per experiment, computed from the rows below.
+    // The summary: one line per experiment and path, computed from the rows below.
+    let paths = paths_in(outcomes);
     for exp in EXPERIMENTS {
-        let r = ratios(exp, outcomes, study);
+      for &path in &paths {
+        let r = ratios(exp, path, outcomes, study);
         if r.wall.is_empty() && r.gpu.is_empty() {
             continue;
         }
@@ -198,11 +285,20 @@ pub fn markdown(plan: &Plan, outcomes: &[Outcome], accel: &[AccelRun], agreement
         };
         let _ = writeln!(
             s,
-            "- **{exp}**: Vulkan/OpenGL {}; {}; study {}. {why}.{spirv}",
+            "- **{exp}, {path} path**: Vulkan/OpenGL {}; {}; study (fragment) {}. {why}.{spirv}",
             describe("wall", &r.wall),
             describe("GPU", &r.gpu),
             describe("", &r.study).trim_start()
         );
+      }
+    }
+    if paths.len() == 2 {
+        let _ = writeln!(s);
+        for line in path_summary(outcomes, study) {
+            let _ = writeln!(s, "{line}");
+        }
+        let _ = writeln!(s, "\nEach experiment's largest point on both paths, median GPU ms / wall ms:\n");
+        let _ = write!(s, "{}", four_numbers(outcomes));
     }
     let _ = writeln!(s);
     if interrupted {
@@ -212,7 +308,7 @@ pub fn markdown(plan: &Plan, outcomes: &[Outcome], accel: &[AccelRun], agreement
         s,
         "Ratios are Vulkan time / OpenGL time (above 1: OpenGL faster). Wall time is one render-loop iteration \
          (submit + wait), as the study measured; GPU time comes from Vulkan timestamps and GL_TIME_ELAPSED queries \
-         around the draw. Preset: {}; up to {} frames per point (fewer for slow points, about {} s per app per point), \
+         around the draw (fragment path) or the dispatch (compute path); the study measured the fragment path only. Preset: {}; up to {} frames per point (fewer for slow points, about {} s per app per point), \
          statistics over the last 30 (or the last half of shorter runs). Each API runs in its own process, the order \
          alternating from point to point. The study's times are seconds per frame; ours are milliseconds.\n",
         plan.preset, plan.frames, plan.seconds_per_point
@@ -245,6 +341,15 @@ pub fn markdown(plan: &Plan, outcomes: &[Outcome], accel: &[AccelRun], agreement
         if plots.contains(&format!("{exp}.svg")) {
             let _ = writeln!(s, "![{exp}]({exp}.svg)\n");
         }
+        let all_rows = rows;
+      for &path in &paths {
+        let rows: Vec<&Outcome> = all_rows.iter().copied().filter(|o| o.path == path).collect();
+        if rows.is_empty() {
+            continue;
+        }
+        if paths.len() > 1 {
+            let _ = writeln!(s, "### {} path\n", path);
+        }
         let has_spirv = rows.iter().any(|o| o.api == Api::OpenglSpirv);
         let _ = writeln!(
             s,
@@ -257,11 +362,11 @@ pub fn markdown(plan: &Plan, outcomes: &[Outcome], accel: &[AccelRun], agreement
         values.dedup();
         for v in &values {
             let st = study::find(study, exp, v);
-            let vk = report_of(&rows, v, Api::Vulkan);
-            let gl = report_of(&rows, v, Api::Opengl);
+            let vk = report_of(&rows, v, Api::Vulkan, path);
+            let gl = report_of(&rows, v, Api::Opengl, path);
             let med = |r: Option<&RunReport>, gpu: bool| r.and_then(|r| if gpu { r.gpu_ms } else { r.wall_ms }).map(|x| x.median);
             let frames = |r: Option<&RunReport>| r.map(|r| r.frames.len().to_string()).unwrap_or_else(|| "failed".into());
-            let glspv = report_of(&rows, v, Api::OpenglSpirv);
+            let glspv = report_of(&rows, v, Api::OpenglSpirv, path);
             let extra = if has_spirv {
                 format!(" {} | {} |", f(med(glspv, true), 3), f(ratio(med(vk, true), med(glspv, true)), 2))
             } else {
@@ -284,6 +389,7 @@ pub fn markdown(plan: &Plan, outcomes: &[Outcome], accel: &[AccelRun], agreement
             );
         }
         let _ = writeln!(s);
+      }
     }
 
     if !accel.is_empty() {
@@ -341,13 +447,37 @@ pub fn markdown(plan: &Plan, outcomes: &[Outcome], accel: &[AccelRun], agreement
              reference (spherelist with 100 extra spheres). Share of pixels within 1/255 on every channel, the largest \
              channel difference in 1/255 steps, and pixels that were NaN/Inf before quantisation.\n"
         );
-        let _ = writeln!(s, "| scene | size | VK vs GL | VK vs reference | GL vs reference | max abs VK/GL/ref | NaN |\n|---|---|---|---|---|---|---|");
+        let with_paths = agreement.iter().any(|a| a.paths.is_some());
+        if with_paths {
+            let _ = writeln!(
+                s,
+                "The last two columns compare each API's compute-path image with its fragment-path image (`images/*-compute.png`).\n"
+            );
+        }
+        let _ = writeln!(
+            s,
+            "| scene | size | VK vs GL | VK vs reference | GL vs reference | max abs VK/GL/ref | NaN |{}\n|---|---|---|---|---|---|---|{}",
+            if with_paths { " VK compute vs fragment | GL compute vs fragment |" } else { "" },
+            if with_paths { "---|---|" } else { "" }
+        );
         for a in agreement {
+            let paths = match &a.paths {
+                Some(Ok(m)) => format!(
+                    " {:.4}% (max {}) | {:.4}% (max {}) |",
+                    100.0 * m[0].within_1(),
+                    m[0].max_abs,
+                    100.0 * m[1].within_1(),
+                    m[1].max_abs
+                ),
+                Some(Err(e)) => format!(" failed: {} | |", e.replace('|', "/")),
+                None if with_paths => " – | – |".into(),
+                None => String::new(),
+            };
             match &a.result {
                 Ok(m) => {
                     let _ = writeln!(
                         s,
-                        "| {} | {} | {:.4}% | {:.4}% | {:.4}% | {} / {} / {} | {} |",
+                        "| {} | {} | {:.4}% | {:.4}% | {:.4}% | {} / {} / {} | {} |{paths}",
                         a.scene,
                         a.size,
                         100.0 * m[0].within_1(),
@@ -373,10 +503,11 @@ pub fn markdown(plan: &Plan, outcomes: &[Outcome], accel: &[AccelRun], agreement
         for o in failures {
             let _ = writeln!(
                 s,
-                "- {} {} {}: {}",
+                "- {} {} {} {}: {}",
                 o.point.experiment,
                 o.point.param_value,
                 api_name(o.api),
+                o.path,
                 o.result.as_ref().err().map(String::as_str).unwrap_or("")
             );
         }
@@ -396,12 +527,20 @@ fn x_of(exp: &str, value: &str) -> f64 {
 
 fn plot(path: &Path, exp: &str, rows: &[&Outcome], study: &[StudyRow]) -> anyhow::Result<()> {
     let mut series: Vec<(String, RGBColor, Vec<(f64, f64)>)> = Vec::new();
-    let colours = [(Api::Vulkan, RGBColor(200, 30, 30)), (Api::Opengl, RGBColor(30, 80, 200)), (Api::OpenglSpirv, RGBColor(120, 60, 160))];
-    for (api, colour) in colours {
+    // Fragment in the full colour, compute in a lighter shade of it.
+    let colours = [
+        (Api::Vulkan, RenderPath::Fragment, RGBColor(200, 30, 30)),
+        (Api::Opengl, RenderPath::Fragment, RGBColor(30, 80, 200)),
+        (Api::OpenglSpirv, RenderPath::Fragment, RGBColor(120, 60, 160)),
+        (Api::Vulkan, RenderPath::Compute, RGBColor(250, 120, 110)),
+        (Api::Opengl, RenderPath::Compute, RGBColor(100, 170, 250)),
+        (Api::OpenglSpirv, RenderPath::Compute, RGBColor(190, 140, 220)),
+    ];
+    for (api, path, colour) in colours {
         for gpu in [false, true] {
             let pts: Vec<(f64, f64)> = rows
                 .iter()
-                .filter(|o| o.api == api)
+                .filter(|o| o.api == api && o.path == path)
                 .filter_map(|o| {
                     let r = o.result.as_ref().ok()?;
                     let v = if gpu { r.gpu_ms } else { r.wall_ms }?.median;
@@ -409,7 +548,7 @@ fn plot(path: &Path, exp: &str, rows: &[&Outcome], study: &[StudyRow]) -> anyhow
                 })
                 .collect();
             if !pts.is_empty() {
-                series.push((format!("ours {} {}", api_name(api), if gpu { "GPU" } else { "wall" }), colour, pts));
+                series.push((format!("ours {} {path} {}", api_name(api), if gpu { "GPU" } else { "wall" }), colour, pts));
             }
         }
     }
@@ -517,4 +656,58 @@ fn plot_scaling(path: &Path, outcomes: &[Outcome], accel: &[AccelRun]) -> anyhow
     chart.configure_series_labels().background_style(WHITE.mix(0.8)).border_style(BLACK).position(SeriesLabelPosition::UpperLeft).draw()?;
     root.present()?;
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::compare::Point;
+    use twinray_common::cli::Size;
+
+    fn outcome(api: Api, path: RenderPath, ms: f64) -> Outcome {
+        let json = format!(
+            r#"{{"api":"x","device":"d","driver":"v","api_version":"1","os":"o","scene":{{"name":"box","triangles":30,"spheres":2,"lights":1,"materials":3,"max_depth":5}},
+               "variant":"v","width":8,"height":8,{}"frames":[{{"gpu_ms":{ms},"wall_ms":{ms}}}],"gpu_ms":null,"wall_ms":null,
+               "nonfinite_pixels":0,"setup_ms":1.0,"validation_messages":0}}"#,
+            if path == RenderPath::Compute { r#""path":"compute","workgroup":"16x8","# } else { "" }
+        );
+        let mut r: RunReport = serde_json::from_str(&json).expect("a report without `path` still parses");
+        r.summarise();
+        let point = Point {
+            experiment: "box",
+            param_name: "resolution",
+            param_value: "8x8".into(),
+            scene: "box",
+            size: Size { width: 8, height: 8 },
+            set: vec![],
+            work: 1.0,
+        };
+        Outcome { point, api, path, result: Ok(r) }
+    }
+
+    #[test]
+    fn csv_has_a_path_column_and_the_summary_compares_paths() {
+        let rows = [
+            outcome(Api::Vulkan, RenderPath::Fragment, 10.0),
+            outcome(Api::Opengl, RenderPath::Fragment, 10.0),
+            outcome(Api::Vulkan, RenderPath::Compute, 1.0),
+            outcome(Api::Opengl, RenderPath::Compute, 2.0),
+        ];
+        let text = csv(&rows, "cpu");
+        let mut lines = text.lines();
+        let header: Vec<&str> = lines.next().unwrap().split(',').collect();
+        let col = |name: &str| header.iter().position(|h| *h == name).unwrap();
+        let body: Vec<Vec<&str>> = lines.map(|l| l.split(',').collect()).collect();
+        assert_eq!(body.len(), 4);
+        assert_eq!(body.iter().map(|r| r[col("path")]).collect::<Vec<_>>(), ["fragment", "fragment", "compute", "compute"]);
+        assert_eq!(body[2][col("workgroup")], "16x8");
+        assert_eq!(body[0][col("workgroup")], "");
+        assert!(body.iter().all(|r| r.len() == header.len()));
+        let summary = path_summary(&rows, &[]);
+        assert_eq!(summary.len(), 1, "{summary:?}");
+        assert!(summary[0].contains("1.00× on the fragment path, 0.50× on the compute path"), "{}", summary[0]);
+        assert!(summary[0].contains("Vulkan 10.00×, OpenGL 5.00×"), "{}", summary[0]);
+        let four = four_numbers(&rows);
+        assert!(four.contains("| box | 8x8 | 10.000 / 10.000 | 1.000 / 1.000 | 10.000 / 10.000 | 2.000 / 2.000 |"), "{four}");
+    }
 }

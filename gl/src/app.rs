@@ -3,6 +3,7 @@
 //! PNG and JSON.
 
 use crate::buffers::SceneBuffers;
+use crate::compute::Compute;
 use crate::context::Gl;
 use crate::debug::DebugLog;
 use crate::program::{EmptyVertexArray, Program};
@@ -11,7 +12,8 @@ use crate::timer::Timer;
 use anyhow::{anyhow, Context as _};
 use glow::HasContext;
 use std::time::Instant;
-use twinray_common::cli::RenderArgs;
+use twinray_common::cli::{RenderArgs, RenderPath};
+use twinray_common::error::bad_input;
 use twinray_common::explain;
 use twinray_common::gpu::{check_storage_limit, GpuScene};
 use twinray_common::image_io::FloatImage;
@@ -26,16 +28,16 @@ pub fn run(args: RenderArgs, started: Instant) -> anyhow::Result<()> {
     }
     if !args.headless {
         if args.gl_spirv {
-            return Err(twinray_common::error::bad_input("--gl-spirv is a headless measurement option; run it with --headless"));
+            return Err(bad_input("--gl-spirv is a headless measurement option; run it with --headless"));
+        }
+        if args.path == RenderPath::Compute {
+            return Err(bad_input("--path compute runs headless only; add --headless"));
         }
         return run_windowed(&args, started);
     }
     let scene = args.load_scene()?;
     let variant = if args.generic { Variant::generic() } else { Variant::for_scene(&scene) };
-    let shaders = shader::build(&variant)?;
-    explain::step("Shaders: GLSL -> naga module -> GLSL 450 core (twinray-common)", || {
-        format!("variant {}", variant.label())
-    });
+    let workgroup = args.compute_workgroup()?;
     let (width, height) = (args.size.width, args.size.height);
     let gpu_scene = GpuScene::new(&scene, width, height);
 
@@ -57,25 +59,51 @@ pub fn run(args: RenderArgs, started: Instant) -> anyhow::Result<()> {
 
     // Declaration order is creation order; Rust drops locals in reverse, so GL
     // objects are deleted in reverse order on success and on every error path.
-    let program = if args.gl_spirv {
-        let fs = shader::spirv_for_opengl(&shaders.fragment_spirv);
-        Program::from_spirv(gl, &|name| ctx.proc_address(name), &shaders.vertex_glsl, &fs)?
-    } else {
-        Program::new(gl, &shaders.vertex_glsl, &shaders.fragment_glsl)?
+    let (frames, setup_ms, pixels) = match args.path {
+        RenderPath::Fragment => {
+            let shaders = shader::build(&variant)?;
+            explain::step("Shaders: GLSL -> naga module -> GLSL 450 core (twinray-common)", || {
+                format!("variant {}", variant.label())
+            });
+            let program = if args.gl_spirv {
+                let fs = shader::spirv_for_opengl(&shaders.fragment_spirv);
+                Program::from_spirv(gl, &|name| ctx.proc_address(name), &shaders.vertex_glsl, &fs)?
+            } else {
+                Program::new(gl, &shaders.vertex_glsl, &shaders.fragment_glsl)?
+            };
+            let _buffers = SceneBuffers::new(gl, &gpu_scene)?;
+            let target = Target::new(gl, width, height)?;
+            let vao = EmptyVertexArray::new(gl)?;
+            let timer = Timer::new(gl, &renderer)?;
+            program.bind(&vao);
+            log.check(gl, "after setup");
+            // SAFETY: program, VAO, buffers and FBO are bound and alive.
+            let draw = || unsafe { gl.draw_arrays(glow::TRIANGLES, 0, 3) };
+            let (frames, setup_ms) = frame_loop(gl, &timer, args.frame_count(), started, &draw);
+            (frames, setup_ms, target.read())
+        }
+        // The same tracer as a compute shader: compute.rs owns its program and texture.
+        RenderPath::Compute => {
+            let shader = shader::build_compute(&variant, workgroup)?;
+            let proc_address = |name: &std::ffi::CStr| ctx.proc_address(name);
+            let spirv = args.gl_spirv.then_some(&proc_address as &dyn Fn(&std::ffi::CStr) -> *const std::ffi::c_void);
+            let compute = Compute::new(gl, &shader, spirv, width, height)?;
+            let _buffers = SceneBuffers::new(gl, &gpu_scene)?;
+            let timer = Timer::new(gl, &renderer)?;
+            log.check(gl, "after setup");
+            let dispatch = || {
+                compute.barrier_between_frames();
+                compute.dispatch();
+            };
+            let (frames, setup_ms) = frame_loop(gl, &timer, args.frame_count(), started, &dispatch);
+            (frames, setup_ms, compute.read())
+        }
     };
-    let _buffers = SceneBuffers::new(gl, &gpu_scene)?;
-    let target = Target::new(gl, width, height)?;
-    let vao = EmptyVertexArray::new(gl)?;
-    let timer = Timer::new(gl, &renderer)?;
-    program.bind(&vao);
-    log.check(gl, "after setup");
-
-    let (frames, setup_ms) = frame_loop(gl, &timer, args.frame_count(), started);
-    explain::step("Frames: glDrawArrays + glFinish each", || {
+    explain::step("Frames: the draw or dispatch + glFinish each", || {
         format!("{} frame(s); first wall {:.3} ms", frames.len(), frames.first().map_or(0.0, |f| f.wall_ms))
     });
-    let image = FloatImage::from_rgba(width, height, &target.read());
-    explain::step("Readback: glReadPixels", || format!("{width}x{height} RGBA32F, bottom row first = image top"));
+    let image = FloatImage::from_rgba(width, height, &pixels);
+    explain::step("Readback", || format!("{width}x{height} RGBA32F, top row first"));
     log.check(gl, "after the frame loop");
 
     if let Some(out) = &args.out {
@@ -93,6 +121,8 @@ pub fn run(args: RenderArgs, started: Instant) -> anyhow::Result<()> {
             variant: if args.gl_spirv { format!("{} (SPIR-V)", variant.label()) } else { variant.label() },
             width,
             height,
+            path: args.path,
+            workgroup: (args.path == RenderPath::Compute).then(|| workgroup.to_string()),
             frames,
             gpu_ms: None,
             wall_ms: None,
@@ -124,6 +154,8 @@ fn run_windowed(args: &RenderArgs, started: Instant) -> anyhow::Result<()> {
             variant: run.variant.label(),
             width: run.width,
             height: run.height,
+            path: RenderPath::Fragment,
+            workgroup: None,
             frames: run.frames,
             gpu_ms: None,
             wall_ms: None,
@@ -141,8 +173,9 @@ fn run_windowed(args: &RenderArgs, started: Instant) -> anyhow::Result<()> {
 }
 
 /// The same loop as Vulkan's: one iteration is submit + wait, timed on the
-/// wall clock around the GPU-timed draw. Returns the frames and `setup_ms`.
-fn frame_loop(gl: &glow::Context, timer: &Timer, count: u32, started: Instant) -> (Vec<FrameTime>, f64) {
+/// wall clock around the GPU-timed `draw` (the draw call or the dispatch).
+/// Returns the frames and `setup_ms`.
+fn frame_loop(gl: &glow::Context, timer: &Timer, count: u32, started: Instant, draw: &dyn Fn()) -> (Vec<FrameTime>, f64) {
     let mut frames = Vec::with_capacity(count as usize);
     let mut setup_ms = 0.0;
     for i in 0..count {
@@ -151,8 +184,7 @@ fn frame_loop(gl: &glow::Context, timer: &Timer, count: u32, started: Instant) -
             setup_ms = ms(t0 - started);
         }
         timer.begin();
-        // SAFETY: program, VAO, buffers and FBO are bound and alive.
-        unsafe { gl.draw_arrays(glow::TRIANGLES, 0, 3) };
+        draw();
         timer.end();
         // glFinish, not a fence: the wait is part of what the study timed.
         // SAFETY: no arguments; the context is current.

@@ -1,9 +1,11 @@
 //! twinray-gl: the OpenGL twin of twinray-vk. Modules in the order a reader
 //! meets the setup: context, debug output, program, buffers, target, timer,
-//! the headless run that strings them together, and the windowed run.
+//! the compute path (compute.rs), the headless run that strings them together,
+//! and the windowed run.
 
 pub mod app;
 pub mod buffers;
+pub mod compute;
 pub mod context;
 pub mod debug;
 pub mod program;

@@ -158,3 +158,18 @@ fn orchestrator_diff_and_render_errors() {
     expect_one(&tw, &["diff", a.to_str().unwrap(), b.to_str().unwrap()], &[], 2, &["differ in size"]);
     expect_one(&tw, &["render", "--api", "reference", "--scene", "kettle", "--json"], &[], 2, &["'kettle'"]);
 }
+
+#[test]
+fn bad_path_and_workgroup_options() {
+    // A workgroup means nothing to the fragment path: said, not ignored.
+    expect_both(&["--headless", "--size", "16x16", "--workgroup", "8x8"], &[], 2, &["--workgroup", "--path compute"]);
+    for app in App::BOTH {
+        for args in [["--path", "warp"], ["--workgroup", "0x8"], ["--workgroup", "64x64"]] {
+            let mut all = vec!["--headless", "--size", "16x16", "--path", "compute"];
+            all.extend(args);
+            let (code, stderr) = fail(&app.exe(), &all, &[]);
+            assert_eq!(code, 2, "{args:?}: {stderr}");
+            assert!(stderr.contains(args[0]), "{args:?}: {stderr}");
+        }
+    }
+}

@@ -8,6 +8,7 @@
 //! of creation: exactly the order Vulkan needs, on success and on every error path.
 
 use crate::commands::Commands;
+use crate::compute::Compute;
 use crate::device::Device;
 use crate::instance::{Instance, VALIDATION_MESSAGES};
 use crate::pipeline::RenderPass;
@@ -18,7 +19,7 @@ use crate::window;
 use anyhow::{bail, Result};
 use std::sync::atomic::Ordering;
 use std::time::Instant;
-use twinray_common::cli::RenderArgs;
+use twinray_common::cli::{RenderArgs, RenderPath};
 use twinray_common::error::bad_input;
 use twinray_common::explain;
 use twinray_common::gpu::GpuScene;
@@ -35,6 +36,9 @@ pub fn run(args: RenderArgs, process_start: Instant) -> Result<()> {
         return Err(bad_input("--gl-spirv is an OpenGL option: Vulkan always runs naga's SPIR-V"));
     }
     if !args.headless {
+        if args.path == RenderPath::Compute {
+            return Err(bad_input("--path compute runs headless only; add --headless"));
+        }
         return run_windowed(&args, process_start);
     }
     let scene = args.load_scene()?;
@@ -72,6 +76,8 @@ fn run_windowed(args: &RenderArgs, process_start: Instant) -> Result<()> {
             variant: run.variant.label(),
             width: run.width,
             height: run.height,
+            path: RenderPath::Fragment,
+            workgroup: None,
             frames: run.frames,
             gpu_ms: None,
             wall_ms: None,
@@ -97,6 +103,7 @@ fn render(
     process_start: Instant,
 ) -> Result<(RunReport, FloatImage)> {
     let (width, height) = (args.size.width, args.size.height);
+    let workgroup = args.compute_workgroup()?;
     let shaders = shader::build(variant)?;
     explain::step("Shaders: GLSL -> naga module -> SPIR-V (twinray-common)", || {
         format!("variant {}", variant.label())
@@ -114,40 +121,32 @@ fn render(
         Ok(other) => return Err(bad_input(format!("TWINRAY_VK_WAIT='{other}' is not 'fence' or 'idle'"))),
     };
     let host_memory = crate::scene::host_memory()?;
-    let render_pass = RenderPass::offscreen(&device)?;
-    let rp = render_pass.render_pass;
-    let resources = SceneResources::new(&device, &gpu_scene, &shaders, rp, Some((width, height)))?;
-    let (pipeline, descriptors) = (&resources.pipeline, &resources.descriptors);
-    let target = Target::new(&device, rp, width, height)?;
     let timestamps = Timestamps::new(&device)?;
-    let commands = Commands::record(&device, rp, pipeline, descriptors, &target, timestamps.as_ref())?;
-
-    // The timed loop: one iteration = submit + wait, as the original study measured.
-    let mut frames = Vec::new();
-    let mut setup_ms = 0.0;
-    for i in 0..args.frame_count() {
-        let start = Instant::now();
-        if i == 0 {
-            setup_ms = (start - process_start).as_secs_f64() * 1e3;
-        }
-        commands.submit()?;
-        commands.wait(idle_wait)?;
-        let wall_ms = start.elapsed().as_secs_f64() * 1e3;
-        let gpu_ms = timestamps.as_ref().map(Timestamps::read_ms).transpose()?;
-        commands.reset_fence()?;
-        frames.push(FrameTime { gpu_ms, wall_ms });
-        if i == 0 {
-            explain::step("Frame 1: vkQueueSubmit + vkWaitForFences + vkResetFences", || {
-                let gpu = gpu_ms.map_or("no timestamps on this queue".into(), |g| format!("GPU {g:.3} ms"));
-                format!("wall {wall_ms:.3} ms, {gpu}; later frames resubmit the same command buffer")
+    let run_frames = |commands: &Commands| frame_loop(commands, timestamps.as_ref(), args.frame_count(), idle_wait, process_start);
+    let (frames, setup_ms, image) = match args.path {
+        RenderPath::Fragment => {
+            let render_pass = RenderPass::offscreen(&device)?;
+            let rp = render_pass.render_pass;
+            let resources = SceneResources::new(&device, &gpu_scene, &shaders, rp, Some((width, height)))?;
+            let (pipeline, descriptors) = (&resources.pipeline, &resources.descriptors);
+            let target = Target::new(&device, rp, width, height)?;
+            let commands = Commands::record(&device, rp, pipeline, descriptors, &target, timestamps.as_ref())?;
+            let (frames, setup_ms) = run_frames(&commands)?;
+            let image = target.read_back(&device)?;
+            explain::step("Readback: vkCmdCopyImageToBuffer + HOST barrier, then map", || {
+                format!("{width}x{height} RGBA32F, top row first")
             });
+            (frames, setup_ms, image)
         }
-    }
-
-    let image = target.read_back(&device)?;
-    explain::step("Readback: vkCmdCopyImageToBuffer + HOST barrier, then map", || {
-        format!("{width}x{height} RGBA32F, top row first")
-    });
+        // The same tracer as a compute shader: compute.rs owns its pipeline and storage image.
+        RenderPath::Compute => {
+            let shader = shader::build_compute(variant, workgroup)?;
+            let (frame, storage) = crate::scene::scene_buffers(&device, &gpu_scene)?;
+            let compute = Compute::new(&device, &frame, &storage, &shader, width, height, timestamps.as_ref())?;
+            let (frames, setup_ms) = run_frames(&compute.commands)?;
+            (frames, setup_ms, compute.read_back(&device)?)
+        }
+    };
     let mut report = RunReport {
         api: "vulkan".into(),
         device: device.name.clone(),
@@ -163,6 +162,8 @@ fn render(
         ),
         width,
         height,
+        path: args.path,
+        workgroup: (args.path == RenderPath::Compute).then(|| workgroup.to_string()),
         frames,
         gpu_ms: None,
         wall_ms: None,
@@ -173,4 +174,36 @@ fn render(
     report.summarise();
     Ok((report, image))
     // Every Vulkan object is dropped here, newest first: commands, ..., device, instance.
+}
+
+/// The timed loop: one iteration = submit + wait, as the original study measured.
+/// Returns the frames and `setup_ms` (process start to the first submit).
+fn frame_loop(
+    commands: &Commands,
+    timestamps: Option<&Timestamps>,
+    count: u32,
+    idle_wait: bool,
+    process_start: Instant,
+) -> Result<(Vec<FrameTime>, f64)> {
+    let mut frames = Vec::new();
+    let mut setup_ms = 0.0;
+    for i in 0..count {
+        let start = Instant::now();
+        if i == 0 {
+            setup_ms = (start - process_start).as_secs_f64() * 1e3;
+        }
+        commands.submit()?;
+        commands.wait(idle_wait)?;
+        let wall_ms = start.elapsed().as_secs_f64() * 1e3;
+        let gpu_ms = timestamps.map(Timestamps::read_ms).transpose()?;
+        commands.reset_fence()?;
+        frames.push(FrameTime { gpu_ms, wall_ms });
+        if i == 0 {
+            explain::step("Frame 1: vkQueueSubmit + vkWaitForFences + vkResetFences", || {
+                let gpu = gpu_ms.map_or("no timestamps on this queue".into(), |g| format!("GPU {g:.3} ms"));
+                format!("wall {wall_ms:.3} ms, {gpu}; later frames resubmit the same command buffer")
+            });
+        }
+    }
+    Ok((frames, setup_ms))
 }

@@ -99,6 +99,32 @@ impl Commands {
         Ok(this)
     }
 
+    /// A frame whose commands `record` writes (the compute path's dispatch), with
+    /// the same pool, buffer and fence handling as `record`'s render pass.
+    pub fn record_with(device: &Device, record: impl FnOnce(&ash::Device, vk::CommandBuffer)) -> Result<Commands> {
+        let d = &device.device;
+        let mut this = Commands {
+            device: d.clone(),
+            queue: device.queue,
+            pool: vk::CommandPool::null(),
+            cmd: vk::CommandBuffer::null(),
+            fence: vk::Fence::null(),
+        };
+        let info = vk::CommandPoolCreateInfo::default().queue_family_index(device.queue_family);
+        this.pool = unsafe { d.create_command_pool(&info, None) }.context("creating the command pool")?;
+        let info = vk::CommandBufferAllocateInfo::default()
+            .command_pool(this.pool)
+            .level(vk::CommandBufferLevel::PRIMARY)
+            .command_buffer_count(1);
+        this.cmd = unsafe { d.allocate_command_buffers(&info) }.context("allocating the command buffer")?[0];
+        this.fence = unsafe { d.create_fence(&vk::FenceCreateInfo::default(), None) }.context("creating the fence")?;
+        unsafe { d.begin_command_buffer(this.cmd, &vk::CommandBufferBeginInfo::default()) }
+            .context("recording the frame")?;
+        record(d, this.cmd);
+        unsafe { d.end_command_buffer(this.cmd) }.context("recording the frame")?;
+        Ok(this)
+    }
+
     /// Hands the frame to the GPU; the fence signals when it is done.
     pub fn submit(&self) -> Result<()> {
         let cmds = [self.cmd];

@@ -1,7 +1,8 @@
 //! Descriptors: how the shader's `layout(set = 0, binding = N)` blocks find our buffers.
 //!
 //! Vulkan splits this in three. The *set layout* is the shape (binding 0 is a
-//! uniform buffer, 1–4 are storage buffers, all read by the fragment stage); it
+//! uniform buffer, 1–4 are storage buffers, all read by the fragment stage; the
+//! compute path adds binding 5, a storage image, and names the compute stage); it
 //! exists on its own because the pipeline is compiled against it, before any
 //! buffer is chosen. Sets are allocated from a *pool*, so the driver can manage
 //! their memory in bulk. The *set* is then written once to point at the buffers.
@@ -24,6 +25,19 @@ pub struct Descriptors {
 impl Descriptors {
     /// `frame` is the uniform buffer; `storage` pairs each storage binding with its buffer.
     pub fn new(device: &Device, frame: &Buffer, storage: &[(u32, Buffer)]) -> Result<Descriptors> {
+        Descriptors::for_stage(device, frame, storage, vk::ShaderStageFlags::FRAGMENT, None)
+    }
+
+    /// The same buffers for the shader `stage`, plus, for the compute path, the
+    /// storage image view at binding 5 (in GENERAL layout, the one layout in
+    /// which shaders may write an image).
+    pub fn for_stage(
+        device: &Device,
+        frame: &Buffer,
+        storage: &[(u32, Buffer)],
+        stage: vk::ShaderStageFlags,
+        image: Option<vk::ImageView>,
+    ) -> Result<Descriptors> {
         let d = &device.device;
         let mut this = Descriptors {
             device: d.clone(),
@@ -36,16 +50,25 @@ impl Descriptors {
                 .chain(storage.iter().map(|(b, buf)| (*b, vk::DescriptorType::STORAGE_BUFFER, buf)))
                 .collect();
 
-        let bindings: Vec<_> = all
+        let mut bindings: Vec<_> = all
             .iter()
             .map(|&(b, ty, _)| {
                 vk::DescriptorSetLayoutBinding::default()
                     .binding(b)
                     .descriptor_type(ty)
                     .descriptor_count(1)
-                    .stage_flags(vk::ShaderStageFlags::FRAGMENT)
+                    .stage_flags(stage)
             })
             .collect();
+        if image.is_some() {
+            bindings.push(
+                vk::DescriptorSetLayoutBinding::default()
+                    .binding(binding::IMAGE)
+                    .descriptor_type(vk::DescriptorType::STORAGE_IMAGE)
+                    .descriptor_count(1)
+                    .stage_flags(stage),
+            );
+        }
         let info = vk::DescriptorSetLayoutCreateInfo::default().bindings(&bindings);
         this.set_layout =
             unsafe { d.create_descriptor_set_layout(&info, None) }.context("creating the descriptor set layout")?;
@@ -53,10 +76,13 @@ impl Descriptors {
             all.iter().map(|(b, ty, _)| format!("binding {b}: {ty:?} x1, FRAGMENT stage\n")).collect()
         });
 
-        let sizes = [
+        let mut sizes = vec![
             vk::DescriptorPoolSize { ty: vk::DescriptorType::UNIFORM_BUFFER, descriptor_count: 1 },
             vk::DescriptorPoolSize { ty: vk::DescriptorType::STORAGE_BUFFER, descriptor_count: storage.len() as u32 },
         ];
+        if image.is_some() {
+            sizes.push(vk::DescriptorPoolSize { ty: vk::DescriptorType::STORAGE_IMAGE, descriptor_count: 1 });
+        }
         let info = vk::DescriptorPoolCreateInfo::default().max_sets(1).pool_sizes(&sizes);
         this.pool = unsafe { d.create_descriptor_pool(&info, None) }.context("creating the descriptor pool")?;
         explain::step("VkDescriptorPool", || format!("max 1 set; 1 UNIFORM_BUFFER, {} STORAGE_BUFFER", storage.len()));
@@ -69,13 +95,25 @@ impl Descriptors {
             .iter()
             .map(|(_, _, buf)| [vk::DescriptorBufferInfo { buffer: buf.buffer, offset: 0, range: buf.size }])
             .collect();
-        let writes: Vec<_> = all
+        let mut writes: Vec<_> = all
             .iter()
             .zip(&infos)
             .map(|(&(b, ty, _), info)| {
                 vk::WriteDescriptorSet::default().dst_set(this.set).dst_binding(b).descriptor_type(ty).buffer_info(info)
             })
             .collect();
+        let image_info = image.map(|view| {
+            [vk::DescriptorImageInfo { sampler: vk::Sampler::null(), image_view: view, image_layout: vk::ImageLayout::GENERAL }]
+        });
+        if let Some(info) = &image_info {
+            writes.push(
+                vk::WriteDescriptorSet::default()
+                    .dst_set(this.set)
+                    .dst_binding(binding::IMAGE)
+                    .descriptor_type(vk::DescriptorType::STORAGE_IMAGE)
+                    .image_info(info),
+            );
+        }
         unsafe { d.update_descriptor_sets(&writes, &[]) };
         explain::step("VkDescriptorSet (allocated, then vkUpdateDescriptorSets)", || {
             format!("{} writes: each binding points at its whole buffer", writes.len())

@@ -11,6 +11,7 @@ pub mod device;
 pub mod memory;
 pub mod descriptors;
 pub mod pipeline;
+pub mod compute;
 pub mod scene;
 pub mod swapchain;
 pub mod target;

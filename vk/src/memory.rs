@@ -111,7 +111,7 @@ impl Buffer {
         let buffer = Buffer::new(device, size, usage, &[Flags::DEVICE_LOCAL, Flags::empty()], what)?;
         device.run_once(&format!("uploading the {what}"), |cmd| {
             let region = vk::BufferCopy::default().size(size);
-            // The barrier makes the copied bytes visible to the fragment shader of
+            // The barrier makes the copied bytes visible to the fragment (or compute) shader of
             // every later submission: queue order alone does not order memory.
             let barrier = vk::BufferMemoryBarrier::default()
                 .src_access_mask(vk::AccessFlags::TRANSFER_WRITE)
@@ -125,7 +125,7 @@ impl Buffer {
                 device.device.cmd_pipeline_barrier(
                     cmd,
                     vk::PipelineStageFlags::TRANSFER,
-                    vk::PipelineStageFlags::FRAGMENT_SHADER,
+                    vk::PipelineStageFlags::FRAGMENT_SHADER | vk::PipelineStageFlags::COMPUTE_SHADER,
                     vk::DependencyFlags::empty(),
                     &[],
                     &[barrier],

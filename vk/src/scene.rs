@@ -33,30 +33,37 @@ impl SceneResources {
         render_pass: vk::RenderPass,
         fixed_size: Option<(u32, u32)>,
     ) -> Result<SceneResources> {
-        let limit = device.properties.limits.max_storage_buffer_range as u64;
-        check_storage_limit(scene, limit, "maxStorageBufferRange")?;
-        let host = host_memory()?;
-        let place = |bytes: &[u8], usage: vk::BufferUsageFlags, what: &str| {
-            if host {
-                Buffer::host_visible_with(device, bytes, usage, what)
-            } else {
-                Buffer::device_local_with(device, bytes, usage, what)
-            }
-        };
-        let uniform = vk::BufferUsageFlags::UNIFORM_BUFFER;
-        let frame = place(scene.frame_bytes(), uniform, "frame uniform buffer")?;
-        let storage = binding::STORAGE
-            .iter()
-            .map(|&b| {
-                let what = format!("{} storage buffer", storage_name(b));
-                let usage = vk::BufferUsageFlags::STORAGE_BUFFER;
-                Ok((b, place(scene.storage_bytes(b), usage, &what)?))
-            })
-            .collect::<Result<Vec<_>>>()?;
+        let (frame, storage) = scene_buffers(device, scene)?;
         let descriptors = Descriptors::new(device, &frame, &storage)?;
         let pipeline = Pipeline::new(device, descriptors.set_layout, shaders, render_pass, fixed_size)?;
         Ok(SceneResources { pipeline, descriptors, storage, frame })
     }
+}
+
+/// The `Frame` uniform buffer and the storage buffers, filled with the scene's
+/// bytes: what both the graphics and the compute pipeline read.
+pub fn scene_buffers(device: &Device, scene: &GpuScene) -> Result<(Buffer, Vec<(u32, Buffer)>)> {
+    let limit = device.properties.limits.max_storage_buffer_range as u64;
+    check_storage_limit(scene, limit, "maxStorageBufferRange")?;
+    let host = host_memory()?;
+    let place = |bytes: &[u8], usage: vk::BufferUsageFlags, what: &str| {
+        if host {
+        Buffer::host_visible_with(device, bytes, usage, what)
+        } else {
+        Buffer::device_local_with(device, bytes, usage, what)
+        }
+    };
+    let uniform = vk::BufferUsageFlags::UNIFORM_BUFFER;
+    let frame = place(scene.frame_bytes(), uniform, "frame uniform buffer")?;
+    let storage = binding::STORAGE
+        .iter()
+        .map(|&b| {
+        let what = format!("{} storage buffer", storage_name(b));
+        let usage = vk::BufferUsageFlags::STORAGE_BUFFER;
+        Ok((b, place(scene.storage_bytes(b), usage, &what)?))
+        })
+        .collect::<Result<Vec<_>>>()?;
+    Ok((frame, storage))
 }
 
 /// Device-local memory, filled once through a staging buffer, is the careful

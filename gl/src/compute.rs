@@ -1,0 +1,215 @@
+//! The compute path: the tracer as a compute shader (naga's GLSL of
+//! `shaders/trace.comp`, or with `--gl-spirv` naga's SPIR-V), the RGBA32F
+//! texture it writes through image unit 5, the dispatch, and the readback.
+//!
+//! What the fragment path gets from the framebuffer, GL asks for explicitly
+//! here: `imageStore` writes are *incoherent*, so a `glMemoryBarrier` must order
+//! them before anything else touches the texture, the next dispatch's stores
+//! (SHADER_IMAGE_ACCESS) and the readback (TEXTURE_UPDATE, for glGetTexImage).
+
+use anyhow::{anyhow, Context as _};
+use glow::HasContext;
+use twinray_common::cli::Workgroup;
+use twinray_common::error::{bad_input, no_device};
+use twinray_common::gpu::binding;
+use twinray_common::shader::{spirv_for_opengl, ComputeShader};
+
+/// The compute program, the storage texture and the dispatch grid.
+/// Field order is drop order: program, then texture.
+pub struct Compute<'gl> {
+    gl: &'gl glow::Context,
+    program: glow::Program,
+    texture: glow::Texture,
+    groups: (u32, u32),
+    pub width: u32,
+    pub height: u32,
+}
+
+impl<'gl> Compute<'gl> {
+    /// Builds the program (GLSL, or SPIR-V when `spirv_proc` is given), makes the
+    /// texture, and leaves both bound: nothing else changes them during the run.
+    pub fn new(
+        gl: &'gl glow::Context,
+        shader: &ComputeShader,
+        spirv_proc: Option<&dyn Fn(&std::ffi::CStr) -> *const std::ffi::c_void>,
+        width: u32,
+        height: u32,
+    ) -> anyhow::Result<Compute<'gl>> {
+        let groups = check_limits(gl, shader.workgroup, width, height)?;
+        let program = match spirv_proc {
+            Some(proc_address) => link(gl, spirv_shader(gl, proc_address, &spirv_for_opengl(&shader.spirv))?)?,
+            None => link(gl, glsl_shader(gl, &shader.glsl)?)?,
+        };
+        // SAFETY: a fresh texture on the current context; sizes were checked.
+        let texture = match unsafe { gl.create_texture() } {
+            Ok(t) => t,
+            Err(e) => {
+                unsafe { gl.delete_program(program) };
+                return Err(anyhow!(e).context("glGenTextures"));
+            }
+        };
+        let this = Compute { gl, program, texture, groups, width, height };
+        // SAFETY: both objects are alive on the current context.
+        unsafe {
+            gl.bind_texture(glow::TEXTURE_2D, Some(texture));
+            // Immutable storage, one level: image units need a complete texture.
+            gl.tex_storage_2d(glow::TEXTURE_2D, 1, glow::RGBA32F, width as i32, height as i32);
+            // WRITE_ONLY matches the shader's `writeonly`; the format its `rgba32f`.
+            gl.bind_image_texture(binding::IMAGE, Some(texture), 0, false, 0, glow::WRITE_ONLY, glow::RGBA32F);
+            gl.use_program(Some(program));
+        }
+        Ok(this)
+    }
+
+    /// One frame's GPU work: the dispatch. The timer brackets exactly this.
+    pub fn dispatch(&self) {
+        // SAFETY: program, texture and buffers are bound and alive.
+        unsafe { self.gl.dispatch_compute(self.groups.0, self.groups.1, 1) }
+    }
+
+    /// Orders this frame's image stores before the next frame's (the same
+    /// texels): the counterpart of Vulkan's barrier between dispatches.
+    pub fn barrier_between_frames(&self) {
+        // SAFETY: plain state call on the current context.
+        unsafe { self.gl.memory_barrier(glow::SHADER_IMAGE_ACCESS_BARRIER_BIT) }
+    }
+
+    /// RGBA32F pixels, row 0 first. The shader wrote the top row at y = 0, so
+    /// this is top first, as the PNG wants: no flip, as in the fragment path.
+    pub fn read(&self) -> Vec<f32> {
+        let mut px = vec![0f32; self.width as usize * self.height as usize * 4];
+        // SAFETY: `px` holds exactly width*height RGBA floats, packed with alignment 1.
+        unsafe {
+            // glGetTexImage must see the incoherent image stores.
+            self.gl.memory_barrier(glow::TEXTURE_UPDATE_BARRIER_BIT);
+            self.gl.bind_texture(glow::TEXTURE_2D, Some(self.texture));
+            self.gl.pixel_store_i32(glow::PACK_ALIGNMENT, 1);
+            self.gl.get_tex_image(
+                glow::TEXTURE_2D,
+                0,
+                glow::RGBA,
+                glow::FLOAT,
+                glow::PixelPackData::Slice(Some(bytemuck::cast_slice_mut(&mut px))),
+            );
+        }
+        px
+    }
+}
+
+impl Drop for Compute<'_> {
+    fn drop(&mut self) {
+        // SAFETY: objects of this context, which outlives them.
+        unsafe {
+            self.gl.use_program(None);
+            self.gl.delete_program(self.program);
+            self.gl.delete_texture(self.texture);
+        }
+    }
+}
+
+/// The workgroup and the grid against this driver's limits (bad input: the
+/// user chose the size and workgroup). Returns the group counts.
+fn check_limits(gl: &glow::Context, wg: Workgroup, width: u32, height: u32) -> anyhow::Result<(u32, u32)> {
+    // SAFETY: plain queries on the current context.
+    let (size, invocations, count, texture) = unsafe {
+        (
+            [0, 1].map(|i| gl.get_parameter_indexed_i32(glow::MAX_COMPUTE_WORK_GROUP_SIZE, i).max(0) as u32),
+            gl.get_parameter_i32(glow::MAX_COMPUTE_WORK_GROUP_INVOCATIONS).max(0) as u32,
+            [0, 1].map(|i| gl.get_parameter_indexed_i32(glow::MAX_COMPUTE_WORK_GROUP_COUNT, i).max(0) as u32),
+            gl.get_parameter_i32(glow::MAX_TEXTURE_SIZE).max(0) as u32,
+        )
+    };
+    if wg.x > size[0] || wg.y > size[1] || wg.x * wg.y > invocations {
+        return Err(bad_input(format!(
+            "--workgroup {wg} exceeds this device's limits (GL_MAX_COMPUTE_WORK_GROUP_SIZE {}x{}, GL_MAX_COMPUTE_WORK_GROUP_INVOCATIONS {invocations})",
+            size[0], size[1]
+        )));
+    }
+    if width > texture || height > texture {
+        return Err(bad_input(format!("--size {width}x{height} exceeds this device's limit of {texture} (GL_MAX_TEXTURE_SIZE)")));
+    }
+    let groups = (width.div_ceil(wg.x), height.div_ceil(wg.y));
+    if groups.0 > count[0] || groups.1 > count[1] {
+        return Err(bad_input(format!(
+            "--size {width}x{height} with --workgroup {wg} needs {}x{} workgroups, more than this device's GL_MAX_COMPUTE_WORK_GROUP_COUNT {}x{}",
+            groups.0, groups.1, count[0], count[1]
+        )));
+    }
+    Ok(groups)
+}
+
+fn glsl_shader(gl: &glow::Context, source: &str) -> anyhow::Result<glow::Shader> {
+    // SAFETY: a fresh shader on the current context.
+    unsafe {
+        let s = gl.create_shader(glow::COMPUTE_SHADER).map_err(|e| anyhow!(e)).context("glCreateShader(compute)")?;
+        gl.shader_source(s, source);
+        gl.compile_shader(s);
+        if !gl.get_shader_compile_status(s) {
+            let log = gl.get_shader_info_log(s);
+            gl.delete_shader(s);
+            return Err(anyhow!("the driver rejected naga's compute GLSL:\n{log}"));
+        }
+        Ok(s)
+    }
+}
+
+/// naga's compute SPIR-V through GL_ARB_gl_spirv. glow wraps neither entry point.
+fn spirv_shader(
+    gl: &glow::Context,
+    proc_address: &dyn Fn(&std::ffi::CStr) -> *const std::ffi::c_void,
+    words: &[u32],
+) -> anyhow::Result<glow::Shader> {
+    if !gl.supported_extensions().contains("GL_ARB_gl_spirv") {
+        return Err(no_device("--gl-spirv: this OpenGL driver does not support GL_ARB_gl_spirv"));
+    }
+    type ShaderBinary = unsafe extern "system" fn(i32, *const u32, u32, *const std::ffi::c_void, i32);
+    type SpecializeShader = unsafe extern "system" fn(u32, *const std::ffi::c_char, u32, *const u32, *const u32);
+    let get = |name: &std::ffi::CStr| {
+        let p = proc_address(name);
+        if p.is_null() {
+            Err(anyhow!("the OpenGL driver has no {}", name.to_string_lossy()))
+        } else {
+            Ok(p)
+        }
+    };
+    // SAFETY: each pointer is the driver's entry point of that name, with the
+    // GL 4.6 core signature the type spells out; the words outlive the calls.
+    unsafe {
+        let shader_binary = std::mem::transmute::<*const std::ffi::c_void, ShaderBinary>(get(c"glShaderBinary")?);
+        let specialize = std::mem::transmute::<*const std::ffi::c_void, SpecializeShader>(get(c"glSpecializeShader")?);
+        let s = gl.create_shader(glow::COMPUTE_SHADER).map_err(|e| anyhow!(e)).context("glCreateShader(compute)")?;
+        let id = s.0.get();
+        shader_binary(1, &id, glow::SHADER_BINARY_FORMAT_SPIR_V, words.as_ptr().cast(), (words.len() * 4) as i32);
+        specialize(id, c"main".as_ptr(), 0, std::ptr::null(), std::ptr::null());
+        if !gl.get_shader_compile_status(s) {
+            let log = gl.get_shader_info_log(s);
+            gl.delete_shader(s);
+            return Err(anyhow!("the driver rejected naga's compute SPIR-V:\n{log}"));
+        }
+        Ok(s)
+    }
+}
+
+/// Links one compiled compute shader into a program; the shader goes either way.
+fn link(gl: &glow::Context, shader: glow::Shader) -> anyhow::Result<glow::Program> {
+    // SAFETY: objects of the current context; the shader is detached and deleted once linked.
+    unsafe {
+        let program = match gl.create_program() {
+            Ok(p) => p,
+            Err(e) => {
+                gl.delete_shader(shader);
+                return Err(anyhow!(e).context("glCreateProgram"));
+            }
+        };
+        gl.attach_shader(program, shader);
+        gl.link_program(program);
+        gl.detach_shader(program, shader);
+        gl.delete_shader(shader);
+        if !gl.get_program_link_status(program) {
+            let log = gl.get_program_info_log(program);
+            gl.delete_program(program);
+            return Err(anyhow!("linking the compute program failed:\n{log}"));
+        }
+        Ok(program)
+    }
+}

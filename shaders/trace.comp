@@ -1,0 +1,31 @@
+// trace.comp — compute entry point: the same tracer, one invocation per pixel,
+// written to an RGBA32F storage image instead of a colour attachment.
+//
+// Pixel (x, y) is gl_GlobalInvocationID.xy with y counted from the top, and the
+// primary ray goes through its centre, (x, y) + 0.5: exactly the gl_FragCoord
+// the fragment path sees in Vulkan. Image row 0 is therefore the top row in both
+// APIs, and a plain copy/readback of the image gives the upright picture.
+//
+// WG_X x WG_Y is the workgroup size, set per run through naga defines
+// (common/src/shader.rs); the dispatch is ceil(width / WG_X) x ceil(height / WG_Y),
+// so invocations past the right and bottom edges return at once.
+
+#ifndef WG_X
+#define WG_X 16
+#endif
+#ifndef WG_Y
+#define WG_Y 8
+#endif
+
+layout(local_size_x = WG_X, local_size_y = WG_Y, local_size_z = 1) in;
+
+layout(rgba32f, set = 0, binding = 5) uniform writeonly image2D out_image;
+
+void main() {
+    uvec2 p = gl_GlobalInvocationID.xy;
+    if (p.x >= frame.width || p.y >= frame.height) {
+        return;
+    }
+    vec3 dir = primary_dir(vec2(p) + 0.5);
+    imageStore(out_image, ivec2(p), vec4(trace(frame.eye, dir), 1.0));
+}

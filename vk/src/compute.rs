@@ -1,0 +1,341 @@
+//! The compute path: the same tracer as a compute shader (`shaders/trace.comp`),
+//! the counterpart of the render pass and graphics pipeline in pipeline.rs and
+//! the colour target in target.rs.
+//!
+//! A compute pipeline needs far less than a graphics one: one shader stage and a
+//! pipeline layout. No render pass, framebuffer, viewport, rasteriser or blend
+//! state: nothing is rasterised, each invocation computes one pixel and writes
+//! it into a *storage image* with `imageStore`. What the render pass did for us
+//! must now be said explicitly:
+//! - the image's *layout*: shaders may write an image only in GENERAL layout, so
+//!   it is moved there once at setup and stays until the readback;
+//! - the *barriers*: without a render pass's subpass dependencies, one frame's
+//!   writes are ordered against the next frame's writes, and the last frame's
+//!   against the readback copy, by pipeline barriers;
+//! - the *grid*: the dispatch covers the image in ceil(w / WG_X) x ceil(h / WG_Y)
+//!   workgroups; the shader skips invocations past the edges.
+//!
+//! The descriptor set is descriptors.rs's with the compute stage and binding 5.
+
+use crate::commands::Commands;
+use crate::descriptors::Descriptors;
+use crate::device::Device;
+use crate::memory::{self, Buffer};
+use crate::timestamps::Timestamps;
+use anyhow::{Context, Result};
+use ash::vk;
+use ash::vk::MemoryPropertyFlags as Flags;
+use twinray_common::cli::Workgroup;
+use twinray_common::error::bad_input;
+use twinray_common::image_io::FloatImage;
+use twinray_common::shader::ComputeShader;
+
+/// The same float format as the fragment path's colour image (pipeline.rs), and
+/// the `rgba32f` of the shader's image declaration. Storage-image support for it
+/// is mandatory in Vulkan, so no format query is needed.
+pub const IMAGE_FORMAT: vk::Format = vk::Format::R32G32B32A32_SFLOAT;
+
+/// Everything the compute path owns. Fields drop in declaration order: the
+/// commands first (their Drop waits for the GPU), then what they use.
+pub struct Compute {
+    pub commands: Commands,
+    // Only kept alive for the recorded commands, which use them.
+    _pipeline: ComputePipeline,
+    _descriptors: Descriptors,
+    image: StorageImage,
+    readback: Buffer,
+    width: u32,
+    height: u32,
+}
+
+impl Compute {
+    /// `frame` and `storage` are the scene's buffers, as for the fragment path.
+    pub fn new(
+        device: &Device,
+        frame: &Buffer,
+        storage: &[(u32, Buffer)],
+        shader: &ComputeShader,
+        width: u32,
+        height: u32,
+        timestamps: Option<&Timestamps>,
+    ) -> Result<Compute> {
+        let groups = check_limits(device, shader.workgroup, width, height)?;
+        let bytes = width as u64 * height as u64 * 16;
+        // The CPU reads this one, and uncached reads of mapped memory are very slow.
+        let wishes = [Flags::HOST_VISIBLE | Flags::HOST_CACHED, Flags::HOST_VISIBLE];
+        let readback = Buffer::new(device, bytes, vk::BufferUsageFlags::TRANSFER_DST, &wishes, "readback buffer")?;
+        let image = StorageImage::new(device, width, height)?;
+        let descriptors =
+            Descriptors::for_stage(device, frame, storage, vk::ShaderStageFlags::COMPUTE, Some(image.view))?;
+        let pipeline = ComputePipeline::new(device, descriptors.set_layout, &shader.spirv)?;
+        let commands = Commands::record_with(device, |d, cmd| {
+            if let Some(t) = timestamps {
+                t.record_reset(cmd);
+            }
+            // Write-after-write: this frame's imageStores must come after the
+            // previous frame's (same image). A render pass's external subpass
+            // dependency says this for the fragment path; here it is a barrier.
+            let after_last_frame = image.barrier(
+                vk::AccessFlags::SHADER_WRITE,
+                vk::AccessFlags::SHADER_WRITE,
+                vk::ImageLayout::GENERAL,
+                vk::ImageLayout::GENERAL,
+            );
+            // SAFETY: every handle is alive; the buffer is in the recording state.
+            unsafe {
+                d.cmd_pipeline_barrier(
+                    cmd,
+                    vk::PipelineStageFlags::COMPUTE_SHADER,
+                    vk::PipelineStageFlags::COMPUTE_SHADER,
+                    vk::DependencyFlags::empty(),
+                    &[],
+                    &[],
+                    &[after_last_frame],
+                );
+            }
+            if let Some(t) = timestamps {
+                t.record(cmd, 0);
+            }
+            // SAFETY: as above; the set matches the pipeline's layout.
+            unsafe {
+                d.cmd_bind_pipeline(cmd, vk::PipelineBindPoint::COMPUTE, pipeline.pipeline);
+                d.cmd_bind_descriptor_sets(
+                    cmd,
+                    vk::PipelineBindPoint::COMPUTE,
+                    pipeline.layout,
+                    0,
+                    &[descriptors.set],
+                    &[],
+                );
+                d.cmd_dispatch(cmd, groups.0, groups.1, 1);
+            }
+            if let Some(t) = timestamps {
+                t.record(cmd, 1);
+            }
+        })?;
+        Ok(Compute { commands, _pipeline: pipeline, _descriptors: descriptors, image, readback, width, height })
+    }
+
+    /// Copies the last frame to the CPU: a barrier orders the copy after the
+    /// last dispatch's writes (nothing else would), then the same copy and host
+    /// barrier as target.rs. Rows come out top first, as the shader wrote them.
+    /// Leaves the image in TRANSFER_SRC_OPTIMAL: call it once, after the frames.
+    pub fn read_back(&self, device: &Device) -> Result<FloatImage> {
+        device.run_once("reading the image back", |cmd| {
+            // GENERAL works for copies too, but the layer (rightly) says the
+            // copy may be faster from TRANSFER_SRC_OPTIMAL; this runs once, after
+            // the last frame, so the move costs the timed frames nothing.
+            let after_dispatch = self.image.barrier(
+                vk::AccessFlags::SHADER_WRITE,
+                vk::AccessFlags::TRANSFER_READ,
+                vk::ImageLayout::GENERAL,
+                vk::ImageLayout::TRANSFER_SRC_OPTIMAL,
+            );
+            let region = vk::BufferImageCopy::default()
+                .image_subresource(vk::ImageSubresourceLayers {
+                    aspect_mask: vk::ImageAspectFlags::COLOR,
+                    mip_level: 0,
+                    base_array_layer: 0,
+                    layer_count: 1,
+                })
+                .image_extent(vk::Extent3D { width: self.width, height: self.height, depth: 1 });
+            let to_host = vk::BufferMemoryBarrier::default()
+                .src_access_mask(vk::AccessFlags::TRANSFER_WRITE)
+                .dst_access_mask(vk::AccessFlags::HOST_READ)
+                .src_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
+                .dst_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
+                .buffer(self.readback.buffer)
+                .size(vk::WHOLE_SIZE);
+            let d = &device.device;
+            // SAFETY: handles alive, buffer recording; the image is in GENERAL.
+            unsafe {
+                d.cmd_pipeline_barrier(
+                    cmd,
+                    vk::PipelineStageFlags::COMPUTE_SHADER,
+                    vk::PipelineStageFlags::TRANSFER,
+                    vk::DependencyFlags::empty(),
+                    &[],
+                    &[],
+                    &[after_dispatch],
+                );
+                d.cmd_copy_image_to_buffer(
+                    cmd,
+                    self.image.image,
+                    vk::ImageLayout::TRANSFER_SRC_OPTIMAL,
+                    self.readback.buffer,
+                    &[region],
+                );
+                d.cmd_pipeline_barrier(
+                    cmd,
+                    vk::PipelineStageFlags::TRANSFER,
+                    vk::PipelineStageFlags::HOST,
+                    vk::DependencyFlags::empty(),
+                    &[],
+                    &[to_host],
+                    &[],
+                );
+            }
+        })?;
+        let rgba: Vec<f32> = self.readback.read().context("reading the readback buffer")?;
+        Ok(FloatImage::from_rgba(self.width, self.height, &rgba))
+    }
+}
+
+/// The workgroup against the device's limits (bad input: the user chose it), and
+/// the dispatch size, which has limits of its own. Returns the group counts.
+fn check_limits(device: &Device, wg: Workgroup, width: u32, height: u32) -> Result<(u32, u32)> {
+    let l = &device.properties.limits;
+    if wg.x > l.max_compute_work_group_size[0]
+        || wg.y > l.max_compute_work_group_size[1]
+        || wg.x * wg.y > l.max_compute_work_group_invocations
+    {
+        return Err(bad_input(format!(
+            "--workgroup {wg} exceeds this device's limits (maxComputeWorkGroupSize {}x{}, maxComputeWorkGroupInvocations {})",
+            l.max_compute_work_group_size[0], l.max_compute_work_group_size[1], l.max_compute_work_group_invocations
+        )));
+    }
+    let groups = (width.div_ceil(wg.x), height.div_ceil(wg.y));
+    if groups.0 > l.max_compute_work_group_count[0] || groups.1 > l.max_compute_work_group_count[1] {
+        return Err(bad_input(format!(
+            "--size {width}x{height} with --workgroup {wg} needs {}x{} workgroups, more than this device's maxComputeWorkGroupCount {}x{}",
+            groups.0, groups.1, l.max_compute_work_group_count[0], l.max_compute_work_group_count[1]
+        )));
+    }
+    Ok(groups)
+}
+
+/// The compute pipeline: one stage and the layout it reads its descriptors through.
+struct ComputePipeline {
+    device: ash::Device,
+    layout: vk::PipelineLayout,
+    pipeline: vk::Pipeline,
+}
+
+impl ComputePipeline {
+    fn new(device: &Device, set_layout: vk::DescriptorSetLayout, spirv: &[u32]) -> Result<ComputePipeline> {
+        let d = &device.device;
+        let mut this =
+            ComputePipeline { device: d.clone(), layout: vk::PipelineLayout::null(), pipeline: vk::Pipeline::null() };
+        let set_layouts = [set_layout];
+        let info = vk::PipelineLayoutCreateInfo::default().set_layouts(&set_layouts);
+        this.layout = unsafe { d.create_pipeline_layout(&info, None) }.context("creating the compute pipeline layout")?;
+        let info = vk::ShaderModuleCreateInfo::default().code(spirv);
+        let module = unsafe { d.create_shader_module(&info, None) }.context("creating the compute shader module")?;
+        let stage = vk::PipelineShaderStageCreateInfo::default()
+            .stage(vk::ShaderStageFlags::COMPUTE)
+            .module(module)
+            .name(c"main");
+        let info = vk::ComputePipelineCreateInfo::default().stage(stage).layout(this.layout);
+        let made = unsafe { d.create_compute_pipelines(vk::PipelineCache::null(), &[info], None) };
+        // The pipeline keeps its own copy of the code: the module can go now.
+        unsafe { d.destroy_shader_module(module, None) };
+        this.pipeline = made.map_err(|(_, e)| e).context("creating the compute pipeline")?[0];
+        Ok(this)
+    }
+}
+
+impl Drop for ComputePipeline {
+    fn drop(&mut self) {
+        // SAFETY: no command buffer using them is pending (Commands drops first).
+        unsafe {
+            self.device.destroy_pipeline(self.pipeline, None);
+            self.device.destroy_pipeline_layout(self.layout, None);
+        }
+    }
+}
+
+/// The RGBA32F storage image the shader writes, its memory and view. It is
+/// moved to GENERAL once, here, and never leaves it.
+struct StorageImage {
+    device: ash::Device,
+    image: vk::Image,
+    memory: vk::DeviceMemory,
+    view: vk::ImageView,
+}
+
+impl StorageImage {
+    fn new(device: &Device, width: u32, height: u32) -> Result<StorageImage> {
+        let d = &device.device;
+        let mut this = StorageImage {
+            device: d.clone(),
+            image: vk::Image::null(),
+            memory: vk::DeviceMemory::null(),
+            view: vk::ImageView::null(),
+        };
+        let info = vk::ImageCreateInfo::default()
+            .image_type(vk::ImageType::TYPE_2D)
+            .format(IMAGE_FORMAT)
+            .extent(vk::Extent3D { width, height, depth: 1 })
+            .mip_levels(1)
+            .array_layers(1)
+            .samples(vk::SampleCountFlags::TYPE_1)
+            .tiling(vk::ImageTiling::OPTIMAL)
+            .usage(vk::ImageUsageFlags::STORAGE | vk::ImageUsageFlags::TRANSFER_SRC)
+            .initial_layout(vk::ImageLayout::UNDEFINED);
+        this.image = unsafe { d.create_image(&info, None) }.context("creating the storage image")?;
+        let needs = unsafe { d.get_image_memory_requirements(this.image) };
+        this.memory = memory::allocate(device, needs, &[Flags::DEVICE_LOCAL, Flags::empty()], "storage image")?.0;
+        unsafe { d.bind_image_memory(this.image, this.memory, 0) }.context("binding the storage image's memory")?;
+        let info = vk::ImageViewCreateInfo::default()
+            .image(this.image)
+            .view_type(vk::ImageViewType::TYPE_2D)
+            .format(IMAGE_FORMAT)
+            .subresource_range(
+                vk::ImageSubresourceRange::default().aspect_mask(vk::ImageAspectFlags::COLOR).level_count(1).layer_count(1),
+            );
+        this.view = unsafe { d.create_image_view(&info, None) }.context("creating the storage image view")?;
+
+        // UNDEFINED → GENERAL once: the old contents (none) may be discarded.
+        let to_general = this.barrier(
+            vk::AccessFlags::empty(),
+            vk::AccessFlags::SHADER_WRITE,
+            vk::ImageLayout::UNDEFINED,
+            vk::ImageLayout::GENERAL,
+        );
+        device.run_once("moving the storage image to GENERAL layout", |cmd| unsafe {
+            // SAFETY: the image is alive and the buffer is recording.
+            d.cmd_pipeline_barrier(
+                cmd,
+                vk::PipelineStageFlags::TOP_OF_PIPE,
+                vk::PipelineStageFlags::COMPUTE_SHADER,
+                vk::DependencyFlags::empty(),
+                &[],
+                &[],
+                &[to_general],
+            );
+        })?;
+        Ok(this)
+    }
+
+    /// A barrier on the whole image, from layout `old` to `new`.
+    fn barrier(
+        &self,
+        src: vk::AccessFlags,
+        dst: vk::AccessFlags,
+        old: vk::ImageLayout,
+        new: vk::ImageLayout,
+    ) -> vk::ImageMemoryBarrier<'static> {
+        vk::ImageMemoryBarrier::default()
+            .src_access_mask(src)
+            .dst_access_mask(dst)
+            .old_layout(old)
+            .new_layout(new)
+            .src_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
+            .dst_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
+            .image(self.image)
+            .subresource_range(
+                vk::ImageSubresourceRange::default().aspect_mask(vk::ImageAspectFlags::COLOR).level_count(1).layer_count(1),
+            )
+    }
+}
+
+impl Drop for StorageImage {
+    fn drop(&mut self) {
+        // SAFETY: no command buffer using them is pending (Commands drops first).
+        unsafe {
+            self.device.destroy_image_view(self.view, None);
+            self.device.destroy_image(self.image, None);
+            self.device.free_memory(self.memory, None);
+        }
+    }
+}
