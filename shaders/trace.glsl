@@ -8,6 +8,12 @@
 // common/src/shader.rs: HAS_SPHERES, HAS_TRIANGLES, HAS_MIRROR, HAS_GLASS,
 // and STACK_SIZE (the ray stack, >= max_depth + 1).
 //
+// Numerical choices are defines too (common/src/numerics.rs), one of each:
+//   OFFSET_RAY | OFFSET_NORMAL | OFFSET_NORMAL_SCALED | OFFSET_ULP   (secondary-ray origin)
+//   TRIANGLE_MOLLER_TRUMBORE | TRIANGLE_WATERTIGHT                    (ray-triangle test)
+//   SPHERE_QUADRATIC | SPHERE_STABLE                                  (ray-sphere test)
+// With none given, the shader falls back to normal-scaled / Moller-Trumbore / stable.
+//
 // The CPU reference (common/src/reference.rs) follows this file step by step in
 // f64; change both together.
 
@@ -65,7 +71,7 @@ struct Light {
 layout(std140, set = 0, binding = 0) uniform Frame {
     vec3 eye;
     float min_weight;
-    vec3 top_left;
+    vec3 top_left;  // relative to the eye (see common/src/camera.rs)
     float epsilon;
     vec3 step_x;
     uint max_depth;
@@ -97,14 +103,31 @@ layout(std430, set = 0, binding = 4) readonly buffer Lights {
 
 const float T_MAX = 1.0e30;
 
-// Stable ray-sphere test (Haines et al., Ray Tracing Gems ch. 7): the discriminant
-// is formed from the distance of the centre to the ray, and the two roots as c/q
-// and q, which avoids cancellation for small or far spheres. `dir` is unit length.
+// Ray-sphere tests. `dir` is unit length; both return the nearest t in
+// (t_min, t_max) or -1. Conditions are written so that NaN fails them.
 float hit_sphere(vec3 origin, vec3 dir, Sphere s, float t_min, float t_max) {
     vec3 f = origin - s.center;
+    float r2 = s.radius * s.radius;
+#ifdef SPHERE_QUADRATIC
+    // The textbook quadratic a t^2 + b t + c = 0. b^2 - 4ac cancels when the
+    // sphere is small against its distance, and -b + sqrt(disc) cancels for the
+    // near root.
+    float a = dot(dir, dir);
+    float b = 2.0 * dot(f, dir);
+    float c = dot(f, f) - r2;
+    float disc = b * b - 4.0 * a * c;
+    if (!(disc >= 0.0)) {
+        return -1.0;
+    }
+    float sq = sqrt(disc);
+    float lo = (-b - sq) / (2.0 * a);
+    float hi = (-b + sq) / (2.0 * a);
+#else
+    // Stable form (Haines et al., Ray Tracing Gems ch. 7): the discriminant is
+    // formed from the distance of the centre to the ray, and the two roots as c/q
+    // and q, which avoids cancellation for small or far spheres.
     float b = dot(f, dir);
     vec3 l = f - b * dir;
-    float r2 = s.radius * s.radius;
     float disc = r2 - dot(l, l);
     if (!(disc >= 0.0)) {
         return -1.0;
@@ -115,6 +138,7 @@ float hit_sphere(vec3 origin, vec3 dir, Sphere s, float t_min, float t_max) {
     float t1 = q;
     float lo = min(t0, t1);
     float hi = max(t0, t1);
+#endif
     if (lo > t_min && lo < t_max) {
         return lo;
     }
@@ -124,25 +148,91 @@ float hit_sphere(vec3 origin, vec3 dir, Sphere s, float t_min, float t_max) {
     return -1.0;
 }
 
-// Moller-Trumbore. Conditions are written so that NaN (degenerate triangles give
-// det == 0 or a tiny det) fails them: a degenerate triangle is never hit.
-vec3 hit_triangle(vec3 origin, vec3 dir, Triangle tri, float t_min, float t_max) {
+// A ray as the triangle test wants it. The watertight test permutes and shears
+// space once per ray (Woop, Benthin, Wald 2013): kz is the dominant axis of the
+// direction, kx and ky the others (swapped to keep the winding), s the shear.
+struct TriRay {
+    vec3 o;
+    vec3 d;
+    uvec3 k;
+    vec3 s;
+};
+
+TriRay tri_ray(vec3 o, vec3 d) {
+    TriRay r;
+    r.o = o;
+    r.d = d;
+    r.k = uvec3(0u, 1u, 2u);
+    r.s = vec3(0.0);
+#ifdef TRIANGLE_WATERTIGHT
+    vec3 ad = abs(d);
+    uint kz = ad.x > ad.y ? (ad.x > ad.z ? 0u : 2u) : (ad.y > ad.z ? 1u : 2u);
+    uint kx = kz == 2u ? 0u : kz + 1u;
+    uint ky = kx == 2u ? 0u : kx + 1u;
+    if (d[kz] < 0.0) {
+        uint tmp = kx;
+        kx = ky;
+        ky = tmp;
+    }
+    r.k = uvec3(kx, ky, kz);
+    r.s = vec3(d[kx] / d[kz], d[ky] / d[kz], 1.0 / d[kz]);
+#endif
+    return r;
+}
+
+// Returns (t, u, v) with u, v the weights of p1 and p2, or t = -1 for a miss.
+// Conditions are written so that NaN fails them: a degenerate triangle is never hit.
+vec3 hit_triangle(TriRay r, Triangle tri, float t_min, float t_max) {
+    vec3 miss = vec3(-1.0, 0.0, 0.0);
+#ifdef TRIANGLE_WATERTIGHT
+    // Vertices relative to the origin, in the sheared frame where the ray is +z.
+    // Each vertex is transformed alone, so two triangles sharing an edge compute
+    // the same 2D edge function with opposite sign: no ray slips between them.
+    vec3 a = tri.p0 - r.o;
+    vec3 b = tri.p1 - r.o;
+    vec3 c = tri.p2 - r.o;
+    float ax = a[r.k.x] - r.s.x * a[r.k.z];
+    float ay = a[r.k.y] - r.s.y * a[r.k.z];
+    float bx = b[r.k.x] - r.s.x * b[r.k.z];
+    float by = b[r.k.y] - r.s.y * b[r.k.z];
+    float cx = c[r.k.x] - r.s.x * c[r.k.z];
+    float cy = c[r.k.y] - r.s.y * c[r.k.z];
+    float eu = cx * by - cy * bx;
+    float ev = ax * cy - ay * cx;
+    float ew = bx * ay - by * ax;
+    // Edges exactly through the ray count for both neighbours (the paper's f64
+    // re-test of zero edge functions is left out: GLSL here has no f64).
+    if ((eu < 0.0 || ev < 0.0 || ew < 0.0) && (eu > 0.0 || ev > 0.0 || ew > 0.0)) {
+        return miss;
+    }
+    float det = eu + ev + ew;
+    if (det == 0.0) {
+        return miss;
+    }
+    float tz = eu * (r.s.z * a[r.k.z]) + ev * (r.s.z * b[r.k.z]) + ew * (r.s.z * c[r.k.z]);
+    float inv = 1.0 / det;
+    float t = tz * inv;
+    if (!(t > t_min && t < t_max)) {
+        return miss;
+    }
+    return vec3(t, ev * inv, ew * inv);
+#else
+    // Moller-Trumbore 1997.
     vec3 e1 = tri.p1 - tri.p0;
     vec3 e2 = tri.p2 - tri.p0;
-    vec3 pv = cross(dir, e2);
+    vec3 pv = cross(r.d, e2);
     float det = dot(e1, pv);
-    vec3 miss = vec3(-1.0, 0.0, 0.0);
     if (det == 0.0) {
         return miss;
     }
     float inv = 1.0 / det;
-    vec3 tv = origin - tri.p0;
+    vec3 tv = r.o - tri.p0;
     float u = dot(tv, pv) * inv;
     if (!(u >= 0.0 && u <= 1.0)) {
         return miss;
     }
     vec3 qv = cross(tv, e1);
-    float v = dot(dir, qv) * inv;
+    float v = dot(r.d, qv) * inv;
     if (!(v >= 0.0 && u + v <= 1.0)) {
         return miss;
     }
@@ -151,6 +241,7 @@ vec3 hit_triangle(vec3 origin, vec3 dir, Triangle tri, float t_min, float t_max)
         return miss;
     }
     return vec3(t, u, v);
+#endif
 }
 
 struct Hit {
@@ -179,9 +270,9 @@ void closest_sphere(inout Hit h, vec3 origin, vec3 dir, uint i) {
     }
 }
 
-void closest_triangle(inout Hit h, vec3 origin, vec3 dir, uint i) {
+void closest_triangle(inout Hit h, TriRay ray, uint i) {
     if (i < frame.triangle_count) {
-        vec3 r = hit_triangle(origin, dir, triangle_buf.triangles[i], 0.0, h.t);
+        vec3 r = hit_triangle(ray, triangle_buf.triangles[i], 0.0, h.t);
         if (r.x > 0.0) {
             h.t = r.x;
             h.kind = 2u;
@@ -208,11 +299,12 @@ Hit closest_hit(vec3 origin, vec3 dir) {
     }
 #endif
 #ifdef HAS_TRIANGLES
+    TriRay ray = tri_ray(origin, dir);
     for (uint i = 0u; i < frame.triangle_count; i += PRIMS_PER_ITERATION) {
-        closest_triangle(h, origin, dir, i);
-        closest_triangle(h, origin, dir, i + 1u);
-        closest_triangle(h, origin, dir, i + 2u);
-        closest_triangle(h, origin, dir, i + 3u);
+        closest_triangle(h, ray, i);
+        closest_triangle(h, ray, i + 1u);
+        closest_triangle(h, ray, i + 2u);
+        closest_triangle(h, ray, i + 3u);
     }
 #endif
     return h;
@@ -222,8 +314,8 @@ bool sphere_blocks(vec3 origin, vec3 dir, float dist, uint i) {
     return i < frame.sphere_count && hit_sphere(origin, dir, sphere_buf.spheres[i], 0.0, dist) > 0.0;
 }
 
-bool triangle_blocks(vec3 origin, vec3 dir, float dist, uint i) {
-    return i < frame.triangle_count && hit_triangle(origin, dir, triangle_buf.triangles[i], 0.0, dist).x > 0.0;
+bool triangle_blocks(TriRay ray, float dist, uint i) {
+    return i < frame.triangle_count && hit_triangle(ray, triangle_buf.triangles[i], 0.0, dist).x > 0.0;
 }
 
 // Shadow rays need any hit before the light, not the closest one.
@@ -237,9 +329,10 @@ bool occluded(vec3 origin, vec3 dir, float dist) {
     }
 #endif
 #ifdef HAS_TRIANGLES
+    TriRay ray = tri_ray(origin, dir);
     for (uint i = 0u; i < frame.triangle_count; i += PRIMS_PER_ITERATION) {
-        if (triangle_blocks(origin, dir, dist, i) || triangle_blocks(origin, dir, dist, i + 1u)
-            || triangle_blocks(origin, dir, dist, i + 2u) || triangle_blocks(origin, dir, dist, i + 3u)) {
+        if (triangle_blocks(ray, dist, i) || triangle_blocks(ray, dist, i + 1u)
+            || triangle_blocks(ray, dist, i + 2u) || triangle_blocks(ray, dist, i + 3u)) {
             return true;
         }
     }
@@ -247,11 +340,38 @@ bool occluded(vec3 origin, vec3 dir, float dist) {
     return false;
 }
 
-// Secondary rays start a small, scale-aware distance off the surface, along the
-// geometric normal on the side the new ray leaves from.
-vec3 offset_point(vec3 p, vec3 n) {
+// Where a secondary ray starts: p is the hit point, n the geometric normal on
+// the side the new ray leaves from, dir the new ray's direction. The computed p
+// lies off the surface by its rounding error (about an ULP of its largest
+// coordinate), so a start too close re-hits the surface (acne) and one too far
+// misses nearby occluders (detached shadows, light leaks).
+#ifdef OFFSET_ULP
+// Wachter & Binder, Ray Tracing Gems ch. 6: move each coordinate by 256 ULPs per
+// unit of normal in integer space; near the origin, where ULPs get tiny, by a
+// fixed 1/65536 instead.
+const float ULP_ORIGIN = 1.0 / 32.0;
+const float ULP_FLOAT_SCALE = 1.0 / 65536.0;
+const float ULP_INT_SCALE = 256.0;
+
+float ulp_offset_1(float p, float n) {
+    int of = int(ULP_INT_SCALE * n);
+    float moved = intBitsToFloat(floatBitsToInt(p) + (p < 0.0 ? -of : of));
+    return abs(p) < ULP_ORIGIN ? p + ULP_FLOAT_SCALE * n : moved;
+}
+#endif
+
+vec3 spawn_point(vec3 p, vec3 n, vec3 dir) {
+#if defined(OFFSET_RAY)
+    return p + frame.epsilon * dir;
+#elif defined(OFFSET_NORMAL)
+    return p + frame.epsilon * n;
+#elif defined(OFFSET_ULP)
+    return vec3(ulp_offset_1(p.x, n.x), ulp_offset_1(p.y, n.y), ulp_offset_1(p.z, n.z));
+#else
+    // OFFSET_NORMAL_SCALED: epsilon relative to the largest coordinate, at least absolute.
     float scale = max(1.0, max(abs(p.x), max(abs(p.y), abs(p.z))));
     return p + n * (frame.epsilon * scale);
+#endif
 }
 
 // Unpolarised Fresnel reflectance of a dielectric boundary.
@@ -315,9 +435,10 @@ vec3 trace(vec3 origin, vec3 dir) {
         Material m = material_buf.materials[mat_index];
 
         vec3 local = m.ambient;
-        vec3 p_out = offset_point(p, ng);
         for (uint li = 0u; li < frame.light_count; li++) {
             Light light = light_buf.lights[li];
+            // The offset may depend on the direction (OFFSET_RAY): aim from p first.
+            vec3 p_out = spawn_point(p, ng, normalize(light.position - p));
             vec3 to_light = light.position - p_out;
             float dist = length(to_light);
             vec3 l = to_light / dist;
@@ -351,8 +472,9 @@ vec3 trace(vec3 origin, vec3 dir) {
                     kr += kt * f;
                     float wt = w * kt * (1.0 - f);
                     if (wt >= frame.min_weight && sp < STACK_SIZE) {
-                        st_origin[sp] = offset_point(p, -ng);
-                        st_dir[sp] = normalize(eta * d + (eta * cos_i - cos_t) * ns);
+                        vec3 t_dir = normalize(eta * d + (eta * cos_i - cos_t) * ns);
+                        st_origin[sp] = spawn_point(p, -ng, t_dir);
+                        st_dir[sp] = t_dir;
                         st_weight[sp] = wt;
                         st_depth[sp] = depth + 1u;
                         sp += 1;
@@ -362,8 +484,9 @@ vec3 trace(vec3 origin, vec3 dir) {
 #endif
             float wr = w * kr;
             if (wr >= frame.min_weight && sp < STACK_SIZE) {
-                st_origin[sp] = p_out;
-                st_dir[sp] = reflect(d, ns);
+                vec3 r_dir = reflect(d, ns);
+                st_origin[sp] = spawn_point(p, ng, r_dir);
+                st_dir[sp] = r_dir;
                 st_weight[sp] = wr;
                 st_depth[sp] = depth + 1u;
                 sp += 1;
@@ -375,6 +498,7 @@ vec3 trace(vec3 origin, vec3 dir) {
 }
 
 vec3 primary_dir(vec2 frag_xy) {
-    vec3 target = frame.top_left + (frag_xy.x - 0.5) * frame.step_x + (frag_xy.y - 0.5) * frame.step_y;
-    return normalize(target - frame.eye);
+    // top_left is relative to the eye, so this sum stays small and exact enough
+    // however far the camera is from the origin.
+    return normalize(frame.top_left + (frag_xy.x - 0.5) * frame.step_x + (frag_xy.y - 0.5) * frame.step_y);
 }

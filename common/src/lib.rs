@@ -8,6 +8,7 @@ pub mod error;
 pub mod gpu;
 pub mod image_io;
 pub mod metrics;
+pub mod numerics;
 pub mod reference;
 pub mod report;
 pub mod scene;

@@ -2,6 +2,7 @@
 //! scene's variant through defines, validates the naga module once, and writes
 //! SPIR-V for Vulkan and GLSL 450 core for OpenGL from that same module.
 
+use crate::numerics::Numerics;
 use crate::scene::{Features, Scene, MAX_DEPTH_LIMIT};
 use anyhow::{anyhow, Context};
 use naga::back::{glsl, spv};
@@ -14,20 +15,23 @@ pub const TRACE_FRAG: &str = include_str!("../../shaders/trace.frag");
 pub const FULLSCREEN_VERT: &str = include_str!("../../shaders/fullscreen.vert");
 
 /// The defines that select a shader variant. Same map → same module → same code
-/// in both APIs.
+/// in both APIs. `numerics` is what its numerical defines encode, kept so that
+/// the reference can be asked to take the same choices.
 #[derive(Debug, Clone, PartialEq, Eq, serde::Serialize)]
 pub struct Variant {
     pub defines: BTreeMap<String, String>,
+    pub numerics: Numerics,
 }
 
 impl Variant {
     /// Only what the scene needs: no triangle loop without triangles, no
-    /// refraction code without glass, a ray stack sized to the scene's depth.
+    /// refraction code without glass, a ray stack sized to the scene's depth;
+    /// and the scene's numerical choices (offset, triangle and sphere tests).
     pub fn for_scene(scene: &Scene) -> Variant {
-        Variant::from_features(scene.features(), scene.max_depth)
+        Variant::from_features(scene.features(), scene.max_depth, scene.numerics)
     }
 
-    pub fn from_features(f: Features, max_depth: u32) -> Variant {
+    pub fn from_features(f: Features, max_depth: u32, numerics: Numerics) -> Variant {
         let mut defines = BTreeMap::new();
         let mut flag = |on: bool, name: &str| {
             if on {
@@ -39,16 +43,19 @@ impl Variant {
         flag(f.mirror, "HAS_MIRROR");
         flag(f.glass, "HAS_GLASS");
         defines.insert("STACK_SIZE".into(), (max_depth.max(1) + 1).to_string());
-        Variant { defines }
+        for d in numerics.defines() {
+            defines.insert(d.to_string(), "1".to_string());
+        }
+        Variant { defines, numerics }
     }
 
-    /// Every feature on, the deepest stack: renders any scene.
-    pub fn generic() -> Variant {
+    /// Every feature on, the deepest stack: renders any scene (with the given numerics).
+    pub fn generic(numerics: Numerics) -> Variant {
         let all = Features { spheres: true, triangles: true, mirror: true, glass: true };
-        Variant::from_features(all, MAX_DEPTH_LIMIT)
+        Variant::from_features(all, MAX_DEPTH_LIMIT, numerics)
     }
 
-    /// A short label such as `spheres+triangles+mirror+glass/stack6`.
+    /// A short label such as `spheres+triangles+mirror+glass/stack6/normal-scaled/watertight/stable`.
     pub fn label(&self) -> String {
         let mut parts: Vec<String> = ["HAS_SPHERES", "HAS_TRIANGLES", "HAS_MIRROR", "HAS_GLASS"]
             .iter()
@@ -58,7 +65,12 @@ impl Variant {
         if parts.is_empty() {
             parts.push("background".into());
         }
-        format!("{}/stack{}", parts.join("+"), self.defines.get("STACK_SIZE").map(String::as_str).unwrap_or("?"))
+        format!(
+            "{}/stack{}/{}",
+            parts.join("+"),
+            self.defines.get("STACK_SIZE").map(String::as_str).unwrap_or("?"),
+            self.numerics.label()
+        )
     }
 }
 

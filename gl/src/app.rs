@@ -25,7 +25,7 @@ pub fn run(args: RenderArgs, started: Instant) -> anyhow::Result<()> {
         return Err(bad_input("windowed mode is not available yet; run with --headless"));
     }
     let scene = args.load_scene()?;
-    let variant = if args.generic { Variant::generic() } else { Variant::for_scene(&scene) };
+    let variant = if args.generic { Variant::generic(scene.numerics) } else { Variant::for_scene(&scene) };
     let shaders = shader::build(&variant)?;
     let (width, height) = (args.size.width, args.size.height);
     let gpu_scene = GpuScene::new(&scene, width, height);
