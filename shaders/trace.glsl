@@ -9,7 +9,7 @@
 // and STACK_SIZE (the ray stack, >= max_depth + 1).
 //
 // Numerical choices are defines too (common/src/numerics.rs), one of each:
-//   OFFSET_RAY | OFFSET_NORMAL | OFFSET_NORMAL_SCALED | OFFSET_ULP   (secondary-ray origin)
+//   OFFSET_RAY | OFFSET_NORMAL | OFFSET_NORMAL_SCALED | OFFSET_ULP | OFFSET_SCALE_AWARE  (secondary-ray origin)
 //   TRIANGLE_MOLLER_TRUMBORE | TRIANGLE_WATERTIGHT                    (ray-triangle test)
 //   SPHERE_QUADRATIC | SPHERE_STABLE                                  (ray-sphere test)
 // With none given, the shader falls back to normal-scaled / Moller-Trumbore / stable.
@@ -180,6 +180,14 @@ TriRay tri_ray(vec3 o, vec3 d) {
     return r;
 }
 
+// A triangle whose edges are parallel in f32 has no normal (normalize(0) is
+// undefined), yet rounding can still let a ray through a collinear triangle's
+// line pass either test. Checked only for candidate hits, so it costs little.
+bool is_degenerate(Triangle tri) {
+    vec3 c = cross(tri.p1 - tri.p0, tri.p2 - tri.p0);
+    return c.x == 0.0 && c.y == 0.0 && c.z == 0.0;
+}
+
 // Returns (t, u, v) with u, v the weights of p1 and p2, or t = -1 for a miss.
 // Conditions are written so that NaN fails them: a degenerate triangle is never hit.
 vec3 hit_triangle(TriRay r, Triangle tri, float t_min, float t_max) {
@@ -212,7 +220,7 @@ vec3 hit_triangle(TriRay r, Triangle tri, float t_min, float t_max) {
     float tz = eu * (r.s.z * a[r.k.z]) + ev * (r.s.z * b[r.k.z]) + ew * (r.s.z * c[r.k.z]);
     float inv = 1.0 / det;
     float t = tz * inv;
-    if (!(t > t_min && t < t_max)) {
+    if (!(t > t_min && t < t_max) || is_degenerate(tri)) {
         return miss;
     }
     return vec3(t, ev * inv, ew * inv);
@@ -237,7 +245,7 @@ vec3 hit_triangle(TriRay r, Triangle tri, float t_min, float t_max) {
         return miss;
     }
     float t = dot(e2, qv) * inv;
-    if (!(t > t_min && t < t_max)) {
+    if (!(t > t_min && t < t_max) || is_degenerate(tri)) {
         return miss;
     }
     return vec3(t, u, v);
@@ -345,6 +353,10 @@ bool occluded(vec3 origin, vec3 dir, float dist) {
 // lies off the surface by its rounding error (about an ULP of its largest
 // coordinate), so a start too close re-hits the surface (acne) and one too far
 // misses nearby occluders (detached shadows, light leaks).
+float max_abs(vec3 v) {
+    return max(abs(v.x), max(abs(v.y), abs(v.z)));
+}
+
 #ifdef OFFSET_ULP
 // Wachter & Binder, Ray Tracing Gems ch. 6: move each coordinate by 256 ULPs per
 // unit of normal in integer space; near the origin, where ULPs get tiny, by a
@@ -360,13 +372,24 @@ float ulp_offset_1(float p, float n) {
 }
 #endif
 
-vec3 spawn_point(vec3 p, vec3 n, vec3 dir) {
+// `scale` is the largest coordinate of the ray origin the hit was found from;
+// only OFFSET_SCALE_AWARE uses it. 2^-22 is 2 f32 ULPs at the top of a binade
+// and 4 at its bottom: 2^-23 let acne through in scenes/hard/tiny-1e-4, 2^-21
+// detached the shadows of scenes/hard/far-1e6 (twinray accuracy measures both).
+const float SCALE_AWARE_REL = 1.0 / 4194304.0;
+
+vec3 spawn_point(vec3 p, vec3 n, vec3 dir, float scale) {
 #if defined(OFFSET_RAY)
     return p + frame.epsilon * dir;
 #elif defined(OFFSET_NORMAL)
     return p + frame.epsilon * n;
 #elif defined(OFFSET_ULP)
     return vec3(ulp_offset_1(p.x, n.x), ulp_offset_1(p.y, n.y), ulp_offset_1(p.z, n.z));
+#elif defined(OFFSET_SCALE_AWARE)
+    // The rounding error of p = o + t d is about an ULP of the largest
+    // coordinate of o and p; move a few of those. No absolute floor, so tiny
+    // scenes near the origin keep offsets to scale.
+    return p + n * (SCALE_AWARE_REL * max(scale, max_abs(p)));
 #else
     // OFFSET_NORMAL_SCALED: epsilon relative to the largest coordinate, at least absolute.
     float scale = max(1.0, max(abs(p.x), max(abs(p.y), abs(p.z))));
@@ -413,6 +436,7 @@ vec3 trace(vec3 origin, vec3 dir) {
         vec3 ng;
         vec3 ns;
         uint mat_index;
+        float scale = max_abs(o);
         if (h.kind == 1u) {
             Sphere s = sphere_buf.spheres[h.index];
             ng = (p - s.center) / s.radius;
@@ -438,7 +462,7 @@ vec3 trace(vec3 origin, vec3 dir) {
         for (uint li = 0u; li < frame.light_count; li++) {
             Light light = light_buf.lights[li];
             // The offset may depend on the direction (OFFSET_RAY): aim from p first.
-            vec3 p_out = spawn_point(p, ng, normalize(light.position - p));
+            vec3 p_out = spawn_point(p, ng, normalize(light.position - p), scale);
             vec3 to_light = light.position - p_out;
             float dist = length(to_light);
             vec3 l = to_light / dist;
@@ -473,7 +497,7 @@ vec3 trace(vec3 origin, vec3 dir) {
                     float wt = w * kt * (1.0 - f);
                     if (wt >= frame.min_weight && sp < STACK_SIZE) {
                         vec3 t_dir = normalize(eta * d + (eta * cos_i - cos_t) * ns);
-                        st_origin[sp] = spawn_point(p, -ng, t_dir);
+                        st_origin[sp] = spawn_point(p, -ng, t_dir, scale);
                         st_dir[sp] = t_dir;
                         st_weight[sp] = wt;
                         st_depth[sp] = depth + 1u;
@@ -485,7 +509,7 @@ vec3 trace(vec3 origin, vec3 dir) {
             float wr = w * kr;
             if (wr >= frame.min_weight && sp < STACK_SIZE) {
                 vec3 r_dir = reflect(d, ns);
-                st_origin[sp] = spawn_point(p, ng, r_dir);
+                st_origin[sp] = spawn_point(p, ng, r_dir, scale);
                 st_dir[sp] = r_dir;
                 st_weight[sp] = wr;
                 st_depth[sp] = depth + 1u;

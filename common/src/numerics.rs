@@ -25,6 +25,11 @@ pub enum Offset {
     /// normal, component by component, in integer space; a fixed 1/65536 near
     /// the origin (|p_i| < 1/32). Ignores `epsilon`.
     Ulp,
+    /// Along the normal, `2^-22 * max(|o|, |p|)` (max norms, o the ray origin):
+    /// 2 to 4 f32 ULPs of the largest coordinate the hit point was computed
+    /// from, with no absolute floor, so it follows the scene's scale both ways
+    /// (far and tiny). Ignores `epsilon`.
+    ScaleAware,
 }
 
 /// The ray-triangle test.
@@ -63,13 +68,14 @@ impl Default for Numerics {
 }
 
 impl Offset {
-    pub const ALL: [Offset; 4] = [Offset::Ray, Offset::Normal, Offset::NormalScaled, Offset::Ulp];
+    pub const ALL: [Offset; 5] = [Offset::Ray, Offset::Normal, Offset::NormalScaled, Offset::Ulp, Offset::ScaleAware];
     pub fn name(self) -> &'static str {
         match self {
             Offset::Ray => "ray",
             Offset::Normal => "normal",
             Offset::NormalScaled => "normal-scaled",
             Offset::Ulp => "ulp",
+            Offset::ScaleAware => "scale-aware",
         }
     }
     fn define(self) -> &'static str {
@@ -78,6 +84,7 @@ impl Offset {
             Offset::Normal => "OFFSET_NORMAL",
             Offset::NormalScaled => "OFFSET_NORMAL_SCALED",
             Offset::Ulp => "OFFSET_ULP",
+            Offset::ScaleAware => "OFFSET_SCALE_AWARE",
         }
     }
 }
@@ -120,7 +127,7 @@ fn pick<T: Copy>(key: &str, value: &str, all: &[T], name: impl Fn(T) -> &'static
     let v = match v.as_str() {
         "mt" | "moller" | "möller-trumbore" => "moller-trumbore".to_string(),
         "wbw" => "watertight".into(),
-        "wachter-binder" | "scale-aware" => "ulp".into(),
+        "wachter-binder" => "ulp".into(),
         _ => v,
     };
     all.iter().copied().find(|t| name(*t) == v).ok_or_else(|| {
