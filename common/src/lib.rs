@@ -6,6 +6,7 @@ pub mod camera;
 pub mod cli;
 pub mod error;
 pub mod gpu;
+pub mod hard;
 pub mod image_io;
 pub mod metrics;
 pub mod numerics;

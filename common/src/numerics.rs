@@ -63,7 +63,7 @@ pub struct Numerics {
 impl Default for Numerics {
     /// The default configuration; `twinray accuracy` shows why (comparison/results/*/accuracy/report.md).
     fn default() -> Self {
-        Numerics { offset: Offset::NormalScaled, triangle: TriangleTest::Watertight, sphere: SphereTest::Stable }
+        Numerics { offset: Offset::ScaleAware, triangle: TriangleTest::Watertight, sphere: SphereTest::Stable }
     }
 }
 
