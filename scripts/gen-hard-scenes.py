@@ -63,12 +63,16 @@ def write(name, text):
 FAR_NOTE = """A sphere and a cube resting on a ground quad, lit from above, moved {what}.
 f32 coordinates there are {ulp} apart, so hit points lie off the surface by
 about that much: a secondary-ray offset much smaller gives shadow acne, one
-much larger detaches the contact shadows."""
+much larger detaches the contact shadows. At 1e6 (1/16 apart) even the best
+offset leaves ~10% of pixels off by more than 8/255: sphere normals come from
+hit points quantised to 1/16 (a blocky highlight) and contact shadows detach by
+a few ULPs; the tolerance there catches gross failure (a fixed 1e-4 offset:
+acne; 1e-4 * |p|: shadows gone, 54%)."""
 
 for d in (1e4, 1e5, 1e6):
     ulp = 2.0 ** (math.floor(math.log2(d)) - 23)
     exp = int(round(math.log10(d)))
-    tol = {4: 0.5, 5: 1.0, 6: 3.0}[exp]
+    tol = {4: 0.5, 5: 1.0, 6: 12.0}[exp]
     write(f"far-1e{exp}", small_scene(1.0, [d, d, d], f"far-1e{exp}",
           f"the same object at ({d:g}, {d:g}, {d:g}): no shadow acne, no detached shadows", tol,
           FAR_NOTE.format(what=f"to ({d:g}, {d:g}, {d:g})", ulp=f"{ulp:g}")))
@@ -168,15 +172,18 @@ simple("inside-glass", "the camera inside a glass sphere, looking out at objects
 refracted ray must start outside, the reflected one inside; a wrong side on
 either shows as noise all over the image.""")
 
-simple("total-internal-reflection", "total internal reflection inside a glass cube seen past its critical angle", 1.0,
+simple("total-internal-reflection", "total internal reflection inside a glass cube seen past its critical angle", 8.0,
        '\n[[meshes]]\nobj = "../cube.obj"\nmaterial = "glass"\nscale = 1.6\nrotate_y = 35.0\ntranslate = [0.0, 0.8, 0.0]\nsmooth = false\n'
        '\n[[spheres]]\ncenter = [0.0, 0.5, -2.5]\nradius = 0.5\nmaterial = "red"\n'
        '\n[[quads]]\ncorners = [[-8.0, 0.0, -8.0], [-8.0, 0.0, 8.0], [8.0, 0.0, 8.0], [8.0, 0.0, -8.0]]\nmaterial = "ground"\n',
-       'eye = [2.5, 3.5, 4.0]\nlook_at = [0.0, 0.7, 0.0]\nfov_y = 40.0', render="max_depth = 8",
+       'eye = [2.5, 3.5, 4.0]\nlook_at = [0.0, 0.7, 0.0]\nfov_y = 40.0', render="max_depth = 4",
        materials=MATERIALS + GLASS.replace("ior = 1.5", "ior = 2.0"),
        note="""Rays entering the top of a cube of index 2 (critical angle 30 degrees) meet the
 sides beyond it: every such ray reflects inside (k < 0 in the shader) and must
-stay inside; the edges of the cube are where tests disagree most.""")
+stay inside, without NaN. Paths that bounce inside are chaotic: at 64x64 the
+top and bottom faces alias into speckle even in the f64 reference, and f32
+rounding flips the exit face of ~6% of pixels under every strategy, hence the
+tolerance.""")
 
 simple("nested-glass", "adjacent (touching) and nested glass spheres", 1.5,
        '\n[[spheres]]\ncenter = [-0.7, 0.7, 0.0]\nradius = 0.7\nmaterial = "glass"\n'
@@ -206,7 +213,7 @@ simple("degenerate", "degenerate triangles (zero area, collinear, a point) acros
 on pixel-centre rays (the image's middle row and column). None may be hit and
 none may produce NaN: the image equals a render without them.""")
 
-simple("coplanar", "coplanar overlapping triangles of two colours: a deterministic result", 20.0,
+simple("coplanar", "coplanar overlapping triangles of two colours: a deterministic result", 10.0,
        '\n[[quads]]\ncorners = [[-1.5, -1.0, 0.0], [1.5, -1.0, 0.0], [1.5, 1.0, 0.0], [-1.5, 1.0, 0.0]]\nmaterial = "red"\n'
        '\n[[quads]]\ncorners = [[-0.5, -1.5, 0.0], [2.0, -1.5, 0.0], [2.0, 0.5, 0.0], [-0.5, 0.5, 0.0]]\nmaterial = "blue"\n',
        'eye = [0.3, 0.4, 4.0]\nlook_at = [0.2, -0.1, 0.0]\nfov_y = 50.0', extra=["deterministic"],

@@ -372,8 +372,10 @@ float ulp_offset_1(float p, float n) {
 }
 #endif
 
-// `scale` is the largest coordinate of the ray origin the hit was found from;
-// only OFFSET_SCALE_AWARE uses it. 2^-22 is 2 f32 ULPs at the top of a binade
+// `scale` is the largest coordinate of the ray origin the hit was found from,
+// and of the vertices for a triangle; only OFFSET_SCALE_AWARE uses it. (Not the
+// sphere's |centre| + radius: the stable test re-tests a radius-1e6 ground from
+// near its surface cleanly, and that scale would lift shadow rays by a unit.) 2^-22 is 2 f32 ULPs at the top of a binade
 // and 4 at its bottom: 2^-23 let acne through in scenes/hard/tiny-1e-4, 2^-21
 // detached the shadows of scenes/hard/far-1e6 (twinray accuracy measures both).
 const float SCALE_AWARE_REL = 1.0 / 4194304.0;
@@ -396,6 +398,8 @@ vec3 spawn_point(vec3 p, vec3 n, vec3 dir, float scale) {
     return p + n * (frame.epsilon * scale);
 #endif
 }
+
+const float SHADOW_REACH = 0.9999;
 
 // Unpolarised Fresnel reflectance of a dielectric boundary.
 float fresnel(float cos_i, float cos_t, float eta) {
@@ -444,6 +448,9 @@ vec3 trace(vec3 origin, vec3 dir) {
             mat_index = s.material;
         } else {
             Triangle tri = triangle_buf.triangles[h.index];
+            // A triangle test's error grows with its vertices' magnitude (a floor
+            // quad reaching x = 8 seen from a glass sphere at |o| = 1 re-hit itself).
+            scale = max(scale, max(max_abs(tri.p0), max(max_abs(tri.p1), max_abs(tri.p2))));
             ng = normalize(cross(tri.p1 - tri.p0, tri.p2 - tri.p0));
             ns = normalize((1.0 - h.u - h.v) * tri.n0 + h.u * tri.n1 + h.v * tri.n2);
             mat_index = tri.material;
@@ -469,7 +476,9 @@ vec3 trace(vec3 origin, vec3 dir) {
             float ndl = dot(ns, l);
             bool lit = ndl > 0.0 && dot(ng, l) > 0.0;
             if (lit) {
-                lit = !occluded(p_out, l, dist);
+                // Stop a hair before the light: a light lying on a surface would
+                // otherwise be hidden by that surface at the whim of rounding.
+                lit = !occluded(p_out, l, dist * SHADOW_REACH);
             }
             if (lit) {
                 vec3 r = reflect(-l, ns);

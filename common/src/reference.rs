@@ -210,11 +210,14 @@ fn ulp_offset_1(p: f64, n: f64) -> f64 {
     p + (f32::from_bits(bits as u32) as f64 - pf as f64)
 }
 
+/// The shader's SHADOW_REACH: shadow rays stop this share of the way to the light.
+const SHADOW_REACH: f64 = 0.9999;
+
 /// The shader's SCALE_AWARE_REL (2^-22).
 const SCALE_AWARE_REL: f64 = 1.0 / 4_194_304.0;
 
 /// The shader's `spawn_point`: where a secondary ray along `dir` leaves `p`;
-/// `scale` is the largest coordinate of the ray origin.
+/// `scale` is the largest coordinate of the ray origin (and of a triangle's vertices).
 fn spawn_point(scene: &Scene, p: DVec3, n: DVec3, dir: DVec3, scale: f64) -> DVec3 {
     match scene.numerics.offset {
         Offset::ScaleAware => p + n * (SCALE_AWARE_REL * scale.max(p.abs().max_element())),
@@ -268,7 +271,8 @@ pub fn trace(scene: &Scene, origin: DVec3, dir: DVec3) -> DVec3 {
                 let tri = &scene.triangles[i];
                 let ng = (tri.p[1] - tri.p[0]).cross(tri.p[2] - tri.p[0]).normalize();
                 let ns = ((1.0 - u - v) * tri.n[0] + u * tri.n[1] + v * tri.n[2]).normalize();
-                (ng, ns, tri.material, max_abs(o))
+                let prim = max_abs(tri.p[0]).max(max_abs(tri.p[1])).max(max_abs(tri.p[2]));
+                (ng, ns, tri.material, max_abs(o).max(prim))
             }
         };
         let inside = d.dot(ng) > 0.0;
@@ -287,7 +291,7 @@ pub fn trace(scene: &Scene, origin: DVec3, dir: DVec3) -> DVec3 {
             let dist = to_light.length();
             let l = to_light / dist;
             let ndl = ns.dot(l);
-            if ndl > 0.0 && ng.dot(l) > 0.0 && !occluded(scene, p_out, l, dist) {
+            if ndl > 0.0 && ng.dot(l) > 0.0 && !occluded(scene, p_out, l, dist * SHADOW_REACH) {
                 let r = reflect(-l, ns);
                 let spec = r.dot(-d).max(0.0).powf(m.shininess);
                 local += light.color * (m.diffuse * ndl + m.specular * spec);
