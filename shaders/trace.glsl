@@ -446,6 +446,10 @@ vec3 trace(vec3 origin, vec3 dir) {
             ng = (p - s.center) / s.radius;
             ns = ng;
             mat_index = s.material;
+            // Sphere tests square their inputs (c = f.f - r^2), so a start a few
+            // ULPs inside glass can still re-hit the same sphere: 4x the margin
+            // (scenes/box's glass sphere speckled with 2^-22).
+            scale = 4.0 * max(scale, max_abs(p));
         } else {
             Triangle tri = triangle_buf.triangles[h.index];
             // A triangle test's error grows with its vertices' magnitude (a floor

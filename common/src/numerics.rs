@@ -25,9 +25,10 @@ pub enum Offset {
     /// normal, component by component, in integer space; a fixed 1/65536 near
     /// the origin (|p_i| < 1/32). Ignores `epsilon`.
     Ulp,
-    /// Along the normal, `2^-22 * max(|o|, |p|, |vertices|)` (max norms, o the
-    /// ray origin, vertices for triangles only): 2 to 4 f32 ULPs of the largest
-    /// coordinate the hit was computed from, with no absolute floor, so it follows the scene's scale both ways
+    /// Along the normal, `2^-22 * max(|o|, |p|, |vertices|)` for triangles and
+    /// `2^-20 * max(|o|, |p|)` for spheres (max norms, o the ray origin): a few
+    /// f32 ULPs of the largest coordinate the hit was computed from (more for
+    /// spheres, whose test squares its inputs), with no absolute floor, so it follows the scene's scale both ways
     /// (far and tiny). Ignores `epsilon`.
     ScaleAware,
 }

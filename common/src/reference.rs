@@ -265,7 +265,7 @@ pub fn trace(scene: &Scene, origin: DVec3, dir: DVec3) -> DVec3 {
             Hit::Sphere(i) => {
                 let s = &scene.spheres[i];
                 let n = (p - s.center) / s.radius;
-                (n, n, s.material, max_abs(o))
+                (n, n, s.material, 4.0 * max_abs(o).max(max_abs(p)))
             }
             Hit::Triangle(i, u, v) => {
                 let tri = &scene.triangles[i];
