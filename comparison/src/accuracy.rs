@@ -247,6 +247,16 @@ pub fn run(args: &AccuracyArgs) -> anyhow::Result<()> {
         truth.save_png(&args.out.join(format!("images/{scene_name}-truth.png")))?;
         let truth = truth.to_rgb8();
         let list = configs(&default);
+        // One discarded run per API first: the first process to meet a shader
+        // variant compiles it into Mesa's cache and warms the driver, and that
+        // run would otherwise always be the default's.
+        for api in [Api::Vulkan, Api::Opengl] {
+            let png = args.out.join(format!("images/{scene_name}-warmup.png"));
+            let mut s = set.clone();
+            s.extend(default.set_args());
+            let _ = render_app(api, scene_name, size, s, 2, &png);
+            let _ = std::fs::remove_file(&png);
+        }
         eprintln!("twinray accuracy: {scene_name} at {size}: {} configurations x 2 APIs", list.len());
         for (k, c) in list.iter().enumerate() {
             for api in if k % 2 == 0 { [Api::Vulkan, Api::Opengl] } else { [Api::Opengl, Api::Vulkan] } {
