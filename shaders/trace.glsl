@@ -1,13 +1,18 @@
 // trace.glsl — the one Whitted-style tracer shared by every entry point.
 //
-// Rust concatenates: a `#version` line, this file, then an entry point (trace.frag
-// or trace.comp).
+// Rust concatenates: a `#version` line, this file, then an entry point (trace.frag).
 // naga has no #include. Every struct here is mirrored by a #[repr(C)] struct in
 // common/src/gpu.rs and a test checks that naga's layout equals the Rust one.
 //
 // Features a scene lacks are compiled out through defines chosen in
 // common/src/shader.rs: HAS_SPHERES, HAS_TRIANGLES, HAS_MIRROR, HAS_GLASS,
 // and STACK_SIZE (the ray stack, >= max_depth + 1).
+//
+// Numerical choices are defines too (common/src/numerics.rs), one of each:
+//   OFFSET_RAY | OFFSET_NORMAL | OFFSET_NORMAL_SCALED | OFFSET_ULP | OFFSET_SCALE_AWARE  (secondary-ray origin)
+//   TRIANGLE_MOLLER_TRUMBORE | TRIANGLE_WATERTIGHT                    (ray-triangle test)
+//   SPHERE_QUADRATIC | SPHERE_STABLE                                  (ray-sphere test)
+// With none given, the shader falls back to normal-scaled / Moller-Trumbore / stable.
 //
 // The CPU reference (common/src/reference.rs) follows this file step by step in
 // f64; change both together.
@@ -66,7 +71,7 @@ struct Light {
 layout(std140, set = 0, binding = 0) uniform Frame {
     vec3 eye;
     float min_weight;
-    vec3 top_left;
+    vec3 top_left;  // relative to the eye (see common/src/camera.rs)
     float epsilon;
     vec3 step_x;
     uint max_depth;
@@ -117,16 +122,31 @@ layout(std430, set = 0, binding = 7) readonly buffer BvhPrims {
 
 const float T_MAX = 1.0e30;
 
-// Stable ray-sphere test (Haines et al., Ray Tracing Gems ch. 7): the discriminant
-// is formed from the distance of the centre to the ray, and the two roots as c/q
-// and q, which avoids cancellation for small or far spheres. `dir` is unit length.
-// It takes the fields it needs, not a `Sphere`: naga turns a struct argument into
-// a load of the whole struct from the storage buffer (see the Performance notes).
-float hit_sphere(vec3 origin, vec3 dir, vec3 center, float radius, float t_min, float t_max) {
-    vec3 f = origin - center;
+// Ray-sphere tests. `dir` is unit length; both return the nearest t in
+// (t_min, t_max) or -1. Conditions are written so that NaN fails them.
+float hit_sphere(vec3 origin, vec3 dir, Sphere s, float t_min, float t_max) {
+    vec3 f = origin - s.center;
+    float r2 = s.radius * s.radius;
+#ifdef SPHERE_QUADRATIC
+    // The textbook quadratic a t^2 + b t + c = 0. b^2 - 4ac cancels when the
+    // sphere is small against its distance, and -b + sqrt(disc) cancels for the
+    // near root.
+    float a = dot(dir, dir);
+    float b = 2.0 * dot(f, dir);
+    float c = dot(f, f) - r2;
+    float disc = b * b - 4.0 * a * c;
+    if (!(disc >= 0.0)) {
+        return -1.0;
+    }
+    float sq = sqrt(disc);
+    float lo = (-b - sq) / (2.0 * a);
+    float hi = (-b + sq) / (2.0 * a);
+#else
+    // Stable form (Haines et al., Ray Tracing Gems ch. 7): the discriminant is
+    // formed from the distance of the centre to the ray, and the two roots as c/q
+    // and q, which avoids cancellation for small or far spheres.
     float b = dot(f, dir);
     vec3 l = f - b * dir;
-    float r2 = radius * radius;
     float disc = r2 - dot(l, l);
     if (!(disc >= 0.0)) {
         return -1.0;
@@ -137,6 +157,7 @@ float hit_sphere(vec3 origin, vec3 dir, vec3 center, float radius, float t_min, 
     float t1 = q;
     float lo = min(t0, t1);
     float hi = max(t0, t1);
+#endif
     if (lo > t_min && lo < t_max) {
         return lo;
     }
@@ -146,42 +167,108 @@ float hit_sphere(vec3 origin, vec3 dir, vec3 center, float radius, float t_min, 
     return -1.0;
 }
 
-// Moller-Trumbore. Conditions are written so that NaN (degenerate triangles give
-// det == 0 or a tiny det) fails them: a degenerate triangle is never hit.
-vec3 hit_triangle(vec3 origin, vec3 dir, vec3 p0, vec3 p1, vec3 p2, float t_min, float t_max) {
-    vec3 e1 = p1 - p0;
-    vec3 e2 = p2 - p0;
-    vec3 pv = cross(dir, e2);
-    float det = dot(e1, pv);
+// A ray as the triangle test wants it. The watertight test permutes and shears
+// space once per ray (Woop, Benthin, Wald 2013): kz is the dominant axis of the
+// direction, kx and ky the others (swapped to keep the winding), s the shear.
+struct TriRay {
+    vec3 o;
+    vec3 d;
+    uvec3 k;
+    vec3 s;
+};
+
+TriRay tri_ray(vec3 o, vec3 d) {
+    TriRay r;
+    r.o = o;
+    r.d = d;
+    r.k = uvec3(0u, 1u, 2u);
+    r.s = vec3(0.0);
+#ifdef TRIANGLE_WATERTIGHT
+    vec3 ad = abs(d);
+    uint kz = ad.x > ad.y ? (ad.x > ad.z ? 0u : 2u) : (ad.y > ad.z ? 1u : 2u);
+    uint kx = kz == 2u ? 0u : kz + 1u;
+    uint ky = kx == 2u ? 0u : kx + 1u;
+    if (d[kz] < 0.0) {
+        uint tmp = kx;
+        kx = ky;
+        ky = tmp;
+    }
+    r.k = uvec3(kx, ky, kz);
+    r.s = vec3(d[kx] / d[kz], d[ky] / d[kz], 1.0 / d[kz]);
+#endif
+    return r;
+}
+
+// A triangle whose edges are parallel in f32 has no normal (normalize(0) is
+// undefined), yet rounding can still let a ray through a collinear triangle's
+// line pass either test. Checked only for candidate hits, so it costs little.
+bool is_degenerate(Triangle tri) {
+    vec3 c = cross(tri.p1 - tri.p0, tri.p2 - tri.p0);
+    return c.x == 0.0 && c.y == 0.0 && c.z == 0.0;
+}
+
+// Returns (t, u, v) with u, v the weights of p1 and p2, or t = -1 for a miss.
+// Conditions are written so that NaN fails them: a degenerate triangle is never hit.
+vec3 hit_triangle(TriRay r, Triangle tri, float t_min, float t_max) {
     vec3 miss = vec3(-1.0, 0.0, 0.0);
+#ifdef TRIANGLE_WATERTIGHT
+    // Vertices relative to the origin, in the sheared frame where the ray is +z.
+    // Each vertex is transformed alone, so two triangles sharing an edge compute
+    // the same 2D edge function with opposite sign: no ray slips between them.
+    vec3 a = tri.p0 - r.o;
+    vec3 b = tri.p1 - r.o;
+    vec3 c = tri.p2 - r.o;
+    float ax = a[r.k.x] - r.s.x * a[r.k.z];
+    float ay = a[r.k.y] - r.s.y * a[r.k.z];
+    float bx = b[r.k.x] - r.s.x * b[r.k.z];
+    float by = b[r.k.y] - r.s.y * b[r.k.z];
+    float cx = c[r.k.x] - r.s.x * c[r.k.z];
+    float cy = c[r.k.y] - r.s.y * c[r.k.z];
+    float eu = cx * by - cy * bx;
+    float ev = ax * cy - ay * cx;
+    float ew = bx * ay - by * ax;
+    // Edges exactly through the ray count for both neighbours (the paper's f64
+    // re-test of zero edge functions is left out: GLSL here has no f64).
+    if ((eu < 0.0 || ev < 0.0 || ew < 0.0) && (eu > 0.0 || ev > 0.0 || ew > 0.0)) {
+        return miss;
+    }
+    float det = eu + ev + ew;
+    if (det == 0.0) {
+        return miss;
+    }
+    float tz = eu * (r.s.z * a[r.k.z]) + ev * (r.s.z * b[r.k.z]) + ew * (r.s.z * c[r.k.z]);
+    float inv = 1.0 / det;
+    float t = tz * inv;
+    if (!(t > t_min && t < t_max) || is_degenerate(tri)) {
+        return miss;
+    }
+    return vec3(t, ev * inv, ew * inv);
+#else
+    // Moller-Trumbore 1997.
+    vec3 e1 = tri.p1 - tri.p0;
+    vec3 e2 = tri.p2 - tri.p0;
+    vec3 pv = cross(r.d, e2);
+    float det = dot(e1, pv);
     if (det == 0.0) {
         return miss;
     }
     float inv = 1.0 / det;
-    vec3 tv = origin - p0;
+    vec3 tv = r.o - tri.p0;
     float u = dot(tv, pv) * inv;
     if (!(u >= 0.0 && u <= 1.0)) {
         return miss;
     }
     vec3 qv = cross(tv, e1);
-    float v = dot(dir, qv) * inv;
+    float v = dot(r.d, qv) * inv;
     if (!(v >= 0.0 && u + v <= 1.0)) {
         return miss;
     }
     float t = dot(e2, qv) * inv;
-    if (!(t > t_min && t < t_max)) {
+    if (!(t > t_min && t < t_max) || is_degenerate(tri)) {
         return miss;
     }
     return vec3(t, u, v);
-}
-
-float sphere_t(vec3 origin, vec3 dir, uint i, float t_max) {
-    return hit_sphere(origin, dir, sphere_buf.spheres[i].center, sphere_buf.spheres[i].radius, 0.0, t_max);
-}
-
-vec3 triangle_tuv(vec3 origin, vec3 dir, uint i, float t_max) {
-    return hit_triangle(origin, dir, triangle_buf.triangles[i].p0, triangle_buf.triangles[i].p1,
-                        triangle_buf.triangles[i].p2, 0.0, t_max);
+#endif
 }
 
 struct Hit {
@@ -199,9 +286,9 @@ struct Hit {
 // The order of the tests is unchanged, so the result equals the plain loop's.
 #define PRIMS_PER_ITERATION 4u
 
-void closest_sphere(inout Hit h, vec3 origin, vec3 dir, uint i, uint n) {
-    if (i < n) {
-        float t = sphere_t(origin, dir, i, h.t);
+void closest_sphere(inout Hit h, vec3 origin, vec3 dir, uint i) {
+    if (i < frame.sphere_count) {
+        float t = hit_sphere(origin, dir, sphere_buf.spheres[i], 0.0, h.t);
         if (t > 0.0) {
             h.t = t;
             h.kind = 1u;
@@ -210,9 +297,9 @@ void closest_sphere(inout Hit h, vec3 origin, vec3 dir, uint i, uint n) {
     }
 }
 
-void closest_triangle(inout Hit h, vec3 origin, vec3 dir, uint i, uint n) {
-    if (i < n) {
-        vec3 r = triangle_tuv(origin, dir, i, h.t);
+void closest_triangle(inout Hit h, TriRay ray, uint i) {
+    if (i < frame.triangle_count) {
+        vec3 r = hit_triangle(ray, triangle_buf.triangles[i], 0.0, h.t);
         if (r.x > 0.0) {
             h.t = r.x;
             h.kind = 2u;
@@ -257,6 +344,7 @@ Hit traverse(vec3 origin, vec3 dir, float t_max, bool any_hit) {
     h.u = 0.0;
     h.v = 0.0;
     vec3 inv_dir = inverse_dir(dir);
+    TriRay ray = tri_ray(origin, dir);
     uint stack_node[BVH_STACK];
     float stack_t[BVH_STACK];
     int sp = 0;
@@ -272,14 +360,14 @@ Hit traverse(vec3 origin, vec3 dir, float t_max, bool any_hit) {
                 uint prim = prim_buf.prims[first + k];
                 if ((prim & SPHERE_BIT) != 0u) {
                     uint i = prim & ~SPHERE_BIT;
-                    float t = sphere_t(origin, dir, i, h.t);
+                    float t = hit_sphere(origin, dir, sphere_buf.spheres[i], 0.0, h.t);
                     if (t > 0.0) {
                         h.t = t;
                         h.kind = 1u;
                         h.index = i;
                     }
                 } else {
-                    vec3 r = triangle_tuv(origin, dir, prim, h.t);
+                    vec3 r = hit_triangle(ray, triangle_buf.triangles[prim], 0.0, h.t);
                     if (r.x > 0.0) {
                         h.t = r.x;
                         h.kind = 2u;
@@ -341,50 +429,48 @@ Hit closest_hit_brute(vec3 origin, vec3 dir) {
     h.u = 0.0;
     h.v = 0.0;
 #ifdef HAS_SPHERES
-    uint spheres = frame.sphere_count;
-    for (uint i = 0u; i < spheres; i += PRIMS_PER_ITERATION) {
-        closest_sphere(h, origin, dir, i, spheres);
-        closest_sphere(h, origin, dir, i + 1u, spheres);
-        closest_sphere(h, origin, dir, i + 2u, spheres);
-        closest_sphere(h, origin, dir, i + 3u, spheres);
+    for (uint i = 0u; i < frame.sphere_count; i += PRIMS_PER_ITERATION) {
+        closest_sphere(h, origin, dir, i);
+        closest_sphere(h, origin, dir, i + 1u);
+        closest_sphere(h, origin, dir, i + 2u);
+        closest_sphere(h, origin, dir, i + 3u);
     }
 #endif
 #ifdef HAS_TRIANGLES
-    uint triangles = frame.triangle_count;
-    for (uint i = 0u; i < triangles; i += PRIMS_PER_ITERATION) {
-        closest_triangle(h, origin, dir, i, triangles);
-        closest_triangle(h, origin, dir, i + 1u, triangles);
-        closest_triangle(h, origin, dir, i + 2u, triangles);
-        closest_triangle(h, origin, dir, i + 3u, triangles);
+    TriRay ray = tri_ray(origin, dir);
+    for (uint i = 0u; i < frame.triangle_count; i += PRIMS_PER_ITERATION) {
+        closest_triangle(h, ray, i);
+        closest_triangle(h, ray, i + 1u);
+        closest_triangle(h, ray, i + 2u);
+        closest_triangle(h, ray, i + 3u);
     }
 #endif
     return h;
 }
 
-bool sphere_blocks(vec3 origin, vec3 dir, float dist, uint i, uint n) {
-    return i < n && sphere_t(origin, dir, i, dist) > 0.0;
+bool sphere_blocks(vec3 origin, vec3 dir, float dist, uint i) {
+    return i < frame.sphere_count && hit_sphere(origin, dir, sphere_buf.spheres[i], 0.0, dist) > 0.0;
 }
 
-bool triangle_blocks(vec3 origin, vec3 dir, float dist, uint i, uint n) {
-    return i < n && triangle_tuv(origin, dir, i, dist).x > 0.0;
+bool triangle_blocks(TriRay ray, float dist, uint i) {
+    return i < frame.triangle_count && hit_triangle(ray, triangle_buf.triangles[i], 0.0, dist).x > 0.0;
 }
 
 // Shadow rays need any hit before the light, not the closest one.
 bool occluded_brute(vec3 origin, vec3 dir, float dist) {
 #ifdef HAS_SPHERES
-    uint spheres = frame.sphere_count;
-    for (uint i = 0u; i < spheres; i += PRIMS_PER_ITERATION) {
-        if (sphere_blocks(origin, dir, dist, i, spheres) || sphere_blocks(origin, dir, dist, i + 1u, spheres)
-            || sphere_blocks(origin, dir, dist, i + 2u, spheres) || sphere_blocks(origin, dir, dist, i + 3u, spheres)) {
+    for (uint i = 0u; i < frame.sphere_count; i += PRIMS_PER_ITERATION) {
+        if (sphere_blocks(origin, dir, dist, i) || sphere_blocks(origin, dir, dist, i + 1u)
+            || sphere_blocks(origin, dir, dist, i + 2u) || sphere_blocks(origin, dir, dist, i + 3u)) {
             return true;
         }
     }
 #endif
 #ifdef HAS_TRIANGLES
-    uint triangles = frame.triangle_count;
-    for (uint i = 0u; i < triangles; i += PRIMS_PER_ITERATION) {
-        if (triangle_blocks(origin, dir, dist, i, triangles) || triangle_blocks(origin, dir, dist, i + 1u, triangles)
-            || triangle_blocks(origin, dir, dist, i + 2u, triangles) || triangle_blocks(origin, dir, dist, i + 3u, triangles)) {
+    TriRay ray = tri_ray(origin, dir);
+    for (uint i = 0u; i < frame.triangle_count; i += PRIMS_PER_ITERATION) {
+        if (triangle_blocks(ray, dist, i) || triangle_blocks(ray, dist, i + 1u)
+            || triangle_blocks(ray, dist, i + 2u) || triangle_blocks(ray, dist, i + 3u)) {
             return true;
         }
     }
@@ -410,12 +496,58 @@ bool occluded(vec3 origin, vec3 dir, float dist) {
 #endif
 }
 
-// Secondary rays start a small, scale-aware distance off the surface, along the
-// geometric normal on the side the new ray leaves from.
-vec3 offset_point(vec3 p, vec3 n) {
+// Where a secondary ray starts: p is the hit point, n the geometric normal on
+// the side the new ray leaves from, dir the new ray's direction. The computed p
+// lies off the surface by its rounding error (about an ULP of its largest
+// coordinate), so a start too close re-hits the surface (acne) and one too far
+// misses nearby occluders (detached shadows, light leaks).
+float max_abs(vec3 v) {
+    return max(abs(v.x), max(abs(v.y), abs(v.z)));
+}
+
+#ifdef OFFSET_ULP
+// Wachter & Binder, Ray Tracing Gems ch. 6: move each coordinate by 256 ULPs per
+// unit of normal in integer space; near the origin, where ULPs get tiny, by a
+// fixed 1/65536 instead.
+const float ULP_ORIGIN = 1.0 / 32.0;
+const float ULP_FLOAT_SCALE = 1.0 / 65536.0;
+const float ULP_INT_SCALE = 256.0;
+
+float ulp_offset_1(float p, float n) {
+    int of = int(ULP_INT_SCALE * n);
+    float moved = intBitsToFloat(floatBitsToInt(p) + (p < 0.0 ? -of : of));
+    return abs(p) < ULP_ORIGIN ? p + ULP_FLOAT_SCALE * n : moved;
+}
+#endif
+
+// `scale` is the largest coordinate of the ray origin the hit was found from,
+// and of the vertices for a triangle; only OFFSET_SCALE_AWARE uses it. (Not the
+// sphere's |centre| + radius: the stable test re-tests a radius-1e6 ground from
+// near its surface cleanly, and that scale would lift shadow rays by a unit.) 2^-22 is 2 f32 ULPs at the top of a binade
+// and 4 at its bottom: 2^-23 let acne through in scenes/hard/tiny-1e-4, 2^-21
+// detached the shadows of scenes/hard/far-1e6 (twinray accuracy measures both).
+const float SCALE_AWARE_REL = 1.0 / 4194304.0;
+
+vec3 spawn_point(vec3 p, vec3 n, vec3 dir, float scale) {
+#if defined(OFFSET_RAY)
+    return p + frame.epsilon * dir;
+#elif defined(OFFSET_NORMAL)
+    return p + frame.epsilon * n;
+#elif defined(OFFSET_ULP)
+    return vec3(ulp_offset_1(p.x, n.x), ulp_offset_1(p.y, n.y), ulp_offset_1(p.z, n.z));
+#elif defined(OFFSET_SCALE_AWARE)
+    // The rounding error of p = o + t d is about an ULP of the largest
+    // coordinate of o and p; move a few of those. No absolute floor, so tiny
+    // scenes near the origin keep offsets to scale.
+    return p + n * (SCALE_AWARE_REL * max(scale, max_abs(p)));
+#else
+    // OFFSET_NORMAL_SCALED: epsilon relative to the largest coordinate, at least absolute.
     float scale = max(1.0, max(abs(p.x), max(abs(p.y), abs(p.z))));
     return p + n * (frame.epsilon * scale);
+#endif
 }
+
+const float SHADOW_REACH = 0.9999;
 
 // Unpolarised Fresnel reflectance of a dielectric boundary.
 float fresnel(float cos_i, float cos_t, float eta) {
@@ -456,13 +588,21 @@ vec3 trace(vec3 origin, vec3 dir) {
         vec3 ng;
         vec3 ns;
         uint mat_index;
+        float scale = max_abs(o);
         if (h.kind == 1u) {
             Sphere s = sphere_buf.spheres[h.index];
             ng = (p - s.center) / s.radius;
             ns = ng;
             mat_index = s.material;
+            // Sphere tests square their inputs (c = f.f - r^2), so a start a few
+            // ULPs inside glass can still re-hit the same sphere: 4x the margin
+            // (scenes/box's glass sphere speckled with 2^-22).
+            scale = 4.0 * max(scale, max_abs(p));
         } else {
             Triangle tri = triangle_buf.triangles[h.index];
+            // A triangle test's error grows with its vertices' magnitude (a floor
+            // quad reaching x = 8 seen from a glass sphere at |o| = 1 re-hit itself).
+            scale = max(scale, max(max_abs(tri.p0), max(max_abs(tri.p1), max_abs(tri.p2))));
             ng = normalize(cross(tri.p1 - tri.p0, tri.p2 - tri.p0));
             ns = normalize((1.0 - h.u - h.v) * tri.n0 + h.u * tri.n1 + h.v * tri.n2);
             mat_index = tri.material;
@@ -478,17 +618,19 @@ vec3 trace(vec3 origin, vec3 dir) {
         Material m = material_buf.materials[mat_index];
 
         vec3 local = m.ambient;
-        vec3 p_out = offset_point(p, ng);
-        uint light_count = frame.light_count;
-        for (uint li = 0u; li < light_count; li++) {
+        for (uint li = 0u; li < frame.light_count; li++) {
             Light light = light_buf.lights[li];
+            // The offset may depend on the direction (OFFSET_RAY): aim from p first.
+            vec3 p_out = spawn_point(p, ng, normalize(light.position - p), scale);
             vec3 to_light = light.position - p_out;
             float dist = length(to_light);
             vec3 l = to_light / dist;
             float ndl = dot(ns, l);
             bool lit = ndl > 0.0 && dot(ng, l) > 0.0;
             if (lit) {
-                lit = !occluded(p_out, l, dist);
+                // Stop a hair before the light: a light lying on a surface would
+                // otherwise be hidden by that surface at the whim of rounding.
+                lit = !occluded(p_out, l, dist * SHADOW_REACH);
             }
             if (lit) {
                 vec3 r = reflect(-l, ns);
@@ -515,8 +657,9 @@ vec3 trace(vec3 origin, vec3 dir) {
                     kr += kt * f;
                     float wt = w * kt * (1.0 - f);
                     if (wt >= frame.min_weight && sp < STACK_SIZE) {
-                        st_origin[sp] = offset_point(p, -ng);
-                        st_dir[sp] = normalize(eta * d + (eta * cos_i - cos_t) * ns);
+                        vec3 t_dir = normalize(eta * d + (eta * cos_i - cos_t) * ns);
+                        st_origin[sp] = spawn_point(p, -ng, t_dir, scale);
+                        st_dir[sp] = t_dir;
                         st_weight[sp] = wt;
                         st_depth[sp] = depth + 1u;
                         sp += 1;
@@ -526,8 +669,9 @@ vec3 trace(vec3 origin, vec3 dir) {
 #endif
             float wr = w * kr;
             if (wr >= frame.min_weight && sp < STACK_SIZE) {
-                st_origin[sp] = p_out;
-                st_dir[sp] = reflect(d, ns);
+                vec3 r_dir = reflect(d, ns);
+                st_origin[sp] = spawn_point(p, ng, r_dir, scale);
+                st_dir[sp] = r_dir;
                 st_weight[sp] = wr;
                 st_depth[sp] = depth + 1u;
                 sp += 1;
@@ -539,6 +683,7 @@ vec3 trace(vec3 origin, vec3 dir) {
 }
 
 vec3 primary_dir(vec2 frag_xy) {
-    vec3 target = frame.top_left + (frag_xy.x - 0.5) * frame.step_x + (frag_xy.y - 0.5) * frame.step_y;
-    return normalize(target - frame.eye);
+    // top_left is relative to the eye, so this sum stays small and exact enough
+    // however far the camera is from the origin.
+    return normalize(frame.top_left + (frag_xy.x - 0.5) * frame.step_x + (frag_xy.y - 0.5) * frame.step_y);
 }

@@ -6,11 +6,14 @@
 use crate::scene::Camera;
 use glam::DVec3;
 
-/// Primary ray for pixel (x, y), counted from the top-left: from `eye` towards
+/// Primary ray for pixel (x, y), counted from the top-left: from `eye` along
 /// `top_left + x * step_x + y * step_y` (pixel centres; `step_y` points down).
+/// `top_left` is relative to the eye: with an absolute image plane, a camera at
+/// 1e5 or 1e6 would round every f32 ray target to a grid coarser than a pixel.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct RayFrame {
     pub eye: DVec3,
+    /// From the eye to the centre of the top-left pixel.
     pub top_left: DVec3,
     pub step_x: DVec3,
     pub step_y: DVec3,
@@ -25,13 +28,19 @@ impl RayFrame {
         let half_w = half_h * width as f64 / height as f64;
         let step_x = right * (2.0 * half_w / width as f64);
         let step_y = -up * (2.0 * half_h / height as f64);
-        let top_left = cam.eye + forward - right * half_w + up * half_h + 0.5 * step_x + 0.5 * step_y;
+        let top_left = forward - right * half_w + up * half_h + 0.5 * step_x + 0.5 * step_y;
         RayFrame { eye: cam.eye, top_left, step_x, step_y }
+    }
+
+    /// The frame as the GPU's uniform buffer holds it (every vector in f32).
+    pub fn rounded_to_f32(&self) -> RayFrame {
+        let v = |x: DVec3| x.as_vec3().as_dvec3();
+        RayFrame { eye: v(self.eye), top_left: v(self.top_left), step_x: v(self.step_x), step_y: v(self.step_y) }
     }
 
     /// Unit direction through the centre of pixel (x, y).
     pub fn dir(&self, x: f64, y: f64) -> DVec3 {
-        (self.top_left + x * self.step_x + y * self.step_y - self.eye).normalize()
+        (self.top_left + x * self.step_x + y * self.step_y).normalize()
     }
 }
 
@@ -45,7 +54,7 @@ pub struct Frustum {
 impl Frustum {
     pub fn new(frame: &RayFrame, width: u32, height: u32) -> Frustum {
         // Image-plane corners (pixel edges, not centres).
-        let tl = frame.top_left - 0.5 * frame.step_x - 0.5 * frame.step_y - frame.eye;
+        let tl = frame.top_left - 0.5 * frame.step_x - 0.5 * frame.step_y;
         let tr = tl + width as f64 * frame.step_x;
         let bl = tl + height as f64 * frame.step_y;
         let br = tr + height as f64 * frame.step_y;

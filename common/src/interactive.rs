@@ -147,7 +147,7 @@ pub fn window_attributes(args: &RenderArgs, scene: &str, api: &str) -> WindowAtt
 /// The scene and variant a windowed run starts with (the same choice as headless).
 pub fn variant_for(args: &RenderArgs, scene: &Scene) -> Variant {
     if args.generic {
-        Variant::generic()
+        Variant::generic(scene.numerics)
     } else {
         Variant::for_scene(scene)
     }
@@ -593,6 +593,6 @@ mod tests {
         shallow_scene.max_depth = 1;
         let flat = Variant::for_scene(&shallow_scene);
         assert!(!flat.covers(&shallow), "depth 1 compiles mirror and glass out");
-        assert!(Variant::generic().covers(&deep));
+        assert!(Variant::generic(Default::default()).covers(&deep));
     }
 }

@@ -3,6 +3,7 @@
 //! through tobj. Everything downstream sees one resolved, validated `Scene` in f64.
 
 use crate::error::bad_input;
+use crate::numerics::Numerics;
 use glam::{DMat3, DVec3};
 use serde::Deserialize;
 use std::collections::HashMap;
@@ -21,7 +22,8 @@ const BUILTIN_FILES: &[(&str, &str)] = &[
 ];
 
 /// Keys accepted by `--set`.
-pub const OVERRIDE_KEYS: &[&str] = &["max_depth", "min_weight", "epsilon", "extra_spheres", "fov_y", "tessellation"];
+pub const OVERRIDE_KEYS: &[&str] =
+    &["max_depth", "min_weight", "epsilon", "extra_spheres", "fov_y", "tessellation", "offset", "triangle", "sphere"];
 
 /// The finest `tessellation` accepted per direction (400 x 400 quads per patch is
 /// 10 million triangles for the 32-patch teapot).
@@ -84,11 +86,23 @@ struct RenderDef {
     max_depth: u32,
     min_weight: f64,
     epsilon: f64,
+    /// Numerics (see numerics.rs); absent keys keep the default configuration.
+    offset: Option<String>,
+    triangle: Option<String>,
+    sphere: Option<String>,
 }
 
 impl Default for RenderDef {
     fn default() -> Self {
-        RenderDef { background: [0.0; 3], max_depth: 5, min_weight: 0.01, epsilon: 1e-4 }
+        RenderDef {
+            background: [0.0; 3],
+            max_depth: 5,
+            min_weight: 0.01,
+            epsilon: 1e-4,
+            offset: None,
+            triangle: None,
+            sphere: None,
+        }
     }
 }
 
@@ -248,6 +262,8 @@ pub struct Scene {
     pub max_depth: u32,
     pub min_weight: f64,
     pub epsilon: f64,
+    /// Secondary-ray offset, triangle and sphere tests: the shader variant and the reference follow it.
+    pub numerics: Numerics,
     pub materials: Vec<Material>,
     pub lights: Vec<Light>,
     pub spheres: Vec<Sphere>,
@@ -358,6 +374,36 @@ impl Scene {
         };
     }
 
+    /// The scene as the GPU buffers hold it: every position, normal, radius and
+    /// material value rounded to f32 (the camera is rounded in `RayFrame`). The
+    /// reference traces this in f64, so its images differ from the GPU's by the
+    /// GPU's arithmetic only, not by its inputs — which matters far from the
+    /// origin, where f32 moves a vertex by up to half an ULP (1/32 at 1e6).
+    pub fn rounded_to_f32(&self) -> Scene {
+        let r = |x: f64| x as f32 as f64;
+        let v = |x: DVec3| x.as_vec3().as_dvec3();
+        let mut s = self.clone();
+        s.background = v(s.background);
+        s.min_weight = r(s.min_weight);
+        s.epsilon = r(s.epsilon);
+        for m in &mut s.materials {
+            (m.ambient, m.diffuse, m.specular) = (v(m.ambient), v(m.diffuse), v(m.specular));
+            (m.shininess, m.reflectivity, m.transparency, m.ior) =
+                (r(m.shininess), r(m.reflectivity), r(m.transparency), r(m.ior));
+        }
+        for l in &mut s.lights {
+            (l.position, l.color) = (v(l.position), v(l.color));
+        }
+        for sp in &mut s.spheres {
+            (sp.center, sp.radius) = (v(sp.center), r(sp.radius));
+        }
+        for t in &mut s.triangles {
+            t.p = t.p.map(v);
+            t.n = t.n.map(v);
+        }
+        s
+    }
+
     pub fn stats(&self) -> SceneStats {
         SceneStats {
             name: self.name.clone(),
@@ -413,6 +459,15 @@ fn apply_overrides(def: &mut SceneFile, overrides: &[(String, String)]) -> anyho
                 }
                 if !any {
                     return Err(bad_input("--set tessellation: this scene has no Bezier-patch mesh (try --scene teapot)"));
+                }
+            }
+            "offset" | "triangle" | "sphere" => {
+                // Checked here so that the error names --set rather than the scene file.
+                Numerics::default().set(key, value, &format!("--set {key}"))?;
+                match key.as_str() {
+                    "offset" => def.render.offset = Some(value.clone()),
+                    "triangle" => def.render.triangle = Some(value.clone()),
+                    _ => def.render.sphere = Some(value.clone()),
                 }
             }
             "extra_spheres" => {
@@ -482,6 +537,13 @@ fn resolve(name: &str, def: SceneFile, origin: &str, files: &FileSource) -> anyh
     let epsilon = finite(origin, "render.epsilon", r.epsilon)?;
     if !(epsilon > 0.0 && epsilon < 1.0) {
         return Err(bad_input(format!("{origin}: render.epsilon = {epsilon} must lie between 0 and 1")));
+    }
+
+    let mut numerics = Numerics::default();
+    for (key, value) in [("offset", &r.offset), ("triangle", &r.triangle), ("sphere", &r.sphere)] {
+        if let Some(v) = value {
+            numerics.set(key, v, &format!("{origin}: render.{key}"))?;
+        }
     }
 
     if def.materials.is_empty() {
@@ -631,6 +693,7 @@ fn resolve(name: &str, def: SceneFile, origin: &str, files: &FileSource) -> anyh
         max_depth: r.max_depth,
         min_weight,
         epsilon,
+        numerics,
         materials,
         lights,
         bvh: spheres.len() + triangles.len() >= AUTO_BVH_MIN_PRIMITIVES,

@@ -3,6 +3,7 @@
 //! SPIR-V for Vulkan and GLSL 450 core for OpenGL from that same module.
 
 use crate::cli::Workgroup;
+use crate::numerics::Numerics;
 use crate::scene::{Features, Scene, MAX_DEPTH_LIMIT};
 use anyhow::{anyhow, Context};
 use naga::back::{glsl, spv};
@@ -16,24 +17,27 @@ pub const FULLSCREEN_VERT: &str = include_str!("../../shaders/fullscreen.vert");
 pub const TRACE_COMP: &str = include_str!("../../shaders/trace.comp");
 
 /// The defines that select a shader variant. Same map → same module → same code
-/// in both APIs.
+/// in both APIs. `numerics` is what its numerical defines encode, kept so that
+/// the reference can be asked to take the same choices.
 #[derive(Debug, Clone, PartialEq, Eq, serde::Serialize)]
 pub struct Variant {
     pub defines: BTreeMap<String, String>,
+    pub numerics: Numerics,
 }
 
 impl Variant {
     /// Only what the scene needs: no triangle loop without triangles, no
-    /// refraction code without glass, a ray stack sized to the scene's depth.
+    /// refraction code without glass, a ray stack sized to the scene's depth;
+    /// and the scene's numerical choices (offset, triangle and sphere tests).
     pub fn for_scene(scene: &Scene) -> Variant {
-        let mut v = Variant::from_features(scene.features(), scene.max_depth);
+        let mut v = Variant::from_features(scene.features(), scene.max_depth, scene.numerics);
         if scene.bvh {
             v.defines.insert("USE_BVH".into(), "1".into());
         }
         v
     }
 
-    pub fn from_features(f: Features, max_depth: u32) -> Variant {
+    pub fn from_features(f: Features, max_depth: u32, numerics: Numerics) -> Variant {
         let mut defines = BTreeMap::new();
         let mut flag = |on: bool, name: &str| {
             if on {
@@ -45,13 +49,16 @@ impl Variant {
         flag(f.mirror, "HAS_MIRROR");
         flag(f.glass, "HAS_GLASS");
         defines.insert("STACK_SIZE".into(), (max_depth.max(1) + 1).to_string());
-        Variant { defines }
+        for d in numerics.defines() {
+            defines.insert(d.to_string(), "1".to_string());
+        }
+        Variant { defines, numerics }
     }
 
-    /// Every feature on, the deepest stack: renders any scene.
-    pub fn generic() -> Variant {
+    /// Every feature on, the deepest stack: renders any scene (with the given numerics).
+    pub fn generic(numerics: Numerics) -> Variant {
         let all = Features { spheres: true, triangles: true, mirror: true, glass: true };
-        Variant::from_features(all, MAX_DEPTH_LIMIT)
+        Variant::from_features(all, MAX_DEPTH_LIMIT, numerics)
     }
 
     /// Whether this variant can draw everything `needed` can: every feature of
@@ -63,7 +70,8 @@ impl Variant {
             && stack(self) >= stack(needed)
     }
 
-    /// A short label such as `spheres+triangles+mirror+glass/stack6`.
+    /// A short label such as `spheres+triangles+mirror+glass/stack6/normal-scaled/watertight/stable`
+    /// (with `/bvh` at the end when the variant traces through a BVH).
     pub fn label(&self) -> String {
         let mut parts: Vec<String> = ["HAS_SPHERES", "HAS_TRIANGLES", "HAS_MIRROR", "HAS_GLASS"]
             .iter()
@@ -74,7 +82,12 @@ impl Variant {
             parts.push("background".into());
         }
         let bvh = if self.defines.contains_key("USE_BVH") { "/bvh" } else { "" };
-        format!("{}/stack{}{bvh}", parts.join("+"), self.defines.get("STACK_SIZE").map(String::as_str).unwrap_or("?"))
+        format!(
+            "{}/stack{}/{}{bvh}",
+            parts.join("+"),
+            self.defines.get("STACK_SIZE").map(String::as_str).unwrap_or("?"),
+            self.numerics.label()
+        )
     }
 }
 
@@ -223,7 +236,7 @@ mod tests {
 
     #[test]
     fn spirv_for_opengl_drops_sets_and_flips_origin_only() {
-        let s = build(&Variant::generic()).unwrap();
+        let s = build(&Variant::generic(Default::default())).unwrap();
         let gl = spirv_for_opengl(&s.fragment_spirv);
         let count = |w: &[u32], op: u32, arg2: u32| {
             let mut i = 5;
@@ -247,7 +260,7 @@ mod tests {
     #[test]
     fn compute_shader_builds_with_each_measured_workgroup() {
         for wg in Workgroup::MEASURED {
-            let c = build_compute(&Variant::generic(), wg).unwrap();
+            let c = build_compute(&Variant::generic(Default::default()), wg).unwrap();
             assert_eq!(c.spirv[0], 0x0723_0203, "SPIR-V magic");
             let local = format!("layout(local_size_x = {}, local_size_y = {}, local_size_z = 1) in;", wg.x, wg.y);
             assert!(c.glsl.contains(&local), "{wg}: {}", &c.glsl[..200]);

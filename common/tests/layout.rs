@@ -48,7 +48,7 @@ fn check(name: &str, naga: (Vec<(String, u32)>, u32), rust_offsets: Vec<u32>, ru
 
 #[test]
 fn naga_layout_matches_rust_for_every_shader_struct() {
-    let (module, _) = parse(&fragment_source(), naga::ShaderStage::Fragment, &Variant::generic()).unwrap();
+    let (module, _) = parse(&fragment_source(), naga::ShaderStage::Fragment, &Variant::generic(Default::default())).unwrap();
 
     let (frame_ty, _) = block(&module, binding::FRAME);
     check(
@@ -119,7 +119,16 @@ fn naga_layout_matches_rust_for_every_shader_struct() {
 
 #[test]
 fn every_builtin_variant_and_the_generic_one_compile_for_both_apis() {
-    let mut variants = vec![Variant::generic()];
+    let mut variants = vec![Variant::generic(Default::default())];
+    // Every numerical choice must compile too.
+    use twinray_common::numerics::{Numerics, Offset, SphereTest, TriangleTest};
+    for offset in Offset::ALL {
+        for triangle in TriangleTest::ALL {
+            for sphere in SphereTest::ALL {
+                variants.push(Variant::generic(Numerics { offset, triangle, sphere }));
+            }
+        }
+    }
     let mut bvh = twinray_common::scene::Scene::load("box", &[]).unwrap();
     bvh.bvh = true;
     variants.push(Variant::for_scene(&bvh));

@@ -2,6 +2,7 @@
 //! apps as child processes (one API per process) and reads their JSON, renders
 //! the f64 reference itself, and compares images.
 
+mod accuracy;
 mod apps;
 mod compare;
 mod diff;
@@ -31,6 +32,8 @@ enum Command {
     },
     /// Side-by-side Vulkan vs OpenGL on the study's three experiments: results.csv, report.md, plots.
     Compare(compare::CompareArgs),
+    /// Speed against error: sweeps of depth, offset, triangle and sphere tests against the f64 truth, and the hard cases.
+    Accuracy(accuracy::AccuracyArgs),
     /// Compare two PNGs: RMSE, PSNR, max abs error, share of pixels above 1/255 and 8/255.
     Diff {
         a: std::path::PathBuf,
@@ -57,6 +60,7 @@ fn main() {
         Command::Render { api, args } => apps::render(api, &args),
         Command::Diff { a, b, json, heatmap } => diff::run(&a, &b, json, heatmap.as_deref()),
         Command::Compare(args) => compare::run(&args),
+        Command::Accuracy(args) => accuracy::run(&args),
     };
     if let Err(e) = result {
         exit_with("twinray", e);

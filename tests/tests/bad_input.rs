@@ -135,6 +135,14 @@ fn unknown_override_key() {
 }
 
 #[test]
+fn unknown_numerics_value() {
+    expect_both(&["--headless", "--set", "triangle=octagonal"], &[], 2, &["--set triangle", "octagonal", "watertight"]);
+    let dir = scratch("numerics-file");
+    let p = scene_file(&dir, "n.toml", "[render]\noffset = \"far\"\n");
+    expect_both(&strs(&headless(&p)), &[], 2, &["n.toml", "render.offset", "'far'"]);
+}
+
+#[test]
 fn no_vulkan_driver_says_what_to_install() {
     let env = [("VK_DRIVER_FILES", "/nonexistent/icd.json"), ("VK_ICD_FILENAMES", "/nonexistent/icd.json")];
     expect_one(&bin("twinray-vk"), &["--headless", "--size", "16x16"], &env, 3, &["install"]);

@@ -1,0 +1,741 @@
+//! `twinray accuracy`: speed against error. Renders the standard scenes with
+//! both apps over the knobs that trade one for the other (maximum depth, the
+//! secondary-ray offset, the triangle and sphere tests), measures every image
+//! against the f64 truth (reference.rs `render_truth`, depth 16 for the depth
+//! sweep), marks the Pareto front, then runs the hard cases (scenes/hard/) per
+//! strategy. Writes report.md, accuracy.csv, hard_cases.csv, one SVG per scene
+//! and the images.
+
+use crate::apps::{run_json, Api};
+use crate::compare::api_name;
+use anyhow::Context;
+use plotters::prelude::*;
+use std::fmt::Write as _;
+use std::path::{Path, PathBuf};
+use twinray_common::cli::{RenderArgs, Size};
+use twinray_common::hard::{self, HardCase, WRONG_ABOVE};
+use twinray_common::metrics;
+use twinray_common::numerics::{Numerics, Offset, SphereTest, TriangleTest};
+use twinray_common::reference;
+use twinray_common::scene::{Scene, MAX_DEPTH_LIMIT};
+
+#[derive(clap::Args, Debug, Clone)]
+pub struct AccuracyArgs {
+    /// Small images and few frames: a few minutes on software drivers.
+    #[arg(long)]
+    pub quick: bool,
+    /// Output folder.
+    #[arg(long, default_value = "accuracy-out")]
+    pub out: PathBuf,
+    /// The hard-case folder (default: scenes/hard of this source tree).
+    #[arg(long)]
+    pub hard: Option<PathBuf>,
+    /// Skip the hard cases.
+    #[arg(long)]
+    pub no_hard: bool,
+}
+
+/// One point of a sweep: a maximum depth and a numerical configuration.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Config {
+    pub max_depth: u32,
+    pub numerics: Numerics,
+}
+
+impl Config {
+    fn set_args(&self) -> Vec<String> {
+        let mut v = self.numerics.set_args();
+        v.push(format!("max_depth={}", self.max_depth));
+        v
+    }
+    fn label(&self) -> String {
+        format!("depth {} {}", self.max_depth, self.numerics.label())
+    }
+}
+
+/// What a sweep varies; a config may belong to several (the default to all).
+fn sweeps_of(c: &Config, default: &Config) -> Vec<&'static str> {
+    let n = &c.numerics;
+    let d = &default.numerics;
+    let mut s = Vec::new();
+    if n == d {
+        s.push("depth");
+    }
+    if c.max_depth == default.max_depth {
+        if n.triangle == d.triangle && n.sphere == d.sphere {
+            s.push("offset");
+        }
+        if n.offset == d.offset && n.sphere == d.sphere {
+            s.push("triangle");
+        }
+        if n.offset == d.offset && n.triangle == d.triangle {
+            s.push("sphere");
+        }
+    }
+    s
+}
+
+/// The one-knob-at-a-time sweeps around the scene's default.
+pub fn configs(default: &Config) -> Vec<Config> {
+    let mut v: Vec<Config> = Vec::new();
+    let mut push = |c: Config| {
+        if !v.contains(&c) {
+            v.push(c);
+        }
+    };
+    push(default.clone());
+    for d in 1..=8 {
+        push(Config { max_depth: d, numerics: default.numerics });
+    }
+    for offset in Offset::ALL {
+        push(Config { numerics: Numerics { offset, ..default.numerics }, ..default.clone() });
+    }
+    for triangle in TriangleTest::ALL {
+        push(Config { numerics: Numerics { triangle, ..default.numerics }, ..default.clone() });
+    }
+    for sphere in SphereTest::ALL {
+        push(Config { numerics: Numerics { sphere, ..default.numerics }, ..default.clone() });
+    }
+    v
+}
+
+/// The standard scenes and their sizes.
+fn scenes(quick: bool) -> Vec<(&'static str, Size, Vec<String>)> {
+    let s = |w, h| Size { width: w, height: h };
+    if quick {
+        vec![
+            ("box", s(96, 72), vec![]),
+            ("teapot", s(48, 36), vec![]),
+            ("spherelist", s(96, 72), vec!["extra_spheres=100".into()]),
+        ]
+    } else {
+        vec![
+            ("box", s(640, 480), vec![]),
+            ("teapot", s(320, 240), vec![]),
+            ("spherelist", s(400, 300), vec!["extra_spheres=100".into()]),
+        ]
+    }
+}
+
+/// Error of one image against the truth.
+#[derive(Debug, Clone, Copy)]
+pub struct Error {
+    pub rmse: f64,
+    pub max_abs: u8,
+    pub above_1: f64,
+    pub wrong: f64,
+    pub flip: Option<f64>,
+}
+
+fn error_of(test: &image::RgbImage, truth: &image::RgbImage) -> anyhow::Result<Error> {
+    let m = metrics::compare(test, truth)?;
+    Ok(Error { rmse: m.rmse, max_abs: m.max_abs, above_1: m.above_1, wrong: hard::wrong_share(test, truth), flip: flip_mean(test, truth) })
+}
+
+/// Mean FLIP error (NVIDIA's perceptual metric, nv-flip) at the default
+/// viewing distance (67 pixels per degree).
+fn flip_mean(test: &image::RgbImage, truth: &image::RgbImage) -> Option<f64> {
+    if test.dimensions() != truth.dimensions() {
+        return None;
+    }
+    let (w, h) = truth.dimensions();
+    let r = nv_flip::FlipImageRgb8::with_data(w, h, truth.as_raw());
+    let t = nv_flip::FlipImageRgb8::with_data(w, h, test.as_raw());
+    let map = nv_flip::flip(r, t, nv_flip::DEFAULT_PIXELS_PER_DEGREE);
+    Some(nv_flip::FlipPool::from_image(&map).mean() as f64)
+}
+
+/// One app run at one config.
+#[derive(Debug, Clone)]
+pub struct Row {
+    pub scene: String,
+    pub size: Size,
+    pub config: Config,
+    pub sweeps: Vec<&'static str>,
+    pub api: Api,
+    pub result: Result<(Option<f64>, f64, Error, u64), String>,
+    pub pareto: bool,
+    pub is_default: bool,
+}
+
+impl Row {
+    /// GPU time if the driver has timers, else wall time (fastest frame).
+    fn time(&self) -> Option<f64> {
+        self.result.as_ref().ok().map(|(g, w, _, _)| g.unwrap_or(*w))
+    }
+    fn error(&self) -> Option<&Error> {
+        self.result.as_ref().ok().map(|r| &r.2)
+    }
+}
+
+fn render_app(api: Api, scene: &str, size: Size, set: Vec<String>, frames: u32, png: &Path) -> anyhow::Result<(Option<f64>, f64, u64, image::RgbImage)> {
+    let args = RenderArgs {
+        frames: Some(frames),
+        out: Some(png.to_path_buf()),
+        json: true,
+        set,
+        ..RenderArgs::headless(scene, size)
+    };
+    let r = run_json(api, &args)?;
+    let img = twinray_common::image_io::load_png(png)?;
+    // The fastest frame, not the median: other work on a shared machine only
+    // ever adds time, so the minimum is the steadiest estimate of the cost.
+    let wall = r.wall_ms.map(|s| s.min).unwrap_or(f64::NAN);
+    Ok((r.gpu_ms.map(|s| s.min), wall, r.nonfinite_pixels, img))
+}
+
+fn overrides(set: &[String]) -> Vec<(String, String)> {
+    set.iter().filter_map(|kv| kv.split_once('=')).map(|(k, v)| (k.into(), v.into())).collect()
+}
+
+/// Times within this factor count as equal: frame times on a shared machine
+/// scatter by a few percent from run to run.
+pub const TIME_TIE: f64 = 1.05;
+/// RMSE within this factor (or 1e-6) counts as equal.
+pub const ERROR_TIE: f64 = 1.01;
+
+/// Whether (t2, e2) dominates (t, e): at least as fast and as accurate, and
+/// clearly better in one, with the tie margins above.
+pub fn dominates(t2: f64, e2: f64, t: f64, e: f64) -> bool {
+    let as_fast = t2 <= t * TIME_TIE;
+    let as_good = e2 <= e * ERROR_TIE + 1e-6;
+    let faster = t2 * TIME_TIE < t;
+    let better = e2 * ERROR_TIE + 1e-6 < e;
+    as_fast && as_good && (faster || better)
+}
+
+/// Marks the rows on the Pareto front of (time, RMSE), per scene and API: no
+/// other row dominates them.
+fn mark_pareto(rows: &mut [Row]) {
+    let snapshot: Vec<(String, Api, Option<f64>, Option<f64>)> =
+        rows.iter().map(|r| (r.scene.clone(), r.api, r.time(), r.error().map(|e| e.rmse))).collect();
+    for (i, row) in rows.iter_mut().enumerate() {
+        let (Some(t), Some(e)) = (snapshot[i].2, snapshot[i].3) else { continue };
+        row.pareto = !snapshot.iter().enumerate().any(|(j, o)| {
+            j != i && o.0 == snapshot[i].0 && o.1 == snapshot[i].1 && matches!((o.2, o.3), (Some(t2), Some(e2)) if dominates(t2, e2, t, e))
+        });
+    }
+}
+
+/// One hard case under one strategy and API.
+#[derive(Debug, Clone)]
+pub struct HardRow {
+    pub case: String,
+    pub tolerance_pct: f64,
+    pub strategy: String,
+    pub api: Api,
+    /// (wrong share, crack pixels if checked, time ms, non-finite pixels)
+    pub result: Result<(f64, Option<usize>, f64, u64), String>,
+}
+
+pub fn run(args: &AccuracyArgs) -> anyhow::Result<()> {
+    std::fs::create_dir_all(args.out.join("images"))
+        .with_context(|| format!("creating --out folder '{}'", args.out.display()))?;
+    let frames = if args.quick { 5 } else { 30 };
+    let mut rows: Vec<Row> = Vec::new();
+    let started = std::time::Instant::now();
+    for (scene_name, size, set) in scenes(args.quick) {
+        let scene = Scene::load(scene_name, &overrides(&set))?;
+        let default = Config { max_depth: scene.max_depth, numerics: scene.numerics };
+        let mut deep = scene.clone();
+        deep.max_depth = MAX_DEPTH_LIMIT;
+        let truth = reference::render_truth(&deep, size.width, size.height);
+        truth.save_png(&args.out.join(format!("images/{scene_name}-truth.png")))?;
+        let truth = truth.to_rgb8();
+        // The default goes in the middle of the run order, not first: on the
+        // software driver the first timed configuration after the truth render
+        // came out 30-45% slower than the same shader later on.
+        let mut list = configs(&default);
+        let mid = list.len() / 2;
+        list.rotate_left(mid);
+        // One discarded run per API first: the first process to meet a shader
+        // variant compiles it into Mesa's cache and warms the driver, and that
+        // run would otherwise always be the default's.
+        for api in [Api::Vulkan, Api::Opengl] {
+            let png = args.out.join(format!("images/{scene_name}-warmup.png"));
+            let mut s = set.clone();
+            s.extend(default.set_args());
+            let _ = render_app(api, scene_name, size, s, 2, &png);
+            let _ = std::fs::remove_file(&png);
+        }
+        eprintln!("twinray accuracy: {scene_name} at {size}: {} configurations x 2 APIs", list.len());
+        for (k, c) in list.iter().enumerate() {
+            for api in if k % 2 == 0 { [Api::Vulkan, Api::Opengl] } else { [Api::Opengl, Api::Vulkan] } {
+                let png = args.out.join(format!("images/{scene_name}-{}-{k}.png", api_name(api)));
+                let mut s = set.clone();
+                s.extend(c.set_args());
+                let result = render_app(api, scene_name, size, s, frames, &png)
+                    .and_then(|(g, w, nan, img)| Ok((g, w, error_of(&img, &truth)?, nan)))
+                    .map_err(|e| format!("{e:#}"));
+                if let Err(e) = &result {
+                    eprintln!("  {scene_name} {} {}: FAILED: {e}", c.label(), api_name(api));
+                }
+                rows.push(Row {
+                    scene: scene_name.into(),
+                    size,
+                    config: c.clone(),
+                    sweeps: sweeps_of(c, &default),
+                    api,
+                    result,
+                    pareto: false,
+                    is_default: *c == default,
+                });
+            }
+        }
+    }
+    mark_pareto(&mut rows);
+
+    let mut hard_rows = Vec::new();
+    let mut cases = Vec::new();
+    if !args.no_hard {
+        let dir = args.hard.clone().unwrap_or_else(|| {
+            let local = PathBuf::from("scenes/hard");
+            if local.is_dir() { local } else { PathBuf::from(hard::SOURCE_DIR) }
+        });
+        cases = hard::list(&dir)?;
+        let size = Size { width: 64, height: 64 };
+        eprintln!("twinray accuracy: {} hard cases at {size}, {} strategies x 2 APIs", cases.len(), hard_strategies().len());
+        for case in &cases {
+            hard_rows.extend(run_hard(case, size, &args.out)?);
+        }
+    }
+
+    let cpu = crate::report::cpu_model();
+    std::fs::write(args.out.join("accuracy.csv"), csv(&rows)).context("writing accuracy.csv")?;
+    std::fs::write(args.out.join("hard_cases.csv"), hard_csv(&hard_rows)).context("writing hard_cases.csv")?;
+    let mut plots = Vec::new();
+    for (scene_name, _, _) in scenes(args.quick) {
+        let file = format!("accuracy-{scene_name}.svg");
+        let these: Vec<&Row> = rows.iter().filter(|r| r.scene == scene_name).collect();
+        plot(&args.out.join(&file), scene_name, &these).with_context(|| format!("plotting {file}"))?;
+        plots.push(file);
+    }
+    let md = markdown(args, &rows, &hard_rows, &cases, &plots, &cpu, started.elapsed().as_secs_f64());
+    std::fs::write(args.out.join("report.md"), md).context("writing report.md")?;
+    eprintln!("twinray accuracy: report: {}", args.out.join("report.md").display());
+    Ok(())
+}
+
+/// The strategies of the hard-case table: the default, then one knob changed.
+pub fn hard_strategies() -> Vec<(String, Numerics)> {
+    let d = Numerics::default();
+    let mut v = vec![("default".to_string(), d)];
+    for offset in Offset::ALL {
+        if offset != d.offset {
+            v.push((format!("offset={}", offset.name()), Numerics { offset, ..d }));
+        }
+    }
+    for triangle in TriangleTest::ALL {
+        if triangle != d.triangle {
+            v.push((format!("triangle={}", triangle.name()), Numerics { triangle, ..d }));
+        }
+    }
+    for sphere in SphereTest::ALL {
+        if sphere != d.sphere {
+            v.push((format!("sphere={}", sphere.name()), Numerics { sphere, ..d }));
+        }
+    }
+    v
+}
+
+fn run_hard(case: &HardCase, size: Size, out: &Path) -> anyhow::Result<Vec<HardRow>> {
+    let path = case.path.to_string_lossy().to_string();
+    let scene = Scene::load(&path, &[])?;
+    let truth = reference::render_truth(&scene, size.width, size.height);
+    truth.save_png(&out.join(format!("images/hard-{}-truth.png", case.name)))?;
+    let truth = truth.to_rgb8();
+    let bg = twinray_common::image_io::FloatImage { width: 1, height: 1, pixels: vec![scene.background.as_vec3().to_array()] }.to_rgb8();
+    let background = bg.get_pixel(0, 0).0;
+    let cracks = case.extra.iter().any(|e| e == "cracks");
+    let mut rows = Vec::new();
+    for (label, numerics) in hard_strategies() {
+        // --set overrides whatever the scene file's [render] section chose.
+        let n = numerics;
+        for api in [Api::Vulkan, Api::Opengl] {
+            let png = out.join(format!("images/hard-{}-{}-{}.png", case.name, label.replace('=', "-"), api_name(api)));
+            let result = render_app(api, &path, size, n.set_args(), 1, &png)
+                .map(|(g, w, nan, img)| {
+                    let crack = cracks.then(|| hard::crack_pixels(&img, &truth, background));
+                    (hard::wrong_share(&img, &truth), crack, g.unwrap_or(w), nan)
+                })
+                .map_err(|e| format!("{e:#}"));
+            rows.push(HardRow { case: case.name.clone(), tolerance_pct: case.tolerance_pct, strategy: label.clone(), api, result });
+        }
+    }
+    Ok(rows)
+}
+
+fn q(s: &str) -> String {
+    if s.contains([',', '"', '\n']) {
+        format!("\"{}\"", s.replace('"', "\"\""))
+    } else {
+        s.to_string()
+    }
+}
+
+fn opt(v: Option<f64>) -> String {
+    v.map(|x| format!("{x}")).unwrap_or_default()
+}
+
+pub fn csv(rows: &[Row]) -> String {
+    let mut s = String::from(
+        "scene,width,height,api,max_depth,offset,triangle,sphere,sweeps,default,pareto,status,gpu_min_ms,wall_min_ms,rmse,max_abs,above_1,above_8,flip_mean,nonfinite_pixels\n",
+    );
+    for r in rows {
+        let n = &r.config.numerics;
+        let head = format!(
+            "{},{},{},{},{},{},{},{},{},{},{}",
+            r.scene,
+            r.size.width,
+            r.size.height,
+            api_name(r.api),
+            r.config.max_depth,
+            n.offset.name(),
+            n.triangle.name(),
+            n.sphere.name(),
+            r.sweeps.join("+"),
+            r.is_default,
+            r.pareto
+        );
+        match &r.result {
+            Ok((g, w, e, nan)) => {
+                let _ = writeln!(s, "{head},ok,{},{w},{},{},{},{},{},{nan}", opt(*g), e.rmse, e.max_abs, e.above_1, e.wrong, opt(e.flip));
+            }
+            Err(e) => {
+                let _ = writeln!(s, "{head},{},,,,,,,,", q(&format!("failed: {e}")));
+            }
+        }
+    }
+    s
+}
+
+fn hard_csv(rows: &[HardRow]) -> String {
+    let mut s = String::from("case,tolerance_pct,strategy,api,status,wrong_pct,crack_pixels,time_ms,nonfinite_pixels\n");
+    for r in rows {
+        let head = format!("{},{},{},{}", r.case, r.tolerance_pct, q(&r.strategy), api_name(r.api));
+        match &r.result {
+            Ok((w, c, t, nan)) => {
+                let _ = writeln!(s, "{head},ok,{},{},{t},{nan}", 100.0 * w, c.map(|c| c.to_string()).unwrap_or_default());
+            }
+            Err(e) => {
+                let _ = writeln!(s, "{head},{},,,,", q(&format!("failed: {e}")));
+            }
+        }
+    }
+    s
+}
+
+fn f3(v: f64) -> String {
+    format!("{v:.3}")
+}
+
+fn markdown(args: &AccuracyArgs, rows: &[Row], hard_rows: &[HardRow], cases: &[HardCase], plots: &[String], cpu: &str, secs: f64) -> String {
+    let mut s = String::new();
+    let _ = writeln!(s, "# twinray accuracy — speed against error\n");
+    let _ = writeln!(
+        s,
+        "Preset: {}. CPU: {cpu}. Run time: {:.0} s. Command: `twinray accuracy{} --out {}`.\n",
+        if args.quick { "quick" } else { "full" },
+        secs,
+        if args.quick { " --quick" } else { "" },
+        args.out.display()
+    );
+    let d = Numerics::default();
+    let _ = writeln!(
+        s,
+        "**Default configuration**: offset `{}`, triangle test `{}`, sphere test `{}` (each scene's own max depth).\n",
+        d.offset.name(),
+        d.triangle.name(),
+        d.sphere.name()
+    );
+    let _ = writeln!(
+        s,
+        "Error is measured against the *truth*: the f64 reference (`reference::render_truth`) with a 1e-8 offset \
+         along the normal, watertight triangles, the stable sphere test, and max depth 16 — so the depth sweep shows \
+         what stopping early costs and the numerical sweeps what f32 costs. RMSE and max abs are over 8-bit channels \
+         (0..1 and 1/255 steps); `>1/255` and `wrong` are shares of pixels off by more than 1 and {WRONG_ABOVE} steps; FLIP is \
+         the mean of NVIDIA's perceptual FLIP error (nv-flip 0.1.2, 67 pixels per degree). Time is the fastest frame's GPU \
+         time where the driver has timers, else its wall time (submit + wait); the minimum, because other load on a \
+         shared machine only adds time. Every sweep changes one knob from the default; ★ marks the Pareto front of \
+         (time, RMSE) per scene and API, ◆ the default; times within 5% and RMSE within 1% count as ties.\n"
+    );
+
+    // Summary: where the default stands.
+    let _ = writeln!(s, "## Summary\n");
+    for api in [Api::Vulkan, Api::Opengl] {
+        for scene in rows.iter().map(|r| r.scene.clone()).collect::<std::collections::BTreeSet<_>>() {
+            let these: Vec<&Row> = rows.iter().filter(|r| r.scene == scene && r.api == api && r.result.is_ok()).collect();
+            let Some(def) = these.iter().find(|r| r.is_default) else { continue };
+            let Some(cheap) = these.iter().min_by(|a, b| a.time().unwrap_or(f64::MAX).total_cmp(&b.time().unwrap_or(f64::MAX))) else { continue };
+            let (dt, de) = (def.time().unwrap_or(f64::NAN), def.error().map(|e| e.rmse).unwrap_or(f64::NAN));
+            let (ct, ce) = (cheap.time().unwrap_or(f64::NAN), cheap.error().map(|e| e.rmse).unwrap_or(f64::NAN));
+            let _ = writeln!(
+                s,
+                "- {scene}, {}: default {} ms, RMSE {:.5}{}; cheapest ({}) {} ms, RMSE {:.5}: the default costs {:.2}×.",
+                api_name(api),
+                f3(dt),
+                de,
+                if def.pareto { " (on the Pareto front)" } else { " (**not** on the Pareto front)" },
+                cheap.config.label(),
+                f3(ct),
+                ce,
+                dt / ct
+            );
+        }
+    }
+    let _ = writeln!(s);
+
+    let _ = writeln!(s, "## Why this default\n");
+    let _ = writeln!(
+        s,
+        "The numerical knobs decide correctness, the depth decides cost: every numerical choice costs about the same \
+         per ray (the sweeps below differ by noise except where noted), so the default takes the choice that keeps the \
+         hard cases right, and each scene keeps its own max depth.\n"
+    );
+    if !hard_rows.is_empty() {
+        for (label, _) in hard_strategies() {
+            let these: Vec<&HardRow> = hard_rows.iter().filter(|r| r.strategy == label).collect();
+            let ok = these.iter().filter(|r| matches!(&r.result, Ok((w, _, _, nan)) if 100.0 * w <= r.tolerance_pct && *nan == 0)).count();
+            let failed: Vec<String> = these
+                .iter()
+                .filter(|r| !matches!(&r.result, Ok((w, _, _, nan)) if 100.0 * w <= r.tolerance_pct && *nan == 0))
+                .map(|r| r.case.clone())
+                .fold(Vec::new(), |mut v, c| {
+                    if !v.contains(&c) {
+                        v.push(c);
+                    }
+                    v
+                });
+            let _ = writeln!(
+                s,
+                "- `{label}`: {ok} of {} hard-case renders within tolerance{}",
+                these.len(),
+                if failed.is_empty() { String::new() } else { format!("; fails {}", failed.join(", ")) }
+            );
+        }
+        let _ = writeln!(s);
+    }
+    for r in rows.iter().filter(|r| r.is_default && r.result.is_ok()) {
+        let (Some(t), Some(e)) = (r.time(), r.error().map(|e| e.rmse)) else { continue };
+        let by: Vec<String> = rows
+            .iter()
+            .filter(|o| o.scene == r.scene && o.api == r.api && !o.is_default)
+            .filter(|o| matches!((o.time(), o.error().map(|e| e.rmse)), (Some(t2), Some(e2)) if dominates(t2, e2, t, e)))
+            .map(|o| o.config.label())
+            .collect();
+        let _ = writeln!(
+            s,
+            "- {} {}: {}",
+            r.scene,
+            api_name(r.api),
+            if by.is_empty() { "the default is on the Pareto front".to_string() } else { format!("the default is dominated by {}", by.join("; ")) }
+        );
+    }
+    let _ = writeln!(
+        s,
+        "\nWhere a configuration with a *smaller max depth* dominates, the scene simply needs fewer bounces than it allows \
+         (no mirror or glass in view beyond that depth): max depth is a per-scene setting, not part of the numerical \
+         default. Where a numerical choice dominates by a few percent of time at equal error, that is within run-to-run \
+         scatter on a shared software driver; the GPU report is the one to read for speed.\n"
+    );
+
+    for scene in rows.iter().map(|r| r.scene.clone()).collect::<Vec<_>>().iter().fold(Vec::<String>::new(), |mut v, x| {
+        if !v.contains(x) {
+            v.push(x.clone());
+        }
+        v
+    }) {
+        let these: Vec<&Row> = rows.iter().filter(|r| r.scene == scene).collect();
+        let size = these.first().map(|r| r.size.to_string()).unwrap_or_default();
+        let _ = writeln!(s, "## {scene} ({size})\n");
+        if let Some(p) = plots.iter().find(|p| p.contains(&format!("-{scene}."))) {
+            let _ = writeln!(s, "![{scene}]({p})\n");
+        }
+        let _ = writeln!(s, "| sweep | max depth | offset | triangle | sphere | API | GPU ms (min) | wall ms (min) | RMSE | max abs | >1/255 | wrong | FLIP | NaN | |\n|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|");
+        for r in these {
+            let n = &r.config.numerics;
+            let mark = format!("{}{}", if r.pareto { "★" } else { "" }, if r.is_default { "◆" } else { "" });
+            match &r.result {
+                Ok((g, w, e, nan)) => {
+                    let _ = writeln!(
+                        s,
+                        "| {} | {} | {} | {} | {} | {} | {} | {} | {:.5} | {} | {:.2}% | {:.2}% | {} | {} | {mark} |",
+                        r.sweeps.join(", "),
+                        r.config.max_depth,
+                        n.offset.name(),
+                        n.triangle.name(),
+                        n.sphere.name(),
+                        api_name(r.api),
+                        g.map(f3).unwrap_or_else(|| "–".into()),
+                        f3(*w),
+                        e.rmse,
+                        e.max_abs,
+                        100.0 * e.above_1,
+                        100.0 * e.wrong,
+                        e.flip.map(|f| format!("{f:.4}")).unwrap_or_else(|| "–".into()),
+                        nan
+                    );
+                }
+                Err(e) => {
+                    let _ = writeln!(s, "| {} | {} | {} | {} | {} | {} | failed: {} | | | | | | | | |", r.sweeps.join(", "), r.config.max_depth, n.offset.name(), n.triangle.name(), n.sphere.name(), api_name(r.api), e.replace('|', "/"));
+                }
+            }
+        }
+        let _ = writeln!(s);
+    }
+
+    if !hard_rows.is_empty() {
+        let strategies: Vec<String> = hard_strategies().into_iter().map(|(l, _)| l).collect();
+        let _ = writeln!(
+            s,
+            "## Hard cases (scenes/hard/, 64x64)\n\nShare of wrong pixels (off by more than {WRONG_ABOVE}/255 against the truth) per case, \
+             strategy and API (Vulkan / OpenGL); crack pixels in brackets where the case counts them. **Bold**: above the case's \
+             tolerance. The default must pass every case (tests/tests/hard_cases.rs checks it).\n"
+        );
+        let _ = write!(s, "| case | tolerance |");
+        for st in &strategies {
+            let _ = write!(s, " {st} |");
+        }
+        let _ = writeln!(s, "\n|---|---|{}", "---|".repeat(strategies.len()));
+        for case in cases {
+            let _ = write!(s, "| {} | {}% |", case.name, case.tolerance_pct);
+            for st in &strategies {
+                let cell: Vec<String> = [Api::Vulkan, Api::Opengl]
+                    .iter()
+                    .map(|api| {
+                        match hard_rows.iter().find(|r| r.case == case.name && &r.strategy == st && r.api == *api).map(|r| &r.result) {
+                            Some(Ok((w, c, _, nan))) => {
+                                let v = format!("{:.2}", 100.0 * w);
+                                let v = if 100.0 * w > case.tolerance_pct { format!("**{v}**") } else { v };
+                                let c = c.map(|c| format!(" [{c}]")).unwrap_or_default();
+                                let nan = if *nan > 0 { format!(" NaN {nan}") } else { String::new() };
+                                format!("{v}{c}{nan}")
+                            }
+                            Some(Err(_)) => "failed".into(),
+                            None => "–".into(),
+                        }
+                    })
+                    .collect();
+                let _ = write!(s, " {} |", cell.join(" / "));
+            }
+            let _ = writeln!(s);
+        }
+        // What each strategy costs: total time over all cases, and how many cases it fails.
+        let _ = writeln!(s, "\n| strategy | cases within tolerance (VK / GL) | total time over the cases, ms (VK / GL) | worst case |\n|---|---|---|---|");
+        for st in &strategies {
+            let mut cells = Vec::new();
+            let mut times = Vec::new();
+            for api in [Api::Vulkan, Api::Opengl] {
+                let these: Vec<&HardRow> = hard_rows.iter().filter(|r| &r.strategy == st && r.api == api).collect();
+                let ok = these.iter().filter(|r| matches!(&r.result, Ok((w, _, _, nan)) if 100.0 * w <= r.tolerance_pct && *nan == 0)).count();
+                cells.push(format!("{ok}/{}", these.len()));
+                times.push(f3(these.iter().filter_map(|r| r.result.as_ref().ok().map(|x| x.2)).sum::<f64>()));
+            }
+            let worst = hard_rows
+                .iter()
+                .filter(|r| &r.strategy == st)
+                .filter_map(|r| r.result.as_ref().ok().map(|x| (r, x.0)))
+                .max_by(|a, b| a.1.total_cmp(&b.1))
+                .map(|(r, w)| format!("{} ({}): {:.2}% wrong", r.case, api_name(r.api), 100.0 * w))
+                .unwrap_or_default();
+            let _ = writeln!(s, "| {st} | {} | {} | {worst} |", cells.join(" / "), times.join(" / "));
+        }
+        let _ = writeln!(s);
+    }
+    let _ = writeln!(s, "Every row is in `accuracy.csv` and `hard_cases.csv`; the images are in `images/`.");
+    s
+}
+
+fn plot(path: &Path, scene: &str, rows: &[&Row]) -> anyhow::Result<()> {
+    let pts: Vec<(f64, f64)> = rows
+        .iter()
+        .filter_map(|r| {
+            let (g, w, e, _) = r.result.as_ref().ok()?;
+            Some([g.map(|g| (g, e.rmse)), Some((*w, e.rmse))])
+        })
+        .flatten()
+        .flatten()
+        .map(|(t, e)| (t.max(1e-3), e.max(1e-5)))
+        .collect();
+    let root = SVGBackend::new(path, (900, 560)).into_drawing_area();
+    root.fill(&WHITE)?;
+    if pts.is_empty() {
+        root.present()?;
+        return Ok(());
+    }
+    let (xmin, xmax) = pts.iter().fold((f64::MAX, f64::MIN), |a, p| (a.0.min(p.0), a.1.max(p.0)));
+    let (ymin, ymax) = pts.iter().fold((f64::MAX, f64::MIN), |a, p| (a.0.min(p.1), a.1.max(p.1)));
+    let mut chart = ChartBuilder::on(&root)
+        .caption(format!("{scene}: time against error (log scales; ★ Pareto front, ◆ default)"), ("sans-serif", 20))
+        .margin(12)
+        .x_label_area_size(45)
+        .y_label_area_size(80)
+        .build_cartesian_2d((xmin * 0.8..xmax * 1.25).log_scale(), (ymin * 0.5..ymax * 2.0).log_scale())?;
+    chart.configure_mesh().x_desc("milliseconds per frame (fastest frame)").y_desc("RMSE against the f64 truth").draw()?;
+    for (api, colour) in [(Api::Vulkan, RGBColor(200, 30, 30)), (Api::Opengl, RGBColor(30, 80, 200))] {
+        for gpu in [true, false] {
+            let mine: Vec<(&Row, f64, f64)> = rows
+                .iter()
+                .filter(|r| r.api == api)
+                .filter_map(|r| {
+                    let (g, w, e, _) = r.result.as_ref().ok()?;
+                    let t = if gpu { (*g)? } else { *w };
+                    Some((*r, t.max(1e-3), e.rmse.max(1e-5)))
+                })
+                .collect();
+            if mine.is_empty() {
+                continue;
+            }
+            let label = format!("{} {}", api_name(api), if gpu { "GPU time" } else { "wall time" });
+            if gpu {
+                chart
+                    .draw_series(mine.iter().map(|(_, t, e)| Circle::new((*t, *e), 4, colour.filled())))?
+                    .label(label)
+                    .legend(move |(x, y)| Circle::new((x + 10, y), 4, colour.filled()));
+            } else {
+                chart
+                    .draw_series(mine.iter().map(|(_, t, e)| Circle::new((*t, *e), 4, colour.stroke_width(1))))?
+                    .label(label)
+                    .legend(move |(x, y)| Circle::new((x + 10, y), 4, colour.stroke_width(1)));
+            }
+            // The Pareto front (per API, on the time the front was computed from) as a step line.
+            let primary = mine.iter().all(|(r, _, _)| r.result.as_ref().map(|x| x.0.is_some()).unwrap_or(false)) == gpu;
+            if primary {
+                let mut front: Vec<(f64, f64)> = mine.iter().filter(|(r, _, _)| r.pareto).map(|(_, t, e)| (*t, *e)).collect();
+                front.sort_by(|a, b| a.0.total_cmp(&b.0));
+                chart.draw_series(LineSeries::new(front, colour.stroke_width(2)))?;
+            }
+            for (r, t, e) in &mine {
+                if r.is_default {
+                    chart.draw_series(std::iter::once(Circle::new((*t, *e), 9, BLACK.stroke_width(2))))?;
+                }
+            }
+        }
+    }
+    chart.configure_series_labels().background_style(WHITE.mix(0.8)).border_style(BLACK).position(SeriesLabelPosition::UpperRight).draw()?;
+    root.present()?;
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn sweeps_change_one_knob_and_include_the_default_once() {
+        let d = Config { max_depth: 5, numerics: Numerics::default() };
+        let c = configs(&d);
+        assert_eq!(c.iter().filter(|x| **x == d).count(), 1);
+        assert_eq!(c.len(), 8 + (Offset::ALL.len() - 1) + 1 + 1);
+        assert_eq!(sweeps_of(&d, &d), vec!["depth", "offset", "triangle", "sphere"]);
+    }
+
+    #[test]
+    fn ties_do_not_dominate() {
+        assert!(!dominates(10.2, 0.01, 10.0, 0.01), "2% slower, same error");
+        assert!(!dominates(9.8, 0.01, 10.0, 0.01), "2% faster is noise");
+        assert!(dominates(8.0, 0.01, 10.0, 0.01));
+        assert!(dominates(10.2, 0.005, 10.0, 0.01));
+        assert!(!dominates(8.0, 0.02, 10.0, 0.01));
+    }
+}

@@ -1,0 +1,259 @@
+#!/usr/bin/env python3
+"""Writes scenes/hard/*.toml (and icosphere.obj): the numerical hard cases.
+
+The far and tiny cases are one small scene, scaled and translated; writing them
+from one place keeps them the same scene. Run it from the repository root after
+editing; the files it writes are committed. Each file opens with comment lines
+that tests/tests/hard_cases.rs parses:
+  # checks: <the property>
+  # tolerance: <share of pixels off by more than 8/255 against the f64 truth, in %>
+  # check: deterministic | cracks    (optional extra checks)
+"""
+import math, os
+
+OUT = os.path.join(os.path.dirname(__file__), "..", "scenes", "hard")
+
+def v(x):
+    return "[" + ", ".join(repr(float(c)) for c in x) + "]"
+
+def header(name, checks, tolerance, extra=(), note=""):
+    lines = [f"# hard case: {name}", f"# checks: {checks}", f"# tolerance: {tolerance}%"]
+    lines += [f"# check: {e}" for e in extra]
+    if note:
+        lines += ["#", *[f"# {l}" for l in note.strip().splitlines()]]
+    lines += ["# Written by scripts/gen-hard-scenes.py; edit there.", ""]
+    return "\n".join(lines) + "\n"
+
+MATERIALS = '''
+[[materials]]
+name = "ground"
+ambient = [0.05, 0.05, 0.05]
+diffuse = [0.8, 0.8, 0.8]
+
+[[materials]]
+name = "red"
+ambient = [0.05, 0.0, 0.0]
+diffuse = [0.8, 0.15, 0.1]
+specular = [0.3, 0.3, 0.3]
+shininess = 32.0
+
+[[materials]]
+name = "blue"
+ambient = [0.0, 0.0, 0.05]
+diffuse = [0.1, 0.2, 0.8]
+'''
+
+def small_scene(scale, t, name, checks, tol, note):
+    """A sphere and a cube on a ground quad, lit from above: shadows touch the objects."""
+    p = lambda x: [c * scale + o for c, o in zip(x, t)]
+    s = header(name, checks, tol, note=note)
+    s += f'description = "{checks}"\n\n[camera]\neye = {v(p([0.0, 1.6, 3.2]))}\nlook_at = {v(p([0.0, 0.3, 0.0]))}\nfov_y = 45.0\n'
+    s += "\n[render]\nbackground = [0.1, 0.1, 0.15]\nmax_depth = 2\n" + MATERIALS
+    s += f"\n[[lights]]\nposition = {v(p([1.5, 3.0, 1.0]))}\n"
+    s += f'\n[[spheres]]\ncenter = {v(p([-0.55, 0.5, 0.0]))}\nradius = {0.5 * scale!r}\nmaterial = "red"\n'
+    g = 2.5
+    s += f'\n[[quads]]\ncorners = [{v(p([-g, 0, -g]))}, {v(p([-g, 0, g]))}, {v(p([g, 0, g]))}, {v(p([g, 0, -g]))}]\nmaterial = "ground"\n'
+    s += f'\n[[meshes]]\nobj = "../cube.obj"\nmaterial = "blue"\nscale = {0.6 * scale!r}\nrotate_y = 30.0\ntranslate = {v(p([0.6, 0.3, 0.2]))}\nsmooth = false\n'
+    return s
+
+def write(name, text):
+    with open(os.path.join(OUT, name + ".toml"), "w") as f:
+        f.write(text)
+
+FAR_NOTE = """A sphere and a cube resting on a ground quad, lit from above, moved {what}.
+f32 coordinates there are {ulp} apart, so hit points lie off the surface by
+about that much: a secondary-ray offset much smaller gives shadow acne, one
+much larger detaches the contact shadows. At 1e6 (1/16 apart) even the best
+offset leaves ~13% of pixels off by more than 8/255: sphere normals come from
+hit points quantised to 1/16 (a blocky highlight) and contact shadows detach by
+a few ULPs (a fixed 1e-4 offset has fewer wrong pixels here, 7.5%, but
+visible acne, and fails at 1e4 and 1e5; 1e-4 * |p| loses the shadows, 54%)."""
+
+for d in (1e4, 1e5, 1e6):
+    ulp = 2.0 ** (math.floor(math.log2(d)) - 23)
+    exp = int(round(math.log10(d)))
+    tol = {4: 0.5, 5: 1.0, 6: 15.0}[exp]
+    write(f"far-1e{exp}", small_scene(1.0, [d, d, d], f"far-1e{exp}",
+          f"the same object at ({d:g}, {d:g}, {d:g}): no shadow acne, no detached shadows", tol,
+          FAR_NOTE.format(what=f"to ({d:g}, {d:g}, {d:g})", ulp=f"{ulp:g}")))
+for s_, tol in ((1e-3, 0.5), (1e-4, 0.5)):
+    exp = int(round(math.log10(s_)))
+    write(f"tiny-1e{exp}", small_scene(s_, [0.0, 0.0, 0.0], f"tiny-1e{exp}",
+          f"the same object scaled by {s_:g}: no shadow acne, no detached shadows", tol,
+          FAR_NOTE.format(what=f"scaled down by {s_:g} (the camera too)", ulp="tiny") .replace(
+              "f32 coordinates there are tiny apart, so hit points lie off the surface by\nabout that much",
+              "An absolute offset (1e-4, or Wachter & Binder's 1/65536 near the origin)\nis now a large share of the object")))
+
+# ---------------------------------------------------------------- closed mesh
+def icosphere(level):
+    t = (1 + 5 ** 0.5) / 2
+    verts = [(-1, t, 0), (1, t, 0), (-1, -t, 0), (1, -t, 0), (0, -1, t), (0, 1, t), (0, -1, -t), (0, 1, -t),
+             (t, 0, -1), (t, 0, 1), (-t, 0, -1), (-t, 0, 1)]
+    verts = [tuple(c / math.sqrt(sum(x * x for x in p)) for c in p) for p in verts]
+    faces = [(0, 11, 5), (0, 5, 1), (0, 1, 7), (0, 7, 10), (0, 10, 11), (1, 5, 9), (5, 11, 4), (11, 10, 2),
+             (10, 7, 6), (7, 1, 8), (3, 9, 4), (3, 4, 2), (3, 2, 6), (3, 6, 8), (3, 8, 9), (4, 9, 5), (2, 4, 11),
+             (6, 2, 10), (8, 6, 7), (9, 8, 1)]
+    for _ in range(level):
+        cache, nf = {}, []
+        def mid(a, b):
+            k = (min(a, b), max(a, b))
+            if k not in cache:
+                p = [(x + y) / 2 for x, y in zip(verts[a], verts[b])]
+                n = math.sqrt(sum(c * c for c in p))
+                verts.append(tuple(c / n for c in p))
+                cache[k] = len(verts) - 1
+            return cache[k]
+        for a, b, c in faces:
+            ab, bc, ca = mid(a, b), mid(b, c), mid(c, a)
+            nf += [(a, ab, ca), (b, bc, ab), (c, ca, bc), (ab, bc, ca)]
+        faces = nf
+    return verts, faces
+
+verts, faces = icosphere(2)
+with open(os.path.join(OUT, "icosphere.obj"), "w") as f:
+    f.write(f"# Icosphere, 2 subdivisions: {len(verts)} shared vertices, {len(faces)} triangles, closed.\n")
+    for p in verts:
+        f.write("v {:.7f} {:.7f} {:.7f}\n".format(*p))
+    for a, b, c in faces:
+        f.write(f"f {a + 1} {b + 1} {c + 1}\n")
+
+C = [1000.0, 1000.0, 1000.0]
+add = lambda a, b: [x + y for x, y in zip(a, b)]
+s = header("closed-mesh", "a closed mesh (icosphere, 320 triangles with shared edges and vertices) seen in six orientations, 1000 units from the origin: no cracks", 0.2, extra=["cracks"],
+           note="""A ray through a crack between two triangles of the front hits the inside of the
+back (dark: in its own shadow) or the background (magenta). The crack check counts
+pixels inside the reference silhouette (eroded by one pixel) that differ by more
+than 8/255; the test allows none with the default configuration.""")
+s += 'description = "closed icosphere meshes, six orientations: no cracks"\n'
+s += f"\n[camera]\neye = {v(add(C, [0.0, 2.2, 6.5]))}\nlook_at = {v(add(C, [0.0, 0.0, 0.0]))}\nfov_y = 40.0\n"
+s += "\n[render]\nbackground = [1.0, 0.0, 1.0]\nmax_depth = 1\n"
+s += '\n[[materials]]\nname = "mesh"\nambient = [0.05, 0.05, 0.05]\ndiffuse = [0.2, 0.8, 0.3]\n'
+s += f"\n[[lights]]\nposition = {v(add(C, [2.0, 6.0, 8.0]))}\n"
+for i, (x, y, rot, sc) in enumerate([(-2.1, 0.9, 0.0, 1.0), (0.0, 0.9, 17.0, 0.97), (2.1, 0.9, 41.0, 1.03),
+                                       (-2.1, -1.2, 63.0, 0.99), (0.0, -1.2, 89.0, 1.01), (2.1, -1.2, 131.0, 0.98)]):
+    s += f'\n[[meshes]]\nobj = "icosphere.obj"\nmaterial = "mesh"\nscale = {sc!r}\nrotate_y = {rot!r}\ntranslate = {v(add(C, [x, y, 0.0]))}\nsmooth = false\n'
+write("closed-mesh", s)
+
+# ---------------------------------------------------------------- the rest
+BASE_LIGHT = '\n[[lights]]\nposition = [2.0, 5.0, 4.0]\n'
+
+def simple(name, checks, tol, body, camera, render="max_depth = 5", extra=(), note="", lights=BASE_LIGHT, materials=MATERIALS):
+    s = header(name, checks, tol, extra=extra, note=note)
+    s += f'description = "{checks}"\n\n[camera]\n{camera}\n\n[render]\nbackground = [0.1, 0.1, 0.15]\n{render}\n'
+    s += materials + lights + body
+    write(name, s)
+
+GLASS = '''
+[[materials]]
+name = "glass"
+specular = [0.8, 0.8, 0.8]
+shininess = 200.0
+transparency = 0.95
+ior = 1.5
+'''
+CHECKER = "".join(
+    f'\n[[quads]]\ncorners = [[{x}.0, 0.0, {z}.0], [{x}.0, 0.0, {z + 1}.0], [{x + 1}.0, 0.0, {z + 1}.0], [{x + 1}.0, 0.0, {z}.0]]\nmaterial = "{"ground" if (x + z) % 2 == 0 else "blue"}"\n'
+    for x in range(-3, 3) for z in range(-3, 3))
+
+simple("grazing", "grazing angles: a tiled floor seen and lit almost edge-on, a sphere on it", 1.0,
+       CHECKER + '\n[[spheres]]\ncenter = [0.0, 0.4, -1.0]\nradius = 0.4\nmaterial = "red"\n',
+       'eye = [0.0, 0.05, 3.0]\nlook_at = [0.0, 0.0, -3.0]\nfov_y = 30.0',
+       lights='\n[[lights]]\nposition = [-40.0, 0.8, -2.0]\n',
+       note="""The view ray meets the floor at about 1 degree and the light at about 1 degree:
+shadow rays leave almost along the surface, where an offset along the ray adds
+almost no height (acne) and the floor's edges between tiles are hit edge-on.""")
+
+simple("inside-glass", "the camera inside a glass sphere, looking out at objects", 1.0,
+       '\n[[spheres]]\ncenter = [0.0, 1.0, 0.0]\nradius = 2.0\nmaterial = "glass"\n'
+       '\n[[spheres]]\ncenter = [0.0, 0.6, -4.0]\nradius = 0.6\nmaterial = "red"\n'
+       '\n[[quads]]\ncorners = [[-8.0, -1.0, -8.0], [-8.0, -1.0, 8.0], [8.0, -1.0, 8.0], [8.0, -1.0, -8.0]]\nmaterial = "ground"\n',
+       'eye = [0.0, 1.2, 0.5]\nlook_at = [0.0, 0.6, -4.0]\nfov_y = 60.0', render="max_depth = 6", materials=MATERIALS + GLASS,
+       note="""Every primary ray starts inside glass and leaves it (ratio 1.5 -> 1): the
+refracted ray must start outside, the reflected one inside; a wrong side on
+either shows as noise all over the image.""")
+
+simple("total-internal-reflection", "total internal reflection inside a glass cube seen past its critical angle", 8.0,
+       '\n[[meshes]]\nobj = "../cube.obj"\nmaterial = "glass"\nscale = 1.6\nrotate_y = 35.0\ntranslate = [0.0, 0.8, 0.0]\nsmooth = false\n'
+       '\n[[spheres]]\ncenter = [0.0, 0.5, -2.5]\nradius = 0.5\nmaterial = "red"\n'
+       '\n[[quads]]\ncorners = [[-8.0, 0.0, -8.0], [-8.0, 0.0, 8.0], [8.0, 0.0, 8.0], [8.0, 0.0, -8.0]]\nmaterial = "ground"\n',
+       'eye = [2.5, 3.5, 4.0]\nlook_at = [0.0, 0.7, 0.0]\nfov_y = 40.0', render="max_depth = 4",
+       materials=MATERIALS + GLASS.replace("ior = 1.5", "ior = 2.0"),
+       note="""Rays entering the top of a cube of index 2 (critical angle 30 degrees) meet the
+sides beyond it: every such ray reflects inside (k < 0 in the shader) and must
+stay inside, without NaN. Paths that bounce inside are chaotic: at 64x64 the
+top and bottom faces alias into speckle even in the f64 reference, and f32
+rounding flips the exit face of ~6% of pixels under every strategy, hence the
+tolerance.""")
+
+simple("nested-glass", "adjacent (touching) and nested glass spheres", 1.5,
+       '\n[[spheres]]\ncenter = [-0.7, 0.7, 0.0]\nradius = 0.7\nmaterial = "glass"\n'
+       '\n[[spheres]]\ncenter = [0.7, 0.7, 0.0]\nradius = 0.7\nmaterial = "glass"\n'
+       '\n[[spheres]]\ncenter = [0.0, 0.9, -2.0]\nradius = 0.9\nmaterial = "glass"\n'
+       '\n[[spheres]]\ncenter = [0.0, 0.9, -2.0]\nradius = 0.45\nmaterial = "glass"\n'
+       '\n[[spheres]]\ncenter = [0.0, 0.9, -2.0]\nradius = 0.2\nmaterial = "red"\n'
+       '\n[[quads]]\ncorners = [[-8.0, 0.0, -8.0], [-8.0, 0.0, 8.0], [8.0, 0.0, 8.0], [8.0, 0.0, -8.0]]\nmaterial = "ground"\n',
+       'eye = [0.0, 1.5, 4.0]\nlook_at = [0.0, 0.7, -0.6]\nfov_y = 45.0', render="max_depth = 8", materials=MATERIALS + GLASS,
+       note="""Two glass spheres touch at one point; a third holds a smaller glass sphere and a
+red core. Rays leave one glass surface a hair away from the next: the offset
+decides whether they skip it. (The tracer assumes air outside every surface.)""")
+
+DEGEN = "".join(f'\n[[triangles]]\nvertices = {t}\nmaterial = "red"\n' for t in [
+    "[[0.0, 0.0, 0.0], [0.0, 0.0, 0.0], [0.0, 0.0, 0.0]]",
+    "[[-1.0, 0.5, 0.0], [-1.0, 0.5, 0.0], [1.0, 0.5, 0.0]]",
+    "[[-1.0, -1.0, 0.0], [0.0, 0.0, 0.0], [1.0, 1.0, 0.0]]",
+    "[[-1.0, 1.0, 0.0], [0.0, 1.0, 0.0], [1.0, 1.0, 0.0]]",
+    "[[0.0, -1.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 0.0]]",
+    "[[-1.0, -0.5, 0.0], [1.0, -0.5, 0.0], [1e-30, -0.5, 0.0]]",
+    "[[0.3, 0.3, 1.0], [0.3, 0.3, -1.0], [0.3, 0.3, 0.0]]",
+])
+simple("degenerate", "degenerate triangles (zero area, collinear, a point) across the view: no NaN, no hit", 0.0,
+       DEGEN + '\n[[spheres]]\ncenter = [0.0, 0.0, -2.0]\nradius = 1.0\nmaterial = "blue"\n',
+       'eye = [0.0, 0.0, 4.0]\nlook_at = [0.0, 0.0, 0.0]\nfov_y = 45.0',
+       note="""Seven triangles with zero area lie in front of a sphere, several of them exactly
+on pixel-centre rays (the image's middle row and column). None may be hit and
+none may produce NaN: the image equals a render without them.""")
+
+simple("coplanar", "coplanar overlapping triangles of two colours: a deterministic result", 10.0,
+       '\n[[quads]]\ncorners = [[-1.5, -1.0, 0.0], [1.5, -1.0, 0.0], [1.5, 1.0, 0.0], [-1.5, 1.0, 0.0]]\nmaterial = "red"\n'
+       '\n[[quads]]\ncorners = [[-0.5, -1.5, 0.0], [2.0, -1.5, 0.0], [2.0, 0.5, 0.0], [-0.5, 0.5, 0.0]]\nmaterial = "blue"\n',
+       'eye = [0.3, 0.4, 4.0]\nlook_at = [0.2, -0.1, 0.0]\nfov_y = 50.0', extra=["deterministic"],
+       note="""Two quads in the same plane overlap. Which one a pixel shows depends on the last
+bit of each t, so the overlap may speckle ("z-fighting") and differ from the
+f64 reference; the check is that repeated renders are identical, bit for bit,
+and the tolerance covers the overlap's share of the image.""")
+
+simple("light-on-surface", "a point light lying exactly on the floor, beside a sphere", 0.5,
+       '\n[[quads]]\ncorners = [[-4.0, 0.0, -4.0], [-4.0, 0.0, 4.0], [4.0, 0.0, 4.0], [4.0, 0.0, -4.0]]\nmaterial = "ground"\n'
+       '\n[[spheres]]\ncenter = [0.0, 0.5, -0.5]\nradius = 0.5\nmaterial = "red"\n',
+       'eye = [0.0, 2.5, 3.5]\nlook_at = [0.0, 0.0, -0.5]\nfov_y = 45.0',
+       lights='\n[[lights]]\nposition = [1.2, 0.0, 0.3]\n',
+       note="""The light lies in the floor's plane: N.L is zero up to rounding, so the floor must
+stay unlit (ambient only) and no pixel may divide by a zero distance; the sphere
+is lit from the side.""")
+
+simple("light-inside-sphere", "a point light inside a closed opaque sphere: nothing outside is lit", 0.2,
+       '\n[[quads]]\ncorners = [[-4.0, 0.0, -4.0], [-4.0, 0.0, 4.0], [4.0, 0.0, 4.0], [4.0, 0.0, -4.0]]\nmaterial = "ground"\n'
+       '\n[[spheres]]\ncenter = [0.0, 0.8, 0.0]\nradius = 0.8\nmaterial = "red"\n',
+       'eye = [0.0, 2.5, 4.0]\nlook_at = [0.0, 0.5, 0.0]\nfov_y = 45.0',
+       lights='\n[[lights]]\nposition = [0.2, 0.9, 0.1]\n',
+       note="""The only light sits inside an opaque sphere. Every shadow ray from outside must
+hit the sphere: a light leak (a missed sphere test, an offset through the
+shell) lights a floor pixel.""")
+
+simple("huge-ground", "a sphere of radius 1e6 as the ground, a small sphere resting on it", 1.0,
+       '\n[[spheres]]\ncenter = [0.0, -1000000.0, 0.0]\nradius = 1000000.0\nmaterial = "ground"\n'
+       '\n[[spheres]]\ncenter = [0.0, 0.5, 0.0]\nradius = 0.5\nmaterial = "red"\n',
+       'eye = [0.0, 1.5, 4.0]\nlook_at = [0.0, 0.4, 0.0]\nfov_y = 45.0',
+       note="""The ground's top is at y = 0, but its centre is 1e6 away: f32 can place a point
+relative to that centre only to 1/16, so the ground re-hits itself unless the
+offset knows the sphere's size, and the textbook quadratic loses the hit.""")
+
+simple("far-tiny-sphere", "a sphere of radius 1 seen from 1e4 away through a narrow lens, its shadow on a wall behind", 0.5,
+       '\n[[spheres]]\ncenter = [0.0, 0.0, -10000.0]\nradius = 1.0\nmaterial = "red"\n'
+       '\n[[quads]]\ncorners = [[-3.0, -3.0, -10003.0], [3.0, -3.0, -10003.0], [3.0, 3.0, -10003.0], [-3.0, 3.0, -10003.0]]\nmaterial = "ground"\n',
+       'eye = [0.0, 0.0, 0.0]\nlook_at = [0.0, 0.0, -10000.0]\nfov_y = 0.025',
+       lights='\n[[lights]]\nposition = [3.0, 4.0, -9990.0]\n',
+       note="""From 1e4 away, b^2 and c of the textbook quadratic are about 1e8 and differ by
+r^2 = 1: in f32 (8 units apart at 1e8) the discriminant is noise, while the
+stable form keeps it.""")
+print("wrote", sorted(os.listdir(OUT)))
