@@ -254,8 +254,47 @@ pub fn markdown(plan: &Plan, outcomes: &[Outcome], accel: &[AccelRun], agreement
     let device = any(Api::Vulkan).or(any(Api::Opengl)).map(|r| r.device.clone()).unwrap_or_else(|| "no device".into());
     let _ = writeln!(s, "# twinray compare — {device}\n");
 
-    // The summary: one line per experiment and path, computed from the rows below.
+    // The three-line summary: one line per experiment, computed from the rows below.
     let paths = paths_in(outcomes);
+    let med = |v: &[f64]| range(v).map(|(_, m, _)| m);
+    for exp in EXPERIMENTS {
+        let mut parts = Vec::new();
+        let mut why = String::new();
+        for &path in &paths {
+            let r = ratios(exp, path, outcomes, study);
+            let (what, m) = match (med(&r.gpu), med(&r.wall)) {
+                (Some(g), _) => ("GPU", g),
+                (None, Some(w)) => ("wall", w),
+                _ => continue,
+            };
+            let who = if m > 1.02 { "OpenGL faster" } else if m < 0.98 { "Vulkan faster" } else { "a tie" };
+            parts.push(format!("{path} {m:.2}× ({what}, {who})"));
+            if path == RenderPath::Fragment {
+                if let Some(st) = med(&r.study) {
+                    parts.push(format!("the study {st:.2}×"));
+                }
+                why = match (med(&r.gpu), med(&r.spirv), med(&r.wall)) {
+                    (Some(g), Some(sp), _) if (g - 1.0).abs() >= 0.03 && (sp - 1.0).abs() < 0.03 => {
+                        "OpenGL running Vulkan's very SPIR-V is as slow as Vulkan, so the gap is naga's SPIR-V through the driver's SPIR-V compiler, not the API".into()
+                    }
+                    (Some(g), Some(sp), _) if (g - 1.0).abs() >= 0.03 => format!(
+                        "OpenGL running Vulkan's very SPIR-V closes {:.0} % of the gap: that part is the shader-compiler path, the rest stays with the API",
+                        100.0 * ((g - sp) / (g - 1.0)).clamp(0.0, 1.0)
+                    ),
+                    (Some(g), _, Some(w)) if (w - g).abs() < 0.05 => {
+                        "wall and GPU ratios agree: any gap is in executing the shader, not in per-frame API overhead".into()
+                    }
+                    (Some(_), _, Some(_)) => "the wall and GPU ratios differ: part of the gap is per-frame overhead outside the draw".into(),
+                    _ => "this driver has no usable GPU timer: wall time only".into(),
+                };
+            }
+        }
+        if !parts.is_empty() {
+            let _ = writeln!(s, "- **{exp}** — Vulkan/OpenGL: {}. Why: {why}.", parts.join(", "));
+        }
+    }
+    let _ = writeln!(s);
+    let _ = writeln!(s, "## Summary by path\n");
     for exp in EXPERIMENTS {
       for &path in &paths {
         let r = ratios(exp, path, outcomes, study);

@@ -15,34 +15,39 @@ fn quick_comparison_writes_every_api_experiment_and_point() {
     let mut lines = csv.lines();
     let header: Vec<&str> = lines.next().unwrap().split(',').collect();
     let col = |name: &str| header.iter().position(|h| *h == name).unwrap_or_else(|| panic!("no column {name}"));
-    let (exp, value, api, status) = (col("experiment"), col("param_value"), col("api"), col("status"));
+    let (exp, value, api, status, path) = (col("experiment"), col("param_value"), col("api"), col("status"), col("path"));
     let mut seen = BTreeSet::new();
     for line in lines {
         // Quoted fields come after the key columns, so a plain split is enough for these.
         let f: Vec<&str> = line.split(',').collect();
         assert_eq!(f[status], "ok", "failed point: {line}");
-        seen.insert((f[exp].to_string(), f[value].to_string(), f[api].to_string()));
+        seen.insert((f[exp].to_string(), f[value].to_string(), f[api].to_string(), f[path].to_string()));
     }
     let mut expected = BTreeSet::new();
+    let points = [
+        ("teapot", &["40x40", "80x80"][..]),
+        ("box", &["100x100", "200x200", "300x300"][..]),
+        ("spherelist", &["1", "10", "100", "1000"][..]),
+    ];
     for a in ["vulkan", "opengl"] {
-        for r in ["40x40", "80x80"] {
-            expected.insert(("teapot".to_string(), r.to_string(), a.to_string()));
-        }
-        for r in ["100x100", "200x200", "300x300"] {
-            expected.insert(("box".to_string(), r.to_string(), a.to_string()));
-        }
-        for n in ["1", "10", "100", "1000"] {
-            expected.insert(("spherelist".to_string(), n.to_string(), a.to_string()));
+        for p in ["fragment", "compute"] {
+            for (e, values) in points {
+                for v in values {
+                    expected.insert((e.to_string(), v.to_string(), a.to_string(), p.to_string()));
+                }
+            }
         }
     }
-    assert_eq!(seen, expected, "results.csv must hold every API x experiment x point of the quick preset");
+    assert_eq!(seen, expected, "results.csv must hold every API x path x experiment x point of the quick preset");
 
     let report = std::fs::read_to_string(out.join("report.md")).unwrap();
-    let summary: Vec<&str> = report.lines().skip(2).take(3).collect();
+    let summary: Vec<&str> = report.lines().skip(2).take(4).collect();
     for (line, exp) in summary.iter().zip(["teapot", "box", "spherelist"]) {
-        assert!(line.starts_with(&format!("- **{exp}**")), "report opens with a summary line per experiment: {line}");
+        assert!(line.starts_with(&format!("- **{exp}** — Vulkan/OpenGL: fragment")), "report opens with a summary line per experiment: {line}");
+        assert!(line.contains("compute") && line.contains("Why:"), "{line}");
     }
-    for f in ["teapot.svg", "box.svg", "spherelist.svg", "images/box-vulkan.png", "images/box-reference.png"] {
+    assert_eq!(summary[3], "", "the summary is three lines");
+    for f in ["teapot.svg", "box.svg", "spherelist.svg", "scaling.svg", "images/box-reference.png"] {
         assert!(out.join(f).exists(), "{f} missing");
     }
     std::fs::remove_dir_all(out).ok();
