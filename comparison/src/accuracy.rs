@@ -155,6 +155,8 @@ pub struct Row {
     pub api: Api,
     pub result: Result<(Option<f64>, f64, Error, u64), String>,
     pub pareto: bool,
+    /// Its numerics render every hard case within tolerance (or no hard cases ran).
+    pub sound: bool,
     pub is_default: bool,
 }
 
@@ -218,6 +220,7 @@ fn mark_pareto(rows: &mut [Row], unsound: &[Numerics]) {
         .collect();
     for (i, row) in rows.iter_mut().enumerate() {
         row.pareto = false;
+        row.sound = !unsound.contains(&row.config.numerics);
         let (Some(t), Some(e)) = (snapshot[i].2, snapshot[i].3) else { continue };
         row.pareto = !snapshot.iter().enumerate().any(|(j, o)| {
             j != i && o.0 == snapshot[i].0 && o.1 == snapshot[i].1 && matches!((o.2, o.3), (Some(t2), Some(e2)) if dominates(t2, e2, t, e))
@@ -286,6 +289,7 @@ pub fn run(args: &AccuracyArgs) -> anyhow::Result<()> {
                     api,
                     result,
                     pareto: false,
+                    sound: true,
                     is_default: *c == default,
                 });
             }
@@ -540,7 +544,7 @@ fn markdown(args: &AccuracyArgs, rows: &[Row], hard_rows: &[HardRow], cases: &[H
         let (Some(t), Some(e)) = (r.time(), r.error().map(|e| e.rmse)) else { continue };
         let by: Vec<String> = rows
             .iter()
-            .filter(|o| o.scene == r.scene && o.api == r.api && !o.is_default)
+            .filter(|o| o.scene == r.scene && o.api == r.api && !o.is_default && o.sound)
             .filter(|o| matches!((o.time(), o.error().map(|e| e.rmse)), (Some(t2), Some(e2)) if dominates(t2, e2, t, e)))
             .map(|o| o.config.label())
             .collect();
