@@ -645,7 +645,8 @@ fn plot_scaling(path: &Path, outcomes: &[Outcome], accel: &[AccelRun]) -> anyhow
         // Brute force: the study's sphere-list sweep plus the crossover runs.
         let mut brute: Vec<(f64, f64)> = outcomes
             .iter()
-            .filter(|o| o.api == api && o.point.experiment == "spherelist")
+            // The BVH runs are fragment-path runs: compare like with like.
+            .filter(|o| o.api == api && o.point.experiment == "spherelist" && o.path == RenderPath::Fragment)
             .filter_map(|o| o.result.as_ref().ok())
             .filter_map(|r| Some((primitives(r), ms(r)?)))
             .collect();
