@@ -4,5 +4,10 @@ fn main() {
     let s = twinray_common::scene::Scene::load(&scene, &[]).unwrap_or_else(|e| panic!("{e:#}"));
     let v = twinray_common::shader::Variant::for_scene(&s);
     let sh = twinray_common::shader::build(&v).unwrap_or_else(|e| panic!("{e:#}"));
-    println!("// variant {}\n{}\n{}", v.label(), sh.vertex_glsl, sh.fragment_glsl);
+    println!(
+        "// variant {}\n{}\n{}",
+        v.label(),
+        sh.vertex_glsl,
+        sh.fragment_glsl
+    );
 }

@@ -5,6 +5,11 @@ fn main() {
     let size = twinray_common::cli::parse_size(&a[2]).unwrap();
     let t = std::time::Instant::now();
     let img = twinray_common::reference::render(&scene, size.width, size.height);
-    eprintln!("{} in {:?}, nonfinite {}", a[1], t.elapsed(), img.nonfinite_pixels());
+    eprintln!(
+        "{} in {:?}, nonfinite {}",
+        a[1],
+        t.elapsed(),
+        img.nonfinite_pixels()
+    );
     img.save_png(std::path::Path::new(&a[3])).unwrap();
 }

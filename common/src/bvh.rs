@@ -21,7 +21,10 @@ struct Aabb {
 }
 
 impl Aabb {
-    const EMPTY: Aabb = Aabb { min: DVec3::splat(f64::INFINITY), max: DVec3::splat(f64::NEG_INFINITY) };
+    const EMPTY: Aabb = Aabb {
+        min: DVec3::splat(f64::INFINITY),
+        max: DVec3::splat(f64::NEG_INFINITY),
+    };
 
     fn grow(&mut self, o: &Aabb) {
         self.min = self.min.min(o.min);
@@ -55,15 +58,30 @@ pub struct Bvh {
 impl Bvh {
     pub fn build(scene: &Scene) -> Bvh {
         let start = std::time::Instant::now();
-        let mut refs: Vec<PrimRef> = Vec::with_capacity(scene.spheres.len() + scene.triangles.len());
+        let mut refs: Vec<PrimRef> =
+            Vec::with_capacity(scene.spheres.len() + scene.triangles.len());
         for (i, s) in scene.spheres.iter().enumerate() {
             let r = DVec3::splat(s.radius);
-            let bounds = Aabb { min: s.center - r, max: s.center + r };
-            refs.push(PrimRef { bounds, centroid: s.center, code: PRIM_SPHERE_BIT | i as u32 });
+            let bounds = Aabb {
+                min: s.center - r,
+                max: s.center + r,
+            };
+            refs.push(PrimRef {
+                bounds,
+                centroid: s.center,
+                code: PRIM_SPHERE_BIT | i as u32,
+            });
         }
         for (i, t) in scene.triangles.iter().enumerate() {
-            let bounds = Aabb { min: t.p[0].min(t.p[1]).min(t.p[2]), max: t.p[0].max(t.p[1]).max(t.p[2]) };
-            refs.push(PrimRef { bounds, centroid: (bounds.min + bounds.max) * 0.5, code: i as u32 });
+            let bounds = Aabb {
+                min: t.p[0].min(t.p[1]).min(t.p[2]),
+                max: t.p[0].max(t.p[1]).max(t.p[2]),
+            };
+            refs.push(PrimRef {
+                bounds,
+                centroid: (bounds.min + bounds.max) * 0.5,
+                code: i as u32,
+            });
         }
         let mut bvh = Bvh::default();
         if !refs.is_empty() {
@@ -86,7 +104,10 @@ fn bounds_of(refs: &[PrimRef]) -> (Aabb, Aabb) {
     let mut c = Aabb::EMPTY;
     for r in refs {
         b.grow(&r.bounds);
-        c.grow(&Aabb { min: r.centroid, max: r.centroid });
+        c.grow(&Aabb {
+            min: r.centroid,
+            max: r.centroid,
+        });
     }
     (b, c)
 }
@@ -100,7 +121,11 @@ fn build_node(bvh: &mut Bvh, refs: &mut [PrimRef], lo: usize, hi: usize, depth: 
     let (bounds, centroids) = bounds_of(&refs[lo..hi]);
     bvh.nodes.push(GpuBvhNode::default());
     let count = hi - lo;
-    let split = if count <= 1 { None } else { sah_split(&refs[lo..hi], &bounds, &centroids) };
+    let split = if count <= 1 {
+        None
+    } else {
+        sah_split(&refs[lo..hi], &bounds, &centroids)
+    };
     let split = match split {
         Some(s) => Some(s),
         // Too many for a leaf but SAH found no useful split (e.g. identical
@@ -192,7 +217,13 @@ fn sah_split(refs: &[PrimRef], bounds: &Aabb, centroids: &Aabb) -> Option<(usize
         let scale = BINS as f64 / (cmax - cmin);
         let mut bins = [(Aabb::EMPTY, 0usize); BINS];
         for r in refs {
-            let b = Plane { axis, cmin, scale, last_left: 0 }.bin(r);
+            let b = Plane {
+                axis,
+                cmin,
+                scale,
+                last_left: 0,
+            }
+            .bin(r);
             bins[b].0.grow(&r.bounds);
             bins[b].1 += 1;
         }
@@ -217,14 +248,26 @@ fn sah_split(refs: &[PrimRef], bounds: &Aabb, centroids: &Aabb) -> Option<(usize
                 continue;
             }
             let cost = TRAVERSAL_COST
-                + INTERSECT_COST * (acc.area() * nl as f64 + right_area[i + 1] * nr as f64) / bounds.area().max(1e-300);
+                + INTERSECT_COST * (acc.area() * nl as f64 + right_area[i + 1] * nr as f64)
+                    / bounds.area().max(1e-300);
             if best.is_none_or(|b| cost < b.0) {
-                best = Some((cost, nl, Plane { axis, cmin, scale, last_left: i }));
+                best = Some((
+                    cost,
+                    nl,
+                    Plane {
+                        axis,
+                        cmin,
+                        scale,
+                        last_left: i,
+                    },
+                ));
             }
         }
     }
     match best {
-        Some((cost, nl, plane)) if cost < leaf_cost || refs.len() > MAX_LEAF => Some((nl, Some(plane))),
+        Some((cost, nl, plane)) if cost < leaf_cost || refs.len() > MAX_LEAF => {
+            Some((nl, Some(plane)))
+        }
         _ => None,
     }
 }
@@ -245,23 +288,34 @@ mod tests {
         for (i, n) in bvh.nodes.iter().enumerate() {
             if n.count > 0 {
                 assert!(n.count as usize <= MAX_LEAF, "leaf {i} holds {}", n.count);
-                for &code in &bvh.prims[n.left_or_first as usize..(n.left_or_first + n.count) as usize] {
+                for &code in
+                    &bvh.prims[n.left_or_first as usize..(n.left_or_first + n.count) as usize]
+                {
                     let (lo, hi) = if code & PRIM_SPHERE_BIT != 0 {
                         let s = &scene.spheres[(code & !PRIM_SPHERE_BIT) as usize];
                         (s.center - s.radius, s.center + s.radius)
                     } else {
                         let t = &scene.triangles[code as usize];
-                        (t.p[0].min(t.p[1]).min(t.p[2]), t.p[0].max(t.p[1]).max(t.p[2]))
+                        (
+                            t.p[0].min(t.p[1]).min(t.p[2]),
+                            t.p[0].max(t.p[1]).max(t.p[2]),
+                        )
                     };
                     for a in 0..3 {
-                        assert!(n.min[a] as f64 <= lo[a] && n.max[a] as f64 >= hi[a], "leaf {i} box misses a primitive");
+                        assert!(
+                            n.min[a] as f64 <= lo[a] && n.max[a] as f64 >= hi[a],
+                            "leaf {i} box misses a primitive"
+                        );
                     }
                 }
             } else {
                 for child in [i + 1, n.left_or_first as usize] {
                     let c = &bvh.nodes[child];
                     for a in 0..3 {
-                        assert!(c.min[a] >= n.min[a] && c.max[a] <= n.max[a], "child {child} outside parent {i}");
+                        assert!(
+                            c.min[a] >= n.min[a] && c.max[a] <= n.max[a],
+                            "child {child} outside parent {i}"
+                        );
                     }
                 }
             }

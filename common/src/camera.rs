@@ -29,13 +29,23 @@ impl RayFrame {
         let step_x = right * (2.0 * half_w / width as f64);
         let step_y = -up * (2.0 * half_h / height as f64);
         let top_left = forward - right * half_w + up * half_h + 0.5 * step_x + 0.5 * step_y;
-        RayFrame { eye: cam.eye, top_left, step_x, step_y }
+        RayFrame {
+            eye: cam.eye,
+            top_left,
+            step_x,
+            step_y,
+        }
     }
 
     /// The frame as the GPU's uniform buffer holds it (every vector in f32).
     pub fn rounded_to_f32(&self) -> RayFrame {
         let v = |x: DVec3| x.as_vec3().as_dvec3();
-        RayFrame { eye: v(self.eye), top_left: v(self.top_left), step_x: v(self.step_x), step_y: v(self.step_y) }
+        RayFrame {
+            eye: v(self.eye),
+            top_left: v(self.top_left),
+            step_x: v(self.step_x),
+            step_y: v(self.step_y),
+        }
     }
 
     /// Unit direction through the centre of pixel (x, y).
@@ -59,13 +69,17 @@ impl Frustum {
         let bl = tl + height as f64 * frame.step_y;
         let br = tr + height as f64 * frame.step_y;
         let centre = (tl + br) * 0.5;
-        let mut normals = [tl.cross(tr), tr.cross(br), br.cross(bl), bl.cross(tl)].map(|n| n.normalize());
+        let mut normals =
+            [tl.cross(tr), tr.cross(br), br.cross(bl), bl.cross(tl)].map(|n| n.normalize());
         for n in &mut normals {
             if n.dot(centre) < 0.0 {
                 *n = -*n;
             }
         }
-        Frustum { eye: frame.eye, normals }
+        Frustum {
+            eye: frame.eye,
+            normals,
+        }
     }
 
     /// Whether any part of the sphere can be seen (it is in front of every side plane).
@@ -107,17 +121,32 @@ impl Orbit {
         let distance = offset.length();
         let flat = offset - up * offset.dot(up);
         // An eye straight above the target has no yaw; any axis at right angles will do.
-        let axis_a = if flat.length() > 1e-9 * distance.max(1.0) { flat.normalize() } else { up.any_orthonormal_vector() };
+        let axis_a = if flat.length() > 1e-9 * distance.max(1.0) {
+            flat.normalize()
+        } else {
+            up.any_orthonormal_vector()
+        };
         let axis_b = up.cross(axis_a);
         let pitch = (offset.dot(up) / distance).clamp(-1.0, 1.0).asin();
-        Orbit { home: cam.clone(), up, axis_a, axis_b, yaw: 0.0, pitch, distance }
+        Orbit {
+            home: cam.clone(),
+            up,
+            axis_a,
+            axis_b,
+            yaw: 0.0,
+            pitch,
+            distance,
+        }
     }
 
     /// The camera these angles describe (same target, up and field of view).
     pub fn camera(&self) -> Camera {
         let flat = self.axis_a * self.yaw.cos() + self.axis_b * self.yaw.sin();
         let dir = flat * self.pitch.cos() + self.up * self.pitch.sin();
-        Camera { eye: self.home.look_at + dir * self.distance, ..self.home.clone() }
+        Camera {
+            eye: self.home.look_at + dir * self.distance,
+            ..self.home.clone()
+        }
     }
 
     /// A mouse drag of (dx, dy) pixels in a window `height` pixels tall: right
@@ -151,13 +180,26 @@ mod tests {
 
     #[test]
     fn orbit_round_trips_the_scene_camera() {
-        let tilted = Camera { eye: DVec3::new(1.0, 2.0, 6.0), look_at: DVec3::new(0.5, -1.0, 0.0), up: DVec3::new(0.0, 2.0, 0.1), fov_y: 40.0 };
-        let above = Camera { eye: DVec3::new(0.0, 5.0, 0.0), look_at: DVec3::ZERO, up: DVec3::Y, fov_y: 60.0 };
+        let tilted = Camera {
+            eye: DVec3::new(1.0, 2.0, 6.0),
+            look_at: DVec3::new(0.5, -1.0, 0.0),
+            up: DVec3::new(0.0, 2.0, 0.1),
+            fov_y: 40.0,
+        };
+        let above = Camera {
+            eye: DVec3::new(0.0, 5.0, 0.0),
+            look_at: DVec3::ZERO,
+            up: DVec3::Y,
+            fov_y: 60.0,
+        };
         for c in [cam(), tilted, above] {
             let o = Orbit::new(&c);
             let back = o.camera();
             assert!(close(back.eye, c.eye), "{c:?} -> {back:?}");
-            assert_eq!((back.look_at, back.up, back.fov_y), (c.look_at, c.up, c.fov_y));
+            assert_eq!(
+                (back.look_at, back.up, back.fov_y),
+                (c.look_at, c.up, c.fov_y)
+            );
         }
     }
 
@@ -168,13 +210,19 @@ mod tests {
         o.drag(150.0, 0.0, 300); // half a window: a quarter turn
         let e = o.camera().eye;
         assert!((e.length() - 5.0).abs() < 1e-9);
-        assert!(e.x.abs() > 4.99, "a quarter turn puts the eye on the x axis: {e:?}");
+        assert!(
+            e.x.abs() > 4.99,
+            "a quarter turn puts the eye on the x axis: {e:?}"
+        );
         assert!(e.x < 0.0, "dragging right moves the eye left");
         o.drag(-150.0, 0.0, 300);
         assert!(close(o.camera().eye, c.eye), "dragging back returns");
         o.drag(0.0, 75.0, 300); // 45 degrees up
         let e = o.camera().eye;
-        assert!((e.y - 5.0 * std::f64::consts::FRAC_1_SQRT_2).abs() < 1e-9, "{e:?}");
+        assert!(
+            (e.y - 5.0 * std::f64::consts::FRAC_1_SQRT_2).abs() < 1e-9,
+            "{e:?}"
+        );
     }
 
     #[test]
@@ -184,7 +232,10 @@ mod tests {
         assert_eq!(o.pitch, Orbit::MAX_PITCH);
         let c = o.camera();
         let forward = (c.look_at - c.eye).normalize();
-        assert!(forward.cross(c.up).length() > 0.01, "the view never looks along up");
+        assert!(
+            forward.cross(c.up).length() > 0.01,
+            "the view never looks along up"
+        );
         o.drag(0.0, -20_000.0, 100);
         assert_eq!(o.pitch, -Orbit::MAX_PITCH);
     }
@@ -197,7 +248,10 @@ mod tests {
         o.zoom(-2.0);
         assert!((o.distance - 5.0 / 0.9).abs() < 1e-12);
         o.zoom(1e6);
-        assert!((o.distance - 0.05).abs() < 1e-12, "never through the target");
+        assert!(
+            (o.distance - 0.05).abs() < 1e-12,
+            "never through the target"
+        );
         o.zoom(-1e6);
         assert!((o.distance - 500.0).abs() < 1e-9);
         o.drag(33.0, 17.0, 200);
@@ -207,7 +261,12 @@ mod tests {
     }
 
     fn cam() -> Camera {
-        Camera { eye: DVec3::new(0.0, 0.0, 5.0), look_at: DVec3::ZERO, up: DVec3::Y, fov_y: 90.0 }
+        Camera {
+            eye: DVec3::new(0.0, 0.0, 5.0),
+            look_at: DVec3::ZERO,
+            up: DVec3::Y,
+            fov_y: 90.0,
+        }
     }
 
     #[test]
@@ -216,7 +275,10 @@ mod tests {
         let d = f.dir(50.0, 50.0);
         assert!((d - DVec3::new(0.0, 0.0, -1.0)).length() < 1e-12);
         assert!(f.dir(50.0, 0.0).y > 0.0, "row 0 is the top of the image");
-        assert!(f.dir(0.0, 50.0).x < 0.0, "column 0 is the left of the image");
+        assert!(
+            f.dir(0.0, 50.0).x < 0.0,
+            "column 0 is the left of the image"
+        );
     }
 
     #[test]
@@ -224,8 +286,17 @@ mod tests {
         let f = RayFrame::new(&cam(), 100, 100);
         let fr = Frustum::new(&f, 100, 100);
         assert!(fr.sees_sphere(DVec3::ZERO, 0.5));
-        assert!(!fr.sees_sphere(DVec3::new(0.0, 0.0, 10.0), 0.5), "behind the eye");
-        assert!(!fr.sees_sphere(DVec3::new(20.0, 0.0, 0.0), 0.5), "far to the right");
-        assert!(fr.sees_sphere(DVec3::new(5.0, 0.0, 0.0), 0.5), "45 degree edge at distance 5 is inside");
+        assert!(
+            !fr.sees_sphere(DVec3::new(0.0, 0.0, 10.0), 0.5),
+            "behind the eye"
+        );
+        assert!(
+            !fr.sees_sphere(DVec3::new(20.0, 0.0, 0.0), 0.5),
+            "far to the right"
+        );
+        assert!(
+            fr.sees_sphere(DVec3::new(5.0, 0.0, 0.0), 0.5),
+            "45 degree edge at distance 5 is inside"
+        );
     }
 }

@@ -77,7 +77,18 @@ impl Accel {
 }
 
 /// The tracer's entry point: the two ways one GLSL tracer reaches the GPU.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default, clap::ValueEnum, serde::Serialize, serde::Deserialize)]
+#[derive(
+    Debug,
+    Clone,
+    Copy,
+    PartialEq,
+    Eq,
+    Hash,
+    Default,
+    clap::ValueEnum,
+    serde::Serialize,
+    serde::Deserialize,
+)]
 #[serde(rename_all = "lowercase")]
 pub enum RenderPath {
     /// One fullscreen triangle; the fragment shader traces (shaders/trace.frag).
@@ -115,7 +126,11 @@ impl Workgroup {
     /// most every Vulkan device must accept (maxComputeWorkGroupInvocations).
     pub const DEFAULT: Workgroup = Workgroup { x: 16, y: 8 };
     /// The sizes the comparison measures.
-    pub const MEASURED: [Workgroup; 3] = [Workgroup { x: 8, y: 8 }, Workgroup { x: 16, y: 8 }, Workgroup { x: 16, y: 16 }];
+    pub const MEASURED: [Workgroup; 3] = [
+        Workgroup { x: 8, y: 8 },
+        Workgroup { x: 16, y: 8 },
+        Workgroup { x: 16, y: 16 },
+    ];
 }
 
 impl std::fmt::Display for Workgroup {
@@ -130,7 +145,12 @@ pub fn parse_workgroup(s: &str) -> Result<Workgroup, String> {
     let (x, y) = s
         .split_once(['x', 'X'])
         .ok_or_else(|| format!("'{s}' is not WxH (for example 16x8)"))?;
-    let parse = |v: &str| v.trim().parse::<u32>().ok().filter(|&n| (1..=1024).contains(&n));
+    let parse = |v: &str| {
+        v.trim()
+            .parse::<u32>()
+            .ok()
+            .filter(|&n| (1..=1024).contains(&n))
+    };
     match (parse(x), parse(y)) {
         (Some(x), Some(y)) if x * y <= 1024 => Ok(Workgroup { x, y }),
         _ => Err(format!("'{s}' is not a workgroup size: two whole numbers from 1 to 1024 with a product of at most 1024")),
@@ -158,11 +178,15 @@ pub fn parse_size(s: &str) -> Result<Size, String> {
         .split_once(['x', 'X'])
         .ok_or_else(|| format!("'{s}' is not WxH (for example 800x600)"))?;
     let parse = |v: &str, what: &str| -> Result<u32, String> {
-        v.trim().parse::<u32>().map_err(|_| format!("the {what} in '{s}' is not a whole number"))
+        v.trim()
+            .parse::<u32>()
+            .map_err(|_| format!("the {what} in '{s}' is not a whole number"))
     };
     let (width, height) = (parse(w, "width")?, parse(h, "height")?);
     if width == 0 || height == 0 {
-        return Err(format!("'{s}' has a zero dimension; width and height must be at least 1"));
+        return Err(format!(
+            "'{s}' has a zero dimension; width and height must be at least 1"
+        ));
     }
     if width > MAX_SIZE || height > MAX_SIZE {
         return Err(format!("'{s}' is larger than {MAX_SIZE} in one dimension"));
@@ -199,7 +223,8 @@ impl RenderArgs {
             Ok(a) => a,
             Err(e) => {
                 let code = match e.kind() {
-                    clap::error::ErrorKind::DisplayHelp | clap::error::ErrorKind::DisplayVersion => 0,
+                    clap::error::ErrorKind::DisplayHelp
+                    | clap::error::ErrorKind::DisplayVersion => 0,
                     _ => 2,
                 };
                 let _ = e.print();

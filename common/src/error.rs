@@ -38,11 +38,19 @@ impl std::error::Error for Failure {}
 
 /// Shorthand: `Err(bad_input(format!(..)))?`.
 pub fn bad_input(message: impl Into<String>) -> anyhow::Error {
-    Failure { kind: FailureKind::BadInput, message: message.into() }.into()
+    Failure {
+        kind: FailureKind::BadInput,
+        message: message.into(),
+    }
+    .into()
 }
 
 pub fn no_device(message: impl Into<String>) -> anyhow::Error {
-    Failure { kind: FailureKind::NoDevice, message: message.into() }.into()
+    Failure {
+        kind: FailureKind::NoDevice,
+        message: message.into(),
+    }
+    .into()
 }
 
 /// The exit code an error maps to: the first `Failure` in its chain decides.
@@ -58,7 +66,11 @@ pub fn exit_code_of(err: &anyhow::Error) -> i32 {
 pub fn exit_with(program: &str, err: anyhow::Error) -> ! {
     let msg = match err.chain().find_map(|e| e.downcast_ref::<Failure>()) {
         Some(f) => f.message.clone(),
-        None => err.chain().map(|e| e.to_string()).collect::<Vec<_>>().join(": "),
+        None => err
+            .chain()
+            .map(|e| e.to_string())
+            .collect::<Vec<_>>()
+            .join(": "),
     };
     eprintln!("{program}: error: {msg}");
     std::process::exit(exit_code_of(&err));

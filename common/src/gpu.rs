@@ -94,11 +94,21 @@ pub struct GpuBvhNode {
 
 impl GpuBvhNode {
     pub fn leaf((min, max): ([f32; 3], [f32; 3]), first: u32, count: u32) -> GpuBvhNode {
-        GpuBvhNode { min, left_or_first: first, max, count }
+        GpuBvhNode {
+            min,
+            left_or_first: first,
+            max,
+            count,
+        }
     }
 
     pub fn interior((min, max): ([f32; 3], [f32; 3]), right: u32) -> GpuBvhNode {
-        GpuBvhNode { min, left_or_first: right, max, count: 0 }
+        GpuBvhNode {
+            min,
+            left_or_first: right,
+            max,
+            count: 0,
+        }
     }
 }
 
@@ -165,13 +175,22 @@ impl GpuFrame {
 
 impl GpuScene {
     pub fn new(scene: &Scene, width: u32, height: u32) -> GpuScene {
-        let bvh = if scene.bvh { crate::bvh::Bvh::build(scene) } else { crate::bvh::Bvh::default() };
+        let bvh = if scene.bvh {
+            crate::bvh::Bvh::build(scene)
+        } else {
+            crate::bvh::Bvh::default()
+        };
         GpuScene {
             frame: GpuFrame::new(scene, &scene.camera, width, height),
             spheres: scene
                 .spheres
                 .iter()
-                .map(|s| GpuSphere { center: v3(s.center), radius: s.radius as f32, material: s.material, pad: [0; 3] })
+                .map(|s| GpuSphere {
+                    center: v3(s.center),
+                    radius: s.radius as f32,
+                    material: s.material,
+                    pad: [0; 3],
+                })
                 .collect(),
             triangles: scene
                 .triangles
@@ -204,7 +223,11 @@ impl GpuScene {
             lights: scene
                 .lights
                 .iter()
-                .map(|l| GpuLight { position: v3(l.position), color: v3(l.color), ..Default::default() })
+                .map(|l| GpuLight {
+                    position: v3(l.position),
+                    color: v3(l.color),
+                    ..Default::default()
+                })
                 .collect(),
             bvh_nodes: bvh.nodes,
             bvh_prims: bvh.prims,
@@ -220,7 +243,8 @@ impl GpuScene {
     /// counts in `Frame` keep the shader from reading it.
     pub fn storage_bytes(&self, binding: u32) -> &[u8] {
         // Zeroes for the one element of an empty array (the largest struct is 96 bytes).
-        static ZEROES: [u8; std::mem::size_of::<GpuTriangle>()] = [0; std::mem::size_of::<GpuTriangle>()];
+        static ZEROES: [u8; std::mem::size_of::<GpuTriangle>()] =
+            [0; std::mem::size_of::<GpuTriangle>()];
         fn bytes<T: Pod>(v: &[T]) -> &[u8] {
             if v.is_empty() {
                 &ZEROES[..std::mem::size_of::<T>()]

@@ -28,9 +28,17 @@ pub struct HardCase {
 
 /// Reads the header comment lines of a hard-case scene file.
 pub fn parse(path: &Path) -> anyhow::Result<HardCase> {
-    let text = std::fs::read_to_string(path)
-        .map_err(|e| bad_input(format!("hard case '{}' cannot be read: {e}", path.display())))?;
-    let name = path.file_stem().and_then(|s| s.to_str()).unwrap_or("case").to_string();
+    let text = std::fs::read_to_string(path).map_err(|e| {
+        bad_input(format!(
+            "hard case '{}' cannot be read: {e}",
+            path.display()
+        ))
+    })?;
+    let name = path
+        .file_stem()
+        .and_then(|s| s.to_str())
+        .unwrap_or("case")
+        .to_string();
     let (mut checks, mut tolerance, mut extra) = (None, None, Vec::new());
     for line in text.lines().take_while(|l| l.starts_with('#')) {
         let body = line.trim_start_matches('#').trim();
@@ -38,14 +46,27 @@ pub fn parse(path: &Path) -> anyhow::Result<HardCase> {
             checks = Some(v.trim().to_string());
         } else if let Some(v) = body.strip_prefix("tolerance:") {
             let v = v.trim().trim_end_matches('%').trim();
-            tolerance = Some(v.parse::<f64>().ok().filter(|t| (0.0..=100.0).contains(t)).ok_or_else(|| {
-                bad_input(format!("hard case '{}': '# tolerance: {v}' is not a percentage", path.display()))
-            })?);
+            tolerance = Some(
+                v.parse::<f64>()
+                    .ok()
+                    .filter(|t| (0.0..=100.0).contains(t))
+                    .ok_or_else(|| {
+                        bad_input(format!(
+                            "hard case '{}': '# tolerance: {v}' is not a percentage",
+                            path.display()
+                        ))
+                    })?,
+            );
         } else if let Some(v) = body.strip_prefix("check:") {
             extra.push(v.trim().to_string());
         }
     }
-    let missing = |what: &str| bad_input(format!("hard case '{}' has no '# {what}:' line at the top", path.display()));
+    let missing = |what: &str| {
+        bad_input(format!(
+            "hard case '{}' has no '# {what}:' line at the top",
+            path.display()
+        ))
+    };
     Ok(HardCase {
         name,
         path: path.to_path_buf(),
@@ -57,8 +78,12 @@ pub fn parse(path: &Path) -> anyhow::Result<HardCase> {
 
 /// Every `*.toml` in `dir`, sorted by name.
 pub fn list(dir: &Path) -> anyhow::Result<Vec<HardCase>> {
-    let entries = std::fs::read_dir(dir)
-        .map_err(|e| bad_input(format!("hard-case folder '{}' cannot be read: {e}", dir.display())))?;
+    let entries = std::fs::read_dir(dir).map_err(|e| {
+        bad_input(format!(
+            "hard-case folder '{}' cannot be read: {e}",
+            dir.display()
+        ))
+    })?;
     let mut paths: Vec<PathBuf> = entries
         .filter_map(|e| e.ok().map(|e| e.path()))
         .filter(|p| p.extension().is_some_and(|x| x == "toml"))
@@ -73,7 +98,11 @@ fn worst(a: &image::Rgb<u8>, b: &image::Rgb<u8>) -> u8 {
 
 /// Share of pixels (0..1) off by more than `WRONG_ABOVE` on some channel.
 pub fn wrong_share(test: &image::RgbImage, truth: &image::RgbImage) -> f64 {
-    let n = test.pixels().zip(truth.pixels()).filter(|(a, b)| worst(a, b) > WRONG_ABOVE).count();
+    let n = test
+        .pixels()
+        .zip(truth.pixels())
+        .filter(|(a, b)| worst(a, b) > WRONG_ABOVE)
+        .count();
     n as f64 / (truth.width() as f64 * truth.height() as f64).max(1.0)
 }
 
@@ -86,7 +115,9 @@ pub fn crack_pixels(test: &image::RgbImage, truth: &image::RgbImage, background:
     let mut n = 0;
     for y in 1..h.saturating_sub(1) {
         for x in 1..w.saturating_sub(1) {
-            let inside = (0..3).all(|dy| (0..3).all(|dx| worst(truth.get_pixel(x + dx - 1, y + dy - 1), &bg) > WRONG_ABOVE));
+            let inside = (0..3).all(|dy| {
+                (0..3).all(|dx| worst(truth.get_pixel(x + dx - 1, y + dy - 1), &bg) > WRONG_ABOVE)
+            });
             if inside && worst(test.get_pixel(x, y), truth.get_pixel(x, y)) > WRONG_ABOVE {
                 n += 1;
             }
@@ -105,7 +136,8 @@ mod tests {
         assert!(cases.len() >= 12, "{} hard cases", cases.len());
         for c in &cases {
             assert!(!c.checks.is_empty(), "{}", c.name);
-            crate::scene::Scene::load(c.path.to_str().unwrap(), &[]).unwrap_or_else(|e| panic!("{}: {e:#}", c.name));
+            crate::scene::Scene::load(c.path.to_str().unwrap(), &[])
+                .unwrap_or_else(|e| panic!("{}: {e:#}", c.name));
         }
     }
 

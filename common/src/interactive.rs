@@ -106,7 +106,12 @@ impl TitleClock {
     pub const PERIOD: Duration = Duration::from_millis(500);
 
     pub fn new(now: Instant) -> TitleClock {
-        TitleClock { since: now, frames: 0, gpu_sum: 0.0, gpu_n: 0 }
+        TitleClock {
+            since: now,
+            frames: 0,
+            gpu_sum: 0.0,
+            gpu_n: 0,
+        }
     }
 
     /// Counts a frame; every `PERIOD` returns (FPS, mean GPU ms) and starts over.
@@ -195,11 +200,15 @@ pub fn run<R: Renderer>(
         cursor: None,
         screenshots: 0,
         error: None,
-        resize_test: std::env::var("TWINRAY_TEST_RESIZE").is_ok_and(|v| v == "1").then(ResizeTest::default),
+        resize_test: std::env::var("TWINRAY_TEST_RESIZE")
+            .is_ok_and(|v| v == "1")
+            .then(ResizeTest::default),
         test_keys: test_keys()?,
     };
     event_loop.set_control_flow(ControlFlow::Poll);
-    event_loop.run_app(&mut session).context("running the window's event loop")?;
+    event_loop
+        .run_app(&mut session)
+        .context("running the window's event loop")?;
     // Normally dropped in `finish`; here too on paths where winit stopped the loop.
     session.renderer = None;
     if let Some(e) = session.error.take() {
@@ -222,13 +231,16 @@ pub fn run<R: Renderer>(
 }
 
 fn test_keys() -> anyhow::Result<Vec<Action>> {
-    let Ok(list) = std::env::var("TWINRAY_TEST_KEYS") else { return Ok(Vec::new()) };
+    let Ok(list) = std::env::var("TWINRAY_TEST_KEYS") else {
+        return Ok(Vec::new());
+    };
     let mut actions: Vec<Action> = list
         .split(',')
         .filter(|k| !k.trim().is_empty())
         .map(|k| match k.trim() {
             "esc" => Ok(Action::Quit),
-            c => action_for_char(c).ok_or_else(|| bad_input(format!("TWINRAY_TEST_KEYS: '{c}' is no key of the app"))),
+            c => action_for_char(c)
+                .ok_or_else(|| bad_input(format!("TWINRAY_TEST_KEYS: '{c}' is no key of the app"))),
         })
         .collect::<anyhow::Result<_>>()?;
     actions.reverse(); // popped from the end
@@ -277,7 +289,12 @@ impl<R: Renderer> Session<R> {
     }
 
     fn frame_uniform(&self) -> GpuFrame {
-        GpuFrame::new(&self.scene, &self.orbit.camera(), self.size.width.max(1), self.size.height.max(1))
+        GpuFrame::new(
+            &self.scene,
+            &self.orbit.camera(),
+            self.size.width.max(1),
+            self.size.height.max(1),
+        )
     }
 
     /// Stops the loop; `Err` is kept and returned by `run`.
@@ -295,11 +312,16 @@ impl<R: Renderer> Session<R> {
 
     fn save(&mut self, path: &std::path::Path) -> anyhow::Result<()> {
         if self.minimized() {
-            return Err(bad_input(format!("cannot save '{}': the window is minimized", path.display())));
+            return Err(bad_input(format!(
+                "cannot save '{}': the window is minimized",
+                path.display()
+            )));
         }
         let frame = self.frame_uniform();
         let (w, h) = (self.size.width, self.size.height);
-        let Some(r) = self.renderer.as_mut() else { return Ok(()) };
+        let Some(r) = self.renderer.as_mut() else {
+            return Ok(());
+        };
         let image = r.capture(&frame, w, h).context("capturing the frame")?;
         image.save_png(path)?;
         eprintln!("{}: saved {} ({w}x{h})", self.program, path.display());
@@ -333,8 +355,15 @@ impl<R: Renderer> Session<R> {
             Action::ResetCamera => self.orbit.reset(),
             Action::Screenshot => {
                 self.screenshots += 1;
-                let api = if self.program.ends_with("vk") { "vk" } else { "gl" };
-                let path = PathBuf::from(format!("twinray-{api}-{}-{}.png", self.scene.name, self.screenshots));
+                let api = if self.program.ends_with("vk") {
+                    "vk"
+                } else {
+                    "gl"
+                };
+                let path = PathBuf::from(format!(
+                    "twinray-{api}-{}-{}.png",
+                    self.scene.name, self.screenshots
+                ));
                 match self.save(&path) {
                     Ok(()) => {}
                     // A full disk or a minimized window should not end the session.
@@ -357,7 +386,11 @@ impl<R: Renderer> Session<R> {
             }
             Action::DepthUp | Action::DepthDown => {
                 let d = self.scene.max_depth;
-                let d = if action == Action::DepthUp { (d + 1).min(MAX_DEPTH_LIMIT) } else { d.saturating_sub(1).max(1) };
+                let d = if action == Action::DepthUp {
+                    (d + 1).min(MAX_DEPTH_LIMIT)
+                } else {
+                    d.saturating_sub(1).max(1)
+                };
                 self.scene.max_depth = d;
                 // The uniform block carries the depth; only a deeper stack or a
                 // feature the current shader compiled out needs a new variant.
@@ -367,8 +400,16 @@ impl<R: Renderer> Session<R> {
                     self.variant = needed;
                     self.rebuild()?;
                 }
-                let how = if rebuilt { "new shader variant" } else { "same shader" };
-                eprintln!("{}: max depth {d} ({how}: {})", self.program, self.variant.label());
+                let how = if rebuilt {
+                    "new shader variant"
+                } else {
+                    "same shader"
+                };
+                eprintln!(
+                    "{}: max depth {d} ({how}: {})",
+                    self.program,
+                    self.variant.label()
+                );
             }
         }
         Ok(())
@@ -405,7 +446,10 @@ impl<R: Renderer> Session<R> {
                 if self.drawn == 0 {
                     self.setup_ms = (now - self.started).as_secs_f64() * 1e3;
                 }
-                self.frames.push(FrameTime { gpu_ms: d.gpu_ms, wall_ms: (now - self.last_frame_end).as_secs_f64() * 1e3 });
+                self.frames.push(FrameTime {
+                    gpu_ms: d.gpu_ms,
+                    wall_ms: (now - self.last_frame_end).as_secs_f64() * 1e3,
+                });
                 self.last_frame_end = now;
                 self.drawn += 1;
                 if let Some((fps, gpu)) = self.clock.frame(now, d.gpu_ms) {
@@ -434,7 +478,9 @@ impl<R: Renderer> Session<R> {
             Restore,
             Request(PhysicalSize<u32>),
         }
-        let Some(t) = self.resize_test.as_mut() else { return Ok(()) };
+        let Some(t) = self.resize_test.as_mut() else {
+            return Ok(());
+        };
         t.tick += 1;
         let step = if t.minimized_for > 0 {
             t.minimized_for -= 1;
@@ -457,7 +503,9 @@ impl<R: Renderer> Session<R> {
         } else {
             Step::Wait
         };
-        let Some(window) = self.renderer.as_ref().map(R::window) else { return Ok(()) };
+        let Some(window) = self.renderer.as_ref().map(R::window) else {
+            return Ok(());
+        };
         match step {
             Step::Wait => Ok(()),
             Step::Request(size) => {
@@ -503,13 +551,18 @@ impl<R: Renderer> ApplicationHandler for Session<R> {
                     _ => Ok(()),
                 }
             }
-            WindowEvent::MouseInput { state, button: MouseButton::Left, .. } => {
+            WindowEvent::MouseInput {
+                state,
+                button: MouseButton::Left,
+                ..
+            } => {
                 self.dragging = state == ElementState::Pressed;
                 Ok(())
             }
             WindowEvent::CursorMoved { position, .. } => {
                 if let (true, Some(prev)) = (self.dragging, self.cursor) {
-                    self.orbit.drag(position.x - prev.x, position.y - prev.y, self.size.height);
+                    self.orbit
+                        .drag(position.x - prev.x, position.y - prev.y, self.size.height);
                 }
                 self.cursor = Some(position);
                 Ok(())
@@ -550,7 +603,10 @@ mod tests {
     #[test]
     fn keys_map_to_the_documented_actions() {
         let ch = |s: &str| action_for_key(&Key::Character(s.into()));
-        assert_eq!(action_for_key(&Key::Named(NamedKey::Escape)), Some(Action::Quit));
+        assert_eq!(
+            action_for_key(&Key::Named(NamedKey::Escape)),
+            Some(Action::Quit)
+        );
         assert_eq!(ch("1"), Some(Action::Scene("teapot")));
         assert_eq!(ch("2"), Some(Action::Scene("box")));
         assert_eq!(ch("3"), Some(Action::Scene("spherelist")));
@@ -565,8 +621,14 @@ mod tests {
 
     #[test]
     fn title_format_is_fixed() {
-        assert_eq!(window_title("box", "Vulkan", 61.26, Some(12.414)), "twinray — box — Vulkan — 61.3 FPS — 12.41 ms");
-        assert_eq!(window_title("teapot", "OpenGL", 5.0, None), "twinray — teapot — OpenGL — 5.0 FPS — n/a ms");
+        assert_eq!(
+            window_title("box", "Vulkan", 61.26, Some(12.414)),
+            "twinray — box — Vulkan — 61.3 FPS — 12.41 ms"
+        );
+        assert_eq!(
+            window_title("teapot", "OpenGL", 5.0, None),
+            "twinray — teapot — OpenGL — 5.0 FPS — n/a ms"
+        );
     }
 
     #[test]
@@ -578,7 +640,11 @@ mod tests {
         let (fps, gpu) = c.frame(t0 + Duration::from_millis(500), Some(4.0)).unwrap();
         assert!((fps - 6.0).abs() < 1e-9, "3 frames in 0.5 s: {fps}");
         assert_eq!(gpu, Some(3.0));
-        assert_eq!(c.frame(t0 + Duration::from_millis(600), None), None, "starts over");
+        assert_eq!(
+            c.frame(t0 + Duration::from_millis(600), None),
+            None,
+            "starts over"
+        );
     }
 
     #[test]
@@ -588,11 +654,17 @@ mod tests {
         let mut shallow_scene = scene.clone();
         shallow_scene.max_depth = 2;
         let shallow = Variant::for_scene(&shallow_scene);
-        assert!(deep.covers(&shallow), "a deeper stack draws shallower scenes");
+        assert!(
+            deep.covers(&shallow),
+            "a deeper stack draws shallower scenes"
+        );
         assert!(!shallow.covers(&deep), "a stack too small for the depth");
         shallow_scene.max_depth = 1;
         let flat = Variant::for_scene(&shallow_scene);
-        assert!(!flat.covers(&shallow), "depth 1 compiles mirror and glass out");
+        assert!(
+            !flat.covers(&shallow),
+            "depth 1 compiles mirror and glass out"
+        );
         assert!(Variant::generic(Default::default()).covers(&deep));
     }
 }

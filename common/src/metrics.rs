@@ -54,7 +54,11 @@ pub fn compare(a: &image::RgbImage, b: &image::RgbImage) -> anyhow::Result<Metri
     }
     let n = (a.width() as usize * a.height() as usize).max(1);
     let rmse = (sq / (n * 3) as f64).sqrt();
-    let psnr_db = if rmse == 0.0 { f64::INFINITY } else { -20.0 * rmse.log10() };
+    let psnr_db = if rmse == 0.0 {
+        f64::INFINITY
+    } else {
+        -20.0 * rmse.log10()
+    };
     Ok(Metrics {
         width: a.width(),
         height: a.height(),

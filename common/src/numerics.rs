@@ -68,12 +68,22 @@ impl Default for Numerics {
     /// cases; the watertight triangle test fixed no case that Moller-Trumbore
     /// failed here and costs ~10% on the 19,200-triangle teapot.
     fn default() -> Self {
-        Numerics { offset: Offset::ScaleAware, triangle: TriangleTest::MollerTrumbore, sphere: SphereTest::Stable }
+        Numerics {
+            offset: Offset::ScaleAware,
+            triangle: TriangleTest::MollerTrumbore,
+            sphere: SphereTest::Stable,
+        }
     }
 }
 
 impl Offset {
-    pub const ALL: [Offset; 5] = [Offset::Ray, Offset::Normal, Offset::NormalScaled, Offset::Ulp, Offset::ScaleAware];
+    pub const ALL: [Offset; 5] = [
+        Offset::Ray,
+        Offset::Normal,
+        Offset::NormalScaled,
+        Offset::Ulp,
+        Offset::ScaleAware,
+    ];
     pub fn name(self) -> &'static str {
         match self {
             Offset::Ray => "ray",
@@ -127,7 +137,12 @@ impl SphereTest {
 }
 
 /// Parses one of `names` (case-insensitive; `_` and `-` alike) or says which are allowed.
-fn pick<T: Copy>(key: &str, value: &str, all: &[T], name: impl Fn(T) -> &'static str) -> anyhow::Result<T> {
+fn pick<T: Copy>(
+    key: &str,
+    value: &str,
+    all: &[T],
+    name: impl Fn(T) -> &'static str,
+) -> anyhow::Result<T> {
     let v = value.trim().to_ascii_lowercase().replace('_', "-");
     let v = match v.as_str() {
         "mt" | "moller" | "möller-trumbore" => "moller-trumbore".to_string(),
@@ -137,7 +152,10 @@ fn pick<T: Copy>(key: &str, value: &str, all: &[T], name: impl Fn(T) -> &'static
     };
     all.iter().copied().find(|t| name(*t) == v).ok_or_else(|| {
         let names: Vec<&str> = all.iter().map(|t| name(*t)).collect();
-        bad_input(format!("{key}: '{value}' is not one of {}", names.join(", ")))
+        bad_input(format!(
+            "{key}: '{value}' is not one of {}",
+            names.join(", ")
+        ))
     })
 }
 
@@ -150,7 +168,9 @@ impl Numerics {
     pub fn set(&mut self, key: &str, value: &str, what: &str) -> anyhow::Result<bool> {
         match key {
             "offset" => self.offset = pick(what, value, &Offset::ALL, Offset::name)?,
-            "triangle" => self.triangle = pick(what, value, &TriangleTest::ALL, TriangleTest::name)?,
+            "triangle" => {
+                self.triangle = pick(what, value, &TriangleTest::ALL, TriangleTest::name)?
+            }
             "sphere" => self.sphere = pick(what, value, &SphereTest::ALL, SphereTest::name)?,
             _ => return Ok(false),
         }
@@ -159,12 +179,21 @@ impl Numerics {
 
     /// The shader defines of this configuration (one per choice).
     pub fn defines(&self) -> [&'static str; 3] {
-        [self.offset.define(), self.triangle.define(), self.sphere.define()]
+        [
+            self.offset.define(),
+            self.triangle.define(),
+            self.sphere.define(),
+        ]
     }
 
     /// `normal-scaled/watertight/stable`.
     pub fn label(&self) -> String {
-        format!("{}/{}/{}", self.offset.name(), self.triangle.name(), self.sphere.name())
+        format!(
+            "{}/{}/{}",
+            self.offset.name(),
+            self.triangle.name(),
+            self.sphere.name()
+        )
     }
 
     /// The `--set` arguments that select this configuration.
@@ -196,7 +225,11 @@ mod tests {
 
     #[test]
     fn labels_round_trip_through_set_args() {
-        let n = Numerics { offset: Offset::Ulp, triangle: TriangleTest::MollerTrumbore, sphere: SphereTest::Quadratic };
+        let n = Numerics {
+            offset: Offset::Ulp,
+            triangle: TriangleTest::MollerTrumbore,
+            sphere: SphereTest::Quadratic,
+        };
         let mut m = Numerics::default();
         for kv in n.set_args() {
             let (k, v) = kv.split_once('=').unwrap();

@@ -34,10 +34,21 @@ pub fn render_with(scene: &Scene, width: u32, height: u32, numerics: &Numerics) 
             [c.x as f32, c.y as f32, c.z as f32]
         })
         .collect();
-    FloatImage { width, height, pixels }
+    FloatImage {
+        width,
+        height,
+        pixels,
+    }
 }
 
-fn hit_sphere(test: SphereTest, o: DVec3, d: DVec3, s: &Sphere, t_min: f64, t_max: f64) -> Option<f64> {
+fn hit_sphere(
+    test: SphereTest,
+    o: DVec3,
+    d: DVec3,
+    s: &Sphere,
+    t_min: f64,
+    t_max: f64,
+) -> Option<f64> {
     let f = o - s.center;
     let r2 = s.radius * s.radius;
     let (lo, hi) = match test {
@@ -83,11 +94,20 @@ struct TriRay {
 }
 
 fn tri_ray(test: TriangleTest, o: DVec3, d: DVec3) -> TriRay {
-    let mut r = TriRay { o, d, k: [0, 1, 2], s: DVec3::ZERO };
+    let mut r = TriRay {
+        o,
+        d,
+        k: [0, 1, 2],
+        s: DVec3::ZERO,
+    };
     if test == TriangleTest::Watertight {
         let ad = d.abs();
         let kz = if ad.x > ad.y {
-            if ad.x > ad.z { 0 } else { 2 }
+            if ad.x > ad.z {
+                0
+            } else {
+                2
+            }
         } else if ad.y > ad.z {
             1
         } else {
@@ -109,7 +129,13 @@ fn is_degenerate(tri: &Triangle) -> bool {
     (tri.p[1] - tri.p[0]).cross(tri.p[2] - tri.p[0]) == DVec3::ZERO
 }
 
-fn hit_triangle(test: TriangleTest, r: &TriRay, tri: &Triangle, t_min: f64, t_max: f64) -> Option<(f64, f64, f64)> {
+fn hit_triangle(
+    test: TriangleTest,
+    r: &TriRay,
+    tri: &Triangle,
+    t_min: f64,
+    t_max: f64,
+) -> Option<(f64, f64, f64)> {
     match test {
         TriangleTest::Watertight => {
             let (a, b, c) = (tri.p[0] - r.o, tri.p[1] - r.o, tri.p[2] - r.o);
@@ -191,8 +217,14 @@ fn closest_hit(scene: &Scene, o: DVec3, d: DVec3) -> Option<(f64, Hit)> {
 fn occluded(scene: &Scene, o: DVec3, d: DVec3, dist: f64) -> bool {
     let n = &scene.numerics;
     let r = tri_ray(n.triangle, o, d);
-    scene.spheres.iter().any(|s| hit_sphere(n.sphere, o, d, s, 0.0, dist).is_some())
-        || scene.triangles.iter().any(|t| hit_triangle(n.triangle, &r, t, 0.0, dist).is_some())
+    scene
+        .spheres
+        .iter()
+        .any(|s| hit_sphere(n.sphere, o, d, s, 0.0, dist).is_some())
+        || scene
+            .triangles
+            .iter()
+            .any(|t| hit_triangle(n.triangle, &r, t, 0.0, dist).is_some())
 }
 
 /// The shader's `ulp_offset_1`. The offset is a distance on the f32 grid (256
@@ -223,7 +255,11 @@ fn spawn_point(scene: &Scene, p: DVec3, n: DVec3, dir: DVec3, scale: f64) -> DVe
         Offset::ScaleAware => p + n * (SCALE_AWARE_REL * scale.max(p.abs().max_element())),
         Offset::Ray => p + scene.epsilon * dir,
         Offset::Normal => p + scene.epsilon * n,
-        Offset::Ulp => DVec3::new(ulp_offset_1(p.x, n.x), ulp_offset_1(p.y, n.y), ulp_offset_1(p.z, n.z)),
+        Offset::Ulp => DVec3::new(
+            ulp_offset_1(p.x, n.x),
+            ulp_offset_1(p.y, n.y),
+            ulp_offset_1(p.z, n.z),
+        ),
         Offset::NormalScaled => {
             let scale = p.abs().max_element().max(1.0);
             p + n * (scene.epsilon * scale)
@@ -252,7 +288,12 @@ struct Ray {
 pub fn trace(scene: &Scene, origin: DVec3, dir: DVec3) -> DVec3 {
     let capacity = scene.max_depth as usize + 1;
     let mut stack = Vec::with_capacity(capacity);
-    stack.push(Ray { o: origin, d: dir, w: 1.0, depth: 0 });
+    stack.push(Ray {
+        o: origin,
+        d: dir,
+        w: 1.0,
+        depth: 0,
+    });
     let mut color = DVec3::ZERO;
     while let Some(Ray { o, d, w, depth }) = stack.pop() {
         let Some((t, hit)) = closest_hit(scene, o, d) else {
@@ -271,7 +312,9 @@ pub fn trace(scene: &Scene, origin: DVec3, dir: DVec3) -> DVec3 {
                 let tri = &scene.triangles[i];
                 let ng = (tri.p[1] - tri.p[0]).cross(tri.p[2] - tri.p[0]).normalize();
                 let ns = ((1.0 - u - v) * tri.n[0] + u * tri.n[1] + v * tri.n[2]).normalize();
-                let prim = max_abs(tri.p[0]).max(max_abs(tri.p[1])).max(max_abs(tri.p[2]));
+                let prim = max_abs(tri.p[0])
+                    .max(max_abs(tri.p[1]))
+                    .max(max_abs(tri.p[2]));
                 (ng, ns, tri.material, max_abs(o).max(prim))
             }
         };
@@ -315,14 +358,24 @@ pub fn trace(scene: &Scene, origin: DVec3, dir: DVec3) -> DVec3 {
                     let wt = w * kt * (1.0 - f);
                     if wt >= scene.min_weight && stack.len() < capacity {
                         let dir = (eta * d + (eta * cos_i - cos_t) * ns).normalize();
-                        stack.push(Ray { o: spawn_point(scene, p, -ng, dir, scale), d: dir, w: wt, depth: depth + 1 });
+                        stack.push(Ray {
+                            o: spawn_point(scene, p, -ng, dir, scale),
+                            d: dir,
+                            w: wt,
+                            depth: depth + 1,
+                        });
                     }
                 }
             }
             let wr = w * kr;
             if wr >= scene.min_weight && stack.len() < capacity {
                 let dir = reflect(d, ns);
-                stack.push(Ray { o: spawn_point(scene, p, ng, dir, scale), d: dir, w: wr, depth: depth + 1 });
+                stack.push(Ray {
+                    o: spawn_point(scene, p, ng, dir, scale),
+                    d: dir,
+                    w: wr,
+                    depth: depth + 1,
+                });
             }
         }
     }
@@ -336,7 +389,11 @@ pub fn trace(scene: &Scene, origin: DVec3, dir: DVec3) -> DVec3 {
 pub const TRUTH_EPSILON: f64 = 1e-8;
 
 pub fn truth_numerics() -> Numerics {
-    Numerics { offset: Offset::Normal, triangle: TriangleTest::Watertight, sphere: SphereTest::Stable }
+    Numerics {
+        offset: Offset::Normal,
+        triangle: TriangleTest::Watertight,
+        sphere: SphereTest::Stable,
+    }
 }
 
 /// The f64 reference with the truth numerics (`truth_numerics`, `TRUTH_EPSILON`):

@@ -22,8 +22,17 @@ const BUILTIN_FILES: &[(&str, &str)] = &[
 ];
 
 /// Keys accepted by `--set`.
-pub const OVERRIDE_KEYS: &[&str] =
-    &["max_depth", "min_weight", "epsilon", "extra_spheres", "fov_y", "tessellation", "offset", "triangle", "sphere"];
+pub const OVERRIDE_KEYS: &[&str] = &[
+    "max_depth",
+    "min_weight",
+    "epsilon",
+    "extra_spheres",
+    "fov_y",
+    "tessellation",
+    "offset",
+    "triangle",
+    "sphere",
+];
 
 /// The finest `tessellation` accepted per direction (400 x 400 quads per patch is
 /// 10 million triangles for the 32-patch teapot).
@@ -307,7 +316,13 @@ impl Scene {
     /// Loads a built-in scene by name, or a scene file by path, and applies `--set` overrides.
     pub fn load(name_or_path: &str, overrides: &[(String, String)]) -> anyhow::Result<Scene> {
         if let Some((name, text)) = BUILTIN_SCENES.iter().find(|(n, _)| *n == name_or_path) {
-            return Scene::parse(name, text, &format!("built-in scene '{name}'"), FileSource::Builtin, overrides);
+            return Scene::parse(
+                name,
+                text,
+                &format!("built-in scene '{name}'"),
+                FileSource::Builtin,
+                overrides,
+            );
         }
         let path = Path::new(name_or_path);
         if !path.exists() {
@@ -318,18 +333,41 @@ impl Scene {
                     names.join(", ")
                 )));
             }
-            return Err(bad_input(format!("scene file '{name_or_path}' does not exist")));
+            return Err(bad_input(format!(
+                "scene file '{name_or_path}' does not exist"
+            )));
         }
         let text = std::fs::read_to_string(path)
             .map_err(|e| bad_input(format!("scene file '{name_or_path}' cannot be read: {e}")))?;
-        let name = path.file_stem().and_then(|s| s.to_str()).unwrap_or("scene").to_string();
+        let name = path
+            .file_stem()
+            .and_then(|s| s.to_str())
+            .unwrap_or("scene")
+            .to_string();
         let dir = path.parent().map(Path::to_path_buf).unwrap_or_default();
-        Scene::parse(&name, &text, &format!("scene file '{name_or_path}'"), FileSource::Dir(dir), overrides)
+        Scene::parse(
+            &name,
+            &text,
+            &format!("scene file '{name_or_path}'"),
+            FileSource::Dir(dir),
+            overrides,
+        )
     }
 
     /// Parses TOML text; `origin` names the source in error messages.
-    pub fn from_toml(name: &str, text: &str, dir: &Path, overrides: &[(String, String)]) -> anyhow::Result<Scene> {
-        Scene::parse(name, text, &format!("scene '{name}'"), FileSource::Dir(dir.to_path_buf()), overrides)
+    pub fn from_toml(
+        name: &str,
+        text: &str,
+        dir: &Path,
+        overrides: &[(String, String)],
+    ) -> anyhow::Result<Scene> {
+        Scene::parse(
+            name,
+            text,
+            &format!("scene '{name}'"),
+            FileSource::Dir(dir.to_path_buf()),
+            overrides,
+        )
     }
 
     fn parse(
@@ -350,7 +388,10 @@ impl Scene {
 
     pub fn features(&self) -> Features {
         let used = |pred: &dyn Fn(&Material) -> bool| {
-            self.spheres.iter().map(|s| s.material).chain(self.triangles.iter().map(|t| t.material))
+            self.spheres
+                .iter()
+                .map(|s| s.material)
+                .chain(self.triangles.iter().map(|t| t.material))
                 .any(|m| pred(&self.materials[m as usize]))
         };
         Features {
@@ -388,8 +429,12 @@ impl Scene {
         s.epsilon = r(s.epsilon);
         for m in &mut s.materials {
             (m.ambient, m.diffuse, m.specular) = (v(m.ambient), v(m.diffuse), v(m.specular));
-            (m.shininess, m.reflectivity, m.transparency, m.ior) =
-                (r(m.shininess), r(m.reflectivity), r(m.transparency), r(m.ior));
+            (m.shininess, m.reflectivity, m.transparency, m.ior) = (
+                r(m.shininess),
+                r(m.reflectivity),
+                r(m.transparency),
+                r(m.ior),
+            );
         }
         for l in &mut s.lights {
             (l.position, l.color) = (v(l.position), v(l.color));
@@ -419,7 +464,12 @@ impl Scene {
 fn line_col(text: &str, offset: usize) -> (usize, usize) {
     let before = &text[..offset.min(text.len())];
     let line = before.matches('\n').count() + 1;
-    let col = before.rsplit('\n').next().map(|l| l.chars().count()).unwrap_or(0) + 1;
+    let col = before
+        .rsplit('\n')
+        .next()
+        .map(|l| l.chars().count())
+        .unwrap_or(0)
+        + 1;
     (line, col)
 }
 
@@ -430,12 +480,22 @@ fn apply_overrides(def: &mut SceneFile, overrides: &[(String, String)]) -> anyho
                 .parse::<f64>()
                 .ok()
                 .filter(|v| v.is_finite())
-                .ok_or_else(|| bad_input(format!("--set {key}={value}: '{value}' is not a finite number")))
+                .ok_or_else(|| {
+                    bad_input(format!(
+                        "--set {key}={value}: '{value}' is not a finite number"
+                    ))
+                })
         };
         let int = |max: u32| -> anyhow::Result<u32> {
-            value.parse::<u32>().ok().filter(|v| *v <= max).ok_or_else(|| {
-                bad_input(format!("--set {key}={value}: '{value}' is not a whole number from 0 to {max}"))
-            })
+            value
+                .parse::<u32>()
+                .ok()
+                .filter(|v| *v <= max)
+                .ok_or_else(|| {
+                    bad_input(format!(
+                        "--set {key}={value}: '{value}' is not a whole number from 0 to {max}"
+                    ))
+                })
         };
         match key.as_str() {
             "max_depth" => def.render.max_depth = int(MAX_DEPTH_LIMIT)?,
@@ -496,7 +556,9 @@ fn finite3(origin: &str, what: &str, v: [f64; 3]) -> anyhow::Result<DVec3> {
     if v.iter().all(|x| x.is_finite()) {
         Ok(DVec3::from_array(v))
     } else {
-        Err(bad_input(format!("{origin}: {what} = {v:?} is not finite (NaN or infinity)")))
+        Err(bad_input(format!(
+            "{origin}: {what} = {v:?} is not finite (NaN or infinity)"
+        )))
     }
 }
 
@@ -504,7 +566,9 @@ fn finite(origin: &str, what: &str, v: f64) -> anyhow::Result<f64> {
     if v.is_finite() {
         Ok(v)
     } else {
-        Err(bad_input(format!("{origin}: {what} = {v} is not finite (NaN or infinity)")))
+        Err(bad_input(format!(
+            "{origin}: {what} = {v} is not finite (NaN or infinity)"
+        )))
     }
 }
 
@@ -517,10 +581,15 @@ fn resolve(name: &str, def: SceneFile, origin: &str, files: &FileSource) -> anyh
         fov_y: finite(origin, "camera.fov_y", cam.fov_y)?,
     };
     if !(camera.fov_y > 0.0 && camera.fov_y < 180.0) {
-        return Err(bad_input(format!("{origin}: camera.fov_y = {} must lie between 0 and 180 degrees", camera.fov_y)));
+        return Err(bad_input(format!(
+            "{origin}: camera.fov_y = {} must lie between 0 and 180 degrees",
+            camera.fov_y
+        )));
     }
     let forward = camera.look_at - camera.eye;
-    if forward.length() == 0.0 || forward.cross(camera.up).length() <= 1e-12 * forward.length() * camera.up.length() {
+    if forward.length() == 0.0
+        || forward.cross(camera.up).length() <= 1e-12 * forward.length() * camera.up.length()
+    {
         return Err(bad_input(format!(
             "{origin}: camera.eye, camera.look_at and camera.up must give a view direction not parallel to up"
         )));
@@ -528,26 +597,39 @@ fn resolve(name: &str, def: SceneFile, origin: &str, files: &FileSource) -> anyh
     let r = &def.render;
     let background = finite3(origin, "render.background", r.background)?;
     if !(1..=MAX_DEPTH_LIMIT).contains(&r.max_depth) {
-        return Err(bad_input(format!("{origin}: render.max_depth = {} must be from 1 to {MAX_DEPTH_LIMIT}", r.max_depth)));
+        return Err(bad_input(format!(
+            "{origin}: render.max_depth = {} must be from 1 to {MAX_DEPTH_LIMIT}",
+            r.max_depth
+        )));
     }
     let min_weight = finite(origin, "render.min_weight", r.min_weight)?;
     if min_weight < 0.0 {
-        return Err(bad_input(format!("{origin}: render.min_weight = {min_weight} must not be negative")));
+        return Err(bad_input(format!(
+            "{origin}: render.min_weight = {min_weight} must not be negative"
+        )));
     }
     let epsilon = finite(origin, "render.epsilon", r.epsilon)?;
     if !(epsilon > 0.0 && epsilon < 1.0) {
-        return Err(bad_input(format!("{origin}: render.epsilon = {epsilon} must lie between 0 and 1")));
+        return Err(bad_input(format!(
+            "{origin}: render.epsilon = {epsilon} must lie between 0 and 1"
+        )));
     }
 
     let mut numerics = Numerics::default();
-    for (key, value) in [("offset", &r.offset), ("triangle", &r.triangle), ("sphere", &r.sphere)] {
+    for (key, value) in [
+        ("offset", &r.offset),
+        ("triangle", &r.triangle),
+        ("sphere", &r.sphere),
+    ] {
         if let Some(v) = value {
             numerics.set(key, v, &format!("{origin}: render.{key}"))?;
         }
     }
 
     if def.materials.is_empty() {
-        return Err(bad_input(format!("{origin}: the scene defines no [[materials]]")));
+        return Err(bad_input(format!(
+            "{origin}: the scene defines no [[materials]]"
+        )));
     }
     let mut materials = Vec::new();
     let mut by_name: HashMap<String, u32> = HashMap::new();
@@ -565,24 +647,42 @@ fn resolve(name: &str, def: SceneFile, origin: &str, files: &FileSource) -> anyh
         };
         let colours = [mat.ambient, mat.diffuse, mat.specular];
         if colours.iter().any(|c| c.min_element() < 0.0) {
-            return Err(bad_input(format!("{origin}: {at} has a negative colour component")));
+            return Err(bad_input(format!(
+                "{origin}: {at} has a negative colour component"
+            )));
         }
         if mat.shininess < 0.0 {
-            return Err(bad_input(format!("{origin}: {at}.shininess = {} must not be negative", mat.shininess)));
+            return Err(bad_input(format!(
+                "{origin}: {at}.shininess = {} must not be negative",
+                mat.shininess
+            )));
         }
-        for (what, v) in [("reflectivity", mat.reflectivity), ("transparency", mat.transparency)] {
+        for (what, v) in [
+            ("reflectivity", mat.reflectivity),
+            ("transparency", mat.transparency),
+        ] {
             if !(0.0..=1.0).contains(&v) {
-                return Err(bad_input(format!("{origin}: {at}.{what} = {v} must lie between 0 and 1")));
+                return Err(bad_input(format!(
+                    "{origin}: {at}.{what} = {v} must lie between 0 and 1"
+                )));
             }
         }
         if mat.reflectivity + mat.transparency > 1.0 {
-            return Err(bad_input(format!("{origin}: {at}: reflectivity + transparency must not exceed 1")));
+            return Err(bad_input(format!(
+                "{origin}: {at}: reflectivity + transparency must not exceed 1"
+            )));
         }
         if mat.ior <= 0.0 {
-            return Err(bad_input(format!("{origin}: {at}.ior = {} must be positive", mat.ior)));
+            return Err(bad_input(format!(
+                "{origin}: {at}.ior = {} must be positive",
+                mat.ior
+            )));
         }
         if by_name.insert(m.name.clone(), i as u32).is_some() {
-            return Err(bad_input(format!("{origin}: material '{}' is defined twice", m.name)));
+            return Err(bad_input(format!(
+                "{origin}: material '{}' is defined twice",
+                m.name
+            )));
         }
         materials.push(mat);
     }
@@ -592,7 +692,11 @@ fn resolve(name: &str, def: SceneFile, origin: &str, files: &FileSource) -> anyh
             known.sort();
             bad_input(format!(
                 "{origin}: {at}.material '{name}' is not a defined material (defined: {})",
-                known.iter().map(|s| s.as_str()).collect::<Vec<_>>().join(", ")
+                known
+                    .iter()
+                    .map(|s| s.as_str())
+                    .collect::<Vec<_>>()
+                    .join(", ")
             ))
         })
     };
@@ -601,9 +705,14 @@ fn resolve(name: &str, def: SceneFile, origin: &str, files: &FileSource) -> anyh
     for (i, l) in def.lights.iter().enumerate() {
         let color = finite3(origin, &format!("lights[{i}].color"), l.color)?;
         if color.min_element() < 0.0 {
-            return Err(bad_input(format!("{origin}: lights[{i}].color has a negative component")));
+            return Err(bad_input(format!(
+                "{origin}: lights[{i}].color has a negative component"
+            )));
         }
-        lights.push(Light { position: finite3(origin, &format!("lights[{i}].position"), l.position)?, color });
+        lights.push(Light {
+            position: finite3(origin, &format!("lights[{i}].position"), l.position)?,
+            color,
+        });
     }
 
     let mut spheres = Vec::new();
@@ -611,12 +720,23 @@ fn resolve(name: &str, def: SceneFile, origin: &str, files: &FileSource) -> anyh
         let center = finite3(origin, &format!("{at}.center"), center)?;
         let radius = finite(origin, &format!("{at}.radius"), radius)?;
         if radius <= 0.0 {
-            return Err(bad_input(format!("{origin}: {at}.radius = {radius} must be positive")));
+            return Err(bad_input(format!(
+                "{origin}: {at}.radius = {radius} must be positive"
+            )));
         }
-        Ok(Sphere { center, radius, material: material(at, mat)? })
+        Ok(Sphere {
+            center,
+            radius,
+            material: material(at, mat)?,
+        })
     };
     for (i, s) in def.spheres.iter().enumerate() {
-        spheres.push(sphere(&format!("spheres[{i}]"), s.center, s.radius, &s.material)?);
+        spheres.push(sphere(
+            &format!("spheres[{i}]"),
+            s.center,
+            s.radius,
+            &s.material,
+        )?);
     }
     if let Some(e) = &def.extra_spheres {
         let s = sphere("extra_spheres", e.center, e.radius, &e.material)?;
@@ -640,7 +760,11 @@ fn resolve(name: &str, def: SceneFile, origin: &str, files: &FileSource) -> anyh
             }
             None => [flat_normal(&p); 3],
         };
-        triangles.push(Triangle { p, n, material: material(&at, &t.material)? });
+        triangles.push(Triangle {
+            p,
+            n,
+            material: material(&at, &t.material)?,
+        });
     }
     for (i, q) in def.quads.iter().enumerate() {
         let at = format!("quads[{i}]");
@@ -650,7 +774,11 @@ fn resolve(name: &str, def: SceneFile, origin: &str, files: &FileSource) -> anyh
         }
         let m = material(&at, &q.material)?;
         for p in [[c[0], c[1], c[2]], [c[0], c[2], c[3]]] {
-            triangles.push(Triangle { p, n: [flat_normal(&p); 3], material: m });
+            triangles.push(Triangle {
+                p,
+                n: [flat_normal(&p); 3],
+                material: m,
+            });
         }
     }
     for (i, m) in def.meshes.iter().enumerate() {
@@ -658,9 +786,13 @@ fn resolve(name: &str, def: SceneFile, origin: &str, files: &FileSource) -> anyh
         let mat = material(&at, &m.material)?;
         let scale = finite(origin, &format!("{at}.scale"), m.scale)?;
         if scale <= 0.0 {
-            return Err(bad_input(format!("{origin}: {at}.scale = {scale} must be positive")));
+            return Err(bad_input(format!(
+                "{origin}: {at}.scale = {scale} must be positive"
+            )));
         }
-        let rot = DMat3::from_rotation_y(finite(origin, &format!("{at}.rotate_y"), m.rotate_y)?.to_radians());
+        let rot = DMat3::from_rotation_y(
+            finite(origin, &format!("{at}.rotate_y"), m.rotate_y)?.to_radians(),
+        );
         let translate = finite3(origin, &format!("{at}.translate"), m.translate)?;
         let (obj, file) = match (&m.obj, &m.bpt) {
             (Some(obj), None) if m.tessellation.is_none() => (load_obj(origin, &at, obj, files)?, obj),
@@ -678,10 +810,16 @@ fn resolve(name: &str, def: SceneFile, origin: &str, files: &FileSource) -> anyh
                 (true, Some(n)) => n.map(|v| rot * v),
                 _ => [flat_normal(&p); 3],
             };
-            triangles.push(Triangle { p, n, material: mat });
+            triangles.push(Triangle {
+                p,
+                n,
+                material: mat,
+            });
         }
         if triangles.len() == before {
-            return Err(bad_input(format!("{origin}: {at}: '{file}' contains no faces")));
+            return Err(bad_input(format!(
+                "{origin}: {at}: '{file}' contains no faces"
+            )));
         }
     }
 
@@ -706,7 +844,9 @@ fn unit_normal(origin: &str, what: &str, v: [f64; 3]) -> anyhow::Result<DVec3> {
     let n = finite3(origin, what, v)?;
     let len = n.length();
     if !(len > 1e-12) {
-        return Err(bad_input(format!("{origin}: {what} = {v:?} has zero length")));
+        return Err(bad_input(format!(
+            "{origin}: {what} = {v:?} has zero length"
+        )));
     }
     Ok(n / len)
 }
@@ -729,48 +869,93 @@ fn read_text(origin: &str, what: &str, file: &str, files: &FileSource) -> anyhow
             .ok_or_else(|| bad_input(format!("{origin}: {what} '{file}' is not a built-in file"))),
         FileSource::Dir(dir) => {
             let path = dir.join(file);
-            std::fs::read_to_string(&path)
-                .map_err(|e| bad_input(format!("{origin}: {what} '{}' cannot be read: {e}", path.display())))
+            std::fs::read_to_string(&path).map_err(|e| {
+                bad_input(format!(
+                    "{origin}: {what} '{}' cannot be read: {e}",
+                    path.display()
+                ))
+            })
         }
     }
 }
 
 /// Newell-style Bezier patches, tessellated by the generator that wrote teapot.obj.
-fn load_bpt(origin: &str, at: &str, file: &str, [nu, nv]: [u32; 2], files: &FileSource) -> anyhow::Result<Vec<ObjTriangle>> {
+fn load_bpt(
+    origin: &str,
+    at: &str,
+    file: &str,
+    [nu, nv]: [u32; 2],
+    files: &FileSource,
+) -> anyhow::Result<Vec<ObjTriangle>> {
     if !(1..=MAX_TESSELLATION).contains(&nu) || !(1..=MAX_TESSELLATION).contains(&nv) {
-        return Err(bad_input(format!("{origin}: {at}.tessellation = [{nu}, {nv}]: each must be from 1 to {MAX_TESSELLATION}")));
+        return Err(bad_input(format!(
+            "{origin}: {at}.tessellation = [{nu}, {nv}]: each must be from 1 to {MAX_TESSELLATION}"
+        )));
     }
     let text = read_text(origin, &format!("{at}.bpt"), file, files)?;
-    let patches = crate::teapot::parse_bpt(&text)
-        .map_err(|e| bad_input(format!("{origin}: {at}.bpt '{file}' is not a valid patch file: {e}")))?;
+    let patches = crate::teapot::parse_bpt(&text).map_err(|e| {
+        bad_input(format!(
+            "{origin}: {at}.bpt '{file}' is not a valid patch file: {e}"
+        ))
+    })?;
     let mesh = crate::teapot::tessellate(&patches, nu, nv);
     let v = |i: u32| DVec3::from_array(mesh.positions[i as usize]);
     let n = |i: u32| DVec3::from_array(mesh.normals[i as usize]);
-    Ok(mesh.triangles.iter().map(|t| ([v(t[0]), v(t[1]), v(t[2])], Some([n(t[0]), n(t[1]), n(t[2])]))).collect())
+    Ok(mesh
+        .triangles
+        .iter()
+        .map(|t| {
+            (
+                [v(t[0]), v(t[1]), v(t[2])],
+                Some([n(t[0]), n(t[1]), n(t[2])]),
+            )
+        })
+        .collect())
 }
 
-fn load_obj(origin: &str, at: &str, file: &str, files: &FileSource) -> anyhow::Result<Vec<ObjTriangle>> {
+fn load_obj(
+    origin: &str,
+    at: &str,
+    file: &str,
+    files: &FileSource,
+) -> anyhow::Result<Vec<ObjTriangle>> {
     let text = read_text(origin, &format!("{at}.obj"), file, files)?;
-    let opts = tobj::LoadOptions { triangulate: true, single_index: true, ..Default::default() };
+    let opts = tobj::LoadOptions {
+        triangulate: true,
+        single_index: true,
+        ..Default::default()
+    };
     let (models, _) = tobj::load_obj_buf(&mut text.as_bytes(), &opts, |_| {
         // Materials come from the scene file, never from an OBJ's mtllib.
         Err(tobj::LoadError::OpenFileFailed)
     })
-    .map_err(|e| bad_input(format!("{origin}: {at}.obj '{file}' is not a valid OBJ file: {e}")))?;
+    .map_err(|e| {
+        bad_input(format!(
+            "{origin}: {at}.obj '{file}' is not a valid OBJ file: {e}"
+        ))
+    })?;
     let mut out = Vec::new();
     for model in &models {
         let mesh = &model.mesh;
         let pos = |i: u32| -> anyhow::Result<DVec3> {
             let i = i as usize * 3;
             let v = mesh.positions.get(i..i + 3).ok_or_else(|| {
-                bad_input(format!("{origin}: {at}.obj '{file}' has a face index beyond its vertex list"))
+                bad_input(format!(
+                    "{origin}: {at}.obj '{file}' has a face index beyond its vertex list"
+                ))
             })?;
-            finite3(origin, &format!("{at}.obj '{file}' vertex"), [v[0] as f64, v[1] as f64, v[2] as f64])
+            finite3(
+                origin,
+                &format!("{at}.obj '{file}' vertex"),
+                [v[0] as f64, v[1] as f64, v[2] as f64],
+            )
         };
         let has_normals = !mesh.normals.is_empty();
         for (f, tri) in mesh.indices.chunks(3).enumerate() {
             if tri.len() != 3 {
-                return Err(bad_input(format!("{origin}: {at}.obj '{file}' has an incomplete face")));
+                return Err(bad_input(format!(
+                    "{origin}: {at}.obj '{file}' has an incomplete face"
+                )));
             }
             let p = [pos(tri[0])?, pos(tri[1])?, pos(tri[2])?];
             let n = if has_normals {
@@ -778,7 +963,9 @@ fn load_obj(origin: &str, at: &str, file: &str, files: &FileSource) -> anyhow::R
                 for k in 0..3 {
                     let i = tri[k] as usize * 3;
                     let v = mesh.normals.get(i..i + 3).ok_or_else(|| {
-                        bad_input(format!("{origin}: {at}.obj '{file}' has a normal index beyond its normal list"))
+                        bad_input(format!(
+                            "{origin}: {at}.obj '{file}' has a normal index beyond its normal list"
+                        ))
                     })?;
                     n[k] = unit_normal(
                         origin,
@@ -795,4 +982,3 @@ fn load_obj(origin: &str, at: &str, file: &str, files: &FileSource) -> anyhow::R
     }
     Ok(out)
 }
-

@@ -57,7 +57,12 @@ impl Variant {
 
     /// Every feature on, the deepest stack: renders any scene (with the given numerics).
     pub fn generic(numerics: Numerics) -> Variant {
-        let all = Features { spheres: true, triangles: true, mirror: true, glass: true };
+        let all = Features {
+            spheres: true,
+            triangles: true,
+            mirror: true,
+            glass: true,
+        };
         Variant::from_features(all, MAX_DEPTH_LIMIT, numerics)
     }
 
@@ -65,8 +70,17 @@ impl Variant {
     /// `needed` compiled in, and a ray stack at least as deep. A windowed app keeps
     /// its pipeline when `+`/`-` change the depth to one the current variant covers.
     pub fn covers(&self, needed: &Variant) -> bool {
-        let stack = |v: &Variant| v.defines.get("STACK_SIZE").and_then(|s| s.parse::<u32>().ok()).unwrap_or(0);
-        needed.defines.keys().filter(|k| k.starts_with("HAS_")).all(|k| self.defines.contains_key(k))
+        let stack = |v: &Variant| {
+            v.defines
+                .get("STACK_SIZE")
+                .and_then(|s| s.parse::<u32>().ok())
+                .unwrap_or(0)
+        };
+        needed
+            .defines
+            .keys()
+            .filter(|k| k.starts_with("HAS_"))
+            .all(|k| self.defines.contains_key(k))
             && stack(self) >= stack(needed)
     }
 
@@ -81,11 +95,18 @@ impl Variant {
         if parts.is_empty() {
             parts.push("background".into());
         }
-        let bvh = if self.defines.contains_key("USE_BVH") { "/bvh" } else { "" };
+        let bvh = if self.defines.contains_key("USE_BVH") {
+            "/bvh"
+        } else {
+            ""
+        };
         format!(
             "{}/stack{}/{}{bvh}",
             parts.join("+"),
-            self.defines.get("STACK_SIZE").map(String::as_str).unwrap_or("?"),
+            self.defines
+                .get("STACK_SIZE")
+                .map(String::as_str)
+                .unwrap_or("?"),
             self.numerics.label()
         )
     }
@@ -102,17 +123,31 @@ pub fn compute_source() -> String {
 }
 
 /// Parses and validates one stage.
-pub fn parse(source: &str, stage: ShaderStage, variant: &Variant) -> anyhow::Result<(Module, ModuleInfo)> {
+pub fn parse(
+    source: &str,
+    stage: ShaderStage,
+    variant: &Variant,
+) -> anyhow::Result<(Module, ModuleInfo)> {
     let mut options = naga::front::glsl::Options::from(stage);
     for (k, v) in &variant.defines {
         options.defines.insert(k.clone(), v.clone());
     }
     let module = naga::front::glsl::Frontend::default()
         .parse(&options, source)
-        .map_err(|e| anyhow!("naga could not parse the {stage:?} shader:\n{}", e.emit_to_string(source)))?;
+        .map_err(|e| {
+            anyhow!(
+                "naga could not parse the {stage:?} shader:\n{}",
+                e.emit_to_string(source)
+            )
+        })?;
     let info = Validator::new(ValidationFlags::all(), Capabilities::default())
         .validate(&module)
-        .map_err(|e| anyhow!("naga rejected the {stage:?} shader:\n{}", e.emit_to_string(source)))?;
+        .map_err(|e| {
+            anyhow!(
+                "naga rejected the {stage:?} shader:\n{}",
+                e.emit_to_string(source)
+            )
+        })?;
     Ok((module, info))
 }
 
@@ -163,12 +198,23 @@ pub fn build_compute(variant: &Variant, workgroup: Workgroup) -> anyhow::Result<
     })
 }
 
-pub fn to_spirv(module: &Module, info: &ModuleInfo, stage: ShaderStage) -> anyhow::Result<Vec<u32>> {
+pub fn to_spirv(
+    module: &Module,
+    info: &ModuleInfo,
+    stage: ShaderStage,
+) -> anyhow::Result<Vec<u32>> {
     // No ADJUST_COORDINATE_SPACE (y stays as written, see trace.frag) and no DEBUG,
     // so debug and release builds emit identical SPIR-V.
-    let options = spv::Options { flags: spv::WriterFlags::LABEL_VARYINGS, ..Default::default() };
-    let pipeline = spv::PipelineOptions { shader_stage: stage, entry_point: "main".into() };
-    spv::write_vec(module, info, &options, Some(&pipeline)).with_context(|| format!("writing {stage:?} SPIR-V"))
+    let options = spv::Options {
+        flags: spv::WriterFlags::LABEL_VARYINGS,
+        ..Default::default()
+    };
+    let pipeline = spv::PipelineOptions {
+        shader_stage: stage,
+        entry_point: "main".into(),
+    };
+    spv::write_vec(module, info, &options, Some(&pipeline))
+        .with_context(|| format!("writing {stage:?} SPIR-V"))
 }
 
 pub fn to_glsl(module: &Module, info: &ModuleInfo, stage: ShaderStage) -> anyhow::Result<String> {
@@ -179,7 +225,13 @@ pub fn to_glsl(module: &Module, info: &ModuleInfo, stage: ShaderStage) -> anyhow
     // The storage image (compute only) is bound to image unit 5, yet another
     // binding space in GL; 6 and 7 are the BVH's storage buffers.
     for b in 0..=crate::gpu::binding::LAST {
-        binding_map.insert(naga::ResourceBinding { group: 0, binding: b }, b as u8);
+        binding_map.insert(
+            naga::ResourceBinding {
+                group: 0,
+                binding: b,
+            },
+            b as u8,
+        );
     }
     let options = glsl::Options {
         version: glsl::Version::Desktop(450),
@@ -187,11 +239,24 @@ pub fn to_glsl(module: &Module, info: &ModuleInfo, stage: ShaderStage) -> anyhow
         binding_map,
         zero_initialize_workgroup_memory: true,
     };
-    let pipeline = glsl::PipelineOptions { shader_stage: stage, entry_point: "main".into(), multiview: None };
+    let pipeline = glsl::PipelineOptions {
+        shader_stage: stage,
+        entry_point: "main".into(),
+        multiview: None,
+    };
     let mut out = String::new();
-    let mut writer = glsl::Writer::new(&mut out, module, info, &options, &pipeline, Default::default())
-        .with_context(|| format!("setting up the {stage:?} GLSL writer"))?;
-    writer.write().with_context(|| format!("writing {stage:?} GLSL"))?;
+    let mut writer = glsl::Writer::new(
+        &mut out,
+        module,
+        info,
+        &options,
+        &pipeline,
+        Default::default(),
+    )
+    .with_context(|| format!("setting up the {stage:?} GLSL writer"))?;
+    writer
+        .write()
+        .with_context(|| format!("writing {stage:?} GLSL"))?;
     Ok(out)
 }
 
@@ -250,11 +315,19 @@ mod tests {
             }
             n
         };
-        assert_eq!(count(&s.fragment_spirv, 71, 34), 5, "five resources in set 0");
+        assert_eq!(
+            count(&s.fragment_spirv, 71, 34),
+            5,
+            "five resources in set 0"
+        );
         assert_eq!(count(&gl, 71, 34), 0);
         assert_eq!(count(&s.fragment_spirv, 16, 7), 1);
         assert_eq!(count(&gl, 16, 8), 1);
-        assert_eq!(gl.len(), s.fragment_spirv.len() - 5 * 4, "only the five 4-word decorations go");
+        assert_eq!(
+            gl.len(),
+            s.fragment_spirv.len() - 5 * 4,
+            "only the five 4-word decorations go"
+        );
     }
 
     #[test]
@@ -262,9 +335,15 @@ mod tests {
         for wg in Workgroup::MEASURED {
             let c = build_compute(&Variant::generic(Default::default()), wg).unwrap();
             assert_eq!(c.spirv[0], 0x0723_0203, "SPIR-V magic");
-            let local = format!("layout(local_size_x = {}, local_size_y = {}, local_size_z = 1) in;", wg.x, wg.y);
+            let local = format!(
+                "layout(local_size_x = {}, local_size_y = {}, local_size_z = 1) in;",
+                wg.x, wg.y
+            );
             assert!(c.glsl.contains(&local), "{wg}: {}", &c.glsl[..200]);
-            assert!(c.glsl.contains("binding = 5"), "the storage image is bound by number");
+            assert!(
+                c.glsl.contains("binding = 5"),
+                "the storage image is bound by number"
+            );
             assert!(c.glsl.contains("imageStore"));
         }
     }

@@ -16,7 +16,11 @@ pub struct Summary {
 /// The frames the statistics cover: the last 30 of 60 (the study's method);
 /// for short runs the last half, and a single frame when only one was drawn.
 pub fn measured_tail(values: &[f64]) -> &[f64] {
-    let keep = if values.len() >= 60 { 30 } else { values.len().div_ceil(2) };
+    let keep = if values.len() >= 60 {
+        30
+    } else {
+        values.len().div_ceil(2)
+    };
     &values[values.len() - keep..]
 }
 
@@ -28,7 +32,11 @@ pub fn summarize(values: &[f64]) -> Option<Summary> {
     let mut sorted = tail.to_vec();
     sorted.sort_by(|a, b| a.total_cmp(b));
     let n = sorted.len();
-    let median = if n % 2 == 1 { sorted[n / 2] } else { 0.5 * (sorted[n / 2 - 1] + sorted[n / 2]) };
+    let median = if n % 2 == 1 {
+        sorted[n / 2]
+    } else {
+        0.5 * (sorted[n / 2 - 1] + sorted[n / 2])
+    };
     Some(Summary {
         mean: sorted.iter().sum::<f64>() / n as f64,
         median,

@@ -9,7 +9,10 @@ use twinray_common::shader::{fragment_source, parse, Variant};
 fn naga_members(module: &naga::Module, ty: naga::Handle<naga::Type>) -> (Vec<(String, u32)>, u32) {
     match &module.types[ty].inner {
         naga::TypeInner::Struct { members, span } => (
-            members.iter().map(|m| (m.name.clone().unwrap_or_default(), m.offset)).collect(),
+            members
+                .iter()
+                .map(|m| (m.name.clone().unwrap_or_default(), m.offset))
+                .collect(),
             *span,
         ),
         other => panic!("expected a struct, found {other:?}"),
@@ -17,17 +20,25 @@ fn naga_members(module: &naga::Module, ty: naga::Handle<naga::Type>) -> (Vec<(St
 }
 
 /// The block bound at `binding` and, for storage buffers, its runtime-array element type and stride.
-fn block(module: &naga::Module, binding: u32) -> (naga::Handle<naga::Type>, Option<(naga::Handle<naga::Type>, u32)>) {
+fn block(
+    module: &naga::Module,
+    binding: u32,
+) -> (
+    naga::Handle<naga::Type>,
+    Option<(naga::Handle<naga::Type>, u32)>,
+) {
     let (_, var) = module
         .global_variables
         .iter()
         .find(|(_, v)| v.binding.as_ref().map(|b| (b.group, b.binding)) == Some((0, binding)))
         .unwrap_or_else(|| panic!("no resource at binding {binding}"));
     let elem = match &module.types[var.ty].inner {
-        naga::TypeInner::Struct { members, .. } if members.len() == 1 => match &module.types[members[0].ty].inner {
-            naga::TypeInner::Array { base, stride, .. } => Some((*base, *stride)),
-            _ => None,
-        },
+        naga::TypeInner::Struct { members, .. } if members.len() == 1 => {
+            match &module.types[members[0].ty].inner {
+                naga::TypeInner::Array { base, stride, .. } => Some((*base, *stride)),
+                _ => None,
+            }
+        }
         _ => None,
     };
     (var.ty, elem)
@@ -42,21 +53,41 @@ macro_rules! rust_offsets {
 fn check(name: &str, naga: (Vec<(String, u32)>, u32), rust_offsets: Vec<u32>, rust_size: usize) {
     let (members, span) = naga;
     let offsets: Vec<u32> = members.iter().map(|m| m.1).collect();
-    assert_eq!(offsets, rust_offsets, "{name}: member offsets differ (naga members {members:?})");
+    assert_eq!(
+        offsets, rust_offsets,
+        "{name}: member offsets differ (naga members {members:?})"
+    );
     assert_eq!(span as usize, rust_size, "{name}: size differs");
 }
 
 #[test]
 fn naga_layout_matches_rust_for_every_shader_struct() {
-    let (module, _) = parse(&fragment_source(), naga::ShaderStage::Fragment, &Variant::generic(Default::default())).unwrap();
+    let (module, _) = parse(
+        &fragment_source(),
+        naga::ShaderStage::Fragment,
+        &Variant::generic(Default::default()),
+    )
+    .unwrap();
 
     let (frame_ty, _) = block(&module, binding::FRAME);
     check(
         "Frame",
         naga_members(&module, frame_ty),
         rust_offsets!(GpuFrame {
-            eye, min_weight, top_left, epsilon, step_x, max_depth, step_y, sphere_count, background,
-            triangle_count, light_count, width, height, pad
+            eye,
+            min_weight,
+            top_left,
+            epsilon,
+            step_x,
+            max_depth,
+            step_y,
+            sphere_count,
+            background,
+            triangle_count,
+            light_count,
+            width,
+            height,
+            pad
         }),
         size_of::<GpuFrame>(),
     );
@@ -77,7 +108,20 @@ fn naga_layout_matches_rust_for_every_shader_struct() {
     check(
         "Triangle",
         naga_members(&module, ty),
-        rust_offsets!(GpuTriangle { p0, material, p1, pad0, p2, pad1, n0, pad2, n1, pad3, n2, pad4 }),
+        rust_offsets!(GpuTriangle {
+            p0,
+            material,
+            p1,
+            pad0,
+            p2,
+            pad1,
+            n0,
+            pad2,
+            n1,
+            pad3,
+            n2,
+            pad4
+        }),
         size_of::<GpuTriangle>(),
     );
 
@@ -99,7 +143,12 @@ fn naga_layout_matches_rust_for_every_shader_struct() {
     check(
         "BvhNode",
         naga_members(&module, ty),
-        rust_offsets!(GpuBvhNode { min, left_or_first, max, count }),
+        rust_offsets!(GpuBvhNode {
+            min,
+            left_or_first,
+            max,
+            count
+        }),
         size_of::<GpuBvhNode>(),
     );
     let (_, prims) = block(&module, binding::BVH_PRIMS);
@@ -112,7 +161,12 @@ fn naga_layout_matches_rust_for_every_shader_struct() {
     check(
         "Light",
         naga_members(&module, ty),
-        rust_offsets!(GpuLight { position, pad0, color, pad1 }),
+        rust_offsets!(GpuLight {
+            position,
+            pad0,
+            color,
+            pad1
+        }),
         size_of::<GpuLight>(),
     );
 }
@@ -125,7 +179,11 @@ fn every_builtin_variant_and_the_generic_one_compile_for_both_apis() {
     for offset in Offset::ALL {
         for triangle in TriangleTest::ALL {
             for sphere in SphereTest::ALL {
-                variants.push(Variant::generic(Numerics { offset, triangle, sphere }));
+                variants.push(Variant::generic(Numerics {
+                    offset,
+                    triangle,
+                    sphere,
+                }));
             }
         }
     }
@@ -137,9 +195,19 @@ fn every_builtin_variant_and_the_generic_one_compile_for_both_apis() {
         variants.push(Variant::for_scene(&scene));
     }
     for v in variants {
-        let s = twinray_common::shader::build(&v).unwrap_or_else(|e| panic!("{}: {e:#}", v.label()));
+        let s =
+            twinray_common::shader::build(&v).unwrap_or_else(|e| panic!("{}: {e:#}", v.label()));
         assert_eq!(s.fragment_spirv[0], 0x0723_0203, "SPIR-V magic");
-        assert!(s.fragment_glsl.starts_with("#version 450 core"), "{}", &s.fragment_glsl[..40]);
-        assert!(s.fragment_glsl.contains("layout(std140, binding = 0) uniform"), "{}: UBO bound by number", v.label());
+        assert!(
+            s.fragment_glsl.starts_with("#version 450 core"),
+            "{}",
+            &s.fragment_glsl[..40]
+        );
+        assert!(
+            s.fragment_glsl
+                .contains("layout(std140, binding = 0) uniform"),
+            "{}: UBO bound by number",
+            v.label()
+        );
     }
 }

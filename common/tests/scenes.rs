@@ -6,7 +6,9 @@ use twinray_common::error::exit_code_of;
 use twinray_common::scene::Scene;
 
 fn set(kv: &[(&str, &str)]) -> Vec<(String, String)> {
-    kv.iter().map(|(k, v)| (k.to_string(), v.to_string())).collect()
+    kv.iter()
+        .map(|(k, v)| (k.to_string(), v.to_string()))
+        .collect()
 }
 
 #[test]
@@ -17,7 +19,10 @@ fn teapot_has_the_study_counts_and_its_sphere_is_out_of_view() {
     assert_eq!(s.lights.len(), 3);
     let f = Frustum::new(&RayFrame::new(&s.camera, 800, 600), 800, 600);
     let sp = &s.spheres[0];
-    assert!(!f.sees_sphere(sp.center, sp.radius), "the teapot scene's sphere must be outside the view");
+    assert!(
+        !f.sees_sphere(sp.center, sp.radius),
+        "the teapot scene's sphere must be outside the view"
+    );
 }
 
 #[test]
@@ -26,8 +31,16 @@ fn box_has_30_triangles_a_mirror_and_a_glass_sphere_and_one_light() {
     assert_eq!(s.triangles.len(), 30);
     assert_eq!(s.spheres.len(), 2);
     assert_eq!(s.lights.len(), 1);
-    let mats: Vec<_> = s.spheres.iter().map(|sp| &s.materials[sp.material as usize]).collect();
-    assert!(mats.iter().any(|m| m.reflectivity > 0.5 && m.transparency == 0.0), "a mirror sphere");
+    let mats: Vec<_> = s
+        .spheres
+        .iter()
+        .map(|sp| &s.materials[sp.material as usize])
+        .collect();
+    assert!(
+        mats.iter()
+            .any(|m| m.reflectivity > 0.5 && m.transparency == 0.0),
+        "a mirror sphere"
+    );
     assert!(mats.iter().any(|m| m.transparency > 0.5), "a glass sphere");
 }
 
@@ -64,7 +77,13 @@ position = [0.0, 5.0, 5.0]
 
 #[test]
 fn a_minimal_scene_loads() {
-    let s = Scene::from_toml("ok", &format!("{OK}[[spheres]]\ncenter=[0.0,0.0,0.0]\nradius=1.0\nmaterial=\"m\"\n"), std::path::Path::new("."), &[]).unwrap();
+    let s = Scene::from_toml(
+        "ok",
+        &format!("{OK}[[spheres]]\ncenter=[0.0,0.0,0.0]\nradius=1.0\nmaterial=\"m\"\n"),
+        std::path::Path::new("."),
+        &[],
+    )
+    .unwrap();
     assert_eq!(s.spheres.len(), 1);
 }
 
@@ -77,23 +96,35 @@ fn malformed_toml_names_line_and_column() {
 
 #[test]
 fn unknown_key_is_named_with_its_line() {
-    let (code, msg) = err_of(&format!("{OK}[[spheres]]\ncenter=[0.0,0.0,0.0]\nradius=1.0\nmaterial=\"m\"\ncolour=1\n"));
+    let (code, msg) = err_of(&format!(
+        "{OK}[[spheres]]\ncenter=[0.0,0.0,0.0]\nradius=1.0\nmaterial=\"m\"\ncolour=1\n"
+    ));
     assert_eq!(code, 2);
     assert!(msg.contains("colour") && msg.contains("line 14"), "{msg}");
 }
 
 #[test]
 fn nan_value_is_refused() {
-    let (code, msg) = err_of(&format!("{OK}[[spheres]]\ncenter=[nan,0.0,0.0]\nradius=1.0\nmaterial=\"m\"\n"));
+    let (code, msg) = err_of(&format!(
+        "{OK}[[spheres]]\ncenter=[nan,0.0,0.0]\nradius=1.0\nmaterial=\"m\"\n"
+    ));
     assert_eq!(code, 2);
-    assert!(msg.contains("spheres[0].center") && msg.contains("not finite"), "{msg}");
+    assert!(
+        msg.contains("spheres[0].center") && msg.contains("not finite"),
+        "{msg}"
+    );
 }
 
 #[test]
 fn negative_radius_is_refused() {
-    let (code, msg) = err_of(&format!("{OK}[[spheres]]\ncenter=[0.0,0.0,0.0]\nradius=-1.0\nmaterial=\"m\"\n"));
+    let (code, msg) = err_of(&format!(
+        "{OK}[[spheres]]\ncenter=[0.0,0.0,0.0]\nradius=-1.0\nmaterial=\"m\"\n"
+    ));
     assert_eq!(code, 2);
-    assert!(msg.contains("spheres[0].radius = -1") && msg.contains("positive"), "{msg}");
+    assert!(
+        msg.contains("spheres[0].radius = -1") && msg.contains("positive"),
+        "{msg}"
+    );
 }
 
 #[test]
@@ -102,14 +133,22 @@ fn zero_length_normal_is_refused() {
         "{OK}[[triangles]]\nvertices=[[0.0,0.0,0.0],[1.0,0.0,0.0],[0.0,1.0,0.0]]\nnormals=[[0.0,0.0,1.0],[0.0,0.0,0.0],[0.0,0.0,1.0]]\nmaterial=\"m\"\n"
     ));
     assert_eq!(code, 2);
-    assert!(msg.contains("triangles[0].normals[1]") && msg.contains("zero length"), "{msg}");
+    assert!(
+        msg.contains("triangles[0].normals[1]") && msg.contains("zero length"),
+        "{msg}"
+    );
 }
 
 #[test]
 fn unknown_material_is_named() {
-    let (code, msg) = err_of(&format!("{OK}[[spheres]]\ncenter=[0.0,0.0,0.0]\nradius=1.0\nmaterial=\"gold\"\n"));
+    let (code, msg) = err_of(&format!(
+        "{OK}[[spheres]]\ncenter=[0.0,0.0,0.0]\nradius=1.0\nmaterial=\"gold\"\n"
+    ));
     assert_eq!(code, 2);
-    assert!(msg.contains("'gold'") && msg.contains("not a defined material"), "{msg}");
+    assert!(
+        msg.contains("'gold'") && msg.contains("not a defined material"),
+        "{msg}"
+    );
 }
 
 #[test]
@@ -119,9 +158,16 @@ fn missing_and_broken_obj_files_are_named() {
     let text = format!("{OK}[[meshes]]\nobj=\"thing.obj\"\nmaterial=\"m\"\n");
     let e = Scene::from_toml("s", &text, &dir, &[]).unwrap_err();
     assert_eq!(exit_code_of(&e), 2);
-    assert!(format!("{e}").contains("thing.obj") && format!("{e}").contains("cannot be read"), "{e}");
+    assert!(
+        format!("{e}").contains("thing.obj") && format!("{e}").contains("cannot be read"),
+        "{e}"
+    );
 
-    std::fs::write(dir.join("thing.obj"), "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 9\n").unwrap();
+    std::fs::write(
+        dir.join("thing.obj"),
+        "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 9\n",
+    )
+    .unwrap();
     let e = Scene::from_toml("s", &text, &dir, &[]).unwrap_err();
     assert_eq!(exit_code_of(&e), 2);
     assert!(format!("{e}").contains("thing.obj"), "{e}");
@@ -136,7 +182,10 @@ fn missing_and_broken_obj_files_are_named() {
 fn unknown_scene_name_and_missing_file() {
     let e = Scene::load("kettle", &[]).unwrap_err();
     assert_eq!(exit_code_of(&e), 2);
-    assert!(format!("{e}").contains("'kettle'") && format!("{e}").contains("teapot, box, spherelist"), "{e}");
+    assert!(
+        format!("{e}").contains("'kettle'") && format!("{e}").contains("teapot, box, spherelist"),
+        "{e}"
+    );
     let e = Scene::load("nowhere/scene.toml", &[]).unwrap_err();
     assert!(format!("{e}").contains("does not exist"), "{e}");
 }

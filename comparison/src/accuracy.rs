@@ -85,23 +85,47 @@ pub fn configs(default: &Config) -> Vec<Config> {
     };
     push(default.clone());
     for d in 1..=8 {
-        push(Config { max_depth: d, numerics: default.numerics });
+        push(Config {
+            max_depth: d,
+            numerics: default.numerics,
+        });
     }
     for offset in Offset::ALL {
-        push(Config { numerics: Numerics { offset, ..default.numerics }, ..default.clone() });
+        push(Config {
+            numerics: Numerics {
+                offset,
+                ..default.numerics
+            },
+            ..default.clone()
+        });
     }
     for triangle in TriangleTest::ALL {
-        push(Config { numerics: Numerics { triangle, ..default.numerics }, ..default.clone() });
+        push(Config {
+            numerics: Numerics {
+                triangle,
+                ..default.numerics
+            },
+            ..default.clone()
+        });
     }
     for sphere in SphereTest::ALL {
-        push(Config { numerics: Numerics { sphere, ..default.numerics }, ..default.clone() });
+        push(Config {
+            numerics: Numerics {
+                sphere,
+                ..default.numerics
+            },
+            ..default.clone()
+        });
     }
     v
 }
 
 /// The standard scenes and their sizes.
 fn scenes(quick: bool) -> Vec<(&'static str, Size, Vec<String>)> {
-    let s = |w, h| Size { width: w, height: h };
+    let s = |w, h| Size {
+        width: w,
+        height: h,
+    };
     if quick {
         vec![
             ("box", s(96, 72), vec![]),
@@ -129,7 +153,13 @@ pub struct Error {
 
 fn error_of(test: &image::RgbImage, truth: &image::RgbImage) -> anyhow::Result<Error> {
     let m = metrics::compare(test, truth)?;
-    Ok(Error { rmse: m.rmse, max_abs: m.max_abs, above_1: m.above_1, wrong: hard::wrong_share(test, truth), flip: flip_mean(test, truth) })
+    Ok(Error {
+        rmse: m.rmse,
+        max_abs: m.max_abs,
+        above_1: m.above_1,
+        wrong: hard::wrong_share(test, truth),
+        flip: flip_mean(test, truth),
+    })
 }
 
 /// Mean FLIP error (NVIDIA's perceptual metric, nv-flip) at the default
@@ -163,14 +193,24 @@ pub struct Row {
 impl Row {
     /// GPU time if the driver has timers, else wall time (fastest frame).
     fn time(&self) -> Option<f64> {
-        self.result.as_ref().ok().map(|(g, w, _, _)| g.unwrap_or(*w))
+        self.result
+            .as_ref()
+            .ok()
+            .map(|(g, w, _, _)| g.unwrap_or(*w))
     }
     fn error(&self) -> Option<&Error> {
         self.result.as_ref().ok().map(|r| &r.2)
     }
 }
 
-fn render_app(api: Api, scene: &str, size: Size, set: Vec<String>, frames: u32, png: &Path) -> anyhow::Result<(Option<f64>, f64, u64, image::RgbImage)> {
+fn render_app(
+    api: Api,
+    scene: &str,
+    size: Size,
+    set: Vec<String>,
+    frames: u32,
+    png: &Path,
+) -> anyhow::Result<(Option<f64>, f64, u64, image::RgbImage)> {
     let args = RenderArgs {
         frames: Some(frames),
         out: Some(png.to_path_buf()),
@@ -187,7 +227,10 @@ fn render_app(api: Api, scene: &str, size: Size, set: Vec<String>, frames: u32, 
 }
 
 fn overrides(set: &[String]) -> Vec<(String, String)> {
-    set.iter().filter_map(|kv| kv.split_once('=')).map(|(k, v)| (k.into(), v.into())).collect()
+    set.iter()
+        .filter_map(|kv| kv.split_once('='))
+        .map(|(k, v)| (k.into(), v.into()))
+        .collect()
 }
 
 /// Times within this factor count as equal: frame times on a shared machine
@@ -215,15 +258,25 @@ fn mark_pareto(rows: &mut [Row], unsound: &[Numerics]) {
         .iter()
         .map(|r| {
             let ok = !unsound.contains(&r.config.numerics);
-            (r.scene.clone(), r.api, r.time().filter(|_| ok), r.error().map(|e| e.rmse).filter(|_| ok))
+            (
+                r.scene.clone(),
+                r.api,
+                r.time().filter(|_| ok),
+                r.error().map(|e| e.rmse).filter(|_| ok),
+            )
         })
         .collect();
     for (i, row) in rows.iter_mut().enumerate() {
         row.pareto = false;
         row.sound = !unsound.contains(&row.config.numerics);
-        let (Some(t), Some(e)) = (snapshot[i].2, snapshot[i].3) else { continue };
+        let (Some(t), Some(e)) = (snapshot[i].2, snapshot[i].3) else {
+            continue;
+        };
         row.pareto = !snapshot.iter().enumerate().any(|(j, o)| {
-            j != i && o.0 == snapshot[i].0 && o.1 == snapshot[i].1 && matches!((o.2, o.3), (Some(t2), Some(e2)) if dominates(t2, e2, t, e))
+            j != i
+                && o.0 == snapshot[i].0
+                && o.1 == snapshot[i].1
+                && matches!((o.2, o.3), (Some(t2), Some(e2)) if dominates(t2, e2, t, e))
         });
     }
 }
@@ -247,7 +300,10 @@ pub fn run(args: &AccuracyArgs) -> anyhow::Result<()> {
     let started = std::time::Instant::now();
     for (scene_name, size, set) in scenes(args.quick) {
         let scene = Scene::load(scene_name, &overrides(&set))?;
-        let default = Config { max_depth: scene.max_depth, numerics: scene.numerics };
+        let default = Config {
+            max_depth: scene.max_depth,
+            numerics: scene.numerics,
+        };
         let mut deep = scene.clone();
         deep.max_depth = MAX_DEPTH_LIMIT;
         let truth = reference::render_truth(&deep, size.width, size.height);
@@ -269,17 +325,30 @@ pub fn run(args: &AccuracyArgs) -> anyhow::Result<()> {
             let _ = render_app(api, scene_name, size, s, 2, &png);
             let _ = std::fs::remove_file(&png);
         }
-        eprintln!("twinray accuracy: {scene_name} at {size}: {} configurations x 2 APIs", list.len());
+        eprintln!(
+            "twinray accuracy: {scene_name} at {size}: {} configurations x 2 APIs",
+            list.len()
+        );
         for (k, c) in list.iter().enumerate() {
-            for api in if k % 2 == 0 { [Api::Vulkan, Api::Opengl] } else { [Api::Opengl, Api::Vulkan] } {
-                let png = args.out.join(format!("images/{scene_name}-{}-{k}.png", api_name(api)));
+            for api in if k % 2 == 0 {
+                [Api::Vulkan, Api::Opengl]
+            } else {
+                [Api::Opengl, Api::Vulkan]
+            } {
+                let png = args
+                    .out
+                    .join(format!("images/{scene_name}-{}-{k}.png", api_name(api)));
                 let mut s = set.clone();
                 s.extend(c.set_args());
                 let result = render_app(api, scene_name, size, s, frames, &png)
                     .and_then(|(g, w, nan, img)| Ok((g, w, error_of(&img, &truth)?, nan)))
                     .map_err(|e| format!("{e:#}"));
                 if let Err(e) = &result {
-                    eprintln!("  {scene_name} {} {}: FAILED: {e}", c.label(), api_name(api));
+                    eprintln!(
+                        "  {scene_name} {} {}: FAILED: {e}",
+                        c.label(),
+                        api_name(api)
+                    );
                 }
                 rows.push(Row {
                     scene: scene_name.into(),
@@ -302,18 +371,30 @@ pub fn run(args: &AccuracyArgs) -> anyhow::Result<()> {
     if !args.no_hard {
         let dir = args.hard.clone().unwrap_or_else(|| {
             let local = PathBuf::from("scenes/hard");
-            if local.is_dir() { local } else { PathBuf::from(hard::SOURCE_DIR) }
+            if local.is_dir() {
+                local
+            } else {
+                PathBuf::from(hard::SOURCE_DIR)
+            }
         });
         cases = hard::list(&dir)?;
-        let size = Size { width: 64, height: 64 };
-        eprintln!("twinray accuracy: {} hard cases at {size}, {} strategies x 2 APIs", cases.len(), hard_strategies().len());
+        let size = Size {
+            width: 64,
+            height: 64,
+        };
+        eprintln!(
+            "twinray accuracy: {} hard cases at {size}, {} strategies x 2 APIs",
+            cases.len(),
+            hard_strategies().len()
+        );
         for case in &cases {
             hard_rows.extend(run_hard(case, size, &args.out)?);
         }
     }
 
     let cpu = crate::report::cpu_model();
-    std::fs::write(args.out.join("hard_cases.csv"), hard_csv(&hard_rows)).context("writing hard_cases.csv")?;
+    std::fs::write(args.out.join("hard_cases.csv"), hard_csv(&hard_rows))
+        .context("writing hard_cases.csv")?;
     // With the hard cases known, numerics that fail any of them leave the front.
     let unsound: Vec<Numerics> = hard_strategies()
         .into_iter()
@@ -330,12 +411,24 @@ pub fn run(args: &AccuracyArgs) -> anyhow::Result<()> {
     for (scene_name, _, _) in scenes(args.quick) {
         let file = format!("accuracy-{scene_name}.svg");
         let these: Vec<&Row> = rows.iter().filter(|r| r.scene == scene_name).collect();
-        plot(&args.out.join(&file), scene_name, &these).with_context(|| format!("plotting {file}"))?;
+        plot(&args.out.join(&file), scene_name, &these)
+            .with_context(|| format!("plotting {file}"))?;
         plots.push(file);
     }
-    let md = markdown(args, &rows, &hard_rows, &cases, &plots, &cpu, started.elapsed().as_secs_f64());
+    let md = markdown(
+        args,
+        &rows,
+        &hard_rows,
+        &cases,
+        &plots,
+        &cpu,
+        started.elapsed().as_secs_f64(),
+    );
     std::fs::write(args.out.join("report.md"), md).context("writing report.md")?;
-    eprintln!("twinray accuracy: report: {}", args.out.join("report.md").display());
+    eprintln!(
+        "twinray accuracy: report: {}",
+        args.out.join("report.md").display()
+    );
     Ok(())
 }
 
@@ -345,17 +438,26 @@ pub fn hard_strategies() -> Vec<(String, Numerics)> {
     let mut v = vec![("default".to_string(), d)];
     for offset in Offset::ALL {
         if offset != d.offset {
-            v.push((format!("offset={}", offset.name()), Numerics { offset, ..d }));
+            v.push((
+                format!("offset={}", offset.name()),
+                Numerics { offset, ..d },
+            ));
         }
     }
     for triangle in TriangleTest::ALL {
         if triangle != d.triangle {
-            v.push((format!("triangle={}", triangle.name()), Numerics { triangle, ..d }));
+            v.push((
+                format!("triangle={}", triangle.name()),
+                Numerics { triangle, ..d },
+            ));
         }
     }
     for sphere in SphereTest::ALL {
         if sphere != d.sphere {
-            v.push((format!("sphere={}", sphere.name()), Numerics { sphere, ..d }));
+            v.push((
+                format!("sphere={}", sphere.name()),
+                Numerics { sphere, ..d },
+            ));
         }
     }
     v
@@ -367,7 +469,12 @@ fn run_hard(case: &HardCase, size: Size, out: &Path) -> anyhow::Result<Vec<HardR
     let truth = reference::render_truth(&scene, size.width, size.height);
     truth.save_png(&out.join(format!("images/hard-{}-truth.png", case.name)))?;
     let truth = truth.to_rgb8();
-    let bg = twinray_common::image_io::FloatImage { width: 1, height: 1, pixels: vec![scene.background.as_vec3().to_array()] }.to_rgb8();
+    let bg = twinray_common::image_io::FloatImage {
+        width: 1,
+        height: 1,
+        pixels: vec![scene.background.as_vec3().to_array()],
+    }
+    .to_rgb8();
     let background = bg.get_pixel(0, 0).0;
     let cracks = case.extra.iter().any(|e| e == "cracks");
     let mut rows = Vec::new();
@@ -375,14 +482,25 @@ fn run_hard(case: &HardCase, size: Size, out: &Path) -> anyhow::Result<Vec<HardR
         // --set overrides whatever the scene file's [render] section chose.
         let n = numerics;
         for api in [Api::Vulkan, Api::Opengl] {
-            let png = out.join(format!("images/hard-{}-{}-{}.png", case.name, label.replace('=', "-"), api_name(api)));
+            let png = out.join(format!(
+                "images/hard-{}-{}-{}.png",
+                case.name,
+                label.replace('=', "-"),
+                api_name(api)
+            ));
             let result = render_app(api, &path, size, n.set_args(), 1, &png)
                 .map(|(g, w, nan, img)| {
                     let crack = cracks.then(|| hard::crack_pixels(&img, &truth, background));
                     (hard::wrong_share(&img, &truth), crack, g.unwrap_or(w), nan)
                 })
                 .map_err(|e| format!("{e:#}"));
-            rows.push(HardRow { case: case.name.clone(), tolerance_pct: case.tolerance_pct, strategy: label.clone(), api, result });
+            rows.push(HardRow {
+                case: case.name.clone(),
+                tolerance_pct: case.tolerance_pct,
+                strategy: label.clone(),
+                api,
+                result,
+            });
         }
     }
     Ok(rows)
@@ -422,7 +540,16 @@ pub fn csv(rows: &[Row]) -> String {
         );
         match &r.result {
             Ok((g, w, e, nan)) => {
-                let _ = writeln!(s, "{head},ok,{},{w},{},{},{},{},{},{nan}", opt(*g), e.rmse, e.max_abs, e.above_1, e.wrong, opt(e.flip));
+                let _ = writeln!(
+                    s,
+                    "{head},ok,{},{w},{},{},{},{},{},{nan}",
+                    opt(*g),
+                    e.rmse,
+                    e.max_abs,
+                    e.above_1,
+                    e.wrong,
+                    opt(e.flip)
+                );
             }
             Err(e) => {
                 let _ = writeln!(s, "{head},{},,,,,,,,", q(&format!("failed: {e}")));
@@ -433,12 +560,25 @@ pub fn csv(rows: &[Row]) -> String {
 }
 
 fn hard_csv(rows: &[HardRow]) -> String {
-    let mut s = String::from("case,tolerance_pct,strategy,api,status,wrong_pct,crack_pixels,time_ms,nonfinite_pixels\n");
+    let mut s = String::from(
+        "case,tolerance_pct,strategy,api,status,wrong_pct,crack_pixels,time_ms,nonfinite_pixels\n",
+    );
     for r in rows {
-        let head = format!("{},{},{},{}", r.case, r.tolerance_pct, q(&r.strategy), api_name(r.api));
+        let head = format!(
+            "{},{},{},{}",
+            r.case,
+            r.tolerance_pct,
+            q(&r.strategy),
+            api_name(r.api)
+        );
         match &r.result {
             Ok((w, c, t, nan)) => {
-                let _ = writeln!(s, "{head},ok,{},{},{t},{nan}", 100.0 * w, c.map(|c| c.to_string()).unwrap_or_default());
+                let _ = writeln!(
+                    s,
+                    "{head},ok,{},{},{t},{nan}",
+                    100.0 * w,
+                    c.map(|c| c.to_string()).unwrap_or_default()
+                );
             }
             Err(e) => {
                 let _ = writeln!(s, "{head},{},,,,", q(&format!("failed: {e}")));
@@ -452,7 +592,15 @@ fn f3(v: f64) -> String {
     format!("{v:.3}")
 }
 
-fn markdown(args: &AccuracyArgs, rows: &[Row], hard_rows: &[HardRow], cases: &[HardCase], plots: &[String], cpu: &str, secs: f64) -> String {
+fn markdown(
+    args: &AccuracyArgs,
+    rows: &[Row],
+    hard_rows: &[HardRow],
+    cases: &[HardCase],
+    plots: &[String],
+    cpu: &str,
+    secs: f64,
+) -> String {
     let mut s = String::new();
     let _ = writeln!(s, "# twinray accuracy — speed against error\n");
     let _ = writeln!(
@@ -488,12 +636,33 @@ fn markdown(args: &AccuracyArgs, rows: &[Row], hard_rows: &[HardRow], cases: &[H
     // Summary: where the default stands.
     let _ = writeln!(s, "## Summary\n");
     for api in [Api::Vulkan, Api::Opengl] {
-        for scene in rows.iter().map(|r| r.scene.clone()).collect::<std::collections::BTreeSet<_>>() {
-            let these: Vec<&Row> = rows.iter().filter(|r| r.scene == scene && r.api == api && r.result.is_ok()).collect();
-            let Some(def) = these.iter().find(|r| r.is_default) else { continue };
-            let Some(cheap) = these.iter().min_by(|a, b| a.time().unwrap_or(f64::MAX).total_cmp(&b.time().unwrap_or(f64::MAX))) else { continue };
-            let (dt, de) = (def.time().unwrap_or(f64::NAN), def.error().map(|e| e.rmse).unwrap_or(f64::NAN));
-            let (ct, ce) = (cheap.time().unwrap_or(f64::NAN), cheap.error().map(|e| e.rmse).unwrap_or(f64::NAN));
+        for scene in rows
+            .iter()
+            .map(|r| r.scene.clone())
+            .collect::<std::collections::BTreeSet<_>>()
+        {
+            let these: Vec<&Row> = rows
+                .iter()
+                .filter(|r| r.scene == scene && r.api == api && r.result.is_ok())
+                .collect();
+            let Some(def) = these.iter().find(|r| r.is_default) else {
+                continue;
+            };
+            let Some(cheap) = these.iter().min_by(|a, b| {
+                a.time()
+                    .unwrap_or(f64::MAX)
+                    .total_cmp(&b.time().unwrap_or(f64::MAX))
+            }) else {
+                continue;
+            };
+            let (dt, de) = (
+                def.time().unwrap_or(f64::NAN),
+                def.error().map(|e| e.rmse).unwrap_or(f64::NAN),
+            );
+            let (ct, ce) = (
+                cheap.time().unwrap_or(f64::NAN),
+                cheap.error().map(|e| e.rmse).unwrap_or(f64::NAN),
+            );
             let _ = writeln!(
                 s,
                 "- {scene}, {}: default {} ms, RMSE {:.5}{}; cheapest ({}) {} ms, RMSE {:.5}: the default costs {:.2}×.",
@@ -535,13 +704,19 @@ fn markdown(args: &AccuracyArgs, rows: &[Row], hard_rows: &[HardRow], cases: &[H
                 s,
                 "- `{label}`: {ok} of {} hard-case renders within tolerance{}",
                 these.len(),
-                if failed.is_empty() { String::new() } else { format!("; fails {}", failed.join(", ")) }
+                if failed.is_empty() {
+                    String::new()
+                } else {
+                    format!("; fails {}", failed.join(", "))
+                }
             );
         }
         let _ = writeln!(s);
     }
     for r in rows.iter().filter(|r| r.is_default && r.result.is_ok()) {
-        let (Some(t), Some(e)) = (r.time(), r.error().map(|e| e.rmse)) else { continue };
+        let (Some(t), Some(e)) = (r.time(), r.error().map(|e| e.rmse)) else {
+            continue;
+        };
         let by: Vec<String> = rows
             .iter()
             .filter(|o| o.scene == r.scene && o.api == r.api && !o.is_default && o.sound)
@@ -553,7 +728,11 @@ fn markdown(args: &AccuracyArgs, rows: &[Row], hard_rows: &[HardRow], cases: &[H
             "- {} {}: {}",
             r.scene,
             api_name(r.api),
-            if by.is_empty() { "the default is on the Pareto front".to_string() } else { format!("the default is dominated by {}", by.join("; ")) }
+            if by.is_empty() {
+                "the default is on the Pareto front".to_string()
+            } else {
+                format!("the default is dominated by {}", by.join("; "))
+            }
         );
     }
     let _ = writeln!(
@@ -564,14 +743,23 @@ fn markdown(args: &AccuracyArgs, rows: &[Row], hard_rows: &[HardRow], cases: &[H
          scatter on a shared software driver; the GPU report is the one to read for speed.\n"
     );
 
-    for scene in rows.iter().map(|r| r.scene.clone()).collect::<Vec<_>>().iter().fold(Vec::<String>::new(), |mut v, x| {
-        if !v.contains(x) {
-            v.push(x.clone());
-        }
-        v
-    }) {
+    for scene in rows
+        .iter()
+        .map(|r| r.scene.clone())
+        .collect::<Vec<_>>()
+        .iter()
+        .fold(Vec::<String>::new(), |mut v, x| {
+            if !v.contains(x) {
+                v.push(x.clone());
+            }
+            v
+        })
+    {
         let these: Vec<&Row> = rows.iter().filter(|r| r.scene == scene).collect();
-        let size = these.first().map(|r| r.size.to_string()).unwrap_or_default();
+        let size = these
+            .first()
+            .map(|r| r.size.to_string())
+            .unwrap_or_default();
         let _ = writeln!(s, "## {scene} ({size})\n");
         if let Some(p) = plots.iter().find(|p| p.contains(&format!("-{scene}."))) {
             let _ = writeln!(s, "![{scene}]({p})\n");
@@ -579,7 +767,11 @@ fn markdown(args: &AccuracyArgs, rows: &[Row], hard_rows: &[HardRow], cases: &[H
         let _ = writeln!(s, "| sweep | max depth | offset | triangle | sphere | API | GPU ms (min) | wall ms (min) | RMSE | max abs | >1/255 | wrong | FLIP | NaN | |\n|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|");
         for r in these {
             let n = &r.config.numerics;
-            let mark = format!("{}{}", if r.pareto { "★" } else { "" }, if r.is_default { "◆" } else { "" });
+            let mark = format!(
+                "{}{}",
+                if r.pareto { "★" } else { "" },
+                if r.is_default { "◆" } else { "" }
+            );
             match &r.result {
                 Ok((g, w, e, nan)) => {
                     let _ = writeln!(
@@ -602,7 +794,17 @@ fn markdown(args: &AccuracyArgs, rows: &[Row], hard_rows: &[HardRow], cases: &[H
                     );
                 }
                 Err(e) => {
-                    let _ = writeln!(s, "| {} | {} | {} | {} | {} | {} | failed: {} | | | | | | | | |", r.sweeps.join(", "), r.config.max_depth, n.offset.name(), n.triangle.name(), n.sphere.name(), api_name(r.api), e.replace('|', "/"));
+                    let _ = writeln!(
+                        s,
+                        "| {} | {} | {} | {} | {} | {} | failed: {} | | | | | | | | |",
+                        r.sweeps.join(", "),
+                        r.config.max_depth,
+                        n.offset.name(),
+                        n.triangle.name(),
+                        n.sphere.name(),
+                        api_name(r.api),
+                        e.replace('|', "/")
+                    );
                 }
             }
         }
@@ -628,12 +830,24 @@ fn markdown(args: &AccuracyArgs, rows: &[Row], hard_rows: &[HardRow], cases: &[H
                 let cell: Vec<String> = [Api::Vulkan, Api::Opengl]
                     .iter()
                     .map(|api| {
-                        match hard_rows.iter().find(|r| r.case == case.name && &r.strategy == st && r.api == *api).map(|r| &r.result) {
+                        match hard_rows
+                            .iter()
+                            .find(|r| r.case == case.name && &r.strategy == st && r.api == *api)
+                            .map(|r| &r.result)
+                        {
                             Some(Ok((w, c, _, nan))) => {
                                 let v = format!("{:.2}", 100.0 * w);
-                                let v = if 100.0 * w > case.tolerance_pct { format!("**{v}**") } else { v };
+                                let v = if 100.0 * w > case.tolerance_pct {
+                                    format!("**{v}**")
+                                } else {
+                                    v
+                                };
                                 let c = c.map(|c| format!(" [{c}]")).unwrap_or_default();
-                                let nan = if *nan > 0 { format!(" NaN {nan}") } else { String::new() };
+                                let nan = if *nan > 0 {
+                                    format!(" NaN {nan}")
+                                } else {
+                                    String::new()
+                                };
                                 format!("{v}{c}{nan}")
                             }
                             Some(Err(_)) => "failed".into(),
@@ -651,10 +865,16 @@ fn markdown(args: &AccuracyArgs, rows: &[Row], hard_rows: &[HardRow], cases: &[H
             let mut cells = Vec::new();
             let mut times = Vec::new();
             for api in [Api::Vulkan, Api::Opengl] {
-                let these: Vec<&HardRow> = hard_rows.iter().filter(|r| &r.strategy == st && r.api == api).collect();
+                let these: Vec<&HardRow> = hard_rows
+                    .iter()
+                    .filter(|r| &r.strategy == st && r.api == api)
+                    .collect();
                 let ok = these.iter().filter(|r| matches!(&r.result, Ok((w, _, _, nan)) if 100.0 * w <= r.tolerance_pct && *nan == 0)).count();
                 cells.push(format!("{ok}/{}", these.len()));
-                times.push(f3(these.iter().filter_map(|r| r.result.as_ref().ok().map(|x| x.2)).sum::<f64>()));
+                times.push(f3(these
+                    .iter()
+                    .filter_map(|r| r.result.as_ref().ok().map(|x| x.2))
+                    .sum::<f64>()));
             }
             let worst = hard_rows
                 .iter()
@@ -663,11 +883,19 @@ fn markdown(args: &AccuracyArgs, rows: &[Row], hard_rows: &[HardRow], cases: &[H
                 .max_by(|a, b| a.1.total_cmp(&b.1))
                 .map(|(r, w)| format!("{} ({}): {:.2}% wrong", r.case, api_name(r.api), 100.0 * w))
                 .unwrap_or_default();
-            let _ = writeln!(s, "| {st} | {} | {} | {worst} |", cells.join(" / "), times.join(" / "));
+            let _ = writeln!(
+                s,
+                "| {st} | {} | {} | {worst} |",
+                cells.join(" / "),
+                times.join(" / ")
+            );
         }
         let _ = writeln!(s);
     }
-    let _ = writeln!(s, "Every row is in `accuracy.csv` and `hard_cases.csv`; the images are in `images/`.");
+    let _ = writeln!(
+        s,
+        "Every row is in `accuracy.csv` and `hard_cases.csv`; the images are in `images/`."
+    );
     s
 }
 
@@ -688,16 +916,33 @@ fn plot(path: &Path, scene: &str, rows: &[&Row]) -> anyhow::Result<()> {
         root.present()?;
         return Ok(());
     }
-    let (xmin, xmax) = pts.iter().fold((f64::MAX, f64::MIN), |a, p| (a.0.min(p.0), a.1.max(p.0)));
-    let (ymin, ymax) = pts.iter().fold((f64::MAX, f64::MIN), |a, p| (a.0.min(p.1), a.1.max(p.1)));
+    let (xmin, xmax) = pts
+        .iter()
+        .fold((f64::MAX, f64::MIN), |a, p| (a.0.min(p.0), a.1.max(p.0)));
+    let (ymin, ymax) = pts
+        .iter()
+        .fold((f64::MAX, f64::MIN), |a, p| (a.0.min(p.1), a.1.max(p.1)));
     let mut chart = ChartBuilder::on(&root)
-        .caption(format!("{scene}: time against error (log scales; ★ Pareto front, ◆ default)"), ("sans-serif", 20))
+        .caption(
+            format!("{scene}: time against error (log scales; ★ Pareto front, ◆ default)"),
+            ("sans-serif", 20),
+        )
         .margin(12)
         .x_label_area_size(45)
         .y_label_area_size(80)
-        .build_cartesian_2d((xmin * 0.8..xmax * 1.25).log_scale(), (ymin * 0.5..ymax * 2.0).log_scale())?;
-    chart.configure_mesh().x_desc("milliseconds per frame (fastest frame)").y_desc("RMSE against the f64 truth").draw()?;
-    for (api, colour) in [(Api::Vulkan, RGBColor(200, 30, 30)), (Api::Opengl, RGBColor(30, 80, 200))] {
+        .build_cartesian_2d(
+            (xmin * 0.8..xmax * 1.25).log_scale(),
+            (ymin * 0.5..ymax * 2.0).log_scale(),
+        )?;
+    chart
+        .configure_mesh()
+        .x_desc("milliseconds per frame (fastest frame)")
+        .y_desc("RMSE against the f64 truth")
+        .draw()?;
+    for (api, colour) in [
+        (Api::Vulkan, RGBColor(200, 30, 30)),
+        (Api::Opengl, RGBColor(30, 80, 200)),
+    ] {
         for gpu in [true, false] {
             let mine: Vec<(&Row, f64, f64)> = rows
                 .iter()
@@ -711,33 +956,59 @@ fn plot(path: &Path, scene: &str, rows: &[&Row]) -> anyhow::Result<()> {
             if mine.is_empty() {
                 continue;
             }
-            let label = format!("{} {}", api_name(api), if gpu { "GPU time" } else { "wall time" });
+            let label = format!(
+                "{} {}",
+                api_name(api),
+                if gpu { "GPU time" } else { "wall time" }
+            );
             if gpu {
                 chart
-                    .draw_series(mine.iter().map(|(_, t, e)| Circle::new((*t, *e), 4, colour.filled())))?
+                    .draw_series(
+                        mine.iter()
+                            .map(|(_, t, e)| Circle::new((*t, *e), 4, colour.filled())),
+                    )?
                     .label(label)
                     .legend(move |(x, y)| Circle::new((x + 10, y), 4, colour.filled()));
             } else {
                 chart
-                    .draw_series(mine.iter().map(|(_, t, e)| Circle::new((*t, *e), 4, colour.stroke_width(1))))?
+                    .draw_series(
+                        mine.iter()
+                            .map(|(_, t, e)| Circle::new((*t, *e), 4, colour.stroke_width(1))),
+                    )?
                     .label(label)
                     .legend(move |(x, y)| Circle::new((x + 10, y), 4, colour.stroke_width(1)));
             }
             // The Pareto front (per API, on the time the front was computed from) as a step line.
-            let primary = mine.iter().all(|(r, _, _)| r.result.as_ref().map(|x| x.0.is_some()).unwrap_or(false)) == gpu;
+            let primary = mine
+                .iter()
+                .all(|(r, _, _)| r.result.as_ref().map(|x| x.0.is_some()).unwrap_or(false))
+                == gpu;
             if primary {
-                let mut front: Vec<(f64, f64)> = mine.iter().filter(|(r, _, _)| r.pareto).map(|(_, t, e)| (*t, *e)).collect();
+                let mut front: Vec<(f64, f64)> = mine
+                    .iter()
+                    .filter(|(r, _, _)| r.pareto)
+                    .map(|(_, t, e)| (*t, *e))
+                    .collect();
                 front.sort_by(|a, b| a.0.total_cmp(&b.0));
                 chart.draw_series(LineSeries::new(front, colour.stroke_width(2)))?;
             }
             for (r, t, e) in &mine {
                 if r.is_default {
-                    chart.draw_series(std::iter::once(Circle::new((*t, *e), 9, BLACK.stroke_width(2))))?;
+                    chart.draw_series(std::iter::once(Circle::new(
+                        (*t, *e),
+                        9,
+                        BLACK.stroke_width(2),
+                    )))?;
                 }
             }
         }
     }
-    chart.configure_series_labels().background_style(WHITE.mix(0.8)).border_style(BLACK).position(SeriesLabelPosition::UpperRight).draw()?;
+    chart
+        .configure_series_labels()
+        .background_style(WHITE.mix(0.8))
+        .border_style(BLACK)
+        .position(SeriesLabelPosition::UpperRight)
+        .draw()?;
     root.present()?;
     Ok(())
 }
@@ -748,11 +1019,17 @@ mod tests {
 
     #[test]
     fn sweeps_change_one_knob_and_include_the_default_once() {
-        let d = Config { max_depth: 5, numerics: Numerics::default() };
+        let d = Config {
+            max_depth: 5,
+            numerics: Numerics::default(),
+        };
         let c = configs(&d);
         assert_eq!(c.iter().filter(|x| **x == d).count(), 1);
         assert_eq!(c.len(), 8 + (Offset::ALL.len() - 1) + 1 + 1);
-        assert_eq!(sweeps_of(&d, &d), vec!["depth", "offset", "triangle", "sphere"]);
+        assert_eq!(
+            sweeps_of(&d, &d),
+            vec!["depth", "offset", "triangle", "sphere"]
+        );
     }
 
     #[test]

@@ -33,7 +33,10 @@ impl Api {
 pub fn app_path(name: &str) -> anyhow::Result<PathBuf> {
     let dir = match std::env::var_os("TWINRAY_BIN_DIR") {
         Some(d) => PathBuf::from(d),
-        None => std::env::current_exe()?.parent().map(PathBuf::from).unwrap_or_default(),
+        None => std::env::current_exe()?
+            .parent()
+            .map(PathBuf::from)
+            .unwrap_or_default(),
     };
     let path = dir.join(name);
     if !path.exists() {
@@ -47,7 +50,13 @@ pub fn app_path(name: &str) -> anyhow::Result<PathBuf> {
 
 /// The app's command line for `args` (always headless: the orchestrator never opens windows).
 pub fn app_args(args: &RenderArgs) -> Vec<String> {
-    let mut v = vec!["--headless".to_string(), "--scene".into(), args.scene.clone(), "--size".into(), args.size.to_string()];
+    let mut v = vec![
+        "--headless".to_string(),
+        "--scene".into(),
+        args.scene.clone(),
+        "--size".into(),
+        args.size.to_string(),
+    ];
     if let Some(f) = args.frames {
         v.extend(["--frames".into(), f.to_string()]);
     }
@@ -103,22 +112,38 @@ pub fn run_json(api: Api, args: &RenderArgs) -> anyhow::Result<RunReport> {
     let mut args = args.clone();
     args.json = true;
     args.gl_spirv |= api == Api::OpenglSpirv;
-    let out = Command::new(app_path(bin)?).args(app_args(&args)).output().with_context(|| format!("starting {bin}"))?;
+    let out = Command::new(app_path(bin)?)
+        .args(app_args(&args))
+        .output()
+        .with_context(|| format!("starting {bin}"))?;
     if !out.status.success() {
         let stderr = String::from_utf8_lossy(&out.stderr);
-        let line = stderr.lines().rev().find(|l| !l.trim().is_empty()).unwrap_or("no message").to_string();
+        let line = stderr
+            .lines()
+            .rev()
+            .find(|l| !l.trim().is_empty())
+            .unwrap_or("no message")
+            .to_string();
         let kind = match out.status.code() {
             Some(2) => Some(FailureKind::BadInput),
             Some(3) => Some(FailureKind::NoDevice),
             _ => None,
         };
         return Err(match kind {
-            Some(kind) => Failure { kind, message: line }.into(),
+            Some(kind) => Failure {
+                kind,
+                message: line,
+            }
+            .into(),
             None => anyhow::anyhow!("{bin} failed ({}): {line}", out.status),
         });
     }
     let stdout = String::from_utf8_lossy(&out.stdout);
-    let json = stdout.lines().rev().find(|l| l.starts_with('{')).unwrap_or("");
+    let json = stdout
+        .lines()
+        .rev()
+        .find(|l| l.starts_with('{'))
+        .unwrap_or("");
     serde_json::from_str(json).with_context(|| format!("reading {bin}'s JSON report"))
 }
 
@@ -147,7 +172,10 @@ pub fn render_reference(args: &RenderArgs) -> anyhow::Result<()> {
             height: h,
             path: Default::default(),
             workgroup: None,
-            frames: vec![FrameTime { gpu_ms: None, wall_ms: ms }],
+            frames: vec![FrameTime {
+                gpu_ms: None,
+                wall_ms: ms,
+            }],
             gpu_ms: None,
             wall_ms: None,
             nonfinite_pixels: img.nonfinite_pixels(),
@@ -157,7 +185,9 @@ pub fn render_reference(args: &RenderArgs) -> anyhow::Result<()> {
         report.summarise();
         println!("{}", serde_json::to_string(&report)?);
     } else if args.out.is_none() {
-        return Err(bad_input("render --api reference needs --out FILE.png or --json"));
+        return Err(bad_input(
+            "render --api reference needs --out FILE.png or --json",
+        ));
     }
     Ok(())
 }

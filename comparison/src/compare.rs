@@ -7,7 +7,9 @@ use anyhow::Context;
 use std::path::PathBuf;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::Arc;
-use twinray_common::cli::{parse_size, parse_workgroup, Accel, RenderArgs, RenderPath, Size, Workgroup};
+use twinray_common::cli::{
+    parse_size, parse_workgroup, Accel, RenderArgs, RenderPath, Size, Workgroup,
+};
 use twinray_common::report::RunReport;
 
 #[derive(clap::Args, Debug, Clone)]
@@ -73,20 +75,35 @@ pub fn plan(args: &CompareArgs) -> anyhow::Result<Plan> {
             )));
         }
     }
-    let (res_teapot, res_box, counts, sl_size, frames, secs, preset): (Vec<u32>, Vec<u32>, Vec<u32>, u32, u32, f64, _) =
-        if args.quick {
-            (vec![40, 80], vec![100, 200, 300], vec![1, 10, 100, 1000], 100, 8, 8.0, "quick")
-        } else {
-            (
-                (1..=10).map(|i| i * 100).collect(),
-                (1..=10).map(|i| i * 100).collect(),
-                vec![1, 10, 50, 100, 500, 1000, 2500, 5000, 10000],
-                300,
-                60,
-                30.0,
-                "full",
-            )
-        };
+    let (res_teapot, res_box, counts, sl_size, frames, secs, preset): (
+        Vec<u32>,
+        Vec<u32>,
+        Vec<u32>,
+        u32,
+        u32,
+        f64,
+        _,
+    ) = if args.quick {
+        (
+            vec![40, 80],
+            vec![100, 200, 300],
+            vec![1, 10, 100, 1000],
+            100,
+            8,
+            8.0,
+            "quick",
+        )
+    } else {
+        (
+            (1..=10).map(|i| i * 100).collect(),
+            (1..=10).map(|i| i * 100).collect(),
+            vec![1, 10, 50, 100, 500, 1000, 2500, 5000, 10000],
+            300,
+            60,
+            30.0,
+            "full",
+        )
+    };
     let mut points = Vec::new();
     let wanted = |e: &str| args.only.is_empty() || args.only.iter().any(|o| o == e);
     for (exp, sizes) in [("teapot", &res_teapot), ("box", &res_box)] {
@@ -99,7 +116,10 @@ pub fn plan(args: &CompareArgs) -> anyhow::Result<Plan> {
                 param_name: "resolution",
                 param_value: format!("{r}x{r}"),
                 scene: exp,
-                size: Size { width: r, height: r },
+                size: Size {
+                    width: r,
+                    height: r,
+                },
                 set: vec![],
                 work: (r as f64 / sizes[0] as f64).powi(2),
             });
@@ -147,7 +167,9 @@ pub fn api_name(api: Api) -> &'static str {
 /// Software rasterisers (Mesa's lavapipe/llvmpipe, SwiftShader) get the quick preset.
 fn is_software(device: &str) -> bool {
     let d = device.to_lowercase();
-    ["llvmpipe", "lavapipe", "softpipe", "swiftshader"].iter().any(|s| d.contains(s))
+    ["llvmpipe", "lavapipe", "softpipe", "swiftshader"]
+        .iter()
+        .any(|s| d.contains(s))
 }
 
 pub fn run(args: &CompareArgs) -> anyhow::Result<()> {
@@ -158,28 +180,41 @@ pub fn run(args: &CompareArgs) -> anyhow::Result<()> {
             out: None,
             json: true,
             set: vec![],
-            ..RenderArgs::headless("spherelist", Size { width: 8, height: 8 })
+            ..RenderArgs::headless(
+                "spherelist",
+                Size {
+                    width: 8,
+                    height: 8,
+                },
+            )
         };
         let r = run_json(Api::Vulkan, &probe).context("probing the Vulkan device")?;
         if is_software(&r.device) {
             eprintln!("twinray compare: '{}' is a software driver: running the quick preset (pass --full for the study's full sweeps)", r.device);
             args.quick = true;
         } else {
-            eprintln!("twinray compare: '{}' is a GPU: running the study's full sweeps", r.device);
+            eprintln!(
+                "twinray compare: '{}' is a GPU: running the study's full sweeps",
+                r.device
+            );
         }
     }
     let args = &args;
     let plan = plan(args)?;
-    std::fs::create_dir_all(&args.out).with_context(|| format!("creating --out folder '{}'", args.out.display()))?;
+    std::fs::create_dir_all(&args.out)
+        .with_context(|| format!("creating --out folder '{}'", args.out.display()))?;
     let stop = Arc::new(AtomicBool::new(false));
     {
         let stop = stop.clone();
-        ctrlc::set_handler(move || stop.store(true, Ordering::SeqCst)).context("installing the Ctrl-C handler")?;
+        ctrlc::set_handler(move || stop.store(true, Ordering::SeqCst))
+            .context("installing the Ctrl-C handler")?;
     }
     let mut paths = args.paths.clone();
     paths.dedup();
     if paths.is_empty() {
-        return Err(twinray_common::error::bad_input("--paths names no path; use fragment, compute or both"));
+        return Err(twinray_common::error::bad_input(
+            "--paths names no path; use fragment, compute or both",
+        ));
     }
     let apis = if args.gl_spirv { 3 } else { 2 };
     let runs = apis * paths.len();
@@ -195,8 +230,10 @@ pub fn run(args: &CompareArgs) -> anyhow::Result<()> {
     );
     let bar = indicatif::ProgressBar::new((plan.points.len() * runs) as u64);
     bar.set_style(
-        indicatif::ProgressStyle::with_template("{bar:40} {pos}/{len} [{elapsed_precise} elapsed, ETA {eta}] {msg}")
-            .expect("valid template"),
+        indicatif::ProgressStyle::with_template(
+            "{bar:40} {pos}/{len} [{elapsed_precise} elapsed, ETA {eta}] {msg}",
+        )
+        .expect("valid template"),
     );
     let mut outcomes: Vec<Outcome> = Vec::new();
     let mut interrupted = false;
@@ -208,8 +245,10 @@ pub fn run(args: &CompareArgs) -> anyhow::Result<()> {
         if args.gl_spirv {
             apis.push(Api::OpenglSpirv);
         }
-        let mut order: Vec<(RenderPath, Api)> =
-            paths.iter().flat_map(|&p| apis.iter().map(move |&a| (p, a))).collect();
+        let mut order: Vec<(RenderPath, Api)> = paths
+            .iter()
+            .flat_map(|&p| apis.iter().map(move |&a| (p, a)))
+            .collect();
         if i % 2 == 1 {
             order.reverse();
         }
@@ -217,7 +256,8 @@ pub fn run(args: &CompareArgs) -> anyhow::Result<()> {
             let frames = match last.get(&(point.experiment, path)) {
                 Some(&(work, ms)) if ms > 0.0 => {
                     let predicted = ms * point.work / work;
-                    ((plan.seconds_per_point * 1e3 / predicted).floor() as u32).clamp(plan.frames.min(4), plan.frames)
+                    ((plan.seconds_per_point * 1e3 / predicted).floor() as u32)
+                        .clamp(plan.frames.min(4), plan.frames)
                 }
                 _ => plan.frames,
             };
@@ -225,7 +265,12 @@ pub fn run(args: &CompareArgs) -> anyhow::Result<()> {
                 interrupted = true;
                 break 'points;
             }
-            bar.set_message(format!("{} {} {} {path}", point.experiment, point.param_value, api_name(api)));
+            bar.set_message(format!(
+                "{} {} {} {path}",
+                point.experiment,
+                point.param_value,
+                api_name(api)
+            ));
             let ra = RenderArgs {
                 frames: Some(frames),
                 out: None,
@@ -234,7 +279,11 @@ pub fn run(args: &CompareArgs) -> anyhow::Result<()> {
                 // The study's tracer tests every primitive: so do the sweeps.
                 accel: Accel::None,
                 path,
-                workgroup: if path == RenderPath::Compute { args.workgroup } else { None },
+                workgroup: if path == RenderPath::Compute {
+                    args.workgroup
+                } else {
+                    None
+                },
                 ..RenderArgs::headless(point.scene, point.size)
             };
             let result = run_json(api, &ra).map_err(|e| format!("{e:#}"));
@@ -248,14 +297,28 @@ pub fn run(args: &CompareArgs) -> anyhow::Result<()> {
                     last.insert((point.experiment, path), (point.work, w.median));
                 }
             } else if let Err(e) = &result {
-                bar.println(format!("  {} {} {} {path}: FAILED: {e}", point.experiment, point.param_value, api_name(api)));
+                bar.println(format!(
+                    "  {} {} {} {path}: FAILED: {e}",
+                    point.experiment,
+                    point.param_value,
+                    api_name(api)
+                ));
             }
-            outcomes.push(Outcome { point: point.clone(), api, path, result });
+            outcomes.push(Outcome {
+                point: point.clone(),
+                api,
+                path,
+                result,
+            });
             bar.inc(1);
         }
     }
     bar.finish_and_clear();
-    let accel = if interrupted { Vec::new() } else { acceleration(&plan, &stop) };
+    let accel = if interrupted {
+        Vec::new()
+    } else {
+        acceleration(&plan, &stop)
+    };
     let agreement = if interrupted || stop.load(Ordering::SeqCst) {
         Vec::new()
     } else {
@@ -266,7 +329,11 @@ pub fn run(args: &CompareArgs) -> anyhow::Result<()> {
         "twinray compare: {} of {} runs done{}; report: {}",
         outcomes.iter().filter(|o| o.result.is_ok()).count(),
         plan.points.len() * runs,
-        if interrupted { " (interrupted: the finished points are kept)" } else { "" },
+        if interrupted {
+            " (interrupted: the finished points are kept)"
+        } else {
+            ""
+        },
         args.out.join("report.md").display()
     );
     if interrupted {
@@ -299,13 +366,29 @@ pub fn agreement(
     if std::fs::create_dir_all(&dir).is_err() {
         return rows;
     }
-    let size = if plan.preset == "quick" { Size { width: 160, height: 120 } } else { Size { width: 400, height: 300 } };
-    eprintln!("twinray compare: checking image agreement at {size} (Vulkan, OpenGL, f64 reference)");
+    let size = if plan.preset == "quick" {
+        Size {
+            width: 160,
+            height: 120,
+        }
+    } else {
+        Size {
+            width: 400,
+            height: 300,
+        }
+    };
+    eprintln!(
+        "twinray compare: checking image agreement at {size} (Vulkan, OpenGL, f64 reference)"
+    );
     for scene in EXPERIMENTS {
         if stop.load(Ordering::SeqCst) {
             break;
         }
-        let set = if scene == "spherelist" { vec!["extra_spheres=100".to_string()] } else { vec![] };
+        let set = if scene == "spherelist" {
+            vec!["extra_spheres=100".to_string()]
+        } else {
+            vec![]
+        };
         let result = (|| -> anyhow::Result<[twinray_common::metrics::Metrics; 3]> {
             let mut imgs = Vec::new();
             let mut nan = Vec::new();
@@ -323,8 +406,11 @@ pub fn agreement(
                 nan.push(r.nonfinite_pixels);
                 imgs.push(twinray_common::image_io::load_png(&png)?);
             }
-            let overrides: Vec<(String, String)> =
-                set.iter().filter_map(|kv| kv.split_once('=')).map(|(k, v)| (k.into(), v.into())).collect();
+            let overrides: Vec<(String, String)> = set
+                .iter()
+                .filter_map(|kv| kv.split_once('='))
+                .map(|(k, v)| (k.into(), v.into()))
+                .collect();
             let sc = twinray_common::scene::Scene::load(scene, &overrides)?;
             let reference = twinray_common::reference::render(&sc, size.width, size.height);
             let ref_png = dir.join(format!("{scene}-reference.png"));
@@ -381,11 +467,19 @@ pub fn agreement(
         });
         if let Some(Ok(m)) = &paths {
             let label = |w: &str| format!("{scene} {w}");
-            crate::diff::print_table(&[(&label("vulkan compute vs fragment"), m[0]), (&label("opengl compute vs fragment"), m[1])]);
+            crate::diff::print_table(&[
+                (&label("vulkan compute vs fragment"), m[0]),
+                (&label("opengl compute vs fragment"), m[1]),
+            ]);
         } else if let Some(Err(e)) = &paths {
             eprintln!("  {scene}: compute agreement check failed: {e}");
         }
-        rows.push(Agreement { scene, size, result, paths });
+        rows.push(Agreement {
+            scene,
+            size,
+            result,
+            paths,
+        });
     }
     rows
 }
@@ -404,46 +498,132 @@ pub struct AccelRun {
     pub bvh: Option<(usize, usize, f64)>,
 }
 
-pub const ACCEL_CONFIGS: [&str; 3] = ["generic, brute force", "variant, brute force", "variant, BVH"];
+pub const ACCEL_CONFIGS: [&str; 3] = [
+    "generic, brute force",
+    "variant, brute force",
+    "variant, BVH",
+];
 
 /// Each scene with the all-features brute-force shader, its own variant, and
 /// its variant with a BVH; then the sphere list scaled up with the BVH alone.
 pub fn acceleration(plan: &Plan, stop: &AtomicBool) -> Vec<AccelRun> {
     let quick = plan.preset == "quick";
-    let big = if quick { Size { width: 100, height: 100 } } else { Size { width: 1000, height: 1000 } };
-    let sl = if quick { Size { width: 100, height: 100 } } else { Size { width: 300, height: 300 } };
+    let big = if quick {
+        Size {
+            width: 100,
+            height: 100,
+        }
+    } else {
+        Size {
+            width: 1000,
+            height: 1000,
+        }
+    };
+    let sl = if quick {
+        Size {
+            width: 100,
+            height: 100,
+        }
+    } else {
+        Size {
+            width: 300,
+            height: 300,
+        }
+    };
     let mut cases: Vec<(&'static str, Size, Vec<String>, Vec<&'static str>)> = vec![
-        ("teapot", if quick { Size { width: 40, height: 40 } } else { big }, vec![], ACCEL_CONFIGS.to_vec()),
+        (
+            "teapot",
+            if quick {
+                Size {
+                    width: 40,
+                    height: 40,
+                }
+            } else {
+                big
+            },
+            vec![],
+            ACCEL_CONFIGS.to_vec(),
+        ),
         ("box", big, vec![], ACCEL_CONFIGS.to_vec()),
-        ("spherelist", sl, vec![format!("extra_spheres={}", if quick { 1000 } else { 10000 })], ACCEL_CONFIGS.to_vec()),
+        (
+            "spherelist",
+            sl,
+            vec![format!(
+                "extra_spheres={}",
+                if quick { 1000 } else { 10000 }
+            )],
+            ACCEL_CONFIGS.to_vec(),
+        ),
     ];
     // Where the BVH starts to pay: the crossover behind AUTO_BVH_MIN_PRIMITIVES.
-    let crossover: &[u32] = if quick { &[1, 50, 200] } else { &[1, 10, 25, 50, 100, 200, 500] };
+    let crossover: &[u32] = if quick {
+        &[1, 50, 200]
+    } else {
+        &[1, 10, 25, 50, 100, 200, 500]
+    };
     for &n in crossover {
-        cases.push(("spherelist", sl, vec![format!("extra_spheres={n}")], vec!["variant, brute force", "variant, BVH"]));
+        cases.push((
+            "spherelist",
+            sl,
+            vec![format!("extra_spheres={n}")],
+            vec!["variant, brute force", "variant, BVH"],
+        ));
     }
-    let scaling: &[u32] = if quick { &[10_000] } else { &[1_000, 10_000, 100_000] };
+    let scaling: &[u32] = if quick {
+        &[10_000]
+    } else {
+        &[1_000, 10_000, 100_000]
+    };
     for &n in scaling {
-        cases.push(("spherelist", sl, vec![format!("extra_spheres={n}")], vec!["variant, BVH"]));
+        cases.push((
+            "spherelist",
+            sl,
+            vec![format!("extra_spheres={n}")],
+            vec!["variant, BVH"],
+        ));
     }
     // The teapot from 19.2k to 1.2M triangles: the same generator, finer.
-    let detail: &[&str] = if quick { &["40x30"] } else { &["40x30", "80x60", "160x120"] };
-    let teapot_size = if quick { Size { width: 40, height: 40 } } else { big };
+    let detail: &[&str] = if quick {
+        &["40x30"]
+    } else {
+        &["40x30", "80x60", "160x120"]
+    };
+    let teapot_size = if quick {
+        Size {
+            width: 40,
+            height: 40,
+        }
+    } else {
+        big
+    };
     for t in detail {
-        cases.push(("teapot", teapot_size, vec![format!("tessellation={t}")], vec!["variant, BVH"]));
+        cases.push((
+            "teapot",
+            teapot_size,
+            vec![format!("tessellation={t}")],
+            vec!["variant, BVH"],
+        ));
     }
-    eprintln!("twinray compare: measuring shader variants and the BVH ({} runs)", cases.iter().map(|c| c.3.len() * 2).sum::<usize>());
+    eprintln!(
+        "twinray compare: measuring shader variants and the BVH ({} runs)",
+        cases.iter().map(|c| c.3.len() * 2).sum::<usize>()
+    );
     let mut runs = Vec::new();
     for (scene, size, set, configs) in cases {
         for config in configs {
             let bvh = config.ends_with("BVH");
             let stats = bvh.then(|| {
-                let overrides: Vec<(String, String)> =
-                    set.iter().filter_map(|kv| kv.split_once('=')).map(|(k, v)| (k.into(), v.into())).collect();
-                twinray_common::scene::Scene::load(scene, &overrides).ok().map(|sc| {
-                    let b = twinray_common::bvh::Bvh::build(&sc);
-                    (b.nodes.len(), b.bytes(), b.build_ms)
-                })
+                let overrides: Vec<(String, String)> = set
+                    .iter()
+                    .filter_map(|kv| kv.split_once('='))
+                    .map(|(k, v)| (k.into(), v.into()))
+                    .collect();
+                twinray_common::scene::Scene::load(scene, &overrides)
+                    .ok()
+                    .map(|sc| {
+                        let b = twinray_common::bvh::Bvh::build(&sc);
+                        (b.nodes.len(), b.bytes(), b.build_ms)
+                    })
             });
             for api in [Api::Vulkan, Api::Opengl] {
                 if stop.load(Ordering::SeqCst) {
@@ -458,7 +638,15 @@ pub fn acceleration(plan: &Plan, stop: &AtomicBool) -> Vec<AccelRun> {
                     ..RenderArgs::headless(scene, size)
                 };
                 let result = run_json(api, &ra).map_err(|e| format!("{e:#}"));
-                runs.push(AccelRun { scene, size, set: set.clone(), config, api, result, bvh: stats.flatten() });
+                runs.push(AccelRun {
+                    scene,
+                    size,
+                    set: set.clone(),
+                    config,
+                    api,
+                    result,
+                    bvh: stats.flatten(),
+                });
             }
         }
     }

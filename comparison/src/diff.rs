@@ -15,21 +15,34 @@ pub fn run(a: &Path, b: &Path, json: bool, heatmap: Option<&Path>) -> anyhow::Re
             let (pa, pb) = (ia.get_pixel(x, y), ib.get_pixel(x, y));
             let worst = (0..3).map(|c| pa[c].abs_diff(pb[c])).max().unwrap_or(0);
             let grey = ((pa[0] as u32 + pa[1] as u32 + pa[2] as u32) / 9) as u8;
-            *p = if worst > 1 { image::Rgb([128u8.saturating_add(worst.saturating_mul(2)), 0, 0]) } else { image::Rgb([grey; 3]) };
+            *p = if worst > 1 {
+                image::Rgb([128u8.saturating_add(worst.saturating_mul(2)), 0, 0])
+            } else {
+                image::Rgb([grey; 3])
+            };
         }
         twinray_common::image_io::save_png(&out, path)?;
     }
     if json {
         println!("{}", serde_json::to_string(&m)?);
     } else {
-        println!("{} vs {} ({}x{})", a.display(), b.display(), m.width, m.height);
+        println!(
+            "{} vs {} ({}x{})",
+            a.display(),
+            b.display(),
+            m.width,
+            m.height
+        );
         print_table(&[("", m)]);
     }
     Ok(())
 }
 
 pub fn print_table(rows: &[(&str, Metrics)]) {
-    println!("{:<28} {:>10} {:>9} {:>8} {:>10} {:>10} {:>6}", "", "RMSE", "PSNR dB", "max abs", ">1/255", ">8/255", "NaN");
+    println!(
+        "{:<28} {:>10} {:>9} {:>8} {:>10} {:>10} {:>6}",
+        "", "RMSE", "PSNR dB", "max abs", ">1/255", ">8/255", "NaN"
+    );
     for (name, m) in rows {
         println!(
             "{:<28} {:>10.6} {:>9.2} {:>8} {:>9.4}% {:>9.4}% {:>6}",

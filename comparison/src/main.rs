@@ -14,7 +14,10 @@ use twinray_common::cli::RenderArgs;
 use twinray_common::error::exit_with;
 
 #[derive(Parser)]
-#[command(name = "twinray", about = "One GLSL ray tracer, two front doors: Vulkan vs OpenGL, checked against an f64 reference")]
+#[command(
+    name = "twinray",
+    about = "One GLSL ray tracer, two front doors: Vulkan vs OpenGL, checked against an f64 reference"
+)]
 struct Cli {
     #[command(subcommand)]
     command: Command,
@@ -58,7 +61,12 @@ fn main() {
     };
     let result = match cli.command {
         Command::Render { api, args } => apps::render(api, &args),
-        Command::Diff { a, b, json, heatmap } => diff::run(&a, &b, json, heatmap.as_deref()),
+        Command::Diff {
+            a,
+            b,
+            json,
+            heatmap,
+        } => diff::run(&a, &b, json, heatmap.as_deref()),
         Command::Compare(args) => compare::run(&args),
         Command::Accuracy(args) => accuracy::run(&args),
     };

@@ -2,8 +2,8 @@
 //! report.md (the study's tables with ours beside them, ratios, machine info,
 //! a summary derived from the numbers) and one SVG plot per experiment.
 
-use crate::compare::{api_name, AccelRun, Agreement, Outcome, Plan, EXPERIMENTS};
 use crate::apps::Api;
+use crate::compare::{api_name, AccelRun, Agreement, Outcome, Plan, EXPERIMENTS};
 use crate::study::{self, StudyRow};
 use anyhow::Context;
 use plotters::prelude::*;
@@ -15,18 +15,40 @@ use twinray_common::report::RunReport;
 pub fn cpu_model() -> String {
     std::fs::read_to_string("/proc/cpuinfo")
         .ok()
-        .and_then(|t| t.lines().find_map(|l| l.strip_prefix("model name").map(|v| v.trim_start_matches([' ', '\t', ':']).to_string())))
-        .map(|m| format!("{m} ({} threads)", std::thread::available_parallelism().map(|n| n.get()).unwrap_or(1)))
+        .and_then(|t| {
+            t.lines().find_map(|l| {
+                l.strip_prefix("model name")
+                    .map(|v| v.trim_start_matches([' ', '\t', ':']).to_string())
+            })
+        })
+        .map(|m| {
+            format!(
+                "{m} ({} threads)",
+                std::thread::available_parallelism()
+                    .map(|n| n.get())
+                    .unwrap_or(1)
+            )
+        })
         .unwrap_or_else(|| "unknown CPU".into())
 }
 
-pub fn write_all(out: &Path, plan: &Plan, outcomes: &[Outcome], accel: &[AccelRun], agreement: &[Agreement], interrupted: bool) -> anyhow::Result<()> {
+pub fn write_all(
+    out: &Path,
+    plan: &Plan,
+    outcomes: &[Outcome],
+    accel: &[AccelRun],
+    agreement: &[Agreement],
+    interrupted: bool,
+) -> anyhow::Result<()> {
     let cpu = cpu_model();
     std::fs::write(out.join("results.csv"), csv(outcomes, &cpu)).context("writing results.csv")?;
     let study = study::rows();
     let mut plots: Vec<String> = Vec::new();
     for exp in EXPERIMENTS {
-        let rows: Vec<&Outcome> = outcomes.iter().filter(|o| o.point.experiment == exp).collect();
+        let rows: Vec<&Outcome> = outcomes
+            .iter()
+            .filter(|o| o.point.experiment == exp)
+            .collect();
         if rows.is_empty() {
             continue;
         }
@@ -38,8 +60,20 @@ pub fn write_all(out: &Path, plan: &Plan, outcomes: &[Outcome], accel: &[AccelRu
         plot_scaling(&out.join("scaling.svg"), outcomes, accel).context("plotting scaling.svg")?;
         plots.push("scaling.svg".to_string());
     }
-    std::fs::write(out.join("report.md"), markdown(plan, outcomes, accel, agreement, &study, &cpu, &plots, interrupted))
-        .context("writing report.md")?;
+    std::fs::write(
+        out.join("report.md"),
+        markdown(
+            plan,
+            outcomes,
+            accel,
+            agreement,
+            &study,
+            &cpu,
+            &plots,
+            interrupted,
+        ),
+    )
+    .context("writing report.md")?;
     Ok(())
 }
 
@@ -58,8 +92,20 @@ pub fn csv(outcomes: &[Outcome], cpu: &str) -> String {
     s.push('\n');
     for o in outcomes {
         let p = &o.point;
-        let workgroup = o.result.as_ref().ok().and_then(|r| r.workgroup.clone()).unwrap_or_default();
-        let head = format!("{},{},{},{},{},{workgroup}", p.experiment, p.param_name, p.param_value, api_name(o.api), o.path);
+        let workgroup = o
+            .result
+            .as_ref()
+            .ok()
+            .and_then(|r| r.workgroup.clone())
+            .unwrap_or_default();
+        let head = format!(
+            "{},{},{},{},{},{workgroup}",
+            p.experiment,
+            p.param_name,
+            p.param_value,
+            api_name(o.api),
+            o.path
+        );
         match &o.result {
             Ok(r) => {
                 let st = |x: Option<twinray_common::stats::Summary>| match x {
@@ -85,14 +131,26 @@ pub fn csv(outcomes: &[Outcome], cpu: &str) -> String {
                 );
             }
             Err(e) => {
-                let _ = writeln!(s, "{head},{},0,,,,,,,,,,,,{},{},,,,,{}", q(&format!("failed: {e}")), p.size.width, p.size.height, q(cpu));
+                let _ = writeln!(
+                    s,
+                    "{head},{},0,,,,,,,,,,,,{},{},,,,,{}",
+                    q(&format!("failed: {e}")),
+                    p.size.width,
+                    p.size.height,
+                    q(cpu)
+                );
             }
         }
     }
     s
 }
 
-fn report_of<'a>(outcomes: &'a [&Outcome], value: &str, api: Api, path: RenderPath) -> Option<&'a RunReport> {
+fn report_of<'a>(
+    outcomes: &'a [&Outcome],
+    value: &str,
+    api: Api,
+    path: RenderPath,
+) -> Option<&'a RunReport> {
     outcomes
         .iter()
         .find(|o| o.point.param_value == value && o.api == api && o.path == path)
@@ -101,7 +159,10 @@ fn report_of<'a>(outcomes: &'a [&Outcome], value: &str, api: Api, path: RenderPa
 
 /// The paths that have at least one row, fragment first.
 fn paths_in(outcomes: &[Outcome]) -> Vec<RenderPath> {
-    [RenderPath::Fragment, RenderPath::Compute].into_iter().filter(|p| outcomes.iter().any(|o| o.path == *p)).collect()
+    [RenderPath::Fragment, RenderPath::Compute]
+        .into_iter()
+        .filter(|p| outcomes.iter().any(|o| o.path == *p))
+        .collect()
 }
 
 fn ratio(a: Option<f64>, b: Option<f64>) -> Option<f64> {
@@ -112,7 +173,8 @@ fn ratio(a: Option<f64>, b: Option<f64>) -> Option<f64> {
 }
 
 fn f(v: Option<f64>, digits: usize) -> String {
-    v.map(|v| format!("{v:.digits$}")).unwrap_or_else(|| "–".into())
+    v.map(|v| format!("{v:.digits$}"))
+        .unwrap_or_else(|| "–".into())
 }
 
 fn range(v: &[f64]) -> Option<(f64, f64, f64)> {
@@ -133,21 +195,38 @@ struct ExpRatios {
 }
 
 fn ratios(exp: &str, path: RenderPath, outcomes: &[Outcome], study: &[StudyRow]) -> ExpRatios {
-    let rows: Vec<&Outcome> = outcomes.iter().filter(|o| o.point.experiment == exp && o.path == path).collect();
+    let rows: Vec<&Outcome> = outcomes
+        .iter()
+        .filter(|o| o.point.experiment == exp && o.path == path)
+        .collect();
     let mut values: Vec<String> = rows.iter().map(|o| o.point.param_value.clone()).collect();
     values.dedup();
-    let mut r = ExpRatios { wall: vec![], gpu: vec![], study: vec![], spirv: vec![] };
+    let mut r = ExpRatios {
+        wall: vec![],
+        gpu: vec![],
+        study: vec![],
+        spirv: vec![],
+    };
     for v in &values {
         let vk = report_of(&rows, v, Api::Vulkan, path);
         let gl = report_of(&rows, v, Api::Opengl, path);
-        if let Some(x) = ratio(vk.and_then(|r| r.wall_ms).map(|s| s.median), gl.and_then(|r| r.wall_ms).map(|s| s.median)) {
+        if let Some(x) = ratio(
+            vk.and_then(|r| r.wall_ms).map(|s| s.median),
+            gl.and_then(|r| r.wall_ms).map(|s| s.median),
+        ) {
             r.wall.push(x);
         }
-        if let Some(x) = ratio(vk.and_then(|r| r.gpu_ms).map(|s| s.median), gl.and_then(|r| r.gpu_ms).map(|s| s.median)) {
+        if let Some(x) = ratio(
+            vk.and_then(|r| r.gpu_ms).map(|s| s.median),
+            gl.and_then(|r| r.gpu_ms).map(|s| s.median),
+        ) {
             r.gpu.push(x);
         }
         let glspv = report_of(&rows, v, Api::OpenglSpirv, path);
-        if let Some(x) = ratio(vk.and_then(|r| r.gpu_ms).map(|s| s.median), glspv.and_then(|r| r.gpu_ms).map(|s| s.median)) {
+        if let Some(x) = ratio(
+            vk.and_then(|r| r.gpu_ms).map(|s| s.median),
+            glspv.and_then(|r| r.gpu_ms).map(|s| s.median),
+        ) {
             r.spirv.push(x);
         }
         if let Some(s) = study::find(study, exp, v) {
@@ -186,16 +265,27 @@ fn path_summary(outcomes: &[Outcome], study: &[StudyRow]) -> Vec<String> {
         } else {
             ("wall", range(&frag.wall), range(&comp.wall))
         };
-        let (Some((_, f, _)), Some((_, c, _))) = (f, c) else { continue };
+        let (Some((_, f, _)), Some((_, c, _))) = (f, c) else {
+            continue;
+        };
         let verdict = if (c - f).abs() < 0.03 * f {
             "the API gap does not depend on the entry point".to_string()
         } else if c < f {
-            format!("Vulkan gains {:.0} % on OpenGL when the tracer runs as a compute shader", 100.0 * (1.0 - c / f))
+            format!(
+                "Vulkan gains {:.0} % on OpenGL when the tracer runs as a compute shader",
+                100.0 * (1.0 - c / f)
+            )
         } else {
-            format!("Vulkan loses {:.0} % to OpenGL when the tracer runs as a compute shader", 100.0 * (c / f - 1.0))
+            format!(
+                "Vulkan loses {:.0} % to OpenGL when the tracer runs as a compute shader",
+                100.0 * (c / f - 1.0)
+            )
         };
         // Each API's fragment time / compute time, median over the points.
-        let rows: Vec<&Outcome> = outcomes.iter().filter(|o| o.point.experiment == exp).collect();
+        let rows: Vec<&Outcome> = outcomes
+            .iter()
+            .filter(|o| o.point.experiment == exp)
+            .collect();
         let mut values: Vec<String> = rows.iter().map(|o| o.point.param_value.clone()).collect();
         values.dedup();
         let speedup = |api: Api| {
@@ -203,12 +293,16 @@ fn path_summary(outcomes: &[Outcome], study: &[StudyRow]) -> Vec<String> {
                 .iter()
                 .filter_map(|v| {
                     let t = |path| {
-                        report_of(&rows, v, api, path).and_then(|r| if what == "GPU" { r.gpu_ms } else { r.wall_ms }).map(|x| x.median)
+                        report_of(&rows, v, api, path)
+                            .and_then(|r| if what == "GPU" { r.gpu_ms } else { r.wall_ms })
+                            .map(|x| x.median)
                     };
                     ratio(t(RenderPath::Fragment), t(RenderPath::Compute))
                 })
                 .collect();
-            range(&v).map(|(_, m, _)| format!("{m:.2}×")).unwrap_or_else(|| "–".into())
+            range(&v)
+                .map(|(_, m, _)| format!("{m:.2}×"))
+                .unwrap_or_else(|| "–".into())
         };
         lines.push(format!(
             "- **{exp}, fragment → compute**: Vulkan/OpenGL {what} median {f:.2}× on the fragment path, {c:.2}× on the compute path: {verdict}. \
@@ -228,11 +322,19 @@ fn four_numbers(outcomes: &[Outcome]) -> String {
     );
     let mut any = false;
     for exp in EXPERIMENTS {
-        let rows: Vec<&Outcome> = outcomes.iter().filter(|o| o.point.experiment == exp).collect();
-        let Some(last) = rows.last().map(|o| o.point.param_value.clone()) else { continue };
+        let rows: Vec<&Outcome> = outcomes
+            .iter()
+            .filter(|o| o.point.experiment == exp)
+            .collect();
+        let Some(last) = rows.last().map(|o| o.point.param_value.clone()) else {
+            continue;
+        };
         let cell = |api: Api, path: RenderPath| {
             let r = report_of(&rows, &last, api, path);
-            let med = |gpu: bool| r.and_then(|r| if gpu { r.gpu_ms } else { r.wall_ms }).map(|x| x.median);
+            let med = |gpu: bool| {
+                r.and_then(|r| if gpu { r.gpu_ms } else { r.wall_ms })
+                    .map(|x| x.median)
+            };
             format!("{} / {}", f(med(true), 3), f(med(false), 3))
         };
         any = true;
@@ -245,13 +347,34 @@ fn four_numbers(outcomes: &[Outcome]) -> String {
             cell(Api::Opengl, RenderPath::Compute)
         );
     }
-    if any { s } else { String::new() }
+    if any {
+        s
+    } else {
+        String::new()
+    }
 }
 
-pub fn markdown(plan: &Plan, outcomes: &[Outcome], accel: &[AccelRun], agreement: &[Agreement], study: &[StudyRow], cpu: &str, plots: &[String], interrupted: bool) -> String {
+pub fn markdown(
+    plan: &Plan,
+    outcomes: &[Outcome],
+    accel: &[AccelRun],
+    agreement: &[Agreement],
+    study: &[StudyRow],
+    cpu: &str,
+    plots: &[String],
+    interrupted: bool,
+) -> String {
     let mut s = String::new();
-    let any = |api: Api| outcomes.iter().find(|o| o.api == api).and_then(|o| o.result.as_ref().ok());
-    let device = any(Api::Vulkan).or(any(Api::Opengl)).map(|r| r.device.clone()).unwrap_or_else(|| "no device".into());
+    let any = |api: Api| {
+        outcomes
+            .iter()
+            .find(|o| o.api == api)
+            .and_then(|o| o.result.as_ref().ok())
+    };
+    let device = any(Api::Vulkan)
+        .or(any(Api::Opengl))
+        .map(|r| r.device.clone())
+        .unwrap_or_else(|| "no device".into());
     let _ = writeln!(s, "# twinray compare — {device}\n");
 
     // The three-line summary: one line per experiment, computed from the rows below.
@@ -267,7 +390,13 @@ pub fn markdown(plan: &Plan, outcomes: &[Outcome], accel: &[AccelRun], agreement
                 (None, Some(w)) => ("wall", w),
                 _ => continue,
             };
-            let who = if m > 1.02 { "OpenGL faster" } else if m < 0.98 { "Vulkan faster" } else { "a tie" };
+            let who = if m > 1.02 {
+                "OpenGL faster"
+            } else if m < 0.98 {
+                "Vulkan faster"
+            } else {
+                "a tie"
+            };
             parts.push(format!("{path} {m:.2}× ({what}, {who})"));
             if path == RenderPath::Fragment {
                 if let Some(st) = med(&r.study) {
@@ -290,18 +419,22 @@ pub fn markdown(plan: &Plan, outcomes: &[Outcome], accel: &[AccelRun], agreement
             }
         }
         if !parts.is_empty() {
-            let _ = writeln!(s, "- **{exp}** — Vulkan/OpenGL: {}. Why: {why}.", parts.join(", "));
+            let _ = writeln!(
+                s,
+                "- **{exp}** — Vulkan/OpenGL: {}. Why: {why}.",
+                parts.join(", ")
+            );
         }
     }
     let _ = writeln!(s);
     let _ = writeln!(s, "## Summary by path\n");
     for exp in EXPERIMENTS {
-      for &path in &paths {
-        let r = ratios(exp, path, outcomes, study);
-        if r.wall.is_empty() && r.gpu.is_empty() {
-            continue;
-        }
-        let why = match (range(&r.wall), range(&r.gpu)) {
+        for &path in &paths {
+            let r = ratios(exp, path, outcomes, study);
+            if r.wall.is_empty() && r.gpu.is_empty() {
+                continue;
+            }
+            let why = match (range(&r.wall), range(&r.gpu)) {
             (Some((_, w, _)), Some((_, g, _))) if (w - g).abs() < 0.05 => {
                 "wall and GPU ratios agree, so the gap (if any) is in executing the shader, not in API overhead"
             }
@@ -309,39 +442,48 @@ pub fn markdown(plan: &Plan, outcomes: &[Outcome], accel: &[AccelRun], agreement
             (Some(_), Some(_)) => "OpenGL's per-frame overhead outside the draw exceeds Vulkan's",
             _ => "GPU timers unavailable on this driver: wall time only",
         };
-        let spirv = match (range(&r.gpu), range(&r.spirv)) {
-            (Some((_, g, _)), Some((_, sp, _))) => {
-                let verdict = if (sp - 1.0).abs() < 0.03 && (g - 1.0).abs() >= 0.03 {
-                    "so the gap comes with naga's SPIR-V through the driver's SPIR-V compiler, not with the Vulkan API"
-                } else if (sp - g).abs() < 0.03 {
-                    "so the gap is not the shader binary: it stays with the API"
-                } else {
-                    "so part of the gap is the shader path and part the API"
-                };
-                format!(" With OpenGL running the very same SPIR-V, {}, {verdict}.", describe("Vulkan/OpenGL-SPIR-V GPU", &r.spirv))
-            }
-            _ => String::new(),
-        };
-        let _ = writeln!(
+            let spirv = match (range(&r.gpu), range(&r.spirv)) {
+                (Some((_, g, _)), Some((_, sp, _))) => {
+                    let verdict = if (sp - 1.0).abs() < 0.03 && (g - 1.0).abs() >= 0.03 {
+                        "so the gap comes with naga's SPIR-V through the driver's SPIR-V compiler, not with the Vulkan API"
+                    } else if (sp - g).abs() < 0.03 {
+                        "so the gap is not the shader binary: it stays with the API"
+                    } else {
+                        "so part of the gap is the shader path and part the API"
+                    };
+                    format!(
+                        " With OpenGL running the very same SPIR-V, {}, {verdict}.",
+                        describe("Vulkan/OpenGL-SPIR-V GPU", &r.spirv)
+                    )
+                }
+                _ => String::new(),
+            };
+            let _ = writeln!(
             s,
             "- **{exp}, {path} path**: Vulkan/OpenGL {}; {}; study (fragment) {}. {why}.{spirv}",
             describe("wall", &r.wall),
             describe("GPU", &r.gpu),
             describe("", &r.study).trim_start()
         );
-      }
+        }
     }
     if paths.len() == 2 {
         let _ = writeln!(s);
         for line in path_summary(outcomes, study) {
             let _ = writeln!(s, "{line}");
         }
-        let _ = writeln!(s, "\nEach experiment's largest point on both paths, median GPU ms / wall ms:\n");
+        let _ = writeln!(
+            s,
+            "\nEach experiment's largest point on both paths, median GPU ms / wall ms:\n"
+        );
         let _ = write!(s, "{}", four_numbers(outcomes));
     }
     let _ = writeln!(s);
     if interrupted {
-        let _ = writeln!(s, "> Interrupted with Ctrl-C: only the points that finished are below.\n");
+        let _ = writeln!(
+            s,
+            "> Interrupted with Ctrl-C: only the points that finished are below.\n"
+        );
     }
     let _ = writeln!(
         s,
@@ -354,19 +496,31 @@ pub fn markdown(plan: &Plan, outcomes: &[Outcome], accel: &[AccelRun], agreement
     );
 
     let _ = writeln!(s, "## Machine\n\n| | Vulkan | OpenGL |\n|---|---|---|");
-    let field = |api: Api, g: &dyn Fn(&RunReport) -> String| any(api).map(g).unwrap_or_else(|| "–".into());
+    let field =
+        |api: Api, g: &dyn Fn(&RunReport) -> String| any(api).map(g).unwrap_or_else(|| "–".into());
     for (name, g) in [
-        ("device", &(|r: &RunReport| r.device.clone()) as &dyn Fn(&RunReport) -> String),
+        (
+            "device",
+            &(|r: &RunReport| r.device.clone()) as &dyn Fn(&RunReport) -> String,
+        ),
         ("driver", &|r: &RunReport| r.driver.clone()),
         ("API version", &|r: &RunReport| r.api_version.clone()),
         ("OS", &|r: &RunReport| r.os.clone()),
     ] {
-        let _ = writeln!(s, "| {name} | {} | {} |", field(Api::Vulkan, g), field(Api::Opengl, g));
+        let _ = writeln!(
+            s,
+            "| {name} | {} | {} |",
+            field(Api::Vulkan, g),
+            field(Api::Opengl, g)
+        );
     }
     let _ = writeln!(s, "| CPU | {cpu} | {cpu} |\n");
 
     for exp in EXPERIMENTS {
-        let rows: Vec<&Outcome> = outcomes.iter().filter(|o| o.point.experiment == exp).collect();
+        let rows: Vec<&Outcome> = outcomes
+            .iter()
+            .filter(|o| o.point.experiment == exp)
+            .collect();
         if rows.is_empty() {
             continue;
         }
@@ -381,54 +535,75 @@ pub fn markdown(plan: &Plan, outcomes: &[Outcome], accel: &[AccelRun], agreement
             let _ = writeln!(s, "![{exp}]({exp}.svg)\n");
         }
         let all_rows = rows;
-      for &path in &paths {
-        let rows: Vec<&Outcome> = all_rows.iter().copied().filter(|o| o.path == path).collect();
-        if rows.is_empty() {
-            continue;
-        }
-        if paths.len() > 1 {
-            let _ = writeln!(s, "### {} path\n", path);
-        }
-        let has_spirv = rows.iter().any(|o| o.api == Api::OpenglSpirv);
-        let _ = writeln!(
+        for &path in &paths {
+            let rows: Vec<&Outcome> = all_rows
+                .iter()
+                .copied()
+                .filter(|o| o.path == path)
+                .collect();
+            if rows.is_empty() {
+                continue;
+            }
+            if paths.len() > 1 {
+                let _ = writeln!(s, "### {} path\n", path);
+            }
+            let has_spirv = rows.iter().any(|o| o.api == Api::OpenglSpirv);
+            let _ = writeln!(
             s,
             "| {} | study VK mean / median (s) | study GL mean / median (s) | study VK/GL | VK wall (ms) | GL wall (ms) | VK/GL wall | VK GPU (ms) | GL GPU (ms) | VK/GL GPU | frames VK/GL |{}",
             first.param_name,
             if has_spirv { " GL SPIR-V GPU (ms) | VK/GL-SPIR-V GPU |" } else { "" }
         );
-        let _ = writeln!(s, "|---|---|---|---|---|---|---|---|---|---|---|{}", if has_spirv { "---|---|" } else { "" });
-        let mut values: Vec<String> = rows.iter().map(|o| o.point.param_value.clone()).collect();
-        values.dedup();
-        for v in &values {
-            let st = study::find(study, exp, v);
-            let vk = report_of(&rows, v, Api::Vulkan, path);
-            let gl = report_of(&rows, v, Api::Opengl, path);
-            let med = |r: Option<&RunReport>, gpu: bool| r.and_then(|r| if gpu { r.gpu_ms } else { r.wall_ms }).map(|x| x.median);
-            let frames = |r: Option<&RunReport>| r.map(|r| r.frames.len().to_string()).unwrap_or_else(|| "failed".into());
-            let glspv = report_of(&rows, v, Api::OpenglSpirv, path);
-            let extra = if has_spirv {
-                format!(" {} | {} |", f(med(glspv, true), 3), f(ratio(med(vk, true), med(glspv, true)), 2))
-            } else {
-                String::new()
-            };
             let _ = writeln!(
                 s,
-                "| {v} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {}/{} |{extra}",
-                st.map(|x| format!("{:.5} / {:.5}", x.vulkan_mean_s, x.vulkan_median_s)).unwrap_or_else(|| "–".into()),
-                st.map(|x| format!("{:.5} / {:.5}", x.opengl_mean_s, x.opengl_median_s)).unwrap_or_else(|| "–".into()),
-                f(st.map(|x| x.vulkan_median_s / x.opengl_median_s), 2),
-                f(med(vk, false), 3),
-                f(med(gl, false), 3),
-                f(ratio(med(vk, false), med(gl, false)), 2),
-                f(med(vk, true), 3),
-                f(med(gl, true), 3),
-                f(ratio(med(vk, true), med(gl, true)), 2),
-                frames(vk),
-                frames(gl)
+                "|---|---|---|---|---|---|---|---|---|---|---|{}",
+                if has_spirv { "---|---|" } else { "" }
             );
+            let mut values: Vec<String> =
+                rows.iter().map(|o| o.point.param_value.clone()).collect();
+            values.dedup();
+            for v in &values {
+                let st = study::find(study, exp, v);
+                let vk = report_of(&rows, v, Api::Vulkan, path);
+                let gl = report_of(&rows, v, Api::Opengl, path);
+                let med = |r: Option<&RunReport>, gpu: bool| {
+                    r.and_then(|r| if gpu { r.gpu_ms } else { r.wall_ms })
+                        .map(|x| x.median)
+                };
+                let frames = |r: Option<&RunReport>| {
+                    r.map(|r| r.frames.len().to_string())
+                        .unwrap_or_else(|| "failed".into())
+                };
+                let glspv = report_of(&rows, v, Api::OpenglSpirv, path);
+                let extra = if has_spirv {
+                    format!(
+                        " {} | {} |",
+                        f(med(glspv, true), 3),
+                        f(ratio(med(vk, true), med(glspv, true)), 2)
+                    )
+                } else {
+                    String::new()
+                };
+                let _ = writeln!(
+                    s,
+                    "| {v} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {}/{} |{extra}",
+                    st.map(|x| format!("{:.5} / {:.5}", x.vulkan_mean_s, x.vulkan_median_s))
+                        .unwrap_or_else(|| "–".into()),
+                    st.map(|x| format!("{:.5} / {:.5}", x.opengl_mean_s, x.opengl_median_s))
+                        .unwrap_or_else(|| "–".into()),
+                    f(st.map(|x| x.vulkan_median_s / x.opengl_median_s), 2),
+                    f(med(vk, false), 3),
+                    f(med(gl, false), 3),
+                    f(ratio(med(vk, false), med(gl, false)), 2),
+                    f(med(vk, true), 3),
+                    f(med(gl, true), 3),
+                    f(ratio(med(vk, true), med(gl, true)), 2),
+                    frames(vk),
+                    frames(gl)
+                );
+            }
+            let _ = writeln!(s);
         }
-        let _ = writeln!(s);
-      }
     }
 
     if !accel.is_empty() {
@@ -440,7 +615,13 @@ pub fn markdown(plan: &Plan, outcomes: &[Outcome], accel: &[AccelRun], agreement
              has no GPU timer); speed-up against the generic brute-force shader of the same API.\n"
         );
         let _ = writeln!(s, "| scene | size | configuration | VK (ms) | GL (ms) | VK speed-up | GL speed-up | BVH nodes / bytes / build ms |\n|---|---|---|---|---|---|---|---|");
-        let time = |r: &AccelRun| r.result.as_ref().ok().and_then(|r| r.gpu_ms.or(r.wall_ms)).map(|x| x.median);
+        let time = |r: &AccelRun| {
+            r.result
+                .as_ref()
+                .ok()
+                .and_then(|r| r.gpu_ms.or(r.wall_ms))
+                .map(|x| x.median)
+        };
         let mut keys: Vec<(&str, String, String, &str)> = Vec::new();
         for r in accel {
             let k = (r.scene, r.size.to_string(), r.set.join(" "), r.config);
@@ -450,7 +631,13 @@ pub fn markdown(plan: &Plan, outcomes: &[Outcome], accel: &[AccelRun], agreement
         }
         for (scene, size, set, config) in &keys {
             let find = |api: Api, cfg: &str| {
-                accel.iter().find(|r| r.scene == *scene && r.size.to_string() == *size && r.set.join(" ") == *set && r.config == cfg && r.api == api)
+                accel.iter().find(|r| {
+                    r.scene == *scene
+                        && r.size.to_string() == *size
+                        && r.set.join(" ") == *set
+                        && r.config == cfg
+                        && r.api == api
+                })
             };
             let vk = find(Api::Vulkan, config).and_then(time);
             let gl = find(Api::Opengl, config).and_then(time);
@@ -459,14 +646,22 @@ pub fn markdown(plan: &Plan, outcomes: &[Outcome], accel: &[AccelRun], agreement
                 .and_then(|r| r.bvh)
                 .map(|(n, b, ms)| format!("{n} / {:.1} KiB / {ms:.1}", b as f64 / 1024.0))
                 .unwrap_or_else(|| "–".into());
-            let label = if set.is_empty() { scene.to_string() } else { format!("{scene} ({set})") };
+            let label = if set.is_empty() {
+                scene.to_string()
+            } else {
+                format!("{scene} ({set})")
+            };
             let _ = writeln!(
                 s,
                 "| {label} | {size} | {config} | {} | {} | {} | {} | {bvh} |",
                 f(vk, 3),
                 f(gl, 3),
-                ratio(base(Api::Vulkan), vk).map(|x| format!("{x:.1}×")).unwrap_or_else(|| "–".into()),
-                ratio(base(Api::Opengl), gl).map(|x| format!("{x:.1}×")).unwrap_or_else(|| "–".into()),
+                ratio(base(Api::Vulkan), vk)
+                    .map(|x| format!("{x:.1}×"))
+                    .unwrap_or_else(|| "–".into()),
+                ratio(base(Api::Opengl), gl)
+                    .map(|x| format!("{x:.1}×"))
+                    .unwrap_or_else(|| "–".into()),
             );
         }
         if plots.iter().any(|p| p == "scaling.svg") {
@@ -474,7 +669,15 @@ pub fn markdown(plan: &Plan, outcomes: &[Outcome], accel: &[AccelRun], agreement
         }
         let failed: Vec<&AccelRun> = accel.iter().filter(|r| r.result.is_err()).collect();
         for r in failed {
-            let _ = writeln!(s, "\n- {} {} {} {}: {}", r.scene, r.config, api_name(r.api), r.size, r.result.as_ref().err().map(String::as_str).unwrap_or(""));
+            let _ = writeln!(
+                s,
+                "\n- {} {} {} {}: {}",
+                r.scene,
+                r.config,
+                api_name(r.api),
+                r.size,
+                r.result.as_ref().err().map(String::as_str).unwrap_or("")
+            );
         }
         let _ = writeln!(s);
     }
@@ -529,7 +732,13 @@ pub fn markdown(plan: &Plan, outcomes: &[Outcome], accel: &[AccelRun], agreement
                     );
                 }
                 Err(e) => {
-                    let _ = writeln!(s, "| {} | {} | failed: {} | | | | |", a.scene, a.size, e.replace('|', "/"));
+                    let _ = writeln!(
+                        s,
+                        "| {} | {} | failed: {} | | | | |",
+                        a.scene,
+                        a.size,
+                        e.replace('|', "/")
+                    );
                 }
             }
         }
@@ -552,7 +761,10 @@ pub fn markdown(plan: &Plan, outcomes: &[Outcome], accel: &[AccelRun], agreement
         }
         let _ = writeln!(s);
     }
-    let _ = writeln!(s, "Full statistics (mean, median, min, max of wall and GPU time) are in `results.csv`.");
+    let _ = writeln!(
+        s,
+        "Full statistics (mean, median, min, max of wall and GPU time) are in `results.csv`."
+    );
     s
 }
 
@@ -560,7 +772,11 @@ fn x_of(exp: &str, value: &str) -> f64 {
     if exp == "spherelist" {
         value.parse().unwrap_or(1.0)
     } else {
-        value.split('x').next().and_then(|w| w.parse().ok()).unwrap_or(1.0)
+        value
+            .split('x')
+            .next()
+            .and_then(|w| w.parse().ok())
+            .unwrap_or(1.0)
     }
 }
 
@@ -570,10 +786,18 @@ fn plot(path: &Path, exp: &str, rows: &[&Outcome], study: &[StudyRow]) -> anyhow
     let colours = [
         (Api::Vulkan, RenderPath::Fragment, RGBColor(200, 30, 30)),
         (Api::Opengl, RenderPath::Fragment, RGBColor(30, 80, 200)),
-        (Api::OpenglSpirv, RenderPath::Fragment, RGBColor(120, 60, 160)),
+        (
+            Api::OpenglSpirv,
+            RenderPath::Fragment,
+            RGBColor(120, 60, 160),
+        ),
         (Api::Vulkan, RenderPath::Compute, RGBColor(250, 120, 110)),
         (Api::Opengl, RenderPath::Compute, RGBColor(100, 170, 250)),
-        (Api::OpenglSpirv, RenderPath::Compute, RGBColor(190, 140, 220)),
+        (
+            Api::OpenglSpirv,
+            RenderPath::Compute,
+            RGBColor(190, 140, 220),
+        ),
     ];
     for (api, path, colour) in colours {
         for gpu in [false, true] {
@@ -587,43 +811,99 @@ fn plot(path: &Path, exp: &str, rows: &[&Outcome], study: &[StudyRow]) -> anyhow
                 })
                 .collect();
             if !pts.is_empty() {
-                series.push((format!("ours {} {path} {}", api_name(api), if gpu { "GPU" } else { "wall" }), colour, pts));
+                series.push((
+                    format!(
+                        "ours {} {path} {}",
+                        api_name(api),
+                        if gpu { "GPU" } else { "wall" }
+                    ),
+                    colour,
+                    pts,
+                ));
             }
         }
     }
     let st: Vec<&StudyRow> = study.iter().filter(|r| r.experiment == exp).collect();
-    series.push(("study vulkan".into(), RGBColor(240, 140, 40), st.iter().map(|r| (x_of(exp, &r.param_value), r.vulkan_median_s * 1e3)).collect()));
-    series.push(("study opengl".into(), RGBColor(40, 170, 170), st.iter().map(|r| (x_of(exp, &r.param_value), r.opengl_median_s * 1e3)).collect()));
+    series.push((
+        "study vulkan".into(),
+        RGBColor(240, 140, 40),
+        st.iter()
+            .map(|r| (x_of(exp, &r.param_value), r.vulkan_median_s * 1e3))
+            .collect(),
+    ));
+    series.push((
+        "study opengl".into(),
+        RGBColor(40, 170, 170),
+        st.iter()
+            .map(|r| (x_of(exp, &r.param_value), r.opengl_median_s * 1e3))
+            .collect(),
+    ));
 
-    let all: Vec<(f64, f64)> = series.iter().flat_map(|s| s.2.iter().copied()).filter(|p| p.0 > 0.0 && p.1 > 0.0).collect();
-    let (xmin, xmax) = all.iter().fold((f64::MAX, f64::MIN), |a, p| (a.0.min(p.0), a.1.max(p.0)));
-    let (ymin, ymax) = all.iter().fold((f64::MAX, f64::MIN), |a, p| (a.0.min(p.1), a.1.max(p.1)));
+    let all: Vec<(f64, f64)> = series
+        .iter()
+        .flat_map(|s| s.2.iter().copied())
+        .filter(|p| p.0 > 0.0 && p.1 > 0.0)
+        .collect();
+    let (xmin, xmax) = all
+        .iter()
+        .fold((f64::MAX, f64::MIN), |a, p| (a.0.min(p.0), a.1.max(p.0)));
+    let (ymin, ymax) = all
+        .iter()
+        .fold((f64::MAX, f64::MIN), |a, p| (a.0.min(p.1), a.1.max(p.1)));
     let root = SVGBackend::new(path, (900, 560)).into_drawing_area();
     root.fill(&WHITE)?;
-    let xlabel = if exp == "spherelist" { "extra spheres" } else { "image width = height (pixels)" };
+    let xlabel = if exp == "spherelist" {
+        "extra spheres"
+    } else {
+        "image width = height (pixels)"
+    };
     let mut chart = ChartBuilder::on(&root)
-        .caption(format!("{exp}: time per frame (log scale)"), ("sans-serif", 22))
+        .caption(
+            format!("{exp}: time per frame (log scale)"),
+            ("sans-serif", 22),
+        )
         .margin(12)
         .x_label_area_size(45)
         .y_label_area_size(70)
-        .build_cartesian_2d((xmin * 0.8..xmax * 1.25).log_scale(), (ymin * 0.5..ymax * 2.0).log_scale())?;
-    chart.configure_mesh().x_desc(xlabel).y_desc("milliseconds").draw()?;
+        .build_cartesian_2d(
+            (xmin * 0.8..xmax * 1.25).log_scale(),
+            (ymin * 0.5..ymax * 2.0).log_scale(),
+        )?;
+    chart
+        .configure_mesh()
+        .x_desc(xlabel)
+        .y_desc("milliseconds")
+        .draw()?;
     for (name, colour, pts) in series {
         let dashed = name.contains("GPU");
-        let style = if name.starts_with("study") { colour.stroke_width(1) } else { colour.stroke_width(2) };
+        let style = if name.starts_with("study") {
+            colour.stroke_width(1)
+        } else {
+            colour.stroke_width(2)
+        };
         let mut pts = pts;
         pts.sort_by(|a, b| a.0.total_cmp(&b.0));
         chart
             .draw_series(LineSeries::new(pts.clone(), style))?
             .label(name.clone())
-            .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], colour.stroke_width(2)));
+            .legend(move |(x, y)| {
+                PathElement::new(vec![(x, y), (x + 20, y)], colour.stroke_width(2))
+            });
         if dashed {
-            chart.draw_series(pts.iter().map(|p| Cross::new(*p, 4, colour.stroke_width(1))))?;
+            chart.draw_series(
+                pts.iter()
+                    .map(|p| Cross::new(*p, 4, colour.stroke_width(1))),
+            )?;
         } else {
             chart.draw_series(pts.iter().map(|p| Circle::new(*p, 3, colour.filled())))?;
         }
     }
-    chart.configure_series_labels().background_style(WHITE.mix(0.8)).border_style(BLACK).position(SeriesLabelPosition::UpperLeft).draw()?;
+    chart
+        .configure_series_labels()
+        .background_style(WHITE.mix(0.8))
+        .border_style(BLACK)
+        .position(SeriesLabelPosition::UpperLeft)
+        .draw()?;
     root.present()?;
     Ok(())
 }
@@ -638,22 +918,40 @@ fn plot_scaling(path: &Path, outcomes: &[Outcome], accel: &[AccelRun]) -> anyhow
     let ms = |r: &RunReport| r.gpu_ms.or(r.wall_ms).map(|x| x.median);
     let mut series: Vec<(String, RGBColor, Vec<(f64, f64)>)> = Vec::new();
     let palette = [
-        (Api::Vulkan, [RGBColor(200, 30, 30), RGBColor(240, 130, 40), RGBColor(150, 0, 90)]),
-        (Api::Opengl, [RGBColor(30, 80, 200), RGBColor(40, 170, 170), RGBColor(90, 40, 160)]),
+        (
+            Api::Vulkan,
+            [
+                RGBColor(200, 30, 30),
+                RGBColor(240, 130, 40),
+                RGBColor(150, 0, 90),
+            ],
+        ),
+        (
+            Api::Opengl,
+            [
+                RGBColor(30, 80, 200),
+                RGBColor(40, 170, 170),
+                RGBColor(90, 40, 160),
+            ],
+        ),
     ];
     for (api, [colour, sphere_bvh, teapot_bvh]) in palette {
         // Brute force: the study's sphere-list sweep plus the crossover runs.
         let mut brute: Vec<(f64, f64)> = outcomes
             .iter()
             // The BVH runs are fragment-path runs: compare like with like.
-            .filter(|o| o.api == api && o.point.experiment == "spherelist" && o.path == RenderPath::Fragment)
+            .filter(|o| {
+                o.api == api && o.point.experiment == "spherelist" && o.path == RenderPath::Fragment
+            })
             .filter_map(|o| o.result.as_ref().ok())
             .filter_map(|r| Some((primitives(r), ms(r)?)))
             .collect();
         brute.extend(
             accel
                 .iter()
-                .filter(|a| a.api == api && a.scene == "spherelist" && a.config == "variant, brute force")
+                .filter(|a| {
+                    a.api == api && a.scene == "spherelist" && a.config == "variant, brute force"
+                })
                 .filter_map(|a| a.result.as_ref().ok())
                 .filter_map(|r| Some((primitives(r), ms(r)?))),
         );
@@ -665,35 +963,72 @@ fn plot_scaling(path: &Path, outcomes: &[Outcome], accel: &[AccelRun]) -> anyhow
                 .filter_map(|r| Some((primitives(r), ms(r)?)))
                 .collect()
         };
-        series.push((format!("spherelist brute force, {}", api_name(api)), colour, brute));
-        series.push((format!("spherelist BVH, {}", api_name(api)), sphere_bvh, bvh("spherelist")));
-        series.push((format!("teapot BVH, {}", api_name(api)), teapot_bvh, bvh("teapot")));
+        series.push((
+            format!("spherelist brute force, {}", api_name(api)),
+            colour,
+            brute,
+        ));
+        series.push((
+            format!("spherelist BVH, {}", api_name(api)),
+            sphere_bvh,
+            bvh("spherelist"),
+        ));
+        series.push((
+            format!("teapot BVH, {}", api_name(api)),
+            teapot_bvh,
+            bvh("teapot"),
+        ));
     }
     series.retain(|s| !s.2.is_empty());
-    let all: Vec<(f64, f64)> = series.iter().flat_map(|s| s.2.iter().copied()).filter(|p| p.0 > 0.0 && p.1 > 0.0).collect();
+    let all: Vec<(f64, f64)> = series
+        .iter()
+        .flat_map(|s| s.2.iter().copied())
+        .filter(|p| p.0 > 0.0 && p.1 > 0.0)
+        .collect();
     if all.is_empty() {
         return Ok(());
     }
-    let (xmin, xmax) = all.iter().fold((f64::MAX, f64::MIN), |a, p| (a.0.min(p.0), a.1.max(p.0)));
-    let (ymin, ymax) = all.iter().fold((f64::MAX, f64::MIN), |a, p| (a.0.min(p.1), a.1.max(p.1)));
+    let (xmin, xmax) = all
+        .iter()
+        .fold((f64::MAX, f64::MIN), |a, p| (a.0.min(p.0), a.1.max(p.0)));
+    let (ymin, ymax) = all
+        .iter()
+        .fold((f64::MAX, f64::MIN), |a, p| (a.0.min(p.1), a.1.max(p.1)));
     let root = SVGBackend::new(path, (900, 560)).into_drawing_area();
     root.fill(&WHITE)?;
     let mut chart = ChartBuilder::on(&root)
-        .caption("frame time against primitives (log-log)", ("sans-serif", 22))
+        .caption(
+            "frame time against primitives (log-log)",
+            ("sans-serif", 22),
+        )
         .margin(12)
         .x_label_area_size(45)
         .y_label_area_size(70)
-        .build_cartesian_2d((xmin * 0.8..xmax * 1.25).log_scale(), (ymin * 0.5..ymax * 2.0).log_scale())?;
-    chart.configure_mesh().x_desc("spheres + triangles").y_desc("milliseconds").draw()?;
+        .build_cartesian_2d(
+            (xmin * 0.8..xmax * 1.25).log_scale(),
+            (ymin * 0.5..ymax * 2.0).log_scale(),
+        )?;
+    chart
+        .configure_mesh()
+        .x_desc("spheres + triangles")
+        .y_desc("milliseconds")
+        .draw()?;
     for (name, colour, mut pts) in series {
         pts.sort_by(|a, b| a.0.total_cmp(&b.0));
         chart
             .draw_series(LineSeries::new(pts.clone(), colour.stroke_width(2)))?
             .label(name)
-            .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], colour.stroke_width(2)));
+            .legend(move |(x, y)| {
+                PathElement::new(vec![(x, y), (x + 20, y)], colour.stroke_width(2))
+            });
         chart.draw_series(pts.iter().map(|p| Circle::new(*p, 3, colour.filled())))?;
     }
-    chart.configure_series_labels().background_style(WHITE.mix(0.8)).border_style(BLACK).position(SeriesLabelPosition::UpperLeft).draw()?;
+    chart
+        .configure_series_labels()
+        .background_style(WHITE.mix(0.8))
+        .border_style(BLACK)
+        .position(SeriesLabelPosition::UpperLeft)
+        .draw()?;
     root.present()?;
     Ok(())
 }
@@ -709,20 +1044,33 @@ mod tests {
             r#"{{"api":"x","device":"d","driver":"v","api_version":"1","os":"o","scene":{{"name":"box","triangles":30,"spheres":2,"lights":1,"materials":3,"max_depth":5}},
                "variant":"v","width":8,"height":8,{}"frames":[{{"gpu_ms":{ms},"wall_ms":{ms}}}],"gpu_ms":null,"wall_ms":null,
                "nonfinite_pixels":0,"setup_ms":1.0,"validation_messages":0}}"#,
-            if path == RenderPath::Compute { r#""path":"compute","workgroup":"16x8","# } else { "" }
+            if path == RenderPath::Compute {
+                r#""path":"compute","workgroup":"16x8","#
+            } else {
+                ""
+            }
         );
-        let mut r: RunReport = serde_json::from_str(&json).expect("a report without `path` still parses");
+        let mut r: RunReport =
+            serde_json::from_str(&json).expect("a report without `path` still parses");
         r.summarise();
         let point = Point {
             experiment: "box",
             param_name: "resolution",
             param_value: "8x8".into(),
             scene: "box",
-            size: Size { width: 8, height: 8 },
+            size: Size {
+                width: 8,
+                height: 8,
+            },
             set: vec![],
             work: 1.0,
         };
-        Outcome { point, api, path, result: Ok(r) }
+        Outcome {
+            point,
+            api,
+            path,
+            result: Ok(r),
+        }
     }
 
     #[test]
@@ -739,15 +1087,31 @@ mod tests {
         let col = |name: &str| header.iter().position(|h| *h == name).unwrap();
         let body: Vec<Vec<&str>> = lines.map(|l| l.split(',').collect()).collect();
         assert_eq!(body.len(), 4);
-        assert_eq!(body.iter().map(|r| r[col("path")]).collect::<Vec<_>>(), ["fragment", "fragment", "compute", "compute"]);
+        assert_eq!(
+            body.iter().map(|r| r[col("path")]).collect::<Vec<_>>(),
+            ["fragment", "fragment", "compute", "compute"]
+        );
         assert_eq!(body[2][col("workgroup")], "16x8");
         assert_eq!(body[0][col("workgroup")], "");
         assert!(body.iter().all(|r| r.len() == header.len()));
         let summary = path_summary(&rows, &[]);
         assert_eq!(summary.len(), 1, "{summary:?}");
-        assert!(summary[0].contains("1.00× on the fragment path, 0.50× on the compute path"), "{}", summary[0]);
-        assert!(summary[0].contains("Vulkan 10.00×, OpenGL 5.00×"), "{}", summary[0]);
+        assert!(
+            summary[0].contains("1.00× on the fragment path, 0.50× on the compute path"),
+            "{}",
+            summary[0]
+        );
+        assert!(
+            summary[0].contains("Vulkan 10.00×, OpenGL 5.00×"),
+            "{}",
+            summary[0]
+        );
         let four = four_numbers(&rows);
-        assert!(four.contains("| box | 8x8 | 10.000 / 10.000 | 1.000 / 1.000 | 10.000 / 10.000 | 2.000 / 2.000 |"), "{four}");
+        assert!(
+            four.contains(
+                "| box | 8x8 | 10.000 / 10.000 | 1.000 / 1.000 | 10.000 / 10.000 | 2.000 / 2.000 |"
+            ),
+            "{four}"
+        );
     }
 }

@@ -34,7 +34,8 @@ pub fn rows() -> Vec<StudyRow> {
 }
 
 pub fn find<'a>(rows: &'a [StudyRow], experiment: &str, value: &str) -> Option<&'a StudyRow> {
-    rows.iter().find(|r| r.experiment == experiment && r.param_value == value)
+    rows.iter()
+        .find(|r| r.experiment == experiment && r.param_value == value)
 }
 
 #[cfg(test)]

@@ -28,15 +28,23 @@ pub fn run(args: RenderArgs, started: Instant) -> anyhow::Result<()> {
     }
     if !args.headless {
         if args.gl_spirv {
-            return Err(bad_input("--gl-spirv is a headless measurement option; run it with --headless"));
+            return Err(bad_input(
+                "--gl-spirv is a headless measurement option; run it with --headless",
+            ));
         }
         if args.path == RenderPath::Compute {
-            return Err(bad_input("--path compute runs headless only; add --headless"));
+            return Err(bad_input(
+                "--path compute runs headless only; add --headless",
+            ));
         }
         return run_windowed(&args, started);
     }
     let scene = args.load_scene()?;
-    let variant = if args.generic { Variant::generic(scene.numerics) } else { Variant::for_scene(&scene) };
+    let variant = if args.generic {
+        Variant::generic(scene.numerics)
+    } else {
+        Variant::for_scene(&scene)
+    };
     let workgroup = args.compute_workgroup()?;
     let (width, height) = (args.size.width, args.size.height);
     let gpu_scene = GpuScene::new(&scene, width, height);
@@ -55,19 +63,29 @@ pub fn run(args: RenderArgs, started: Instant) -> anyhow::Result<()> {
     target::check_size(gl, width, height)?;
     // SAFETY: plain query; 64-bit because the limit may exceed 2 GiB.
     let max_ssbo = unsafe { gl.get_parameter_i64(glow::MAX_SHADER_STORAGE_BLOCK_SIZE) };
-    check_storage_limit(&gpu_scene, max_ssbo.max(0) as u64, "GL_MAX_SHADER_STORAGE_BLOCK_SIZE")?;
+    check_storage_limit(
+        &gpu_scene,
+        max_ssbo.max(0) as u64,
+        "GL_MAX_SHADER_STORAGE_BLOCK_SIZE",
+    )?;
 
     // Declaration order is creation order; Rust drops locals in reverse, so GL
     // objects are deleted in reverse order on success and on every error path.
     let (frames, setup_ms, pixels) = match args.path {
         RenderPath::Fragment => {
             let shaders = shader::build(&variant)?;
-            explain::step("Shaders: GLSL -> naga module -> GLSL 450 core (twinray-common)", || {
-                format!("variant {}", variant.label())
-            });
+            explain::step(
+                "Shaders: GLSL -> naga module -> GLSL 450 core (twinray-common)",
+                || format!("variant {}", variant.label()),
+            );
             let program = if args.gl_spirv {
                 let fs = shader::spirv_for_opengl(&shaders.fragment_spirv);
-                Program::from_spirv(gl, &|name| ctx.proc_address(name), &shaders.vertex_glsl, &fs)?
+                Program::from_spirv(
+                    gl,
+                    &|name| ctx.proc_address(name),
+                    &shaders.vertex_glsl,
+                    &fs,
+                )?
             } else {
                 Program::new(gl, &shaders.vertex_glsl, &shaders.fragment_glsl)?
             };
@@ -86,7 +104,9 @@ pub fn run(args: RenderArgs, started: Instant) -> anyhow::Result<()> {
         RenderPath::Compute => {
             let shader = shader::build_compute(&variant, workgroup)?;
             let proc_address = |name: &std::ffi::CStr| ctx.proc_address(name);
-            let spirv = args.gl_spirv.then_some(&proc_address as &dyn Fn(&std::ffi::CStr) -> *const std::ffi::c_void);
+            let spirv = args
+                .gl_spirv
+                .then_some(&proc_address as &dyn Fn(&std::ffi::CStr) -> *const std::ffi::c_void);
             let compute = Compute::new(gl, &shader, spirv, width, height)?;
             let _buffers = SceneBuffers::new(gl, &gpu_scene)?;
             let timer = Timer::new(gl, &renderer)?;
@@ -100,10 +120,16 @@ pub fn run(args: RenderArgs, started: Instant) -> anyhow::Result<()> {
         }
     };
     explain::step("Frames: the draw or dispatch + glFinish each", || {
-        format!("{} frame(s); first wall {:.3} ms", frames.len(), frames.first().map_or(0.0, |f| f.wall_ms))
+        format!(
+            "{} frame(s); first wall {:.3} ms",
+            frames.len(),
+            frames.first().map_or(0.0, |f| f.wall_ms)
+        )
     });
     let image = FloatImage::from_rgba(width, height, &pixels);
-    explain::step("Readback", || format!("{width}x{height} RGBA32F, top row first"));
+    explain::step("Readback", || {
+        format!("{width}x{height} RGBA32F, top row first")
+    });
     log.check(gl, "after the frame loop");
 
     if let Some(out) = &args.out {
@@ -118,7 +144,11 @@ pub fn run(args: RenderArgs, started: Instant) -> anyhow::Result<()> {
             api_version: format!("OpenGL {version}"),
             os: os_description(),
             scene: scene.stats(),
-            variant: if args.gl_spirv { format!("{} (SPIR-V)", variant.label()) } else { variant.label() },
+            variant: if args.gl_spirv {
+                format!("{} (SPIR-V)", variant.label())
+            } else {
+                variant.label()
+            },
             width,
             height,
             path: args.path,
@@ -131,7 +161,10 @@ pub fn run(args: RenderArgs, started: Instant) -> anyhow::Result<()> {
             validation_messages: errors,
         };
         report.summarise();
-        println!("{}", serde_json::to_string(&report).context("serialising the JSON report")?);
+        println!(
+            "{}",
+            serde_json::to_string(&report).context("serialising the JSON report")?
+        );
     }
     if args.validate && errors > 0 {
         return Err(anyhow!("{errors} GL debug errors (see above)"));
@@ -164,7 +197,10 @@ fn run_windowed(args: &RenderArgs, started: Instant) -> anyhow::Result<()> {
             validation_messages: errors,
         };
         report.summarise();
-        println!("{}", serde_json::to_string(&report).context("serialising the JSON report")?);
+        println!(
+            "{}",
+            serde_json::to_string(&report).context("serialising the JSON report")?
+        );
     }
     if args.validate && errors > 0 {
         return Err(anyhow!("{errors} GL debug errors (see above)"));
@@ -175,7 +211,13 @@ fn run_windowed(args: &RenderArgs, started: Instant) -> anyhow::Result<()> {
 /// The same loop as Vulkan's: one iteration is submit + wait, timed on the
 /// wall clock around the GPU-timed `draw` (the draw call or the dispatch).
 /// Returns the frames and `setup_ms`.
-fn frame_loop(gl: &glow::Context, timer: &Timer, count: u32, started: Instant, draw: &dyn Fn()) -> (Vec<FrameTime>, f64) {
+fn frame_loop(
+    gl: &glow::Context,
+    timer: &Timer,
+    count: u32,
+    started: Instant,
+    draw: &dyn Fn(),
+) -> (Vec<FrameTime>, f64) {
     let mut frames = Vec::with_capacity(count as usize);
     let mut setup_ms = 0.0;
     for i in 0..count {
@@ -190,7 +232,10 @@ fn frame_loop(gl: &glow::Context, timer: &Timer, count: u32, started: Instant, d
         // SAFETY: no arguments; the context is current.
         unsafe { gl.finish() };
         let wall_ms = ms(t0.elapsed());
-        frames.push(FrameTime { gpu_ms: timer.result_ms(), wall_ms });
+        frames.push(FrameTime {
+            gpu_ms: timer.result_ms(),
+            wall_ms,
+        });
     }
     (frames, setup_ms)
 }

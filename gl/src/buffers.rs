@@ -17,7 +17,10 @@ impl<'gl> SceneBuffers<'gl> {
     /// the blocks; UBO and SSBO binding points are separate spaces in GL, so
     /// the numbers are the Vulkan descriptor bindings unchanged.
     pub fn new(gl: &'gl glow::Context, scene: &GpuScene) -> anyhow::Result<SceneBuffers<'gl>> {
-        let mut this = SceneBuffers { gl, buffers: Vec::with_capacity(1 + binding::STORAGE.len()) };
+        let mut this = SceneBuffers {
+            gl,
+            buffers: Vec::with_capacity(1 + binding::STORAGE.len()),
+        };
         this.upload(glow::UNIFORM_BUFFER, binding::FRAME, scene.frame_bytes())?;
         for b in binding::STORAGE {
             this.upload(glow::SHADER_STORAGE_BUFFER, b, scene.storage_bytes(b))?;
@@ -36,13 +39,24 @@ impl<'gl> SceneBuffers<'gl> {
             self.buffers.push(buf);
             self.gl.bind_buffer(target, Some(buf));
             // Written once, read every frame: STATIC_DRAW.
-            self.gl.buffer_data_u8_slice(target, bytes, glow::STATIC_DRAW);
+            self.gl
+                .buffer_data_u8_slice(target, bytes, glow::STATIC_DRAW);
             self.gl.bind_buffer_base(target, index, Some(buf));
         }
-        explain::step(&format!("glCreateBuffer + glBufferData + glBindBufferBase (binding {index})"), || {
-            let kind = if target == glow::UNIFORM_BUFFER { "UNIFORM_BUFFER" } else { "SHADER_STORAGE_BUFFER" };
-            format!("{} bytes, {kind}, STATIC_DRAW: the driver picks the memory and uploads", bytes.len())
-        });
+        explain::step(
+            &format!("glCreateBuffer + glBufferData + glBindBufferBase (binding {index})"),
+            || {
+                let kind = if target == glow::UNIFORM_BUFFER {
+                    "UNIFORM_BUFFER"
+                } else {
+                    "SHADER_STORAGE_BUFFER"
+                };
+                format!(
+                    "{} bytes, {kind}, STATIC_DRAW: the driver picks the memory and uploads",
+                    bytes.len()
+                )
+            },
+        );
         Ok(())
     }
 
@@ -51,8 +65,10 @@ impl<'gl> SceneBuffers<'gl> {
     pub fn update_frame(&self, bytes: &[u8]) {
         // SAFETY: the buffer holds exactly one Frame, which `bytes` is.
         unsafe {
-            self.gl.bind_buffer(glow::UNIFORM_BUFFER, Some(self.buffers[0]));
-            self.gl.buffer_sub_data_u8_slice(glow::UNIFORM_BUFFER, 0, bytes);
+            self.gl
+                .bind_buffer(glow::UNIFORM_BUFFER, Some(self.buffers[0]));
+            self.gl
+                .buffer_sub_data_u8_slice(glow::UNIFORM_BUFFER, 0, bytes);
         }
     }
 }

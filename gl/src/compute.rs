@@ -37,7 +37,10 @@ impl<'gl> Compute<'gl> {
     ) -> anyhow::Result<Compute<'gl>> {
         let groups = check_limits(gl, shader.workgroup, width, height)?;
         let program = match spirv_proc {
-            Some(proc_address) => link(gl, spirv_shader(gl, proc_address, &spirv_for_opengl(&shader.spirv))?)?,
+            Some(proc_address) => link(
+                gl,
+                spirv_shader(gl, proc_address, &spirv_for_opengl(&shader.spirv))?,
+            )?,
             None => link(gl, glsl_shader(gl, &shader.glsl)?)?,
         };
         // SAFETY: a fresh texture on the current context; sizes were checked.
@@ -48,14 +51,35 @@ impl<'gl> Compute<'gl> {
                 return Err(anyhow!(e).context("glGenTextures"));
             }
         };
-        let this = Compute { gl, program, texture, groups, width, height };
+        let this = Compute {
+            gl,
+            program,
+            texture,
+            groups,
+            width,
+            height,
+        };
         // SAFETY: both objects are alive on the current context.
         unsafe {
             gl.bind_texture(glow::TEXTURE_2D, Some(texture));
             // Immutable storage, one level: image units need a complete texture.
-            gl.tex_storage_2d(glow::TEXTURE_2D, 1, glow::RGBA32F, width as i32, height as i32);
+            gl.tex_storage_2d(
+                glow::TEXTURE_2D,
+                1,
+                glow::RGBA32F,
+                width as i32,
+                height as i32,
+            );
             // WRITE_ONLY matches the shader's `writeonly`; the format its `rgba32f`.
-            gl.bind_image_texture(binding::IMAGE, Some(texture), 0, false, 0, glow::WRITE_ONLY, glow::RGBA32F);
+            gl.bind_image_texture(
+                binding::IMAGE,
+                Some(texture),
+                0,
+                false,
+                0,
+                glow::WRITE_ONLY,
+                glow::RGBA32F,
+            );
             gl.use_program(Some(program));
         }
         Ok(this)
@@ -71,7 +95,10 @@ impl<'gl> Compute<'gl> {
     /// texels): the counterpart of Vulkan's barrier between dispatches.
     pub fn barrier_between_frames(&self) {
         // SAFETY: plain state call on the current context.
-        unsafe { self.gl.memory_barrier(glow::SHADER_IMAGE_ACCESS_BARRIER_BIT) }
+        unsafe {
+            self.gl
+                .memory_barrier(glow::SHADER_IMAGE_ACCESS_BARRIER_BIT)
+        }
     }
 
     /// RGBA32F pixels, row 0 first. The shader wrote the top row at y = 0, so
@@ -109,13 +136,25 @@ impl Drop for Compute<'_> {
 
 /// The workgroup and the grid against this driver's limits (bad input: the
 /// user chose the size and workgroup). Returns the group counts.
-fn check_limits(gl: &glow::Context, wg: Workgroup, width: u32, height: u32) -> anyhow::Result<(u32, u32)> {
+fn check_limits(
+    gl: &glow::Context,
+    wg: Workgroup,
+    width: u32,
+    height: u32,
+) -> anyhow::Result<(u32, u32)> {
     // SAFETY: plain queries on the current context.
     let (size, invocations, count, texture) = unsafe {
         (
-            [0, 1].map(|i| gl.get_parameter_indexed_i32(glow::MAX_COMPUTE_WORK_GROUP_SIZE, i).max(0) as u32),
-            gl.get_parameter_i32(glow::MAX_COMPUTE_WORK_GROUP_INVOCATIONS).max(0) as u32,
-            [0, 1].map(|i| gl.get_parameter_indexed_i32(glow::MAX_COMPUTE_WORK_GROUP_COUNT, i).max(0) as u32),
+            [0, 1].map(|i| {
+                gl.get_parameter_indexed_i32(glow::MAX_COMPUTE_WORK_GROUP_SIZE, i)
+                    .max(0) as u32
+            }),
+            gl.get_parameter_i32(glow::MAX_COMPUTE_WORK_GROUP_INVOCATIONS)
+                .max(0) as u32,
+            [0, 1].map(|i| {
+                gl.get_parameter_indexed_i32(glow::MAX_COMPUTE_WORK_GROUP_COUNT, i)
+                    .max(0) as u32
+            }),
             gl.get_parameter_i32(glow::MAX_TEXTURE_SIZE).max(0) as u32,
         )
     };
@@ -141,7 +180,10 @@ fn check_limits(gl: &glow::Context, wg: Workgroup, width: u32, height: u32) -> a
 fn glsl_shader(gl: &glow::Context, source: &str) -> anyhow::Result<glow::Shader> {
     // SAFETY: a fresh shader on the current context.
     unsafe {
-        let s = gl.create_shader(glow::COMPUTE_SHADER).map_err(|e| anyhow!(e)).context("glCreateShader(compute)")?;
+        let s = gl
+            .create_shader(glow::COMPUTE_SHADER)
+            .map_err(|e| anyhow!(e))
+            .context("glCreateShader(compute)")?;
         gl.shader_source(s, source);
         gl.compile_shader(s);
         if !gl.get_shader_compile_status(s) {
@@ -160,14 +202,21 @@ fn spirv_shader(
     words: &[u32],
 ) -> anyhow::Result<glow::Shader> {
     if !gl.supported_extensions().contains("GL_ARB_gl_spirv") {
-        return Err(no_device("--gl-spirv: this OpenGL driver does not support GL_ARB_gl_spirv"));
+        return Err(no_device(
+            "--gl-spirv: this OpenGL driver does not support GL_ARB_gl_spirv",
+        ));
     }
-    type ShaderBinary = unsafe extern "system" fn(i32, *const u32, u32, *const std::ffi::c_void, i32);
-    type SpecializeShader = unsafe extern "system" fn(u32, *const std::ffi::c_char, u32, *const u32, *const u32);
+    type ShaderBinary =
+        unsafe extern "system" fn(i32, *const u32, u32, *const std::ffi::c_void, i32);
+    type SpecializeShader =
+        unsafe extern "system" fn(u32, *const std::ffi::c_char, u32, *const u32, *const u32);
     let get = |name: &std::ffi::CStr| {
         let p = proc_address(name);
         if p.is_null() {
-            Err(anyhow!("the OpenGL driver has no {}", name.to_string_lossy()))
+            Err(anyhow!(
+                "the OpenGL driver has no {}",
+                name.to_string_lossy()
+            ))
         } else {
             Ok(p)
         }
@@ -175,11 +224,23 @@ fn spirv_shader(
     // SAFETY: each pointer is the driver's entry point of that name, with the
     // GL 4.6 core signature the type spells out; the words outlive the calls.
     unsafe {
-        let shader_binary = std::mem::transmute::<*const std::ffi::c_void, ShaderBinary>(get(c"glShaderBinary")?);
-        let specialize = std::mem::transmute::<*const std::ffi::c_void, SpecializeShader>(get(c"glSpecializeShader")?);
-        let s = gl.create_shader(glow::COMPUTE_SHADER).map_err(|e| anyhow!(e)).context("glCreateShader(compute)")?;
+        let shader_binary =
+            std::mem::transmute::<*const std::ffi::c_void, ShaderBinary>(get(c"glShaderBinary")?);
+        let specialize = std::mem::transmute::<*const std::ffi::c_void, SpecializeShader>(get(
+            c"glSpecializeShader",
+        )?);
+        let s = gl
+            .create_shader(glow::COMPUTE_SHADER)
+            .map_err(|e| anyhow!(e))
+            .context("glCreateShader(compute)")?;
         let id = s.0.get();
-        shader_binary(1, &id, glow::SHADER_BINARY_FORMAT_SPIR_V, words.as_ptr().cast(), (words.len() * 4) as i32);
+        shader_binary(
+            1,
+            &id,
+            glow::SHADER_BINARY_FORMAT_SPIR_V,
+            words.as_ptr().cast(),
+            (words.len() * 4) as i32,
+        );
         specialize(id, c"main".as_ptr(), 0, std::ptr::null(), std::ptr::null());
         if !gl.get_shader_compile_status(s) {
             let log = gl.get_shader_info_log(s);

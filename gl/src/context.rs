@@ -9,7 +9,8 @@ use glutin::prelude::*;
 use twinray_common::error::{bad_input, no_device};
 use twinray_common::explain;
 
-const NO_DEVICE: &str = "no EGL device found: install libegl1 and libegl-mesa0 + libgl1-mesa-dri (or a GPU driver)";
+const NO_DEVICE: &str =
+    "no EGL device found: install libegl1 and libegl-mesa0 + libgl1-mesa-dri (or a GPU driver)";
 
 /// Mesa's llvmpipe device carries this extension; a hardware device does not.
 const SOFTWARE_EXT: &str = "EGL_MESA_device_software";
@@ -33,8 +34,9 @@ impl Gl {
     pub fn headless(debug: bool) -> anyhow::Result<Gl> {
         // No libEGL, or one without the device extensions, is a missing driver
         // for the user, not a bug: glutin's error alone would not say what to install.
-        let devices: Vec<Device> =
-            Device::query_devices().map_err(|e| no_device(format!("{NO_DEVICE} ({e})")))?.collect();
+        let devices: Vec<Device> = Device::query_devices()
+            .map_err(|e| no_device(format!("{NO_DEVICE} ({e})")))?
+            .collect();
         if devices.is_empty() {
             return Err(no_device(NO_DEVICE));
         }
@@ -43,7 +45,11 @@ impl Gl {
                 .iter()
                 .enumerate()
                 .map(|(i, d)| {
-                    let soft = if d.extensions().contains(SOFTWARE_EXT) { " (software)" } else { "" };
+                    let soft = if d.extensions().contains(SOFTWARE_EXT) {
+                        " (software)"
+                    } else {
+                        ""
+                    };
                     format!("{i}: {}{soft}\n", d.name().unwrap_or("unnamed"))
                 })
                 .collect::<String>()
@@ -63,7 +69,10 @@ impl Gl {
                 Err(e) => failures.push(format!("{e:#}")),
             }
         }
-        Err(no_device(format!("no EGL device offers an OpenGL 4.5 core context: {}", failures.join("; "))))
+        Err(no_device(format!(
+            "no EGL device offers an OpenGL 4.5 core context: {}",
+            failures.join("; ")
+        )))
     }
 }
 
@@ -80,19 +89,26 @@ fn candidates(devices: &[Device]) -> anyhow::Result<Vec<(usize, &Device)>> {
         })?;
         return Ok(vec![(i, &devices[i])]);
     }
-    let (soft, hard): (Vec<_>, Vec<_>) =
-        devices.iter().enumerate().partition(|(_, d)| d.extensions().contains(SOFTWARE_EXT));
+    let (soft, hard): (Vec<_>, Vec<_>) = devices
+        .iter()
+        .enumerate()
+        .partition(|(_, d)| d.extensions().contains(SOFTWARE_EXT));
     Ok(hard.into_iter().chain(soft).collect())
 }
 
 fn create(index: usize, device: &Device, debug: bool) -> anyhow::Result<Gl> {
-    let what = format!("EGL device {index} ({})", device.name().unwrap_or("unnamed"));
+    let what = format!(
+        "EGL device {index} ({})",
+        device.name().unwrap_or("unnamed")
+    );
     // SAFETY: no native display handle is passed, only the device.
-    let display =
-        unsafe { Display::with_device(device, None) }.with_context(|| format!("opening an EGL display on {what}"))?;
+    let display = unsafe { Display::with_device(device, None) }
+        .with_context(|| format!("opening an EGL display on {what}"))?;
     // No surface types: the context renders into our own FBO only.
-    let template =
-        ConfigTemplateBuilder::new().with_surface_type(ConfigSurfaceTypes::empty()).with_api(Api::OPENGL).build();
+    let template = ConfigTemplateBuilder::new()
+        .with_surface_type(ConfigSurfaceTypes::empty())
+        .with_api(Api::OPENGL)
+        .build();
     // SAFETY: the display outlives the configs iterator (same scope).
     let config = unsafe { display.find_configs(template) }
         .with_context(|| format!("listing EGL configs on {what}"))?
@@ -108,10 +124,20 @@ fn create(index: usize, device: &Device, debug: bool) -> anyhow::Result<Gl> {
         .with_context(|| format!("creating an OpenGL 4.5 core context on {what}"))?
         .make_current_surfaceless()
         .with_context(|| format!("making the context current without a surface on {what}"))?;
-    explain::step("EGL display + config + context, made current without a surface", || {
-        format!("{what}: OpenGL 4.5 core{}, surfaceless (renders into our own FBO)", if debug { ", debug" } else { "" })
-    });
+    explain::step(
+        "EGL display + config + context, made current without a surface",
+        || {
+            format!(
+                "{what}: OpenGL 4.5 core{}, surfaceless (renders into our own FBO)",
+                if debug { ", debug" } else { "" }
+            )
+        },
+    );
     // SAFETY: the context is current on this thread, which glow requires.
     let gl = unsafe { glow::Context::from_loader_function_cstr(|s| display.get_proc_address(s)) };
-    Ok(Gl { gl, _context: context, _display: display })
+    Ok(Gl {
+        gl,
+        _context: context,
+        _display: display,
+    })
 }

@@ -36,7 +36,8 @@ impl DebugLog {
             });
         }
         explain::step("KHR_debug: glDebugMessageCallback", || {
-            "DEBUG_OUTPUT + DEBUG_OUTPUT_SYNCHRONOUS; errors and high-severity messages are counted".into()
+            "DEBUG_OUTPUT + DEBUG_OUTPUT_SYNCHRONOUS; errors and high-severity messages are counted"
+                .into()
         });
         log
     }

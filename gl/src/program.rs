@@ -25,7 +25,8 @@ struct SeparablePipeline {
 #[derive(Clone, Copy)]
 struct PipelineFns {
     shader_binary: unsafe extern "system" fn(i32, *const u32, u32, *const std::ffi::c_void, i32),
-    specialize_shader: unsafe extern "system" fn(u32, *const std::ffi::c_char, u32, *const u32, *const u32),
+    specialize_shader:
+        unsafe extern "system" fn(u32, *const std::ffi::c_char, u32, *const u32, *const u32),
     program_parameteri: unsafe extern "system" fn(u32, u32, i32),
     gen_program_pipelines: unsafe extern "system" fn(i32, *mut u32),
     delete_program_pipelines: unsafe extern "system" fn(i32, *const u32),
@@ -34,11 +35,16 @@ struct PipelineFns {
 }
 
 impl PipelineFns {
-    fn load(proc_address: &dyn Fn(&std::ffi::CStr) -> *const std::ffi::c_void) -> anyhow::Result<PipelineFns> {
+    fn load(
+        proc_address: &dyn Fn(&std::ffi::CStr) -> *const std::ffi::c_void,
+    ) -> anyhow::Result<PipelineFns> {
         let get = |name: &std::ffi::CStr| {
             let p = proc_address(name);
             if p.is_null() {
-                Err(anyhow!("the OpenGL driver has no {}", name.to_string_lossy()))
+                Err(anyhow!(
+                    "the OpenGL driver has no {}",
+                    name.to_string_lossy()
+                ))
             } else {
                 Ok(p)
             }
@@ -47,13 +53,27 @@ impl PipelineFns {
         // signature (GL 4.6 core) the field types spell out.
         unsafe {
             Ok(PipelineFns {
-                shader_binary: std::mem::transmute::<*const std::ffi::c_void, _>(get(c"glShaderBinary")?),
-                specialize_shader: std::mem::transmute::<*const std::ffi::c_void, _>(get(c"glSpecializeShader")?),
-                program_parameteri: std::mem::transmute::<*const std::ffi::c_void, _>(get(c"glProgramParameteri")?),
-                gen_program_pipelines: std::mem::transmute::<*const std::ffi::c_void, _>(get(c"glGenProgramPipelines")?),
-                delete_program_pipelines: std::mem::transmute::<*const std::ffi::c_void, _>(get(c"glDeleteProgramPipelines")?),
-                bind_program_pipeline: std::mem::transmute::<*const std::ffi::c_void, _>(get(c"glBindProgramPipeline")?),
-                use_program_stages: std::mem::transmute::<*const std::ffi::c_void, _>(get(c"glUseProgramStages")?),
+                shader_binary: std::mem::transmute::<*const std::ffi::c_void, _>(get(
+                    c"glShaderBinary",
+                )?),
+                specialize_shader: std::mem::transmute::<*const std::ffi::c_void, _>(get(
+                    c"glSpecializeShader",
+                )?),
+                program_parameteri: std::mem::transmute::<*const std::ffi::c_void, _>(get(
+                    c"glProgramParameteri",
+                )?),
+                gen_program_pipelines: std::mem::transmute::<*const std::ffi::c_void, _>(get(
+                    c"glGenProgramPipelines",
+                )?),
+                delete_program_pipelines: std::mem::transmute::<*const std::ffi::c_void, _>(get(
+                    c"glDeleteProgramPipelines",
+                )?),
+                bind_program_pipeline: std::mem::transmute::<*const std::ffi::c_void, _>(get(
+                    c"glBindProgramPipeline",
+                )?),
+                use_program_stages: std::mem::transmute::<*const std::ffi::c_void, _>(get(
+                    c"glUseProgramStages",
+                )?),
             })
         }
     }
@@ -76,19 +96,33 @@ unsafe fn link_separable(
         gl.detach_shader(program, shader);
         gl.delete_shader(shader);
         if !gl.get_program_link_status(program) {
-            return Err(anyhow!("linking the {what} program failed:\n{}", gl.get_program_info_log(program)));
+            return Err(anyhow!(
+                "linking the {what} program failed:\n{}",
+                gl.get_program_info_log(program)
+            ));
         }
         Ok(())
     }
 }
 
 impl<'gl> Program<'gl> {
-    pub fn new(gl: &'gl glow::Context, vertex: &str, fragment: &str) -> anyhow::Result<Program<'gl>> {
+    pub fn new(
+        gl: &'gl glow::Context,
+        vertex: &str,
+        fragment: &str,
+    ) -> anyhow::Result<Program<'gl>> {
         // SAFETY: objects are created and deleted on the current context; the
         // shaders are detached and deleted once linked (the linked program no longer needs them).
         unsafe {
-            let raw = gl.create_program().map_err(|e| anyhow!(e)).context("glCreateProgram")?;
-            let program = Program { gl, raw, pipeline: None };
+            let raw = gl
+                .create_program()
+                .map_err(|e| anyhow!(e))
+                .context("glCreateProgram")?;
+            let program = Program {
+                gl,
+                raw,
+                pipeline: None,
+            };
             let vs = compile(gl, glow::VERTEX_SHADER, vertex, "vertex")?;
             let fs = match compile(gl, glow::FRAGMENT_SHADER, fragment, "fragment") {
                 Ok(fs) => fs,
@@ -106,15 +140,21 @@ impl<'gl> Program<'gl> {
                 gl.delete_shader(s);
             }
             if !linked {
-                return Err(anyhow!("linking the tracer program failed:\n{}", gl.get_program_info_log(raw)));
+                return Err(anyhow!(
+                    "linking the tracer program failed:\n{}",
+                    gl.get_program_info_log(raw)
+                ));
             }
-            explain::step("glCreateShader x2 + glCompileShader + glCreateProgram + glLinkProgram", || {
-                format!(
+            explain::step(
+                "glCreateShader x2 + glCompileShader + glCreateProgram + glLinkProgram",
+                || {
+                    format!(
                     "vertex {} bytes, fragment {} bytes of naga's GLSL; the driver compiles here, no pipeline state",
                     vertex.len(),
                     fragment.len()
                 )
-            });
+                },
+            );
             Ok(program)
         }
     }
@@ -139,25 +179,51 @@ impl<'gl> Program<'gl> {
         }
         let fns = PipelineFns::load(proc_address)?;
         // Separable programs must redeclare the built-in output block they write.
-        let vertex_glsl = vertex_glsl.replacen('\n', "\nout gl_PerVertex { vec4 gl_Position; };\n", 1);
+        let vertex_glsl =
+            vertex_glsl.replacen('\n', "\nout gl_PerVertex { vec4 gl_Position; };\n", 1);
         // SAFETY: objects are created and used on the current context; the word
         // slice outlives the calls; the entry point name is NUL-terminated.
         unsafe {
-            let raw = gl.create_program().map_err(|e| anyhow!(e)).context("glCreateProgram")?;
-            let mut program = Program { gl, raw, pipeline: None };
-            let vertex = gl.create_program().map_err(|e| anyhow!(e)).context("glCreateProgram")?;
+            let raw = gl
+                .create_program()
+                .map_err(|e| anyhow!(e))
+                .context("glCreateProgram")?;
+            let mut program = Program {
+                gl,
+                raw,
+                pipeline: None,
+            };
+            let vertex = gl
+                .create_program()
+                .map_err(|e| anyhow!(e))
+                .context("glCreateProgram")?;
             let mut pipeline = 0u32;
             (fns.gen_program_pipelines)(1, &mut pipeline);
-            program.pipeline = Some(SeparablePipeline { fns, pipeline, vertex });
+            program.pipeline = Some(SeparablePipeline {
+                fns,
+                pipeline,
+                vertex,
+            });
 
-            let fs = gl.create_shader(glow::FRAGMENT_SHADER).map_err(|e| anyhow!(e)).context("glCreateShader")?;
+            let fs = gl
+                .create_shader(glow::FRAGMENT_SHADER)
+                .map_err(|e| anyhow!(e))
+                .context("glCreateShader")?;
             let id = fs.0.get();
-            (fns.shader_binary)(1, &id, glow::SHADER_BINARY_FORMAT_SPIR_V, fragment.as_ptr().cast(), (fragment.len() * 4) as i32);
+            (fns.shader_binary)(
+                1,
+                &id,
+                glow::SHADER_BINARY_FORMAT_SPIR_V,
+                fragment.as_ptr().cast(),
+                (fragment.len() * 4) as i32,
+            );
             (fns.specialize_shader)(id, c"main".as_ptr(), 0, std::ptr::null(), std::ptr::null());
             if !gl.get_shader_compile_status(fs) {
                 let log = gl.get_shader_info_log(fs);
                 gl.delete_shader(fs);
-                return Err(anyhow!("the driver rejected naga's fragment SPIR-V:\n{log}"));
+                return Err(anyhow!(
+                    "the driver rejected naga's fragment SPIR-V:\n{log}"
+                ));
             }
             link_separable(gl, &fns, raw, fs, "SPIR-V fragment")?;
             let vs = compile(gl, glow::VERTEX_SHADER, &vertex_glsl, "vertex")?;
@@ -186,10 +252,18 @@ impl<'gl> Program<'gl> {
 
 /// # Safety
 /// Needs a current context.
-unsafe fn compile(gl: &glow::Context, stage: u32, source: &str, name: &str) -> anyhow::Result<glow::Shader> {
+unsafe fn compile(
+    gl: &glow::Context,
+    stage: u32,
+    source: &str,
+    name: &str,
+) -> anyhow::Result<glow::Shader> {
     // SAFETY: forwarded from the caller.
     unsafe {
-        let s = gl.create_shader(stage).map_err(|e| anyhow!(e)).with_context(|| format!("glCreateShader({name})"))?;
+        let s = gl
+            .create_shader(stage)
+            .map_err(|e| anyhow!(e))
+            .with_context(|| format!("glCreateShader({name})"))?;
         gl.shader_source(s, source);
         gl.compile_shader(s);
         if !gl.get_shader_compile_status(s) {
@@ -226,8 +300,11 @@ pub struct EmptyVertexArray<'gl> {
 impl<'gl> EmptyVertexArray<'gl> {
     pub fn new(gl: &'gl glow::Context) -> anyhow::Result<EmptyVertexArray<'gl>> {
         // SAFETY: a fresh object on the current context.
-        let raw = unsafe { gl.create_vertex_array() }.map_err(|e| anyhow!(e).context("glGenVertexArrays"))?;
-        explain::step("glGenVertexArrays (empty VAO)", || "the core profile draws nothing without one bound".into());
+        let raw = unsafe { gl.create_vertex_array() }
+            .map_err(|e| anyhow!(e).context("glGenVertexArrays"))?;
+        explain::step("glGenVertexArrays (empty VAO)", || {
+            "the core profile draws nothing without one bound".into()
+        });
         Ok(EmptyVertexArray { gl, raw })
     }
 }

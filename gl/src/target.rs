@@ -25,10 +25,15 @@ pub fn check_size(gl: &glow::Context, width: u32, height: u32) -> anyhow::Result
         let rb = gl.get_parameter_i32(glow::MAX_RENDERBUFFER_SIZE);
         let fb_w = gl.get_parameter_i32(glow::MAX_FRAMEBUFFER_WIDTH);
         let fb_h = gl.get_parameter_i32(glow::MAX_FRAMEBUFFER_HEIGHT);
-        (viewport[0].min(rb).min(fb_w).max(0) as u32, viewport[1].min(rb).min(fb_h).max(0) as u32)
+        (
+            viewport[0].min(rb).min(fb_w).max(0) as u32,
+            viewport[1].min(rb).min(fb_h).max(0) as u32,
+        )
     };
     if width > max_w || height > max_h {
-        return Err(bad_input(format!("--size {width}x{height} exceeds this device's limit of {max_w}x{max_h}")));
+        return Err(bad_input(format!(
+            "--size {width}x{height} exceeds this device's limit of {max_w}x{max_h}"
+        )));
     }
     Ok(())
 }
@@ -38,7 +43,10 @@ impl<'gl> Target<'gl> {
     pub fn new(gl: &'gl glow::Context, width: u32, height: u32) -> anyhow::Result<Target<'gl>> {
         // SAFETY: fresh objects on the current context; sizes were checked by `check_size`.
         unsafe {
-            let colour = gl.create_renderbuffer().map_err(|e| anyhow!(e)).context("glCreateRenderbuffer")?;
+            let colour = gl
+                .create_renderbuffer()
+                .map_err(|e| anyhow!(e))
+                .context("glCreateRenderbuffer")?;
             let fbo = match gl.create_framebuffer() {
                 Ok(f) => f,
                 Err(e) => {
@@ -46,19 +54,40 @@ impl<'gl> Target<'gl> {
                     return Err(anyhow!(e).context("glCreateFramebuffer"));
                 }
             };
-            let target = Target { gl, fbo, colour, width, height };
+            let target = Target {
+                gl,
+                fbo,
+                colour,
+                width,
+                height,
+            };
             gl.bind_renderbuffer(glow::RENDERBUFFER, Some(colour));
-            gl.renderbuffer_storage(glow::RENDERBUFFER, glow::RGBA32F, width as i32, height as i32);
+            gl.renderbuffer_storage(
+                glow::RENDERBUFFER,
+                glow::RGBA32F,
+                width as i32,
+                height as i32,
+            );
             gl.bind_framebuffer(glow::FRAMEBUFFER, Some(fbo));
-            gl.framebuffer_renderbuffer(glow::FRAMEBUFFER, glow::COLOR_ATTACHMENT0, glow::RENDERBUFFER, Some(colour));
+            gl.framebuffer_renderbuffer(
+                glow::FRAMEBUFFER,
+                glow::COLOR_ATTACHMENT0,
+                glow::RENDERBUFFER,
+                Some(colour),
+            );
             let status = gl.check_framebuffer_status(glow::FRAMEBUFFER);
             if status != glow::FRAMEBUFFER_COMPLETE {
-                bail!("the RGBA32F {width}x{height} framebuffer is incomplete (status {status:#x})");
+                bail!(
+                    "the RGBA32F {width}x{height} framebuffer is incomplete (status {status:#x})"
+                );
             }
             gl.viewport(0, 0, width as i32, height as i32);
-            explain::step("glCreateRenderbuffer + glCreateFramebuffer (RGBA32F target)", || {
-                format!("{width}x{height} RGBA32F renderbuffer as COLOR_ATTACHMENT0; FRAMEBUFFER_COMPLETE; glViewport")
-            });
+            explain::step(
+                "glCreateRenderbuffer + glCreateFramebuffer (RGBA32F target)",
+                || {
+                    format!("{width}x{height} RGBA32F renderbuffer as COLOR_ATTACHMENT0; FRAMEBUFFER_COMPLETE; glViewport")
+                },
+            );
             Ok(target)
         }
     }
@@ -69,7 +98,8 @@ impl<'gl> Target<'gl> {
         let mut px = vec![0f32; self.width as usize * self.height as usize * 4];
         // SAFETY: `px` holds exactly width*height RGBA floats, packed with alignment 1.
         unsafe {
-            self.gl.bind_framebuffer(glow::READ_FRAMEBUFFER, Some(self.fbo));
+            self.gl
+                .bind_framebuffer(glow::READ_FRAMEBUFFER, Some(self.fbo));
             self.gl.read_buffer(glow::COLOR_ATTACHMENT0);
             self.gl.pixel_store_i32(glow::PACK_ALIGNMENT, 1);
             self.gl.read_pixels(

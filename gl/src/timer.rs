@@ -23,10 +23,18 @@ impl<'gl> Timer<'gl> {
         // only its result is dropped.
         let reliable = !renderer.contains("llvmpipe");
         explain::step("glGenQueries (GL_TIME_ELAPSED)", || {
-            let note = if reliable { "" } else { "; llvmpipe: the result is dropped (not GPU time), wall time is reported" };
+            let note = if reliable {
+                ""
+            } else {
+                "; llvmpipe: the result is dropped (not GPU time), wall time is reported"
+            };
             format!("one query object{note}")
         });
-        Ok(Timer { gl, query, reliable })
+        Ok(Timer {
+            gl,
+            query,
+            reliable,
+        })
     }
 
     pub fn begin(&self) {
@@ -43,7 +51,10 @@ impl<'gl> Timer<'gl> {
     /// after glFinish is already there.
     pub fn result_ms(&self) -> Option<f64> {
         // SAFETY: the query has ended; GL_QUERY_RESULT is 64-bit nanoseconds.
-        let ns = unsafe { self.gl.get_query_parameter_u64(self.query, glow::QUERY_RESULT) };
+        let ns = unsafe {
+            self.gl
+                .get_query_parameter_u64(self.query, glow::QUERY_RESULT)
+        };
         self.reliable.then(|| ns as f64 / 1e6)
     }
 }
@@ -53,7 +64,10 @@ impl Timer<'_> {
     /// finished the timed draw yet (the windowed loop never stalls on a query).
     pub fn try_result_ms(&self) -> Option<f64> {
         // SAFETY: the query has ended at least once.
-        let ready = unsafe { self.gl.get_query_parameter_u32(self.query, glow::QUERY_RESULT_AVAILABLE) } != 0;
+        let ready = unsafe {
+            self.gl
+                .get_query_parameter_u32(self.query, glow::QUERY_RESULT_AVAILABLE)
+        } != 0;
         if ready {
             self.result_ms()
         } else {

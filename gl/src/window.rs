@@ -25,7 +25,9 @@ use crate::timer::Timer;
 use anyhow::{Context as _, Result};
 use glow::HasContext;
 use glutin::config::{Api, Config, ConfigTemplateBuilder, GlConfig};
-use glutin::context::{ContextApi, ContextAttributesBuilder, GlProfile, PossiblyCurrentContext, Version};
+use glutin::context::{
+    ContextApi, ContextAttributesBuilder, GlProfile, PossiblyCurrentContext, Version,
+};
 use glutin::display::{GetGlDisplay, GlDisplay};
 use glutin::prelude::*;
 use glutin::surface::{Surface, SwapInterval, WindowSurface};
@@ -59,34 +61,47 @@ pub fn run(args: &RenderArgs, started: Instant) -> Result<(WindowedRun, DeviceIn
     let scene = args.load_scene()?;
     let variant = interactive::variant_for(args, &scene);
     let shaders = shader::build(&variant)?;
-    explain::step("Shaders: GLSL -> naga module -> GLSL 450 core (twinray-common)", || {
-        format!("variant {}", variant.label())
-    });
+    explain::step(
+        "Shaders: GLSL -> naga module -> GLSL 450 core (twinray-common)",
+        || format!("variant {}", variant.label()),
+    );
 
     let event_loop = interactive::event_loop()?;
     let attributes = interactive::window_attributes(args, &scene.name, "OpenGL");
-    let template = ConfigTemplateBuilder::new().with_api(Api::OPENGL).with_transparency(false);
+    let template = ConfigTemplateBuilder::new()
+        .with_api(Api::OPENGL)
+        .with_transparency(false);
     // EGL first: the same library as the headless path. GLX if EGL has no X11 platform.
-    let builder = DisplayBuilder::new().with_preference(ApiPreference::PreferEgl).with_window_attributes(Some(attributes));
+    let builder = DisplayBuilder::new()
+        .with_preference(ApiPreference::PreferEgl)
+        .with_window_attributes(Some(attributes));
     let (window, config) = builder
         .build(&event_loop, template, pick_config)
         .map_err(|e| no_device(format!("no OpenGL display configuration for a window: {e}")))?;
     let window = window.context("glutin-winit made no window")?;
-    explain::step("Window + display + config (glutin-winit DisplayBuilder)", || {
-        let s = window.inner_size();
-        format!(
-            "{}x{} window; {}; config: RGBA {}-bit alpha {}, sRGB-capable {}, hardware {}",
-            s.width,
-            s.height,
-            config.display().version_string(),
-            config.color_buffer_type().map_or("?".into(), |c| format!("{c:?}")),
-            config.alpha_size(),
-            config.srgb_capable(),
-            config.hardware_accelerated()
-        )
-    });
+    explain::step(
+        "Window + display + config (glutin-winit DisplayBuilder)",
+        || {
+            let s = window.inner_size();
+            format!(
+                "{}x{} window; {}; config: RGBA {}-bit alpha {}, sRGB-capable {}, hardware {}",
+                s.width,
+                s.height,
+                config.display().version_string(),
+                config
+                    .color_buffer_type()
+                    .map_or("?".into(), |c| format!("{c:?}")),
+                config.alpha_size(),
+                config.srgb_capable(),
+                config.hardware_accelerated()
+            )
+        },
+    );
 
-    let handle = window.window_handle().context("getting the window handle")?.as_raw();
+    let handle = window
+        .window_handle()
+        .context("getting the window handle")?
+        .as_raw();
     let context_attributes = ContextAttributesBuilder::new()
         .with_debug(args.validate)
         .with_profile(GlProfile::Core)
@@ -96,27 +111,42 @@ pub fn run(args: &RenderArgs, started: Instant) -> Result<(WindowedRun, DeviceIn
     // SAFETY: the config belongs to this display; the window outlives the context.
     let context = unsafe { display.create_context(&config, &context_attributes) }
         .map_err(|e| no_device(format!("no OpenGL 4.5 core context for the window: {e}")))?;
-    let surface_attributes =
-        window.build_surface_attributes(Default::default()).context("describing the window surface")?;
+    let surface_attributes = window
+        .build_surface_attributes(Default::default())
+        .context("describing the window surface")?;
     // SAFETY: the window outlives the surface (declared before it).
     let surface = unsafe { display.create_window_surface(&config, &surface_attributes) }
         .context("creating the window surface")?;
-    let context = context.make_current(&surface).context("making the OpenGL context current")?;
+    let context = context
+        .make_current(&surface)
+        .context("making the OpenGL context current")?;
     explain::step("Context + window surface, made current", || {
-        format!("OpenGL 4.5 core{}; one surface, double-buffered by the driver", if args.validate { ", debug" } else { "" })
+        format!(
+            "OpenGL 4.5 core{}; one surface, double-buffered by the driver",
+            if args.validate { ", debug" } else { "" }
+        )
     });
-    let interval = if args.vsync { SwapInterval::Wait(NonZeroU32::MIN) } else { SwapInterval::DontWait };
+    let interval = if args.vsync {
+        SwapInterval::Wait(NonZeroU32::MIN)
+    } else {
+        SwapInterval::DontWait
+    };
     if let Err(e) = surface.set_swap_interval(&context, interval) {
         // Some X servers refuse interval 0; the window still works, capped.
         eprintln!("twinray-gl: note: could not set swap interval {interval:?}: {e}");
     }
     explain::step("Swap interval", || {
-        let how = if args.vsync { "1 (--vsync: wait for the display)" } else { "0 (uncapped)" };
+        let how = if args.vsync {
+            "1 (--vsync: wait for the display)"
+        } else {
+            "0 (uncapped)"
+        };
         format!("{how}; the driver owns the back buffers and how many frames are in flight")
     });
 
     // SAFETY: the context is current on this thread, which glow requires.
-    let mut gl = unsafe { glow::Context::from_loader_function_cstr(|s| display.get_proc_address(s)) };
+    let mut gl =
+        unsafe { glow::Context::from_loader_function_cstr(|s| display.get_proc_address(s)) };
     // SAFETY: plain string queries on the current context.
     let info = unsafe {
         DeviceInfo {
@@ -135,10 +165,16 @@ pub fn run(args: &RenderArgs, started: Instant) -> Result<(WindowedRun, DeviceIn
     let gpu = GpuScene::new(&scene, size.width.max(1), size.height.max(1));
     // Declaration order is creation order, so the struct's fields (newest
     // first) and these locals go in reverse on every path.
-    let program = Program::new(gl, &shaders.vertex_glsl, &upper_left_origin(&shaders.fragment_glsl))?;
+    let program = Program::new(
+        gl,
+        &shaders.vertex_glsl,
+        &upper_left_origin(&shaders.fragment_glsl),
+    )?;
     let buffers = SceneBuffers::new(gl, &gpu)?;
     let vao = EmptyVertexArray::new(gl)?;
-    let timers = (0..TIMERS).map(|_| Timer::new(gl, &info.renderer)).collect::<Result<Vec<_>>>()?;
+    let timers = (0..TIMERS)
+        .map(|_| Timer::new(gl, &info.renderer))
+        .collect::<Result<Vec<_>>>()?;
     program.bind(&vao);
     // SAFETY: plain state on the current context: no sRGB encoding on store (see above).
     unsafe {
@@ -163,7 +199,15 @@ pub fn run(args: &RenderArgs, started: Instant) -> Result<(WindowedRun, DeviceIn
     explain::step("Frame loop starts", || {
         "per frame: glBufferSubData (camera), glDrawArrays, SwapBuffers: the driver queues, syncs and presents".into()
     });
-    let run = interactive::run("twinray-gl", event_loop, renderer, args, scene, variant, started)?;
+    let run = interactive::run(
+        "twinray-gl",
+        event_loop,
+        renderer,
+        args,
+        scene,
+        variant,
+        started,
+    )?;
     Ok((run, info, log.errors()))
 }
 
@@ -172,7 +216,13 @@ pub fn run(args: &RenderArgs, started: Instant) -> Result<(WindowedRun, DeviceIn
 /// to blend with the desktop).
 fn pick_config(configs: Box<dyn Iterator<Item = Config> + '_>) -> Config {
     configs
-        .max_by_key(|c| (c.alpha_size() == 0, !c.srgb_capable(), c.hardware_accelerated()))
+        .max_by_key(|c| {
+            (
+                c.alpha_size() == 0,
+                !c.srgb_capable(),
+                c.hardware_accelerated(),
+            )
+        })
         .expect("glutin reports BadConfig instead of calling the picker with no configs")
 }
 
@@ -219,7 +269,9 @@ impl Renderer for GlWindow<'_> {
 
     fn resize(&mut self, width: u32, height: u32) -> Result<()> {
         self.size = (width, height);
-        let (Some(w), Some(h)) = (NonZeroU32::new(width), NonZeroU32::new(height)) else { return Ok(()) };
+        let (Some(w), Some(h)) = (NonZeroU32::new(width), NonZeroU32::new(height)) else {
+            return Ok(());
+        };
         // EGL and GLX resize the surface with the window; the call is for platforms that don't.
         self.surface.resize(self.context, w, h);
         // SAFETY: plain state on the current context.
@@ -234,21 +286,31 @@ impl Renderer for GlWindow<'_> {
         self.buffers.update_frame(bytemuck::bytes_of(frame));
         let (timer, pending) = &mut self.timers[self.next_timer];
         // The ring's oldest query: read it if the GPU has finished it, else skip.
-        let gpu_ms = if *pending { timer.try_result_ms() } else { None };
+        let gpu_ms = if *pending {
+            timer.try_result_ms()
+        } else {
+            None
+        };
         timer.begin();
         // SAFETY: program, VAO and buffers are bound and alive.
         unsafe { self.gl.draw_arrays(glow::TRIANGLES, 0, 3) };
         timer.end();
         *pending = true;
         self.next_timer = (self.next_timer + 1) % TIMERS;
-        self.surface.swap_buffers(self.context).context("swapping buffers")?;
+        self.surface
+            .swap_buffers(self.context)
+            .context("swapping buffers")?;
         self.log.check(self.gl, "after a frame");
         Ok(Some(Drawn { gpu_ms }))
     }
 
     fn load_scene(&mut self, scene: &GpuScene, shaders: &Shaders) -> Result<()> {
         let gl = self.gl;
-        self.program = Program::new(gl, &shaders.vertex_glsl, &upper_left_origin(&shaders.fragment_glsl))?;
+        self.program = Program::new(
+            gl,
+            &shaders.vertex_glsl,
+            &upper_left_origin(&shaders.fragment_glsl),
+        )?;
         self.buffers = SceneBuffers::new(gl, scene)?;
         self.program.bind(&self.vao);
         self.shaders = shaders.clone();
@@ -269,7 +331,7 @@ impl Renderer for GlWindow<'_> {
             unsafe { gl.draw_arrays(glow::TRIANGLES, 0, 3) };
             fbo.read()
         }; // the FBO is deleted here and the window's framebuffer bound again
-        // SAFETY: plain state on the current context.
+           // SAFETY: plain state on the current context.
         unsafe { gl.viewport(0, 0, self.size.0 as i32, self.size.1 as i32) };
         self.log.check(gl, "after a capture");
         Ok(FloatImage::from_rgba(width, height, &pixels).flip_rows())

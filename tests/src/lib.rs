@@ -8,7 +8,11 @@ use twinray_common::report::RunReport;
 /// target/<profile>/, found from this test executable (target/<profile>/deps/…).
 pub fn bin_dir() -> PathBuf {
     let exe = std::env::current_exe().expect("test executable path");
-    let dir = exe.parent().and_then(Path::parent).expect("target/<profile>").to_path_buf();
+    let dir = exe
+        .parent()
+        .and_then(Path::parent)
+        .expect("target/<profile>")
+        .to_path_buf();
     for name in ["twinray-vk", "twinray-gl", "twinray"] {
         assert!(
             dir.join(name).exists(),
@@ -40,7 +44,8 @@ pub fn run(program: &Path, args: &[&str], env: &[(&str, &str)]) -> Output {
     for (k, v) in env {
         cmd.env(k, v);
     }
-    cmd.output().unwrap_or_else(|e| panic!("starting {}: {e}", program.display()))
+    cmd.output()
+        .unwrap_or_else(|e| panic!("starting {}: {e}", program.display()))
 }
 
 /// Which app to run.
@@ -62,14 +67,33 @@ impl App {
 }
 
 /// A successful validated headless render: its report and its 8-bit image.
-pub fn render(app: App, scene: &str, size: &str, extra: &[&str], out: &Path) -> (RunReport, image::RgbImage) {
-    let mut args = vec!["--headless", "--validate", "--json", "--scene", scene, "--size", size, "--out"];
+pub fn render(
+    app: App,
+    scene: &str,
+    size: &str,
+    extra: &[&str],
+    out: &Path,
+) -> (RunReport, image::RgbImage) {
+    let mut args = vec![
+        "--headless",
+        "--validate",
+        "--json",
+        "--scene",
+        scene,
+        "--size",
+        size,
+        "--out",
+    ];
     let out_s = out.to_str().unwrap();
     args.push(out_s);
     args.extend_from_slice(extra);
     let o = run(&app.exe(), &args, &[]);
     let stderr = String::from_utf8_lossy(&o.stderr);
-    assert!(o.status.success(), "{app:?} {args:?} failed ({}): {stderr}", o.status);
+    assert!(
+        o.status.success(),
+        "{app:?} {args:?} failed ({}): {stderr}",
+        o.status
+    );
     let stdout = String::from_utf8_lossy(&o.stdout);
     let report: RunReport = serde_json::from_str(stdout.trim())
         .unwrap_or_else(|e| panic!("{app:?}: stdout is not one JSON report ({e}): {stdout}"));
@@ -81,7 +105,11 @@ pub fn render(app: App, scene: &str, size: &str, extra: &[&str], out: &Path) -> 
 pub fn fail(program: &Path, args: &[&str], env: &[(&str, &str)]) -> (i32, String) {
     let o = run(program, args, env);
     let stderr = String::from_utf8_lossy(&o.stderr).to_string();
-    assert!(!stderr.contains("panicked"), "{} {args:?} panicked: {stderr}", program.display());
+    assert!(
+        !stderr.contains("panicked"),
+        "{} {args:?} panicked: {stderr}",
+        program.display()
+    );
     (o.status.code().unwrap_or(-1), stderr)
 }
 
@@ -97,15 +125,31 @@ impl Xvfb {
     pub fn start() -> Xvfb {
         use std::io::BufRead;
         let mut child = Command::new("Xvfb")
-            .args(["-displayfd", "1", "-screen", "0", "640x480x24", "-nolisten", "tcp"])
+            .args([
+                "-displayfd",
+                "1",
+                "-screen",
+                "0",
+                "640x480x24",
+                "-nolisten",
+                "tcp",
+            ])
             .stdout(std::process::Stdio::piped())
             .stderr(std::process::Stdio::null())
             .spawn()
             .unwrap_or_else(|e| panic!("starting Xvfb ({e}): install xvfb (tests/run.sh does)"));
         let mut line = String::new();
-        std::io::BufReader::new(child.stdout.take().expect("piped")).read_line(&mut line).expect("Xvfb display number");
-        let n: u32 = line.trim().parse().unwrap_or_else(|_| panic!("Xvfb printed '{line}' instead of a display number"));
-        Xvfb { child, display: format!(":{n}") }
+        std::io::BufReader::new(child.stdout.take().expect("piped"))
+            .read_line(&mut line)
+            .expect("Xvfb display number");
+        let n: u32 = line
+            .trim()
+            .parse()
+            .unwrap_or_else(|_| panic!("Xvfb printed '{line}' instead of a display number"));
+        Xvfb {
+            child,
+            display: format!(":{n}"),
+        }
     }
 
     /// Runs `program` on this display (and nowhere else: WAYLAND_DISPLAY is cleared).
@@ -120,7 +164,8 @@ impl Xvfb {
         for (k, v) in env {
             cmd.env(k, v);
         }
-        cmd.output().unwrap_or_else(|e| panic!("starting {}: {e}", program.display()))
+        cmd.output()
+            .unwrap_or_else(|e| panic!("starting {}: {e}", program.display()))
     }
 }
 

@@ -15,7 +15,10 @@ fn agree(app: App, scene: &str, size: &str, a: &[&str], b: &[&str], what: &str) 
     let dir = scratch(&format!("accel-{scene}-{what}"));
     let (ra, ia) = render(app, scene, size, a, &dir.join("a.png"));
     let (rb, ib) = render(app, scene, size, b, &dir.join("b.png"));
-    assert_ne!(ra.variant, rb.variant, "{what}: the two runs must use different shaders");
+    assert_ne!(
+        ra.variant, rb.variant,
+        "{what}: the two runs must use different shaders"
+    );
     let m = compare(&ia, &ib).unwrap();
     assert!(
         m.within_1() >= 0.9999,
@@ -43,7 +46,11 @@ fn every_scene_variant_agrees_with_the_generic_shader() {
     for app in App::BOTH {
         for (scene, size, set) in SCENES {
             let variant: Vec<&str> = set.iter().copied().chain(["--accel", "none"]).collect();
-            let generic: Vec<&str> = set.iter().copied().chain(["--accel", "none", "--generic"]).collect();
+            let generic: Vec<&str> = set
+                .iter()
+                .copied()
+                .chain(["--accel", "none", "--generic"])
+                .collect();
             agree(app, scene, size, &variant, &generic, "generic");
         }
     }
@@ -53,7 +60,15 @@ fn every_scene_variant_agrees_with_the_generic_shader() {
 fn auto_uses_the_bvh_only_for_large_scenes() {
     let dir = scratch("accel-auto");
     let (small, _) = render(App::Vulkan, "box", "16x16", &[], &dir.join("a.png"));
-    assert!(!small.variant.ends_with("/bvh"), "box (32 primitives): {}", small.variant);
+    assert!(
+        !small.variant.ends_with("/bvh"),
+        "box (32 primitives): {}",
+        small.variant
+    );
     let (large, _) = render(App::Vulkan, "teapot", "16x16", &[], &dir.join("b.png"));
-    assert!(large.variant.ends_with("/bvh"), "teapot (19,201 primitives): {}", large.variant);
+    assert!(
+        large.variant.ends_with("/bvh"),
+        "teapot (19,201 primitives): {}",
+        large.variant
+    );
 }

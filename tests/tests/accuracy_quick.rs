@@ -6,39 +6,96 @@ use twinray_tests::{bin, run, scratch};
 
 fn rows(csv: &str) -> (Vec<String>, Vec<Vec<String>>) {
     let mut lines = csv.lines();
-    let header = lines.next().unwrap().split(',').map(str::to_string).collect();
+    let header = lines
+        .next()
+        .unwrap()
+        .split(',')
+        .map(str::to_string)
+        .collect();
     // The key columns come before any quoted field, so a plain split is enough for them.
-    (header, lines.map(|l| l.split(',').map(str::to_string).collect()).collect())
+    (
+        header,
+        lines
+            .map(|l| l.split(',').map(str::to_string).collect())
+            .collect(),
+    )
 }
 
 #[test]
 fn quick_accuracy_report_covers_every_configuration_and_the_default_passes_the_hard_cases() {
     let out = scratch("accuracy-quick");
-    let o = run(&bin("twinray"), &["accuracy", "--quick", "--out", out.to_str().unwrap()], &[]);
-    assert!(o.status.success(), "accuracy failed: {}", String::from_utf8_lossy(&o.stderr));
+    let o = run(
+        &bin("twinray"),
+        &["accuracy", "--quick", "--out", out.to_str().unwrap()],
+        &[],
+    );
+    assert!(
+        o.status.success(),
+        "accuracy failed: {}",
+        String::from_utf8_lossy(&o.stderr)
+    );
 
     let (h, body) = rows(&std::fs::read_to_string(out.join("accuracy.csv")).unwrap());
-    let col = |n: &str| h.iter().position(|c| c == n).unwrap_or_else(|| panic!("no column {n}"));
+    let col = |n: &str| {
+        h.iter()
+            .position(|c| c == n)
+            .unwrap_or_else(|| panic!("no column {n}"))
+    };
     for scene in ["box", "teapot", "spherelist"] {
         for api in ["vulkan", "opengl"] {
-            let these: Vec<&Vec<String>> = body.iter().filter(|r| r[col("scene")] == scene && r[col("api")] == api).collect();
-            assert!(these.len() >= 10, "{scene} {api}: only {} configurations", these.len());
-            assert!(these.iter().all(|r| r[col("status")] == "ok"), "{scene} {api}: a configuration failed");
-            assert_eq!(these.iter().filter(|r| r[col("default")] == "true").count(), 1, "{scene} {api}: one default row");
+            let these: Vec<&Vec<String>> = body
+                .iter()
+                .filter(|r| r[col("scene")] == scene && r[col("api")] == api)
+                .collect();
+            assert!(
+                these.len() >= 10,
+                "{scene} {api}: only {} configurations",
+                these.len()
+            );
+            assert!(
+                these.iter().all(|r| r[col("status")] == "ok"),
+                "{scene} {api}: a configuration failed"
+            );
+            assert_eq!(
+                these.iter().filter(|r| r[col("default")] == "true").count(),
+                1,
+                "{scene} {api}: one default row"
+            );
         }
     }
 
     let (h, body) = rows(&std::fs::read_to_string(out.join("hard_cases.csv")).unwrap());
     let col = |n: &str| h.iter().position(|c| c == n).unwrap();
-    let defaults: Vec<&Vec<String>> = body.iter().filter(|r| r[col("strategy")] == "default").collect();
-    assert!(defaults.len() >= 24, "at least 12 hard cases x 2 APIs, got {}", defaults.len());
+    let defaults: Vec<&Vec<String>> = body
+        .iter()
+        .filter(|r| r[col("strategy")] == "default")
+        .collect();
+    assert!(
+        defaults.len() >= 24,
+        "at least 12 hard cases x 2 APIs, got {}",
+        defaults.len()
+    );
     for r in defaults {
         let wrong: f64 = r[col("wrong_pct")].parse().unwrap();
         let tol: f64 = r[col("tolerance_pct")].parse().unwrap();
-        assert!(r[col("status")] == "ok" && wrong <= tol, "{} {}: {wrong}% wrong > {tol}%", r[col("case")], r[col("api")]);
-        assert_eq!(r[col("nonfinite_pixels")], "0", "{} {}: NaN/Inf", r[col("case")], r[col("api")]);
+        assert!(
+            r[col("status")] == "ok" && wrong <= tol,
+            "{} {}: {wrong}% wrong > {tol}%",
+            r[col("case")],
+            r[col("api")]
+        );
+        assert_eq!(
+            r[col("nonfinite_pixels")],
+            "0",
+            "{} {}: NaN/Inf",
+            r[col("case")],
+            r[col("api")]
+        );
     }
     let report = std::fs::read_to_string(out.join("report.md")).unwrap();
-    assert!(report.contains("Default configuration"), "report names the default");
+    assert!(
+        report.contains("Default configuration"),
+        "report names the default"
+    );
     std::fs::remove_dir_all(out).ok();
 }

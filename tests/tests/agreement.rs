@@ -15,7 +15,10 @@ fn check(scene: &str, size: &str, set: &[(&str, &str)]) {
         extra.extend(["--set", s.as_str()]);
     }
     let sz = twinray_common::cli::parse_size(size).unwrap();
-    let overrides: Vec<(String, String)> = set.iter().map(|(k, v)| (k.to_string(), v.to_string())).collect();
+    let overrides: Vec<(String, String)> = set
+        .iter()
+        .map(|(k, v)| (k.to_string(), v.to_string()))
+        .collect();
     let sc = Scene::load(scene, &overrides).unwrap();
     let reference = reference::render(&sc, sz.width, sz.height);
     assert_eq!(reference.nonfinite_pixels(), 0, "{scene}: reference NaN");
@@ -24,19 +27,41 @@ fn check(scene: &str, size: &str, set: &[(&str, &str)]) {
     let mut images = Vec::new();
     for app in App::BOTH {
         let (report, img) = render(app, scene, size, &extra, &dir.join(format!("{app:?}.png")));
-        assert_eq!(report.validation_messages, 0, "{scene} {app:?}: validation messages");
-        assert_eq!(report.nonfinite_pixels, 0, "{scene} {app:?}: NaN/Inf pixels before quantisation");
+        assert_eq!(
+            report.validation_messages, 0,
+            "{scene} {app:?}: validation messages"
+        );
+        assert_eq!(
+            report.nonfinite_pixels, 0,
+            "{scene} {app:?}: NaN/Inf pixels before quantisation"
+        );
         assert_eq!((report.width, report.height), (sz.width, sz.height));
         assert_eq!(report.scene.triangles, sc.triangles.len());
         assert_eq!(report.scene.spheres, sc.spheres.len());
         let m = compare(&img, &reference).unwrap();
-        println!("{scene} {app:?} vs reference: {:.4}% within 1/255, max {}", 100.0 * m.within_1(), m.max_abs);
-        assert!(m.within_1() >= 0.995, "{scene} {app:?} vs reference: only {:.4}% within 1/255", 100.0 * m.within_1());
+        println!(
+            "{scene} {app:?} vs reference: {:.4}% within 1/255, max {}",
+            100.0 * m.within_1(),
+            m.max_abs
+        );
+        assert!(
+            m.within_1() >= 0.995,
+            "{scene} {app:?} vs reference: only {:.4}% within 1/255",
+            100.0 * m.within_1()
+        );
         images.push(img);
     }
     let m = compare(&images[0], &images[1]).unwrap();
-    println!("{scene} Vulkan vs OpenGL: {:.4}% within 1/255, max {}", 100.0 * m.within_1(), m.max_abs);
-    assert!(m.within_1() >= 0.999, "{scene} Vulkan vs OpenGL: only {:.4}% within 1/255", 100.0 * m.within_1());
+    println!(
+        "{scene} Vulkan vs OpenGL: {:.4}% within 1/255, max {}",
+        100.0 * m.within_1(),
+        m.max_abs
+    );
+    assert!(
+        m.within_1() >= 0.999,
+        "{scene} Vulkan vs OpenGL: only {:.4}% within 1/255",
+        100.0 * m.within_1()
+    );
     std::fs::remove_dir_all(dir).ok();
 }
 
@@ -63,7 +88,11 @@ fn generic_shader_renders_the_same_as_the_variant() {
         let (report, generic) = render(app, "box", "96x72", &["--generic"], &dir.join("g.png"));
         assert!(report.variant.contains("stack17"), "{}", report.variant);
         let m = compare(&variant, &generic).unwrap();
-        assert!(m.within_1() >= 0.9999, "{app:?}: generic vs variant {:.4}%", 100.0 * m.within_1());
+        assert!(
+            m.within_1() >= 0.9999,
+            "{app:?}: generic vs variant {:.4}%",
+            100.0 * m.within_1()
+        );
     }
 }
 
@@ -73,9 +102,19 @@ fn opengl_running_naga_spirv_matches_its_glsl() {
     let dir = scratch("gl-spirv");
     for scene in ["box", "spherelist"] {
         let (_, glsl) = render(App::OpenGl, scene, "96x72", &[], &dir.join("glsl.png"));
-        let (report, spirv) = render(App::OpenGl, scene, "96x72", &["--gl-spirv"], &dir.join("spirv.png"));
+        let (report, spirv) = render(
+            App::OpenGl,
+            scene,
+            "96x72",
+            &["--gl-spirv"],
+            &dir.join("spirv.png"),
+        );
         assert!(report.variant.ends_with("(SPIR-V)"), "{}", report.variant);
         let m = compare(&glsl, &spirv).unwrap();
-        assert!(m.within_1() >= 0.9999, "{scene}: SPIR-V vs GLSL {:.4}%", 100.0 * m.within_1());
+        assert!(
+            m.within_1() >= 0.9999,
+            "{scene}: SPIR-V vs GLSL {:.4}%",
+            100.0 * m.within_1()
+        );
     }
 }

@@ -27,12 +27,21 @@ fn expect_both(args: &[&str], env: &[(&str, &str)], code: i32, expect: &[&str]) 
 fn expect_one(exe: &Path, args: &[&str], env: &[(&str, &str)], code: i32, expect: &[&str]) {
     let (got, stderr) = fail(exe, args, env);
     let name = exe.file_name().unwrap().to_string_lossy().to_string();
-    assert_eq!(got, code, "{name} {args:?}: exit code {got}, stderr: {stderr}");
+    assert_eq!(
+        got, code,
+        "{name} {args:?}: exit code {got}, stderr: {stderr}"
+    );
     let errors: Vec<&str> = stderr.lines().filter(|l| l.contains("error")).collect();
-    assert!(!errors.is_empty(), "{name} {args:?}: no error line in: {stderr}");
+    assert!(
+        !errors.is_empty(),
+        "{name} {args:?}: no error line in: {stderr}"
+    );
     let line = errors[0];
     for word in expect {
-        assert!(line.contains(word), "{name} {args:?}: error line lacks '{word}': {line}");
+        assert!(
+            line.contains(word),
+            "{name} {args:?}: error line lacks '{word}': {line}"
+        );
     }
 }
 
@@ -43,7 +52,10 @@ fn scene_file(dir: &Path, name: &str, body: &str) -> String {
 }
 
 fn headless(scene: &str) -> Vec<String> {
-    ["--headless", "--size", "16x16", "--scene", scene].iter().map(|s| s.to_string()).collect()
+    ["--headless", "--size", "16x16", "--scene", scene]
+        .iter()
+        .map(|s| s.to_string())
+        .collect()
 }
 
 fn strs(v: &[String]) -> Vec<&str> {
@@ -52,21 +64,44 @@ fn strs(v: &[String]) -> Vec<&str> {
 
 #[test]
 fn missing_and_unknown_scenes() {
-    expect_both(&["--headless", "--scene", "/no/such/scene.toml"], &[], 2, &["/no/such/scene.toml", "does not exist"]);
-    expect_both(&["--headless", "--scene", "kettle"], &[], 2, &["'kettle'", "built-in"]);
+    expect_both(
+        &["--headless", "--scene", "/no/such/scene.toml"],
+        &[],
+        2,
+        &["/no/such/scene.toml", "does not exist"],
+    );
+    expect_both(
+        &["--headless", "--scene", "kettle"],
+        &[],
+        2,
+        &["'kettle'", "built-in"],
+    );
 }
 
 #[test]
 fn malformed_scene_names_line_and_column() {
     let dir = scratch("malformed");
-    let p = scene_file(&dir, "bad.toml", "[[spheres]]\ncenter = [0.0, 0.0\nradius = 1.0\n");
-    expect_both(&strs(&headless(&p)), &[], 2, &["bad.toml", "line 12, column"]);
+    let p = scene_file(
+        &dir,
+        "bad.toml",
+        "[[spheres]]\ncenter = [0.0, 0.0\nradius = 1.0\n",
+    );
+    expect_both(
+        &strs(&headless(&p)),
+        &[],
+        2,
+        &["bad.toml", "line 12, column"],
+    );
 }
 
 #[test]
 fn unknown_key_is_named() {
     let dir = scratch("unknown-key");
-    let p = scene_file(&dir, "k.toml", "[[spheres]]\ncenter = [0.0, 0.0, 0.0]\nradius = 1.0\nmaterial = \"m\"\nglow = 2.0\n");
+    let p = scene_file(
+        &dir,
+        "k.toml",
+        "[[spheres]]\ncenter = [0.0, 0.0, 0.0]\nradius = 1.0\nmaterial = \"m\"\nglow = 2.0\n",
+    );
     expect_both(&strs(&headless(&p)), &[], 2, &["k.toml", "glow", "line 14"]);
 }
 
@@ -92,12 +127,21 @@ fn bad_values_are_named() {
 #[test]
 fn missing_and_broken_obj() {
     let dir = scratch("obj");
-    let p = scene_file(&dir, "mesh.toml", "[[meshes]]\nobj = \"pot.obj\"\nmaterial = \"m\"\n");
+    let p = scene_file(
+        &dir,
+        "mesh.toml",
+        "[[meshes]]\nobj = \"pot.obj\"\nmaterial = \"m\"\n",
+    );
     expect_both(&strs(&headless(&p)), &[], 2, &["pot.obj", "cannot be read"]);
     std::fs::write(dir.join("pot.obj"), "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 7\n").unwrap();
     expect_both(&strs(&headless(&p)), &[], 2, &["pot.obj"]);
     std::fs::write(dir.join("pot.obj"), "v 1 2 x\nf 1 1 1\n").unwrap();
-    expect_both(&strs(&headless(&p)), &[], 2, &["pot.obj", "not a valid OBJ"]);
+    expect_both(
+        &strs(&headless(&p)),
+        &[],
+        2,
+        &["pot.obj", "not a valid OBJ"],
+    );
 }
 
 #[test]
@@ -106,16 +150,32 @@ fn bad_sizes() {
     for app in App::BOTH {
         let (code, stderr) = fail(&app.exe(), &["--headless", "--size", "0x10"], &[]);
         assert_eq!(code, 2, "{stderr}");
-        assert!(stderr.contains("--size") && stderr.contains("zero"), "{stderr}");
+        assert!(
+            stderr.contains("--size") && stderr.contains("zero"),
+            "{stderr}"
+        );
     }
-    expect_both(&["--headless", "--size", "20000x16"], &[], 2, &["--size 20000x16", "limit"]);
+    expect_both(
+        &["--headless", "--size", "20000x16"],
+        &[],
+        2,
+        &["--size 20000x16", "limit"],
+    );
 }
 
 #[test]
 fn too_many_primitives_for_the_storage_buffer_limit() {
     // 5 million 32-byte spheres: 160 MB, above Mesa's 128 MiB limit (and most GPUs' 2^27..2^32).
     expect_both(
-        &["--headless", "--size", "16x16", "--scene", "spherelist", "--set", "extra_spheres=5000000"],
+        &[
+            "--headless",
+            "--size",
+            "16x16",
+            "--scene",
+            "spherelist",
+            "--set",
+            "extra_spheres=5000000",
+        ],
         &[],
         2,
         &["spheres", "limit"],
@@ -124,9 +184,27 @@ fn too_many_primitives_for_the_storage_buffer_limit() {
 
 #[test]
 fn gl_spirv_is_an_opengl_option_and_the_vulkan_knobs_are_checked() {
-    expect_one(&bin("twinray-vk"), &["--headless", "--gl-spirv"], &[], 2, &["--gl-spirv", "OpenGL"]);
-    expect_one(&bin("twinray-vk"), &["--headless"], &[("TWINRAY_VK_MEMORY", "vram")], 2, &["TWINRAY_VK_MEMORY", "'vram'"]);
-    expect_one(&bin("twinray-vk"), &["--headless"], &[("TWINRAY_VK_WAIT", "spin")], 2, &["TWINRAY_VK_WAIT", "'spin'"]);
+    expect_one(
+        &bin("twinray-vk"),
+        &["--headless", "--gl-spirv"],
+        &[],
+        2,
+        &["--gl-spirv", "OpenGL"],
+    );
+    expect_one(
+        &bin("twinray-vk"),
+        &["--headless"],
+        &[("TWINRAY_VK_MEMORY", "vram")],
+        2,
+        &["TWINRAY_VK_MEMORY", "'vram'"],
+    );
+    expect_one(
+        &bin("twinray-vk"),
+        &["--headless"],
+        &[("TWINRAY_VK_WAIT", "spin")],
+        2,
+        &["TWINRAY_VK_WAIT", "'spin'"],
+    );
 }
 
 #[test]
@@ -136,22 +214,47 @@ fn unknown_override_key() {
 
 #[test]
 fn unknown_numerics_value() {
-    expect_both(&["--headless", "--set", "triangle=octagonal"], &[], 2, &["--set triangle", "octagonal", "watertight"]);
+    expect_both(
+        &["--headless", "--set", "triangle=octagonal"],
+        &[],
+        2,
+        &["--set triangle", "octagonal", "watertight"],
+    );
     let dir = scratch("numerics-file");
     let p = scene_file(&dir, "n.toml", "[render]\noffset = \"far\"\n");
-    expect_both(&strs(&headless(&p)), &[], 2, &["n.toml", "render.offset", "'far'"]);
+    expect_both(
+        &strs(&headless(&p)),
+        &[],
+        2,
+        &["n.toml", "render.offset", "'far'"],
+    );
 }
 
 #[test]
 fn no_vulkan_driver_says_what_to_install() {
-    let env = [("VK_DRIVER_FILES", "/nonexistent/icd.json"), ("VK_ICD_FILENAMES", "/nonexistent/icd.json")];
-    expect_one(&bin("twinray-vk"), &["--headless", "--size", "16x16"], &env, 3, &["install"]);
+    let env = [
+        ("VK_DRIVER_FILES", "/nonexistent/icd.json"),
+        ("VK_ICD_FILENAMES", "/nonexistent/icd.json"),
+    ];
+    expect_one(
+        &bin("twinray-vk"),
+        &["--headless", "--size", "16x16"],
+        &env,
+        3,
+        &["install"],
+    );
 }
 
 #[test]
 fn no_egl_device_says_what_to_install() {
     let env = [("__EGL_VENDOR_LIBRARY_FILENAMES", "/nonexistent/egl.json")];
-    expect_one(&bin("twinray-gl"), &["--headless", "--size", "16x16"], &env, 3, &["install"]);
+    expect_one(
+        &bin("twinray-gl"),
+        &["--headless", "--size", "16x16"],
+        &env,
+        3,
+        &["install"],
+    );
 }
 
 #[test]
@@ -162,17 +265,51 @@ fn orchestrator_diff_and_render_errors() {
     let b = dir.join("b.png");
     image::RgbImage::new(5, 4).save(&b).unwrap();
     let tw = bin("twinray");
-    expect_one(&tw, &["diff", a.to_str().unwrap(), "/no/such.png"], &[], 2, &["/no/such.png"]);
-    expect_one(&tw, &["diff", a.to_str().unwrap(), b.to_str().unwrap()], &[], 2, &["differ in size"]);
-    expect_one(&tw, &["render", "--api", "reference", "--scene", "kettle", "--json"], &[], 2, &["'kettle'"]);
+    expect_one(
+        &tw,
+        &["diff", a.to_str().unwrap(), "/no/such.png"],
+        &[],
+        2,
+        &["/no/such.png"],
+    );
+    expect_one(
+        &tw,
+        &["diff", a.to_str().unwrap(), b.to_str().unwrap()],
+        &[],
+        2,
+        &["differ in size"],
+    );
+    expect_one(
+        &tw,
+        &[
+            "render",
+            "--api",
+            "reference",
+            "--scene",
+            "kettle",
+            "--json",
+        ],
+        &[],
+        2,
+        &["'kettle'"],
+    );
 }
 
 #[test]
 fn bad_path_and_workgroup_options() {
     // A workgroup means nothing to the fragment path: said, not ignored.
-    expect_both(&["--headless", "--size", "16x16", "--workgroup", "8x8"], &[], 2, &["--workgroup", "--path compute"]);
+    expect_both(
+        &["--headless", "--size", "16x16", "--workgroup", "8x8"],
+        &[],
+        2,
+        &["--workgroup", "--path compute"],
+    );
     for app in App::BOTH {
-        for args in [["--path", "warp"], ["--workgroup", "0x8"], ["--workgroup", "64x64"]] {
+        for args in [
+            ["--path", "warp"],
+            ["--workgroup", "0x8"],
+            ["--workgroup", "64x64"],
+        ] {
             let mut all = vec!["--headless", "--size", "16x16", "--path", "compute"];
             all.extend(args);
             let (code, stderr) = fail(&app.exe(), &all, &[]);

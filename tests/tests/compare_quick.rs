@@ -8,20 +8,44 @@ use twinray_tests::{bin, run, scratch};
 #[test]
 fn quick_comparison_writes_every_api_experiment_and_point() {
     let out = scratch("compare-quick");
-    let o = run(&bin("twinray"), &["compare", "--quick", "--out", out.to_str().unwrap()], &[]);
-    assert!(o.status.success(), "compare failed: {}", String::from_utf8_lossy(&o.stderr));
+    let o = run(
+        &bin("twinray"),
+        &["compare", "--quick", "--out", out.to_str().unwrap()],
+        &[],
+    );
+    assert!(
+        o.status.success(),
+        "compare failed: {}",
+        String::from_utf8_lossy(&o.stderr)
+    );
 
     let csv = std::fs::read_to_string(out.join("results.csv")).unwrap();
     let mut lines = csv.lines();
     let header: Vec<&str> = lines.next().unwrap().split(',').collect();
-    let col = |name: &str| header.iter().position(|h| *h == name).unwrap_or_else(|| panic!("no column {name}"));
-    let (exp, value, api, status, path) = (col("experiment"), col("param_value"), col("api"), col("status"), col("path"));
+    let col = |name: &str| {
+        header
+            .iter()
+            .position(|h| *h == name)
+            .unwrap_or_else(|| panic!("no column {name}"))
+    };
+    let (exp, value, api, status, path) = (
+        col("experiment"),
+        col("param_value"),
+        col("api"),
+        col("status"),
+        col("path"),
+    );
     let mut seen = BTreeSet::new();
     for line in lines {
         // Quoted fields come after the key columns, so a plain split is enough for these.
         let f: Vec<&str> = line.split(',').collect();
         assert_eq!(f[status], "ok", "failed point: {line}");
-        seen.insert((f[exp].to_string(), f[value].to_string(), f[api].to_string(), f[path].to_string()));
+        seen.insert((
+            f[exp].to_string(),
+            f[value].to_string(),
+            f[api].to_string(),
+            f[path].to_string(),
+        ));
     }
     let mut expected = BTreeSet::new();
     let points = [
@@ -38,16 +62,28 @@ fn quick_comparison_writes_every_api_experiment_and_point() {
             }
         }
     }
-    assert_eq!(seen, expected, "results.csv must hold every API x path x experiment x point of the quick preset");
+    assert_eq!(
+        seen, expected,
+        "results.csv must hold every API x path x experiment x point of the quick preset"
+    );
 
     let report = std::fs::read_to_string(out.join("report.md")).unwrap();
     let summary: Vec<&str> = report.lines().skip(2).take(4).collect();
     for (line, exp) in summary.iter().zip(["teapot", "box", "spherelist"]) {
-        assert!(line.starts_with(&format!("- **{exp}** — Vulkan/OpenGL: fragment")), "report opens with a summary line per experiment: {line}");
+        assert!(
+            line.starts_with(&format!("- **{exp}** — Vulkan/OpenGL: fragment")),
+            "report opens with a summary line per experiment: {line}"
+        );
         assert!(line.contains("compute") && line.contains("Why:"), "{line}");
     }
     assert_eq!(summary[3], "", "the summary is three lines");
-    for f in ["teapot.svg", "box.svg", "spherelist.svg", "scaling.svg", "images/box-reference.png"] {
+    for f in [
+        "teapot.svg",
+        "box.svg",
+        "spherelist.svg",
+        "scaling.svg",
+        "images/box-reference.png",
+    ] {
         assert!(out.join(f).exists(), "{f} missing");
     }
     std::fs::remove_dir_all(out).ok();

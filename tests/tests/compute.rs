@@ -14,12 +14,29 @@ fn check(scene: &str, size: &str, extra: &[&str]) {
         args.extend(["--path", "compute"]);
         let (report, compute) = render(app, scene, size, &args, &dir.join("compute.png"));
         assert_eq!(frag_report.path.name(), "fragment");
-        assert_eq!(report.path.name(), "compute", "{app:?}: the report names the path");
-        assert!(report.workgroup.is_some(), "{app:?}: the report names the workgroup");
-        assert_eq!(report.validation_messages, 0, "{scene} {app:?} compute: validation messages");
-        assert_eq!(report.nonfinite_pixels, 0, "{scene} {app:?} compute: NaN/Inf pixels");
+        assert_eq!(
+            report.path.name(),
+            "compute",
+            "{app:?}: the report names the path"
+        );
+        assert!(
+            report.workgroup.is_some(),
+            "{app:?}: the report names the workgroup"
+        );
+        assert_eq!(
+            report.validation_messages, 0,
+            "{scene} {app:?} compute: validation messages"
+        );
+        assert_eq!(
+            report.nonfinite_pixels, 0,
+            "{scene} {app:?} compute: NaN/Inf pixels"
+        );
         let m = compare(&compute, &fragment).unwrap();
-        println!("{scene} {app:?} compute vs fragment: {:.4}% within 1/255, max {}", 100.0 * m.within_1(), m.max_abs);
+        println!(
+            "{scene} {app:?} compute vs fragment: {:.4}% within 1/255, max {}",
+            100.0 * m.within_1(),
+            m.max_abs
+        );
         assert!(
             m.within_1() >= 0.9999,
             "{scene} {app:?}: compute vs fragment only {:.4}% within 1/255",
@@ -51,11 +68,21 @@ fn every_measured_workgroup_covers_an_odd_sized_image() {
     for app in App::BOTH {
         let (_, fragment) = render(app, "box", "61x37", &[], &dir.join("f.png"));
         for wg in ["8x8", "16x8", "16x16"] {
-            let (report, img) = render(app, "box", "61x37", &["--path", "compute", "--workgroup", wg], &dir.join("c.png"));
+            let (report, img) = render(
+                app,
+                "box",
+                "61x37",
+                &["--path", "compute", "--workgroup", wg],
+                &dir.join("c.png"),
+            );
             assert_eq!(report.workgroup.as_deref(), Some(wg));
             assert_eq!(report.validation_messages, 0);
             let m = compare(&img, &fragment).unwrap();
-            assert!(m.within_1() >= 0.9999, "{app:?} {wg}: {:.4}% within 1/255", 100.0 * m.within_1());
+            assert!(
+                m.within_1() >= 0.9999,
+                "{app:?} {wg}: {:.4}% within 1/255",
+                100.0 * m.within_1()
+            );
         }
     }
 }

@@ -22,22 +22,47 @@ fn check(name: &str) {
     let truth = reference::render_truth(&scene, 64, 64);
     assert_eq!(truth.nonfinite_pixels(), 0, "{name}: NaN in the f64 truth");
     let truth = truth.to_rgb8();
-    let background = FloatImage { width: 1, height: 1, pixels: vec![scene.background.as_vec3().to_array()] }.to_rgb8();
+    let background = FloatImage {
+        width: 1,
+        height: 1,
+        pixels: vec![scene.background.as_vec3().to_array()],
+    }
+    .to_rgb8();
     let dir = scratch(&format!("hard-{name}"));
     for app in App::BOTH {
         let (report, img) = render(app, p, SIZE, &[], &dir.join("a.png"));
-        assert_eq!(report.nonfinite_pixels, 0, "{name} {app:?}: NaN/Inf pixels before quantisation");
-        assert_eq!(report.validation_messages, 0, "{name} {app:?}: validation messages");
+        assert_eq!(
+            report.nonfinite_pixels, 0,
+            "{name} {app:?}: NaN/Inf pixels before quantisation"
+        );
+        assert_eq!(
+            report.validation_messages, 0,
+            "{name} {app:?}: validation messages"
+        );
         let wrong = 100.0 * hard::wrong_share(&img, &truth);
-        println!("{name} {app:?}: {wrong:.3}% wrong (tolerance {}%)", case.tolerance_pct);
-        assert!(wrong <= case.tolerance_pct, "{name} {app:?}: {wrong:.3}% of pixels wrong, tolerance {}% ({})", case.tolerance_pct, case.checks);
+        println!(
+            "{name} {app:?}: {wrong:.3}% wrong (tolerance {}%)",
+            case.tolerance_pct
+        );
+        assert!(
+            wrong <= case.tolerance_pct,
+            "{name} {app:?}: {wrong:.3}% of pixels wrong, tolerance {}% ({})",
+            case.tolerance_pct,
+            case.checks
+        );
         if case.extra.iter().any(|e| e == "cracks") {
             let cracks = hard::crack_pixels(&img, &truth, background.get_pixel(0, 0).0);
-            assert_eq!(cracks, 0, "{name} {app:?}: {cracks} crack pixels inside the silhouette");
+            assert_eq!(
+                cracks, 0,
+                "{name} {app:?}: {cracks} crack pixels inside the silhouette"
+            );
         }
         if case.extra.iter().any(|e| e == "deterministic") {
             let (_, again) = render(app, p, SIZE, &[], &dir.join("b.png"));
-            assert!(img == again, "{name} {app:?}: two renders of the same scene differ");
+            assert!(
+                img == again,
+                "{name} {app:?}: two renders of the same scene differ"
+            );
         }
     }
     std::fs::remove_dir_all(dir).ok();
@@ -48,7 +73,11 @@ fn every_hard_case_has_a_test() {
     let cases = hard::list(Path::new(hard::SOURCE_DIR)).unwrap();
     let tested = include_str!("hard_cases.rs");
     for c in &cases {
-        assert!(tested.contains(&format!("check(\"{}\")", c.name)), "scenes/hard/{}.toml has no test here", c.name);
+        assert!(
+            tested.contains(&format!("check(\"{}\")", c.name)),
+            "scenes/hard/{}.toml has no test here",
+            c.name
+        );
     }
     assert!(cases.len() >= 12);
 }
@@ -122,12 +151,33 @@ fn far_tiny_sphere() {
 #[test]
 fn numerics_set_keys_work_in_both_apps() {
     let dir = scratch("numerics-set");
-    let sc = Scene::load("box", &[("triangle".into(), "watertight".into()), ("offset".into(), "ulp".into())]).unwrap();
+    let sc = Scene::load(
+        "box",
+        &[
+            ("triangle".into(), "watertight".into()),
+            ("offset".into(), "ulp".into()),
+        ],
+    )
+    .unwrap();
     let reference = reference::render(&sc, 48, 36).to_rgb8();
     for app in App::BOTH {
-        let (report, img) = render(app, "box", "48x36", &["--set", "triangle=watertight", "--set", "offset=ulp"], &dir.join("n.png"));
-        assert!(report.variant.ends_with("ulp/watertight/stable"), "{}", report.variant);
+        let (report, img) = render(
+            app,
+            "box",
+            "48x36",
+            &["--set", "triangle=watertight", "--set", "offset=ulp"],
+            &dir.join("n.png"),
+        );
+        assert!(
+            report.variant.ends_with("ulp/watertight/stable"),
+            "{}",
+            report.variant
+        );
         let m = twinray_common::metrics::compare(&img, &reference).unwrap();
-        assert!(m.within_1() >= 0.995, "{app:?}: {:.3}% within 1/255", 100.0 * m.within_1());
+        assert!(
+            m.within_1() >= 0.995,
+            "{app:?}: {:.3}% within 1/255",
+            100.0 * m.within_1()
+        );
     }
 }

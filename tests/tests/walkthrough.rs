@@ -6,7 +6,10 @@
 use std::path::{Path, PathBuf};
 
 fn root() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).parent().unwrap().to_path_buf()
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .parent()
+        .unwrap()
+        .to_path_buf()
 }
 
 fn doc_path() -> PathBuf {
@@ -50,7 +53,9 @@ fn every_file_and_function_the_walkthrough_names_exists() {
     let mut checked = 0;
     let mut missing = Vec::new();
     for span in code_spans(&doc) {
-        let Some((path, items)) = file_reference(&span) else { continue };
+        let Some((path, items)) = file_reference(&span) else {
+            continue;
+        };
         let file = root().join(&path);
         let Ok(text) = std::fs::read_to_string(&file) else {
             missing.push(format!("`{span}`: file {path} does not exist"));
@@ -59,31 +64,52 @@ fn every_file_and_function_the_walkthrough_names_exists() {
         checked += 1;
         if let Some((function, owners)) = items.split_last() {
             let defines = |name: &str| {
-                [format!("fn {name}("), format!("fn {name}<")].iter().any(|pat| text.contains(pat.as_str()))
+                [format!("fn {name}("), format!("fn {name}<")]
+                    .iter()
+                    .any(|pat| text.contains(pat.as_str()))
             };
             if !defines(function) {
                 missing.push(format!("`{span}`: no fn {function} in {path}"));
             }
             for owner in owners {
-                let owned = [format!("struct {owner}"), format!("impl {owner}"), format!("for {owner}"), format!("enum {owner}")];
+                let owned = [
+                    format!("struct {owner}"),
+                    format!("impl {owner}"),
+                    format!("for {owner}"),
+                    format!("enum {owner}"),
+                ];
                 if !owned.iter().any(|p| text.contains(p.as_str())) {
                     missing.push(format!("`{span}`: no type {owner} in {path}"));
                 }
             }
         }
     }
-    assert!(missing.is_empty(), "the walkthrough names things that are gone:\n{}", missing.join("\n"));
-    assert!(checked >= 40, "only {checked} references found: is the parser still reading the document?");
+    assert!(
+        missing.is_empty(),
+        "the walkthrough names things that are gone:\n{}",
+        missing.join("\n")
+    );
+    assert!(
+        checked >= 40,
+        "only {checked} references found: is the parser still reading the document?"
+    );
 }
 
 #[test]
 fn every_picture_the_docs_show_exists() {
-    for (doc, dir) in [(doc_path(), root().join("docs")), (root().join("README.md"), root())] {
+    for (doc, dir) in [
+        (doc_path(), root().join("docs")),
+        (root().join("README.md"), root()),
+    ] {
         let text = std::fs::read_to_string(&doc).unwrap();
         for part in text.split("](").skip(1) {
             let target = part.split(')').next().unwrap();
             if target.ends_with(".png") {
-                assert!(dir.join(target).is_file(), "{} shows {target}, which does not exist", doc.display());
+                assert!(
+                    dir.join(target).is_file(),
+                    "{} shows {target}, which does not exist",
+                    doc.display()
+                );
             }
         }
     }
@@ -92,7 +118,10 @@ fn every_picture_the_docs_show_exists() {
 /// Non-blank lines that are not comments (`//`, `//!`, `///`), per file.
 fn code_lines(file: &Path) -> usize {
     let text = std::fs::read_to_string(file).unwrap();
-    text.lines().map(str::trim).filter(|l| !l.is_empty() && !l.starts_with("//")).count()
+    text.lines()
+        .map(str::trim)
+        .filter(|l| !l.is_empty() && !l.starts_with("//"))
+        .count()
 }
 
 fn count(crate_dir: &str) -> Vec<(String, usize)> {
@@ -103,7 +132,18 @@ fn count(crate_dir: &str) -> Vec<(String, usize)> {
         .filter(|p| p.extension().is_some_and(|e| e == "rs"))
         .collect();
     files.sort();
-    files.iter().map(|f| (format!("{crate_dir}/src/{}", f.file_name().unwrap().to_string_lossy()), code_lines(f))).collect()
+    files
+        .iter()
+        .map(|f| {
+            (
+                format!(
+                    "{crate_dir}/src/{}",
+                    f.file_name().unwrap().to_string_lossy()
+                ),
+                code_lines(f),
+            )
+        })
+        .collect()
 }
 
 /// The table between the loc markers, as this test counts it today.
@@ -112,9 +152,15 @@ fn loc_table() -> String {
     let gl = count("gl");
     let total = |v: &[(String, usize)]| v.iter().map(|(_, n)| n).sum::<usize>();
     let (tv, tg) = (total(&vk), total(&gl));
-    let mut s = String::from("| Vulkan (`vk/src/`) | lines | OpenGL (`gl/src/`) | lines |\n|---|---:|---|---:|\n");
+    let mut s = String::from(
+        "| Vulkan (`vk/src/`) | lines | OpenGL (`gl/src/`) | lines |\n|---|---:|---|---:|\n",
+    );
     for i in 0..vk.len().max(gl.len()) {
-        let cell = |v: &[(String, usize)]| v.get(i).map_or(("".into(), "".into()), |(f, n)| (format!("`{f}`"), n.to_string()));
+        let cell = |v: &[(String, usize)]| {
+            v.get(i).map_or(("".into(), "".into()), |(f, n)| {
+                (format!("`{f}`"), n.to_string())
+            })
+        };
         let ((fv, nv), (fg, ng)) = (cell(&vk), cell(&gl));
         s += &format!("| {fv} | {nv} | {fg} | {ng} |\n");
     }

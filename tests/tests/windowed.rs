@@ -17,7 +17,8 @@ fn clean_report(app: App, o: &Output) -> RunReport {
     assert!(o.status.success(), "{app:?} failed ({}): {err}", o.status);
     assert!(!err.contains("panicked"), "{app:?} panicked: {err}");
     let out = String::from_utf8_lossy(&o.stdout);
-    let report: RunReport = serde_json::from_str(out.trim()).unwrap_or_else(|e| panic!("{app:?}: not JSON ({e}): {out}"));
+    let report: RunReport = serde_json::from_str(out.trim())
+        .unwrap_or_else(|e| panic!("{app:?}: not JSON ({e}): {out}"));
     assert_eq!(report.validation_messages, 0, "{app:?}: {err}");
     report
 }
@@ -27,7 +28,16 @@ fn both_apps_open_a_window_render_30_frames_and_exit_cleanly() {
     let x = Xvfb::start();
     let dir = scratch("window-30");
     for app in App::BOTH {
-        let args = ["--scene", "box", "--size", "128x96", "--frames", "30", "--validate", "--json"];
+        let args = [
+            "--scene",
+            "box",
+            "--size",
+            "128x96",
+            "--frames",
+            "30",
+            "--validate",
+            "--json",
+        ];
         let o = x.run(&app.exe(), &args, &[], &dir);
         let r = clean_report(app, &o);
         assert_eq!(r.frames.len(), 30, "{app:?}");
@@ -40,13 +50,32 @@ fn fifty_resizes_and_minimize_restore_cause_no_crash_and_no_message() {
     let x = Xvfb::start();
     let dir = scratch("window-resize");
     for app in App::BOTH {
-        let args = ["--scene", "box", "--size", "120x90", "--frames", "150", "--validate", "--json"];
+        let args = [
+            "--scene",
+            "box",
+            "--size",
+            "120x90",
+            "--frames",
+            "150",
+            "--validate",
+            "--json",
+        ];
         let o = x.run(&app.exe(), &args, &[("TWINRAY_TEST_RESIZE", "1")], &dir);
         clean_report(app, &o);
         let err = stderr(&o);
-        let line = err.lines().find(|l| l.contains("test resize:")).unwrap_or_else(|| panic!("{app:?}: {err}"));
-        let numbers: Vec<u32> = line.split_whitespace().filter_map(|w| w.parse().ok()).collect();
-        assert!(numbers[0] >= 50, "{app:?}: only {} resizes: {line}", numbers[0]);
+        let line = err
+            .lines()
+            .find(|l| l.contains("test resize:"))
+            .unwrap_or_else(|| panic!("{app:?}: {err}"));
+        let numbers: Vec<u32> = line
+            .split_whitespace()
+            .filter_map(|w| w.parse().ok())
+            .collect();
+        assert!(
+            numbers[0] >= 50,
+            "{app:?}: only {} resizes: {line}",
+            numbers[0]
+        );
         assert!(numbers[1] >= 1, "{app:?}: no minimize/restore: {line}");
     }
 }
@@ -60,16 +89,40 @@ fn every_key_action_works_with_zero_messages() {
     // to 1 (same shader), reset, screenshot, and Esc last.
     let keys = "3,2,+,+,-,-,-,-,-,-,r,p,esc";
     for app in App::BOTH {
-        let args = ["--scene", "box", "--size", "96x72", "--frames", "100", "--validate", "--json"];
+        let args = [
+            "--scene",
+            "box",
+            "--size",
+            "96x72",
+            "--frames",
+            "100",
+            "--validate",
+            "--json",
+        ];
         let o = x.run(&app.exe(), &args, &[("TWINRAY_TEST_KEYS", keys)], &dir);
         let r = clean_report(app, &o);
-        assert_eq!(r.frames.len(), 13, "{app:?}: Esc after the 13th frame ends the run");
+        assert_eq!(
+            r.frames.len(),
+            13,
+            "{app:?}: Esc after the 13th frame ends the run"
+        );
         let err = stderr(&o);
-        assert!(err.contains("max depth 7 (new shader variant"), "{app:?}: a deeper stack needs a new variant: {err}");
-        assert!(err.contains("max depth 1 (same shader"), "{app:?}: shallower depths keep the shader: {err}");
-        let tag = if matches!(app, App::Vulkan) { "vk" } else { "gl" };
+        assert!(
+            err.contains("max depth 7 (new shader variant"),
+            "{app:?}: a deeper stack needs a new variant: {err}"
+        );
+        assert!(
+            err.contains("max depth 1 (same shader"),
+            "{app:?}: shallower depths keep the shader: {err}"
+        );
+        let tag = if matches!(app, App::Vulkan) {
+            "vk"
+        } else {
+            "gl"
+        };
         let shot = dir.join(format!("twinray-{tag}-box-1.png"));
-        let img = twinray_common::image_io::load_png(&shot).unwrap_or_else(|e| panic!("{app:?}: P saved nothing: {e}"));
+        let img = twinray_common::image_io::load_png(&shot)
+            .unwrap_or_else(|e| panic!("{app:?}: P saved nothing: {e}"));
         assert_eq!(img.dimensions(), (96, 72));
     }
 }
@@ -80,12 +133,25 @@ fn windowed_out_equals_the_headless_image() {
     let dir = scratch("window-out");
     for app in App::BOTH {
         let win = dir.join("window.png");
-        let args = ["--scene", "box", "--size", "100x80", "--frames", "3", "--validate", "--out", win.to_str().unwrap()];
+        let args = [
+            "--scene",
+            "box",
+            "--size",
+            "100x80",
+            "--frames",
+            "3",
+            "--validate",
+            "--out",
+            win.to_str().unwrap(),
+        ];
         let o = x.run(&app.exe(), &args, &[], &dir);
         assert!(o.status.success(), "{app:?}: {}", stderr(&o));
         let (_, headless) = render(app, "box", "100x80", &[], &dir.join("headless.png"));
         let windowed = twinray_common::image_io::load_png(&win).unwrap();
-        assert!(windowed == headless, "{app:?}: the windowed --out differs from --headless --out");
+        assert!(
+            windowed == headless,
+            "{app:?}: the windowed --out differs from --headless --out"
+        );
     }
 }
 
@@ -93,22 +159,68 @@ fn windowed_out_equals_the_headless_image() {
 fn explain_prints_ordered_steps_on_stderr_only() {
     let dir = scratch("explain");
     for app in App::BOTH {
-        let args = ["--explain", "--headless", "--scene", "box", "--size", "64x64"];
+        let args = [
+            "--explain",
+            "--headless",
+            "--scene",
+            "box",
+            "--size",
+            "64x64",
+        ];
         let o = twinray_tests::run(&app.exe(), &args, &[]);
         assert!(o.status.success(), "{app:?}: {}", stderr(&o));
-        assert!(o.stdout.is_empty(), "{app:?}: --explain must leave stdout to --json");
+        assert!(
+            o.stdout.is_empty(),
+            "{app:?}: --explain must leave stdout to --json"
+        );
         let steps: Vec<u32> = stderr(&o)
             .lines()
-            .filter_map(|l| l.strip_prefix('[').and_then(|r| r.split(']').next()).and_then(|n| n.trim().parse().ok()))
+            .filter_map(|l| {
+                l.strip_prefix('[')
+                    .and_then(|r| r.split(']').next())
+                    .and_then(|n| n.trim().parse().ok())
+            })
             .collect();
-        assert!(steps.len() >= 12, "{app:?}: only {} steps:\n{}", steps.len(), stderr(&o));
-        assert_eq!(steps, (1..=steps.len() as u32).collect::<Vec<_>>(), "{app:?}: steps out of order");
+        assert!(
+            steps.len() >= 12,
+            "{app:?}: only {} steps:\n{}",
+            steps.len(),
+            stderr(&o)
+        );
+        assert_eq!(
+            steps,
+            (1..=steps.len() as u32).collect::<Vec<_>>(),
+            "{app:?}: steps out of order"
+        );
     }
     // The Vulkan steps name the objects in the order the walkthrough teaches them.
-    let o = twinray_tests::run(&App::Vulkan.exe(), &["--explain", "--headless", "--scene", "box", "--size", "64x64"], &[]);
+    let o = twinray_tests::run(
+        &App::Vulkan.exe(),
+        &[
+            "--explain",
+            "--headless",
+            "--scene",
+            "box",
+            "--size",
+            "64x64",
+        ],
+        &[],
+    );
     let err = stderr(&o);
-    let order = ["VkInstance", "VkPhysicalDevice", "VkDevice", "VkRenderPass", "VkDescriptorSetLayout", "VkPipeline ", "VkFramebuffer", "VkCommandPool"];
-    let pos: Vec<usize> = order.iter().map(|s| err.find(s).unwrap_or_else(|| panic!("no {s} in:\n{err}"))).collect();
+    let order = [
+        "VkInstance",
+        "VkPhysicalDevice",
+        "VkDevice",
+        "VkRenderPass",
+        "VkDescriptorSetLayout",
+        "VkPipeline ",
+        "VkFramebuffer",
+        "VkCommandPool",
+    ];
+    let pos: Vec<usize> = order
+        .iter()
+        .map(|s| err.find(s).unwrap_or_else(|| panic!("no {s} in:\n{err}")))
+        .collect();
     assert!(pos.windows(2).all(|w| w[0] < w[1]), "out of order:\n{err}");
     let _ = dir;
 }
@@ -124,6 +236,9 @@ fn no_display_is_exit_3_with_one_sentence() {
             .unwrap();
         let err = stderr(&o);
         assert_eq!(o.status.code(), Some(3), "{app:?}: {err}");
-        assert!(err.contains("xvfb-run") && err.lines().count() == 1, "{app:?}: {err}");
+        assert!(
+            err.contains("xvfb-run") && err.lines().count() == 1,
+            "{app:?}: {err}"
+        );
     }
 }

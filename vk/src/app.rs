@@ -33,16 +33,24 @@ pub fn run(args: RenderArgs, process_start: Instant) -> Result<()> {
         explain::enable("twinray-vk", "Vulkan");
     }
     if args.gl_spirv {
-        return Err(bad_input("--gl-spirv is an OpenGL option: Vulkan always runs naga's SPIR-V"));
+        return Err(bad_input(
+            "--gl-spirv is an OpenGL option: Vulkan always runs naga's SPIR-V",
+        ));
     }
     if !args.headless {
         if args.path == RenderPath::Compute {
-            return Err(bad_input("--path compute runs headless only; add --headless"));
+            return Err(bad_input(
+                "--path compute runs headless only; add --headless",
+            ));
         }
         return run_windowed(&args, process_start);
     }
     let scene = args.load_scene()?;
-    let variant = if args.generic { Variant::generic(scene.numerics) } else { Variant::for_scene(&scene) };
+    let variant = if args.generic {
+        Variant::generic(scene.numerics)
+    } else {
+        Variant::for_scene(&scene)
+    };
     let (mut report, image) = render(&args, &scene, &variant, process_start)?;
 
     // Counted only now that every Vulkan object is gone, so teardown mistakes count too.
@@ -54,7 +62,10 @@ pub fn run(args: RenderArgs, process_start: Instant) -> Result<()> {
         println!("{}", serde_json::to_string(&report)?);
     }
     if args.validate && report.validation_messages > 0 {
-        bail!("{} validation messages (see above)", report.validation_messages);
+        bail!(
+            "{} validation messages (see above)",
+            report.validation_messages
+        );
     }
     Ok(())
 }
@@ -105,9 +116,10 @@ fn render(
     let (width, height) = (args.size.width, args.size.height);
     let workgroup = args.compute_workgroup()?;
     let shaders = shader::build(variant)?;
-    explain::step("Shaders: GLSL -> naga module -> SPIR-V (twinray-common)", || {
-        format!("variant {}", variant.label())
-    });
+    explain::step(
+        "Shaders: GLSL -> naga module -> SPIR-V (twinray-common)",
+        || format!("variant {}", variant.label()),
+    );
     let gpu_scene = GpuScene::new(scene, width, height);
 
     let instance = Instance::new(args.validate, &[])?;
@@ -118,31 +130,60 @@ fn render(
     let idle_wait = match std::env::var("TWINRAY_VK_WAIT").as_deref() {
         Ok("idle") => true,
         Ok("fence") | Err(_) => false,
-        Ok(other) => return Err(bad_input(format!("TWINRAY_VK_WAIT='{other}' is not 'fence' or 'idle'"))),
+        Ok(other) => {
+            return Err(bad_input(format!(
+                "TWINRAY_VK_WAIT='{other}' is not 'fence' or 'idle'"
+            )))
+        }
     };
     let host_memory = crate::scene::host_memory()?;
     let timestamps = Timestamps::new(&device)?;
-    let run_frames = |commands: &Commands| frame_loop(commands, timestamps.as_ref(), args.frame_count(), idle_wait, process_start);
+    let run_frames = |commands: &Commands| {
+        frame_loop(
+            commands,
+            timestamps.as_ref(),
+            args.frame_count(),
+            idle_wait,
+            process_start,
+        )
+    };
     let (frames, setup_ms, image) = match args.path {
         RenderPath::Fragment => {
             let render_pass = RenderPass::offscreen(&device)?;
             let rp = render_pass.render_pass;
-            let resources = SceneResources::new(&device, &gpu_scene, &shaders, rp, Some((width, height)))?;
+            let resources =
+                SceneResources::new(&device, &gpu_scene, &shaders, rp, Some((width, height)))?;
             let (pipeline, descriptors) = (&resources.pipeline, &resources.descriptors);
             let target = Target::new(&device, rp, width, height)?;
-            let commands = Commands::record(&device, rp, pipeline, descriptors, &target, timestamps.as_ref())?;
+            let commands = Commands::record(
+                &device,
+                rp,
+                pipeline,
+                descriptors,
+                &target,
+                timestamps.as_ref(),
+            )?;
             let (frames, setup_ms) = run_frames(&commands)?;
             let image = target.read_back(&device)?;
-            explain::step("Readback: vkCmdCopyImageToBuffer + HOST barrier, then map", || {
-                format!("{width}x{height} RGBA32F, top row first")
-            });
+            explain::step(
+                "Readback: vkCmdCopyImageToBuffer + HOST barrier, then map",
+                || format!("{width}x{height} RGBA32F, top row first"),
+            );
             (frames, setup_ms, image)
         }
         // The same tracer as a compute shader: compute.rs owns its pipeline and storage image.
         RenderPath::Compute => {
             let shader = shader::build_compute(variant, workgroup)?;
             let (frame, storage) = crate::scene::scene_buffers(&device, &gpu_scene)?;
-            let compute = Compute::new(&device, &frame, &storage, &shader, width, height, timestamps.as_ref())?;
+            let compute = Compute::new(
+                &device,
+                &frame,
+                &storage,
+                &shader,
+                width,
+                height,
+                timestamps.as_ref(),
+            )?;
             let (frames, setup_ms) = run_frames(&compute.commands)?;
             (frames, setup_ms, compute.read_back(&device)?)
         }
@@ -157,7 +198,11 @@ fn render(
         variant: format!(
             "{}{}{}",
             variant.label(),
-            if host_memory { " (host-visible buffers)" } else { "" },
+            if host_memory {
+                " (host-visible buffers)"
+            } else {
+                ""
+            },
             if idle_wait { " (idle wait)" } else { "" }
         ),
         width,
@@ -199,10 +244,15 @@ fn frame_loop(
         commands.reset_fence()?;
         frames.push(FrameTime { gpu_ms, wall_ms });
         if i == 0 {
-            explain::step("Frame 1: vkQueueSubmit + vkWaitForFences + vkResetFences", || {
-                let gpu = gpu_ms.map_or("no timestamps on this queue".into(), |g| format!("GPU {g:.3} ms"));
-                format!("wall {wall_ms:.3} ms, {gpu}; later frames resubmit the same command buffer")
-            });
+            explain::step(
+                "Frame 1: vkQueueSubmit + vkWaitForFences + vkResetFences",
+                || {
+                    let gpu = gpu_ms.map_or("no timestamps on this queue".into(), |g| {
+                        format!("GPU {g:.3} ms")
+                    });
+                    format!("wall {wall_ms:.3} ms, {gpu}; later frames resubmit the same command buffer")
+                },
+            );
         }
     }
     Ok((frames, setup_ms))

@@ -45,16 +45,22 @@ impl Commands {
             fence: vk::Fence::null(),
         };
         let info = vk::CommandPoolCreateInfo::default().queue_family_index(device.queue_family);
-        this.pool = unsafe { d.create_command_pool(&info, None) }.context("creating the command pool")?;
+        this.pool =
+            unsafe { d.create_command_pool(&info, None) }.context("creating the command pool")?;
         let info = vk::CommandBufferAllocateInfo::default()
             .command_pool(this.pool)
             .level(vk::CommandBufferLevel::PRIMARY)
             .command_buffer_count(1);
-        this.cmd = unsafe { d.allocate_command_buffers(&info) }.context("allocating the command buffer")?[0];
+        this.cmd = unsafe { d.allocate_command_buffers(&info) }
+            .context("allocating the command buffer")?[0];
         // Unsignalled: the first wait is for the first frame.
-        this.fence = unsafe { d.create_fence(&vk::FenceCreateInfo::default(), None) }.context("creating the fence")?;
+        this.fence = unsafe { d.create_fence(&vk::FenceCreateInfo::default(), None) }
+            .context("creating the fence")?;
         explain::step("VkCommandPool + VkCommandBuffer + VkFence", || {
-            format!("pool on queue family {}; 1 PRIMARY buffer; fence created unsignalled", device.queue_family)
+            format!(
+                "pool on queue family {}; 1 PRIMARY buffer; fence created unsignalled",
+                device.queue_family
+            )
         });
 
         // No ONE_TIME_SUBMIT flag: the buffer is resubmitted every frame.
@@ -70,7 +76,10 @@ impl Commands {
             .framebuffer(target.framebuffer)
             .render_area(vk::Rect2D {
                 offset: vk::Offset2D::default(),
-                extent: vk::Extent2D { width: target.width, height: target.height },
+                extent: vk::Extent2D {
+                    width: target.width,
+                    height: target.height,
+                },
             });
         unsafe {
             d.cmd_begin_render_pass(cmd, &begin, vk::SubpassContents::INLINE);
@@ -91,17 +100,27 @@ impl Commands {
             t.record(cmd, 1);
         }
         unsafe { d.end_command_buffer(cmd) }.context("recording the frame")?;
-        explain::step("Command buffer recorded once (resubmitted every frame)", || {
-            let ts = if timestamps.is_some() { "reset queries, timestamp TOP_OF_PIPE, " } else { "" };
-            format!("{ts}begin render pass {}x{}, bind pipeline, bind descriptor set 0, draw 3 vertices, end pass{}",
+        explain::step(
+            "Command buffer recorded once (resubmitted every frame)",
+            || {
+                let ts = if timestamps.is_some() {
+                    "reset queries, timestamp TOP_OF_PIPE, "
+                } else {
+                    ""
+                };
+                format!("{ts}begin render pass {}x{}, bind pipeline, bind descriptor set 0, draw 3 vertices, end pass{}",
                 target.width, target.height, if timestamps.is_some() { ", timestamp BOTTOM_OF_PIPE" } else { "" })
-        });
+            },
+        );
         Ok(this)
     }
 
     /// A frame whose commands `record` writes (the compute path's dispatch), with
     /// the same pool, buffer and fence handling as `record`'s render pass.
-    pub fn record_with(device: &Device, record: impl FnOnce(&ash::Device, vk::CommandBuffer)) -> Result<Commands> {
+    pub fn record_with(
+        device: &Device,
+        record: impl FnOnce(&ash::Device, vk::CommandBuffer),
+    ) -> Result<Commands> {
         let d = &device.device;
         let mut this = Commands {
             device: d.clone(),
@@ -111,13 +130,16 @@ impl Commands {
             fence: vk::Fence::null(),
         };
         let info = vk::CommandPoolCreateInfo::default().queue_family_index(device.queue_family);
-        this.pool = unsafe { d.create_command_pool(&info, None) }.context("creating the command pool")?;
+        this.pool =
+            unsafe { d.create_command_pool(&info, None) }.context("creating the command pool")?;
         let info = vk::CommandBufferAllocateInfo::default()
             .command_pool(this.pool)
             .level(vk::CommandBufferLevel::PRIMARY)
             .command_buffer_count(1);
-        this.cmd = unsafe { d.allocate_command_buffers(&info) }.context("allocating the command buffer")?[0];
-        this.fence = unsafe { d.create_fence(&vk::FenceCreateInfo::default(), None) }.context("creating the fence")?;
+        this.cmd = unsafe { d.allocate_command_buffers(&info) }
+            .context("allocating the command buffer")?[0];
+        this.fence = unsafe { d.create_fence(&vk::FenceCreateInfo::default(), None) }
+            .context("creating the fence")?;
         unsafe { d.begin_command_buffer(this.cmd, &vk::CommandBufferBeginInfo::default()) }
             .context("recording the frame")?;
         record(d, this.cmd);
@@ -129,7 +151,8 @@ impl Commands {
     pub fn submit(&self) -> Result<()> {
         let cmds = [self.cmd];
         let submit = vk::SubmitInfo::default().command_buffers(&cmds);
-        unsafe { self.device.queue_submit(self.queue, &[submit], self.fence) }.context("submitting a frame")
+        unsafe { self.device.queue_submit(self.queue, &[submit], self.fence) }
+            .context("submitting a frame")
     }
 
     /// Blocks until the GPU has finished the frame. A fence waits for exactly
@@ -137,10 +160,12 @@ impl Commands {
     /// (vkQueueWaitIdle + vkDeviceWaitIdle), kept to measure whether that costs.
     pub fn wait(&self, idle: bool) -> Result<()> {
         if idle {
-            unsafe { self.device.queue_wait_idle(self.queue) }.context("waiting for the queue to idle")?;
+            unsafe { self.device.queue_wait_idle(self.queue) }
+                .context("waiting for the queue to idle")?;
             unsafe { self.device.device_wait_idle() }.context("waiting for the device to idle")?;
         }
-        unsafe { self.device.wait_for_fences(&[self.fence], true, u64::MAX) }.context("waiting for a frame")
+        unsafe { self.device.wait_for_fences(&[self.fence], true, u64::MAX) }
+            .context("waiting for a frame")
     }
 
     /// A fence stays signalled until reset; the next submit needs it unsignalled.

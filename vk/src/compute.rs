@@ -62,11 +62,25 @@ impl Compute {
         let groups = check_limits(device, shader.workgroup, width, height)?;
         let bytes = width as u64 * height as u64 * 16;
         // The CPU reads this one, and uncached reads of mapped memory are very slow.
-        let wishes = [Flags::HOST_VISIBLE | Flags::HOST_CACHED, Flags::HOST_VISIBLE];
-        let readback = Buffer::new(device, bytes, vk::BufferUsageFlags::TRANSFER_DST, &wishes, "readback buffer")?;
+        let wishes = [
+            Flags::HOST_VISIBLE | Flags::HOST_CACHED,
+            Flags::HOST_VISIBLE,
+        ];
+        let readback = Buffer::new(
+            device,
+            bytes,
+            vk::BufferUsageFlags::TRANSFER_DST,
+            &wishes,
+            "readback buffer",
+        )?;
         let image = StorageImage::new(device, width, height)?;
-        let descriptors =
-            Descriptors::for_stage(device, frame, storage, vk::ShaderStageFlags::COMPUTE, Some(image.view))?;
+        let descriptors = Descriptors::for_stage(
+            device,
+            frame,
+            storage,
+            vk::ShaderStageFlags::COMPUTE,
+            Some(image.view),
+        )?;
         let pipeline = ComputePipeline::new(device, descriptors.set_layout, &shader.spirv)?;
         let commands = Commands::record_with(device, |d, cmd| {
             if let Some(t) = timestamps {
@@ -113,7 +127,15 @@ impl Compute {
                 t.record(cmd, 1);
             }
         })?;
-        Ok(Compute { commands, _pipeline: pipeline, _descriptors: descriptors, image, readback, width, height })
+        Ok(Compute {
+            commands,
+            _pipeline: pipeline,
+            _descriptors: descriptors,
+            image,
+            readback,
+            width,
+            height,
+        })
     }
 
     /// Copies the last frame to the CPU: a barrier orders the copy after the
@@ -138,7 +160,11 @@ impl Compute {
                     base_array_layer: 0,
                     layer_count: 1,
                 })
-                .image_extent(vk::Extent3D { width: self.width, height: self.height, depth: 1 });
+                .image_extent(vk::Extent3D {
+                    width: self.width,
+                    height: self.height,
+                    depth: 1,
+                });
             let to_host = vk::BufferMemoryBarrier::default()
                 .src_access_mask(vk::AccessFlags::TRANSFER_WRITE)
                 .dst_access_mask(vk::AccessFlags::HOST_READ)
@@ -176,7 +202,10 @@ impl Compute {
                 );
             }
         })?;
-        let rgba: Vec<f32> = self.readback.read().context("reading the readback buffer")?;
+        let rgba: Vec<f32> = self
+            .readback
+            .read()
+            .context("reading the readback buffer")?;
         Ok(FloatImage::from_rgba(self.width, self.height, &rgba))
     }
 }
@@ -195,7 +224,8 @@ fn check_limits(device: &Device, wg: Workgroup, width: u32, height: u32) -> Resu
         )));
     }
     let groups = (width.div_ceil(wg.x), height.div_ceil(wg.y));
-    if groups.0 > l.max_compute_work_group_count[0] || groups.1 > l.max_compute_work_group_count[1] {
+    if groups.0 > l.max_compute_work_group_count[0] || groups.1 > l.max_compute_work_group_count[1]
+    {
         return Err(bad_input(format!(
             "--size {width}x{height} with --workgroup {wg} needs {}x{} workgroups, more than this device's maxComputeWorkGroupCount {}x{}",
             groups.0, groups.1, l.max_compute_work_group_count[0], l.max_compute_work_group_count[1]
@@ -212,24 +242,37 @@ struct ComputePipeline {
 }
 
 impl ComputePipeline {
-    fn new(device: &Device, set_layout: vk::DescriptorSetLayout, spirv: &[u32]) -> Result<ComputePipeline> {
+    fn new(
+        device: &Device,
+        set_layout: vk::DescriptorSetLayout,
+        spirv: &[u32],
+    ) -> Result<ComputePipeline> {
         let d = &device.device;
-        let mut this =
-            ComputePipeline { device: d.clone(), layout: vk::PipelineLayout::null(), pipeline: vk::Pipeline::null() };
+        let mut this = ComputePipeline {
+            device: d.clone(),
+            layout: vk::PipelineLayout::null(),
+            pipeline: vk::Pipeline::null(),
+        };
         let set_layouts = [set_layout];
         let info = vk::PipelineLayoutCreateInfo::default().set_layouts(&set_layouts);
-        this.layout = unsafe { d.create_pipeline_layout(&info, None) }.context("creating the compute pipeline layout")?;
+        this.layout = unsafe { d.create_pipeline_layout(&info, None) }
+            .context("creating the compute pipeline layout")?;
         let info = vk::ShaderModuleCreateInfo::default().code(spirv);
-        let module = unsafe { d.create_shader_module(&info, None) }.context("creating the compute shader module")?;
+        let module = unsafe { d.create_shader_module(&info, None) }
+            .context("creating the compute shader module")?;
         let stage = vk::PipelineShaderStageCreateInfo::default()
             .stage(vk::ShaderStageFlags::COMPUTE)
             .module(module)
             .name(c"main");
-        let info = vk::ComputePipelineCreateInfo::default().stage(stage).layout(this.layout);
+        let info = vk::ComputePipelineCreateInfo::default()
+            .stage(stage)
+            .layout(this.layout);
         let made = unsafe { d.create_compute_pipelines(vk::PipelineCache::null(), &[info], None) };
         // The pipeline keeps its own copy of the code: the module can go now.
         unsafe { d.destroy_shader_module(module, None) };
-        this.pipeline = made.map_err(|(_, e)| e).context("creating the compute pipeline")?[0];
+        this.pipeline = made
+            .map_err(|(_, e)| e)
+            .context("creating the compute pipeline")?[0];
         Ok(this)
     }
 }
@@ -265,25 +308,41 @@ impl StorageImage {
         let info = vk::ImageCreateInfo::default()
             .image_type(vk::ImageType::TYPE_2D)
             .format(IMAGE_FORMAT)
-            .extent(vk::Extent3D { width, height, depth: 1 })
+            .extent(vk::Extent3D {
+                width,
+                height,
+                depth: 1,
+            })
             .mip_levels(1)
             .array_layers(1)
             .samples(vk::SampleCountFlags::TYPE_1)
             .tiling(vk::ImageTiling::OPTIMAL)
             .usage(vk::ImageUsageFlags::STORAGE | vk::ImageUsageFlags::TRANSFER_SRC)
             .initial_layout(vk::ImageLayout::UNDEFINED);
-        this.image = unsafe { d.create_image(&info, None) }.context("creating the storage image")?;
+        this.image =
+            unsafe { d.create_image(&info, None) }.context("creating the storage image")?;
         let needs = unsafe { d.get_image_memory_requirements(this.image) };
-        this.memory = memory::allocate(device, needs, &[Flags::DEVICE_LOCAL, Flags::empty()], "storage image")?.0;
-        unsafe { d.bind_image_memory(this.image, this.memory, 0) }.context("binding the storage image's memory")?;
+        this.memory = memory::allocate(
+            device,
+            needs,
+            &[Flags::DEVICE_LOCAL, Flags::empty()],
+            "storage image",
+        )?
+        .0;
+        unsafe { d.bind_image_memory(this.image, this.memory, 0) }
+            .context("binding the storage image's memory")?;
         let info = vk::ImageViewCreateInfo::default()
             .image(this.image)
             .view_type(vk::ImageViewType::TYPE_2D)
             .format(IMAGE_FORMAT)
             .subresource_range(
-                vk::ImageSubresourceRange::default().aspect_mask(vk::ImageAspectFlags::COLOR).level_count(1).layer_count(1),
+                vk::ImageSubresourceRange::default()
+                    .aspect_mask(vk::ImageAspectFlags::COLOR)
+                    .level_count(1)
+                    .layer_count(1),
             );
-        this.view = unsafe { d.create_image_view(&info, None) }.context("creating the storage image view")?;
+        this.view = unsafe { d.create_image_view(&info, None) }
+            .context("creating the storage image view")?;
 
         // UNDEFINED → GENERAL once: the old contents (none) may be discarded.
         let to_general = this.barrier(
@@ -324,7 +383,10 @@ impl StorageImage {
             .dst_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
             .image(self.image)
             .subresource_range(
-                vk::ImageSubresourceRange::default().aspect_mask(vk::ImageAspectFlags::COLOR).level_count(1).layer_count(1),
+                vk::ImageSubresourceRange::default()
+                    .aspect_mask(vk::ImageAspectFlags::COLOR)
+                    .level_count(1)
+                    .layer_count(1),
             )
     }
 }

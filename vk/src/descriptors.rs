@@ -47,7 +47,11 @@ impl Descriptors {
         };
         let all: Vec<(u32, vk::DescriptorType, &Buffer)> =
             std::iter::once((binding::FRAME, vk::DescriptorType::UNIFORM_BUFFER, frame))
-                .chain(storage.iter().map(|(b, buf)| (*b, vk::DescriptorType::STORAGE_BUFFER, buf)))
+                .chain(
+                    storage
+                        .iter()
+                        .map(|(b, buf)| (*b, vk::DescriptorType::STORAGE_BUFFER, buf)),
+                )
                 .collect();
 
         let mut bindings: Vec<_> = all
@@ -70,40 +74,76 @@ impl Descriptors {
             );
         }
         let info = vk::DescriptorSetLayoutCreateInfo::default().bindings(&bindings);
-        this.set_layout =
-            unsafe { d.create_descriptor_set_layout(&info, None) }.context("creating the descriptor set layout")?;
+        this.set_layout = unsafe { d.create_descriptor_set_layout(&info, None) }
+            .context("creating the descriptor set layout")?;
         explain::step("VkDescriptorSetLayout", || {
-            all.iter().map(|(b, ty, _)| format!("binding {b}: {ty:?} x1, FRAGMENT stage\n")).collect()
+            all.iter()
+                .map(|(b, ty, _)| format!("binding {b}: {ty:?} x1, FRAGMENT stage\n"))
+                .collect()
         });
 
         let mut sizes = vec![
-            vk::DescriptorPoolSize { ty: vk::DescriptorType::UNIFORM_BUFFER, descriptor_count: 1 },
-            vk::DescriptorPoolSize { ty: vk::DescriptorType::STORAGE_BUFFER, descriptor_count: storage.len() as u32 },
+            vk::DescriptorPoolSize {
+                ty: vk::DescriptorType::UNIFORM_BUFFER,
+                descriptor_count: 1,
+            },
+            vk::DescriptorPoolSize {
+                ty: vk::DescriptorType::STORAGE_BUFFER,
+                descriptor_count: storage.len() as u32,
+            },
         ];
         if image.is_some() {
-            sizes.push(vk::DescriptorPoolSize { ty: vk::DescriptorType::STORAGE_IMAGE, descriptor_count: 1 });
+            sizes.push(vk::DescriptorPoolSize {
+                ty: vk::DescriptorType::STORAGE_IMAGE,
+                descriptor_count: 1,
+            });
         }
-        let info = vk::DescriptorPoolCreateInfo::default().max_sets(1).pool_sizes(&sizes);
-        this.pool = unsafe { d.create_descriptor_pool(&info, None) }.context("creating the descriptor pool")?;
-        explain::step("VkDescriptorPool", || format!("max 1 set; 1 UNIFORM_BUFFER, {} STORAGE_BUFFER", storage.len()));
+        let info = vk::DescriptorPoolCreateInfo::default()
+            .max_sets(1)
+            .pool_sizes(&sizes);
+        this.pool = unsafe { d.create_descriptor_pool(&info, None) }
+            .context("creating the descriptor pool")?;
+        explain::step("VkDescriptorPool", || {
+            format!(
+                "max 1 set; 1 UNIFORM_BUFFER, {} STORAGE_BUFFER",
+                storage.len()
+            )
+        });
 
         let layouts = [this.set_layout];
-        let info = vk::DescriptorSetAllocateInfo::default().descriptor_pool(this.pool).set_layouts(&layouts);
-        this.set = unsafe { d.allocate_descriptor_sets(&info) }.context("allocating the descriptor set")?[0];
+        let info = vk::DescriptorSetAllocateInfo::default()
+            .descriptor_pool(this.pool)
+            .set_layouts(&layouts);
+        this.set = unsafe { d.allocate_descriptor_sets(&info) }
+            .context("allocating the descriptor set")?[0];
 
         let infos: Vec<[vk::DescriptorBufferInfo; 1]> = all
             .iter()
-            .map(|(_, _, buf)| [vk::DescriptorBufferInfo { buffer: buf.buffer, offset: 0, range: buf.size }])
+            .map(|(_, _, buf)| {
+                [vk::DescriptorBufferInfo {
+                    buffer: buf.buffer,
+                    offset: 0,
+                    range: buf.size,
+                }]
+            })
             .collect();
         let mut writes: Vec<_> = all
             .iter()
             .zip(&infos)
             .map(|(&(b, ty, _), info)| {
-                vk::WriteDescriptorSet::default().dst_set(this.set).dst_binding(b).descriptor_type(ty).buffer_info(info)
+                vk::WriteDescriptorSet::default()
+                    .dst_set(this.set)
+                    .dst_binding(b)
+                    .descriptor_type(ty)
+                    .buffer_info(info)
             })
             .collect();
         let image_info = image.map(|view| {
-            [vk::DescriptorImageInfo { sampler: vk::Sampler::null(), image_view: view, image_layout: vk::ImageLayout::GENERAL }]
+            [vk::DescriptorImageInfo {
+                sampler: vk::Sampler::null(),
+                image_view: view,
+                image_layout: vk::ImageLayout::GENERAL,
+            }]
         });
         if let Some(info) = &image_info {
             writes.push(
@@ -115,9 +155,15 @@ impl Descriptors {
             );
         }
         unsafe { d.update_descriptor_sets(&writes, &[]) };
-        explain::step("VkDescriptorSet (allocated, then vkUpdateDescriptorSets)", || {
-            format!("{} writes: each binding points at its whole buffer", writes.len())
-        });
+        explain::step(
+            "VkDescriptorSet (allocated, then vkUpdateDescriptorSets)",
+            || {
+                format!(
+                    "{} writes: each binding points at its whole buffer",
+                    writes.len()
+                )
+            },
+        );
         Ok(this)
     }
 }
@@ -128,7 +174,8 @@ impl Drop for Descriptors {
         // Destroying the pool frees the set allocated from it.
         unsafe {
             self.device.destroy_descriptor_pool(self.pool, None);
-            self.device.destroy_descriptor_set_layout(self.set_layout, None);
+            self.device
+                .destroy_descriptor_set_layout(self.set_layout, None);
         }
     }
 }

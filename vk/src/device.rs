@@ -44,7 +44,8 @@ impl Device {
     /// to it, and the device must offer VK_KHR_swapchain.
     pub fn new(instance: &Instance, surface: Option<&Surface>) -> Result<Device> {
         let vk_instance = &instance.instance;
-        let physicals = unsafe { vk_instance.enumerate_physical_devices() }.context("listing Vulkan devices")?;
+        let physicals = unsafe { vk_instance.enumerate_physical_devices() }
+            .context("listing Vulkan devices")?;
         if physicals.is_empty() {
             return Err(no_device(
                 "no Vulkan device found: install mesa-vulkan-drivers (lavapipe, on the CPU) or a GPU driver",
@@ -54,56 +55,99 @@ impl Device {
             .into_iter()
             .map(|physical| {
                 let properties = unsafe { vk_instance.get_physical_device_properties(physical) };
-                let families = unsafe { vk_instance.get_physical_device_queue_family_properties(physical) };
+                let families =
+                    unsafe { vk_instance.get_physical_device_queue_family_properties(physical) };
                 let presents = |i: u32| surface.is_none_or(|s| s.supports(physical, i));
                 let graphics_family = (0u32..)
                     .zip(&families)
                     .find(|&(i, f)| f.queue_flags.contains(vk::QueueFlags::GRAPHICS) && presents(i))
                     .filter(|_| surface.is_none() || has_swapchain(vk_instance, physical))
                     .map(|(i, f)| (i, f.timestamp_valid_bits, f.queue_flags));
-                let name = properties.device_name_as_c_str().unwrap_or(c"?").to_string_lossy().into_owned();
-                Candidate { physical, properties, name, graphics_family }
+                let name = properties
+                    .device_name_as_c_str()
+                    .unwrap_or(c"?")
+                    .to_string_lossy()
+                    .into_owned();
+                Candidate {
+                    physical,
+                    properties,
+                    name,
+                    graphics_family,
+                }
             })
             .collect();
         let chosen = choose(&candidates)?;
-        let (queue_family, timestamp_valid_bits, flags) = chosen.graphics_family.expect("choose() checks this");
+        let (queue_family, timestamp_valid_bits, flags) =
+            chosen.graphics_family.expect("choose() checks this");
         explain::step("VkPhysicalDevice chosen", || {
             let mut s = String::new();
             for (i, c) in candidates.iter().enumerate() {
-                let mark = if c.physical == chosen.physical { "->" } else { "  " };
-                let usable = if c.graphics_family.is_some() { "" } else { " (cannot draw/present here)" };
-                s += &format!("{mark} {i}: {} [{:?}]{usable}
-", c.name, c.properties.device_type);
+                let mark = if c.physical == chosen.physical {
+                    "->"
+                } else {
+                    "  "
+                };
+                let usable = if c.graphics_family.is_some() {
+                    ""
+                } else {
+                    " (cannot draw/present here)"
+                };
+                s += &format!(
+                    "{mark} {i}: {} [{:?}]{usable}
+",
+                    c.name, c.properties.device_type
+                );
             }
             let why = if std::env::var("TWINRAY_VK_DEVICE").is_ok_and(|v| !v.trim().is_empty()) {
                 "TWINRAY_VK_DEVICE picked it"
             } else {
                 "the most capable kind present (discrete > integrated > virtual > CPU)"
             };
-            s + &format!("why: {why}
+            s + &format!(
+                "why: {why}
 queue family {queue_family}: {flags:?}, timestampValidBits {timestamp_valid_bits}{}",
-                if surface.is_some() { ", presents to the surface" } else { "" })
+                if surface.is_some() {
+                    ", presents to the surface"
+                } else {
+                    ""
+                }
+            )
         });
 
         // One queue is enough: every frame is submitted and waited for in turn.
         let priorities = [1.0];
-        let queue_infos =
-            [vk::DeviceQueueCreateInfo::default().queue_family_index(queue_family).queue_priorities(&priorities)];
+        let queue_infos = [vk::DeviceQueueCreateInfo::default()
+            .queue_family_index(queue_family)
+            .queue_priorities(&priorities)];
         // A window needs the swapchain, a device extension; headless needs none.
-        let extensions = if surface.is_some() { vec![khr::swapchain::NAME.as_ptr()] } else { vec![] };
-        let info =
-            vk::DeviceCreateInfo::default().queue_create_infos(&queue_infos).enabled_extension_names(&extensions);
+        let extensions = if surface.is_some() {
+            vec![khr::swapchain::NAME.as_ptr()]
+        } else {
+            vec![]
+        };
+        let info = vk::DeviceCreateInfo::default()
+            .queue_create_infos(&queue_infos)
+            .enabled_extension_names(&extensions);
         let device = unsafe { vk_instance.create_device(chosen.physical, &info, None) }
             .with_context(|| format!("opening the Vulkan device '{}'", chosen.name))?;
         let queue = unsafe { device.get_device_queue(queue_family, 0) };
-        explain::step("VkDevice + VkQueue (vkCreateDevice, vkGetDeviceQueue)", || {
-            let ext = if surface.is_some() { "VK_KHR_swapchain" } else { "none" };
-            format!("1 queue from family {queue_family}, priority 1.0; device extensions: {ext}; no optional features")
-        });
+        explain::step(
+            "VkDevice + VkQueue (vkCreateDevice, vkGetDeviceQueue)",
+            || {
+                let ext = if surface.is_some() {
+                    "VK_KHR_swapchain"
+                } else {
+                    "none"
+                };
+                format!("1 queue from family {queue_family}, priority 1.0; device extensions: {ext}; no optional features")
+            },
+        );
         Ok(Device {
             physical: chosen.physical,
             properties: chosen.properties,
-            memory_properties: unsafe { vk_instance.get_physical_device_memory_properties(chosen.physical) },
+            memory_properties: unsafe {
+                vk_instance.get_physical_device_memory_properties(chosen.physical)
+            },
             name: chosen.name.clone(),
             driver: driver_description(instance, chosen),
             queue_family,
@@ -116,7 +160,12 @@ queue family {queue_family}: {flags:?}, timestampValidBits {timestamp_valid_bits
     /// "Vulkan 1.3.230": the version the device (not the loader) supports.
     pub fn api_version(&self) -> String {
         let v = self.properties.api_version;
-        format!("Vulkan {}.{}.{}", vk::api_version_major(v), vk::api_version_minor(v), vk::api_version_patch(v))
+        format!(
+            "Vulkan {}.{}.{}",
+            vk::api_version_major(v),
+            vk::api_version_minor(v),
+            vk::api_version_patch(v)
+        )
     }
 
     /// Image and framebuffer sizes are bounded per device; say which limit a size breaks.
@@ -127,13 +176,21 @@ queue family {queue_family}: {flags:?}, timestampValidBits {timestamp_valid_bits
             (height, l.max_image_dimension2_d, "maxImageDimension2D"),
             (width, l.max_framebuffer_width, "maxFramebufferWidth"),
             (height, l.max_framebuffer_height, "maxFramebufferHeight"),
-            (width, l.max_viewport_dimensions[0], "maxViewportDimensions[0]"),
-            (height, l.max_viewport_dimensions[1], "maxViewportDimensions[1]"),
+            (
+                width,
+                l.max_viewport_dimensions[0],
+                "maxViewportDimensions[0]",
+            ),
+            (
+                height,
+                l.max_viewport_dimensions[1],
+                "maxViewportDimensions[1]",
+            ),
         ];
         match checks.iter().find(|(value, limit, _)| value > limit) {
-            Some((_, limit, name)) => {
-                Err(bad_input(format!("--size {width}x{height} exceeds this device's limit of {limit} ({name})")))
-            }
+            Some((_, limit, name)) => Err(bad_input(format!(
+                "--size {width}x{height} exceeds this device's limit of {limit} ({name})"
+            ))),
             None => Ok(()),
         }
     }
@@ -148,9 +205,12 @@ queue family {queue_family}: {flags:?}, timestampValidBits {timestamp_valid_bits
         let pool = unsafe { d.create_command_pool(&info, None) }
             .with_context(|| format!("creating a command pool for {what}"))?;
         let result = (|| -> ash::prelude::VkResult<()> {
-            let alloc = vk::CommandBufferAllocateInfo::default().command_pool(pool).command_buffer_count(1);
+            let alloc = vk::CommandBufferAllocateInfo::default()
+                .command_pool(pool)
+                .command_buffer_count(1);
             let cmd = unsafe { d.allocate_command_buffers(&alloc) }?[0];
-            let begin = vk::CommandBufferBeginInfo::default().flags(vk::CommandBufferUsageFlags::ONE_TIME_SUBMIT);
+            let begin = vk::CommandBufferBeginInfo::default()
+                .flags(vk::CommandBufferUsageFlags::ONE_TIME_SUBMIT);
             unsafe { d.begin_command_buffer(cmd, &begin) }?;
             record(cmd);
             unsafe { d.end_command_buffer(cmd) }?;
@@ -169,21 +229,32 @@ queue family {queue_family}: {flags:?}, timestampValidBits {timestamp_valid_bits
 /// Whether the device can make swapchains at all.
 fn has_swapchain(instance: &ash::Instance, physical: vk::PhysicalDevice) -> bool {
     // SAFETY: a valid physical device of this instance.
-    let exts = unsafe { instance.enumerate_device_extension_properties(physical) }.unwrap_or_default();
-    exts.iter().any(|e| e.extension_name_as_c_str() == Ok(khr::swapchain::NAME))
+    let exts =
+        unsafe { instance.enumerate_device_extension_properties(physical) }.unwrap_or_default();
+    exts.iter()
+        .any(|e| e.extension_name_as_c_str() == Ok(khr::swapchain::NAME))
 }
 
 /// `TWINRAY_VK_DEVICE` (an index or part of a name) wins; otherwise the kind of
 /// device most likely to be fast: discrete, integrated, virtual, then CPU.
 fn choose(candidates: &[Candidate]) -> Result<&Candidate> {
-    if let Some(wanted) = std::env::var("TWINRAY_VK_DEVICE").ok().filter(|v| !v.trim().is_empty()) {
+    if let Some(wanted) = std::env::var("TWINRAY_VK_DEVICE")
+        .ok()
+        .filter(|v| !v.trim().is_empty())
+    {
         let needle = wanted.trim().to_lowercase();
         // A number is an index, never part of a name ("1" is in "LLVM 15.0.6").
         let found = match needle.parse::<usize>() {
             Ok(i) => candidates.get(i),
-            Err(_) => candidates.iter().find(|c| c.name.to_lowercase().contains(&needle)),
+            Err(_) => candidates
+                .iter()
+                .find(|c| c.name.to_lowercase().contains(&needle)),
         };
-        let list: Vec<String> = candidates.iter().enumerate().map(|(i, c)| format!("{i}: {}", c.name)).collect();
+        let list: Vec<String> = candidates
+            .iter()
+            .enumerate()
+            .map(|(i, c)| format!("{i}: {}", c.name))
+            .collect();
         let c = found.ok_or_else(|| {
             bad_input(format!(
                 "TWINRAY_VK_DEVICE='{wanted}' matches no Vulkan device; the devices are {}",
@@ -214,14 +285,23 @@ fn choose(candidates: &[Candidate]) -> Result<&Candidate> {
 /// The driver's own name ("llvmpipe Mesa 22.3.6 ...") needs Vulkan 1.2 on both
 /// the instance and the device; before that there is only a vendor-coded number.
 fn driver_description(instance: &Instance, c: &Candidate) -> String {
-    if instance.api_version < vk::API_VERSION_1_2 || c.properties.api_version < vk::API_VERSION_1_2 {
+    if instance.api_version < vk::API_VERSION_1_2 || c.properties.api_version < vk::API_VERSION_1_2
+    {
         return format!("driverVersion {:#x}", c.properties.driver_version);
     }
     let mut driver = vk::PhysicalDeviceDriverProperties::default();
     let mut props2 = vk::PhysicalDeviceProperties2::default().push_next(&mut driver);
-    unsafe { instance.instance.get_physical_device_properties2(c.physical, &mut props2) };
+    unsafe {
+        instance
+            .instance
+            .get_physical_device_properties2(c.physical, &mut props2)
+    };
     let text = |s: Result<&std::ffi::CStr, _>| s.unwrap_or(c"?").to_string_lossy().into_owned();
-    format!("{} {}", text(driver.driver_name_as_c_str()), text(driver.driver_info_as_c_str()))
+    format!(
+        "{} {}",
+        text(driver.driver_name_as_c_str()),
+        text(driver.driver_info_as_c_str())
+    )
 }
 
 impl Drop for Device {

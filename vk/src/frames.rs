@@ -45,7 +45,10 @@ struct Slot {
 pub enum FrameResult {
     /// Drawn and queued for presentation; the GPU time is that of the slot's
     /// previous frame (the newest one known to be finished).
-    Presented { gpu_ms: Option<f64>, suboptimal: bool },
+    Presented {
+        gpu_ms: Option<f64>,
+        suboptimal: bool,
+    },
     /// The swapchain no longer matches the window: rebuild it, draw nothing.
     OutOfDate,
 }
@@ -64,16 +67,24 @@ impl Frames {
         let info = vk::CommandPoolCreateInfo::default()
             .queue_family_index(device.queue_family)
             .flags(vk::CommandPoolCreateFlags::RESET_COMMAND_BUFFER);
-        let pool = unsafe { d.create_command_pool(&info, None) }.context("creating the frame command pool")?;
-        let mut this = Frames { device: d.clone(), pool, slots: Vec::new(), next: 0 };
+        let pool = unsafe { d.create_command_pool(&info, None) }
+            .context("creating the frame command pool")?;
+        let mut this = Frames {
+            device: d.clone(),
+            pool,
+            slots: Vec::new(),
+            next: 0,
+        };
         let info = vk::CommandBufferAllocateInfo::default()
             .command_pool(pool)
             .level(vk::CommandBufferLevel::PRIMARY)
             .command_buffer_count(FRAMES_IN_FLIGHT as u32);
-        let cmds = unsafe { d.allocate_command_buffers(&info) }.context("allocating the frame command buffers")?;
+        let cmds = unsafe { d.allocate_command_buffers(&info) }
+            .context("allocating the frame command buffers")?;
         for cmd in cmds {
-            let image_available = unsafe { d.create_semaphore(&vk::SemaphoreCreateInfo::default(), None) }
-                .context("creating an image-available semaphore")?;
+            let image_available =
+                unsafe { d.create_semaphore(&vk::SemaphoreCreateInfo::default(), None) }
+                    .context("creating an image-available semaphore")?;
             let signalled = vk::FenceCreateInfo::default().flags(vk::FenceCreateFlags::SIGNALED);
             let in_flight = match unsafe { d.create_fence(&signalled, None) } {
                 Ok(f) => f,
@@ -82,7 +93,13 @@ impl Frames {
                     return Err(e).context("creating an in-flight fence");
                 }
             };
-            this.slots.push(Slot { cmd, image_available, in_flight, timestamps: None, submitted: false });
+            this.slots.push(Slot {
+                cmd,
+                image_available,
+                in_flight,
+                timestamps: None,
+                submitted: false,
+            });
             let slot = this.slots.last_mut().expect("just pushed");
             slot.timestamps = Timestamps::new(device)?;
         }
@@ -108,15 +125,22 @@ impl Frames {
         let d = &device.device;
         let slot = &mut self.slots[self.next];
         // SAFETY: the fence belongs to this device.
-        unsafe { d.wait_for_fences(&[slot.in_flight], true, u64::MAX) }.context("waiting for a frame in flight")?;
+        unsafe { d.wait_for_fences(&[slot.in_flight], true, u64::MAX) }
+            .context("waiting for a frame in flight")?;
         let gpu_ms = match (&slot.timestamps, slot.submitted) {
             (Some(t), true) => Some(t.read_ms()?),
             _ => None,
         };
 
         // SAFETY: the semaphore is unsignalled: its last signal was waited on by the slot's last submit.
-        let acquired =
-            unsafe { loader.acquire_next_image(swapchain.swapchain, u64::MAX, slot.image_available, vk::Fence::null()) };
+        let acquired = unsafe {
+            loader.acquire_next_image(
+                swapchain.swapchain,
+                u64::MAX,
+                slot.image_available,
+                vk::Fence::null(),
+            )
+        };
         let (index, suboptimal) = match acquired {
             Ok(r) => r,
             Err(vk::Result::ERROR_OUT_OF_DATE_KHR) => return Ok(FrameResult::OutOfDate),
@@ -136,7 +160,8 @@ impl Frames {
             .wait_dst_stage_mask(&wait_stages)
             .command_buffers(&cmds)
             .signal_semaphores(&signals);
-        unsafe { d.queue_submit(device.queue, &[submit], slot.in_flight) }.context("submitting a frame")?;
+        unsafe { d.queue_submit(device.queue, &[submit], slot.in_flight) }
+            .context("submitting a frame")?;
         slot.submitted = true;
         self.next = (self.next + 1) % FRAMES_IN_FLIGHT;
 
@@ -169,8 +194,10 @@ fn record(
 ) -> Result<()> {
     let cmd = slot.cmd;
     let extent = swapchain.extent;
-    unsafe { d.reset_command_buffer(cmd, vk::CommandBufferResetFlags::empty()) }.context("resetting a command buffer")?;
-    let begin = vk::CommandBufferBeginInfo::default().flags(vk::CommandBufferUsageFlags::ONE_TIME_SUBMIT);
+    unsafe { d.reset_command_buffer(cmd, vk::CommandBufferResetFlags::empty()) }
+        .context("resetting a command buffer")?;
+    let begin =
+        vk::CommandBufferBeginInfo::default().flags(vk::CommandBufferUsageFlags::ONE_TIME_SUBMIT);
     unsafe { d.begin_command_buffer(cmd, &begin) }.context("recording a frame")?;
     if let Some(t) = &slot.timestamps {
         t.record_reset(cmd);
@@ -189,7 +216,10 @@ fn record(
     let begin_pass = vk::RenderPassBeginInfo::default()
         .render_pass(render_pass)
         .framebuffer(swapchain.framebuffers[index as usize])
-        .render_area(vk::Rect2D { offset: vk::Offset2D::default(), extent });
+        .render_area(vk::Rect2D {
+            offset: vk::Offset2D::default(),
+            extent,
+        });
     let viewport = vk::Viewport {
         x: 0.0,
         y: 0.0,
@@ -198,11 +228,22 @@ fn record(
         min_depth: 0.0,
         max_depth: 1.0,
     };
-    let scissor = vk::Rect2D { offset: vk::Offset2D::default(), extent };
+    let scissor = vk::Rect2D {
+        offset: vk::Offset2D::default(),
+        extent,
+    };
     // SAFETY: every handle is alive; the command buffer is in the recording state.
     unsafe {
         let none = vk::DependencyFlags::empty();
-        d.cmd_pipeline_barrier(cmd, vk::PipelineStageFlags::FRAGMENT_SHADER, vk::PipelineStageFlags::TRANSFER, none, &[], &[], &[]);
+        d.cmd_pipeline_barrier(
+            cmd,
+            vk::PipelineStageFlags::FRAGMENT_SHADER,
+            vk::PipelineStageFlags::TRANSFER,
+            none,
+            &[],
+            &[],
+            &[],
+        );
         d.cmd_update_buffer(cmd, scene.frame.buffer, 0, bytemuck::bytes_of(frame));
         d.cmd_pipeline_barrier(
             cmd,
@@ -216,7 +257,11 @@ fn record(
         d.cmd_begin_render_pass(cmd, &begin_pass, vk::SubpassContents::INLINE);
         d.cmd_set_viewport(cmd, 0, &[viewport]);
         d.cmd_set_scissor(cmd, 0, &[scissor]);
-        d.cmd_bind_pipeline(cmd, vk::PipelineBindPoint::GRAPHICS, scene.pipeline.pipeline);
+        d.cmd_bind_pipeline(
+            cmd,
+            vk::PipelineBindPoint::GRAPHICS,
+            scene.pipeline.pipeline,
+        );
         d.cmd_bind_descriptor_sets(
             cmd,
             vk::PipelineBindPoint::GRAPHICS,

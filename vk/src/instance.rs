@@ -50,8 +50,11 @@ impl Instance {
         // timing run must not pay for it. So it is on only when asked for:
         // --validate (required) or TWINRAY_VK_VALIDATION=1 (best effort).
         let from_env = std::env::var("TWINRAY_VK_VALIDATION").is_ok_and(|v| v == "1");
-        let layers = unsafe { entry.enumerate_instance_layer_properties() }.context("listing Vulkan layers")?;
-        let installed = layers.iter().any(|l| l.layer_name_as_c_str() == Ok(VALIDATION_LAYER));
+        let layers = unsafe { entry.enumerate_instance_layer_properties() }
+            .context("listing Vulkan layers")?;
+        let installed = layers
+            .iter()
+            .any(|l| l.layer_name_as_c_str() == Ok(VALIDATION_LAYER));
         if validate && !installed {
             return Err(no_device(
                 "--validate needs VK_LAYER_KHRONOS_validation, which is not installed: install vulkan-validationlayers",
@@ -80,12 +83,15 @@ impl Instance {
             extension_names.push(debug_utils::NAME.as_ptr());
         }
         let mut early_messenger = messenger_info();
-        let mut info =
-            vk::InstanceCreateInfo::default().application_info(&app).enabled_extension_names(&extension_names);
+        let mut info = vk::InstanceCreateInfo::default()
+            .application_info(&app)
+            .enabled_extension_names(&extension_names);
         if validation {
             // Chained here, the messenger also hears about vkCreateInstance and
             // vkDestroyInstance, when the real messenger does not exist yet or any more.
-            info = info.enabled_layer_names(&layer_names).push_next(&mut early_messenger);
+            info = info
+                .enabled_layer_names(&layer_names)
+                .push_next(&mut early_messenger);
         }
         let instance = unsafe { entry.create_instance(&info, None) }.map_err(|e| match e {
             vk::Result::ERROR_INCOMPATIBLE_DRIVER => {
@@ -95,7 +101,14 @@ impl Instance {
         })?;
 
         explain::step("VkInstance (vkCreateInstance)", || {
-            let v = |v: u32| format!("{}.{}.{}", vk::api_version_major(v), vk::api_version_minor(v), vk::api_version_patch(v));
+            let v = |v: u32| {
+                format!(
+                    "{}.{}.{}",
+                    vk::api_version_major(v),
+                    vk::api_version_minor(v),
+                    vk::api_version_patch(v)
+                )
+            };
             let names: Vec<String> = extension_names
                 .iter()
                 // SAFETY: every pointer comes from a 'static C string (ash or ash-window).
@@ -112,11 +125,17 @@ impl Instance {
         });
 
         // From here on, `Drop` cleans up whatever was created, even on error.
-        let mut this = Instance { entry, instance, api_version, messenger: None };
+        let mut this = Instance {
+            entry,
+            instance,
+            api_version,
+            messenger: None,
+        };
         if validation {
             let functions = debug_utils::Instance::new(&this.entry, &this.instance);
-            let messenger = unsafe { functions.create_debug_utils_messenger(&messenger_info(), None) }
-                .context("creating the debug messenger")?;
+            let messenger =
+                unsafe { functions.create_debug_utils_messenger(&messenger_info(), None) }
+                    .context("creating the debug messenger")?;
             this.messenger = Some((functions, messenger));
             explain::step("VkDebugUtilsMessengerEXT", || {
                 "severity WARNING|ERROR, types GENERAL|VALIDATION|PERFORMANCE: every message is counted and fails --validate".into()
@@ -129,7 +148,10 @@ impl Instance {
 /// Warnings and errors only: "info" and "verbose" are chatter, not mistakes.
 fn messenger_info() -> vk::DebugUtilsMessengerCreateInfoEXT<'static> {
     vk::DebugUtilsMessengerCreateInfoEXT::default()
-        .message_severity(vk::DebugUtilsMessageSeverityFlagsEXT::WARNING | vk::DebugUtilsMessageSeverityFlagsEXT::ERROR)
+        .message_severity(
+            vk::DebugUtilsMessageSeverityFlagsEXT::WARNING
+                | vk::DebugUtilsMessageSeverityFlagsEXT::ERROR,
+        )
         .message_type(
             vk::DebugUtilsMessageTypeFlagsEXT::GENERAL
                 | vk::DebugUtilsMessageTypeFlagsEXT::VALIDATION

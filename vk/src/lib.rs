@@ -5,18 +5,18 @@
 //! The modules are listed in the order a reader meets the setup; `app.rs` ties
 //! them together for the headless run and `window.rs` for the windowed one.
 
-pub mod instance;
-pub mod surface;
-pub mod device;
-pub mod memory;
-pub mod descriptors;
-pub mod pipeline;
+pub mod app;
+pub mod commands;
 pub mod compute;
+pub mod descriptors;
+pub mod device;
+pub mod frames;
+pub mod instance;
+pub mod memory;
+pub mod pipeline;
 pub mod scene;
+pub mod surface;
 pub mod swapchain;
 pub mod target;
 pub mod timestamps;
-pub mod commands;
-pub mod frames;
-pub mod app;
 pub mod window;

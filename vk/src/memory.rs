@@ -37,9 +37,15 @@ pub fn allocate(
                 .map(|i| (i, types[i].property_flags))
         })
         .ok_or_else(|| anyhow!("no memory type suits the {what} ({wishes:?})"))?;
-    let info = vk::MemoryAllocateInfo::default().allocation_size(needs.size).memory_type_index(index as u32);
-    let memory = unsafe { device.device.allocate_memory(&info, None) }
-        .with_context(|| format!("allocating {} KiB of memory for the {what}", needs.size.div_ceil(1024)))?;
+    let info = vk::MemoryAllocateInfo::default()
+        .allocation_size(needs.size)
+        .memory_type_index(index as u32);
+    let memory = unsafe { device.device.allocate_memory(&info, None) }.with_context(|| {
+        format!(
+            "allocating {} KiB of memory for the {what}",
+            needs.size.div_ceil(1024)
+        )
+    })?;
     Ok((memory, flags))
 }
 
@@ -72,14 +78,20 @@ impl Buffer {
             needs_flush: false,
             memory_flags: Flags::empty(),
         };
-        let info = vk::BufferCreateInfo::default().size(size).usage(usage).sharing_mode(vk::SharingMode::EXCLUSIVE);
-        b.buffer = unsafe { b.device.create_buffer(&info, None) }.with_context(|| format!("creating the {what}"))?;
+        let info = vk::BufferCreateInfo::default()
+            .size(size)
+            .usage(usage)
+            .sharing_mode(vk::SharingMode::EXCLUSIVE);
+        b.buffer = unsafe { b.device.create_buffer(&info, None) }
+            .with_context(|| format!("creating the {what}"))?;
         let needs = unsafe { b.device.get_buffer_memory_requirements(b.buffer) };
         let (memory, flags) = allocate(device, needs, wishes, what)?;
         b.memory = memory;
         b.memory_flags = flags;
-        b.needs_flush = flags.contains(Flags::HOST_VISIBLE) && !flags.contains(Flags::HOST_COHERENT);
-        unsafe { b.device.bind_buffer_memory(b.buffer, b.memory, 0) }.with_context(|| format!("binding the {what}"))?;
+        b.needs_flush =
+            flags.contains(Flags::HOST_VISIBLE) && !flags.contains(Flags::HOST_COHERENT);
+        unsafe { b.device.bind_buffer_memory(b.buffer, b.memory, 0) }
+            .with_context(|| format!("binding the {what}"))?;
         Ok(b)
     }
 
@@ -87,18 +99,34 @@ impl Buffer {
     /// written directly by the CPU: what a naive app does. The GPU then reads the
     /// scene across the bus on every access; `TWINRAY_VK_MEMORY=host` selects it
     /// to measure that cost.
-    pub fn host_visible_with(device: &Device, bytes: &[u8], usage: vk::BufferUsageFlags, what: &str) -> Result<Buffer> {
-        let wishes = [Flags::HOST_VISIBLE | Flags::HOST_COHERENT, Flags::HOST_VISIBLE];
+    pub fn host_visible_with(
+        device: &Device,
+        bytes: &[u8],
+        usage: vk::BufferUsageFlags,
+        what: &str,
+    ) -> Result<Buffer> {
+        let wishes = [
+            Flags::HOST_VISIBLE | Flags::HOST_COHERENT,
+            Flags::HOST_VISIBLE,
+        ];
         let buffer = Buffer::new(device, bytes.len() as u64, usage, &wishes, what)?;
         buffer.write(bytes)?;
         Ok(buffer)
     }
 
     /// A device-local buffer holding `bytes`, filled through a staging buffer.
-    pub fn device_local_with(device: &Device, bytes: &[u8], usage: vk::BufferUsageFlags, what: &str) -> Result<Buffer> {
+    pub fn device_local_with(
+        device: &Device,
+        bytes: &[u8],
+        usage: vk::BufferUsageFlags,
+        what: &str,
+    ) -> Result<Buffer> {
         let size = bytes.len() as u64;
         // Coherent memory needs no flush after writing, but any mappable type will do.
-        let upload = [Flags::HOST_VISIBLE | Flags::HOST_COHERENT, Flags::HOST_VISIBLE];
+        let upload = [
+            Flags::HOST_VISIBLE | Flags::HOST_COHERENT,
+            Flags::HOST_VISIBLE,
+        ];
         let staging = Buffer::new(
             device,
             size,
@@ -108,7 +136,13 @@ impl Buffer {
         )?;
         staging.write(bytes)?;
         let usage = usage | vk::BufferUsageFlags::TRANSFER_DST;
-        let buffer = Buffer::new(device, size, usage, &[Flags::DEVICE_LOCAL, Flags::empty()], what)?;
+        let buffer = Buffer::new(
+            device,
+            size,
+            usage,
+            &[Flags::DEVICE_LOCAL, Flags::empty()],
+            what,
+        )?;
         device.run_once(&format!("uploading the {what}"), |cmd| {
             let region = vk::BufferCopy::default().size(size);
             // The barrier makes the copied bytes visible to the fragment (or compute) shader of
@@ -121,11 +155,14 @@ impl Buffer {
                 .buffer(buffer.buffer)
                 .size(vk::WHOLE_SIZE);
             unsafe {
-                device.device.cmd_copy_buffer(cmd, staging.buffer, buffer.buffer, &[region]);
+                device
+                    .device
+                    .cmd_copy_buffer(cmd, staging.buffer, buffer.buffer, &[region]);
                 device.device.cmd_pipeline_barrier(
                     cmd,
                     vk::PipelineStageFlags::TRANSFER,
-                    vk::PipelineStageFlags::FRAGMENT_SHADER | vk::PipelineStageFlags::COMPUTE_SHADER,
+                    vk::PipelineStageFlags::FRAGMENT_SHADER
+                        | vk::PipelineStageFlags::COMPUTE_SHADER,
                     vk::DependencyFlags::empty(),
                     &[],
                     &[barrier],
@@ -145,12 +182,19 @@ impl Buffer {
     /// Copies `bytes` into a host-visible buffer.
     pub fn write(&self, bytes: &[u8]) -> Result<()> {
         let d = &self.device;
-        let ptr = unsafe { d.map_memory(self.memory, 0, vk::WHOLE_SIZE, vk::MemoryMapFlags::empty()) }
-            .context("mapping memory")?;
+        let ptr =
+            unsafe { d.map_memory(self.memory, 0, vk::WHOLE_SIZE, vk::MemoryMapFlags::empty()) }
+                .context("mapping memory")?;
         // SAFETY: the mapping covers the whole buffer, which is bytes.len() long.
         unsafe { std::ptr::copy_nonoverlapping(bytes.as_ptr(), ptr.cast::<u8>(), bytes.len()) };
-        let range = vk::MappedMemoryRange::default().memory(self.memory).size(vk::WHOLE_SIZE);
-        let flushed = if self.needs_flush { unsafe { d.flush_mapped_memory_ranges(&[range]) } } else { Ok(()) };
+        let range = vk::MappedMemoryRange::default()
+            .memory(self.memory)
+            .size(vk::WHOLE_SIZE);
+        let flushed = if self.needs_flush {
+            unsafe { d.flush_mapped_memory_ranges(&[range]) }
+        } else {
+            Ok(())
+        };
         unsafe { d.unmap_memory(self.memory) };
         flushed.context("flushing mapped memory")
     }
@@ -159,10 +203,17 @@ impl Buffer {
     /// cast in place: the mapping is aligned, a Vec<u8> copy of it need not be.)
     pub fn read<T: bytemuck::Pod>(&self) -> Result<Vec<T>> {
         let d = &self.device;
-        let ptr = unsafe { d.map_memory(self.memory, 0, vk::WHOLE_SIZE, vk::MemoryMapFlags::empty()) }
-            .context("mapping memory")?;
-        let range = vk::MappedMemoryRange::default().memory(self.memory).size(vk::WHOLE_SIZE);
-        let fresh = if self.needs_flush { unsafe { d.invalidate_mapped_memory_ranges(&[range]) } } else { Ok(()) };
+        let ptr =
+            unsafe { d.map_memory(self.memory, 0, vk::WHOLE_SIZE, vk::MemoryMapFlags::empty()) }
+                .context("mapping memory")?;
+        let range = vk::MappedMemoryRange::default()
+            .memory(self.memory)
+            .size(vk::WHOLE_SIZE);
+        let fresh = if self.needs_flush {
+            unsafe { d.invalidate_mapped_memory_ranges(&[range]) }
+        } else {
+            Ok(())
+        };
         // SAFETY: the mapping covers the whole buffer, `size` bytes.
         let bytes = unsafe { std::slice::from_raw_parts(ptr.cast::<u8>(), self.size as usize) };
         let data = bytemuck::pod_collect_to_vec(bytes);

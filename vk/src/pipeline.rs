@@ -42,7 +42,11 @@ impl RenderPass {
         RenderPass::new(device, format, vk::ImageLayout::PRESENT_SRC_KHR)
     }
 
-    fn new(device: &Device, format: vk::Format, final_layout: vk::ImageLayout) -> Result<RenderPass> {
+    fn new(
+        device: &Device,
+        format: vk::Format,
+        final_layout: vk::ImageLayout,
+    ) -> Result<RenderPass> {
         let d = &device.device;
         // The fullscreen triangle writes every pixel, so the old contents are not
         // loaded.
@@ -53,7 +57,10 @@ impl RenderPass {
             .store_op(vk::AttachmentStoreOp::STORE)
             .initial_layout(vk::ImageLayout::UNDEFINED)
             .final_layout(final_layout);
-        let color_ref = [vk::AttachmentReference { attachment: 0, layout: vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL }];
+        let color_ref = [vk::AttachmentReference {
+            attachment: 0,
+            layout: vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL,
+        }];
         let subpass = vk::SubpassDescription::default()
             .pipeline_bind_point(vk::PipelineBindPoint::GRAPHICS)
             .color_attachments(&color_ref);
@@ -76,14 +83,19 @@ impl RenderPass {
             .dst_stage_mask(vk::PipelineStageFlags::TRANSFER)
             .dst_access_mask(vk::AccessFlags::TRANSFER_READ);
         let dependencies: &[vk::SubpassDependency] =
-            if final_layout == vk::ImageLayout::TRANSFER_SRC_OPTIMAL { &[incoming, to_copy] } else { &[incoming] };
+            if final_layout == vk::ImageLayout::TRANSFER_SRC_OPTIMAL {
+                &[incoming, to_copy]
+            } else {
+                &[incoming]
+            };
         let attachments = [attachment];
         let subpasses = [subpass];
         let info = vk::RenderPassCreateInfo::default()
             .attachments(&attachments)
             .subpasses(&subpasses)
             .dependencies(dependencies);
-        let render_pass = unsafe { d.create_render_pass(&info, None) }.context("creating the render pass")?;
+        let render_pass =
+            unsafe { d.create_render_pass(&info, None) }.context("creating the render pass")?;
         explain::step("VkRenderPass", || {
             format!(
                 "1 colour attachment {format:?}, load DONT_CARE (every pixel is written), store STORE\n\
@@ -91,7 +103,10 @@ impl RenderPass {
                 dependencies.len()
             )
         });
-        Ok(RenderPass { device: d.clone(), render_pass })
+        Ok(RenderPass {
+            device: d.clone(),
+            render_pass,
+        })
     }
 }
 
@@ -133,13 +148,19 @@ impl Pipeline {
         fixed_size: Option<(u32, u32)>,
     ) -> Result<Pipeline> {
         let d = &device.device;
-        let mut this =
-            Pipeline { device: d.clone(), layout: vk::PipelineLayout::null(), pipeline: vk::Pipeline::null() };
+        let mut this = Pipeline {
+            device: d.clone(),
+            layout: vk::PipelineLayout::null(),
+            pipeline: vk::Pipeline::null(),
+        };
 
         let set_layouts = [set_layout];
         let info = vk::PipelineLayoutCreateInfo::default().set_layouts(&set_layouts);
-        this.layout = unsafe { d.create_pipeline_layout(&info, None) }.context("creating the pipeline layout")?;
-        explain::step("VkPipelineLayout", || "1 descriptor set layout (set 0), no push constants".into());
+        this.layout = unsafe { d.create_pipeline_layout(&info, None) }
+            .context("creating the pipeline layout")?;
+        explain::step("VkPipelineLayout", || {
+            "1 descriptor set layout (set 0), no push constants".into()
+        });
 
         let vertex = module(d, &shaders.vertex_spirv, "vertex")?;
         let fragment = module(d, &shaders.fragment_spirv, "fragment")?;
@@ -163,8 +184,8 @@ impl Pipeline {
         ];
         // No vertex buffers: the vertex shader makes the triangle from gl_VertexIndex.
         let vertex_input = vk::PipelineVertexInputStateCreateInfo::default();
-        let assembly =
-            vk::PipelineInputAssemblyStateCreateInfo::default().topology(vk::PrimitiveTopology::TRIANGLE_LIST);
+        let assembly = vk::PipelineInputAssemblyStateCreateInfo::default()
+            .topology(vk::PrimitiveTopology::TRIANGLE_LIST);
         // A normal viewport (positive height): Vulkan's row 0 is the top, and the
         // shader builds rays with +y down, so rows go to the PNG unflipped.
         let (width, height) = fixed_size.unwrap_or((1, 1));
@@ -176,22 +197,32 @@ impl Pipeline {
             min_depth: 0.0,
             max_depth: 1.0,
         }];
-        let scissors = [vk::Rect2D { offset: vk::Offset2D::default(), extent: vk::Extent2D { width, height } }];
-        let viewport = vk::PipelineViewportStateCreateInfo::default().viewports(&viewports).scissors(&scissors);
+        let scissors = [vk::Rect2D {
+            offset: vk::Offset2D::default(),
+            extent: vk::Extent2D { width, height },
+        }];
+        let viewport = vk::PipelineViewportStateCreateInfo::default()
+            .viewports(&viewports)
+            .scissors(&scissors);
         // Windowed, the size changes with the window: set while recording instead.
         let dynamic_states = [vk::DynamicState::VIEWPORT, vk::DynamicState::SCISSOR];
-        let dynamic = vk::PipelineDynamicStateCreateInfo::default()
-            .dynamic_states(if fixed_size.is_some() { &[] } else { &dynamic_states });
+        let dynamic =
+            vk::PipelineDynamicStateCreateInfo::default().dynamic_states(if fixed_size.is_some() {
+                &[]
+            } else {
+                &dynamic_states
+            });
         // No culling: the one triangle must be drawn whichever way it winds.
         let raster = vk::PipelineRasterizationStateCreateInfo::default()
             .polygon_mode(vk::PolygonMode::FILL)
             .cull_mode(vk::CullModeFlags::NONE)
             .line_width(1.0);
-        let multisample =
-            vk::PipelineMultisampleStateCreateInfo::default().rasterization_samples(vk::SampleCountFlags::TYPE_1);
-        let blend_attachments =
-            [vk::PipelineColorBlendAttachmentState::default().color_write_mask(vk::ColorComponentFlags::RGBA)];
-        let blend = vk::PipelineColorBlendStateCreateInfo::default().attachments(&blend_attachments);
+        let multisample = vk::PipelineMultisampleStateCreateInfo::default()
+            .rasterization_samples(vk::SampleCountFlags::TYPE_1);
+        let blend_attachments = [vk::PipelineColorBlendAttachmentState::default()
+            .color_write_mask(vk::ColorComponentFlags::RGBA)];
+        let blend =
+            vk::PipelineColorBlendStateCreateInfo::default().attachments(&blend_attachments);
         let info = vk::GraphicsPipelineCreateInfo::default()
             .stages(&stages)
             .vertex_input_state(&vertex_input)
@@ -204,18 +235,24 @@ impl Pipeline {
             .layout(this.layout)
             .render_pass(render_pass)
             .subpass(0);
-        let pipelines = unsafe { d.create_graphics_pipelines(vk::PipelineCache::null(), &[info], None) }
-            .map_err(|(_, e)| e)
-            .context("creating the graphics pipeline")?;
+        let pipelines =
+            unsafe { d.create_graphics_pipelines(vk::PipelineCache::null(), &[info], None) }
+                .map_err(|(_, e)| e)
+                .context("creating the graphics pipeline")?;
         this.pipeline = pipelines[0];
-        explain::step("VkPipeline (vkCreateGraphicsPipelines: the driver compiles the tracer here)", || {
-            let size = match fixed_size {
-                Some((w, h)) => format!("fixed viewport + scissor {w}x{h}"),
-                None => "dynamic viewport + scissor (resizes don't recompile)".into(),
-            };
-            format!("TRIANGLE_LIST, no vertex input (3 vertices from gl_VertexIndex); {size}\n\
-                     FILL, cull NONE, 1 sample, no blending, write RGBA; subpass 0")
-        });
+        explain::step(
+            "VkPipeline (vkCreateGraphicsPipelines: the driver compiles the tracer here)",
+            || {
+                let size = match fixed_size {
+                    Some((w, h)) => format!("fixed viewport + scissor {w}x{h}"),
+                    None => "dynamic viewport + scissor (resizes don't recompile)".into(),
+                };
+                format!(
+                    "TRIANGLE_LIST, no vertex input (3 vertices from gl_VertexIndex); {size}\n\
+                     FILL, cull NONE, 1 sample, no blending, write RGBA; subpass 0"
+                )
+            },
+        );
         Ok(this) // the shader modules are dropped here: the pipeline has its own copy.
     }
 }

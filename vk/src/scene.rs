@@ -35,8 +35,19 @@ impl SceneResources {
     ) -> Result<SceneResources> {
         let (frame, storage) = scene_buffers(device, scene)?;
         let descriptors = Descriptors::new(device, &frame, &storage)?;
-        let pipeline = Pipeline::new(device, descriptors.set_layout, shaders, render_pass, fixed_size)?;
-        Ok(SceneResources { pipeline, descriptors, storage, frame })
+        let pipeline = Pipeline::new(
+            device,
+            descriptors.set_layout,
+            shaders,
+            render_pass,
+            fixed_size,
+        )?;
+        Ok(SceneResources {
+            pipeline,
+            descriptors,
+            storage,
+            frame,
+        })
     }
 }
 
@@ -48,9 +59,9 @@ pub fn scene_buffers(device: &Device, scene: &GpuScene) -> Result<(Buffer, Vec<(
     let host = host_memory()?;
     let place = |bytes: &[u8], usage: vk::BufferUsageFlags, what: &str| {
         if host {
-        Buffer::host_visible_with(device, bytes, usage, what)
+            Buffer::host_visible_with(device, bytes, usage, what)
         } else {
-        Buffer::device_local_with(device, bytes, usage, what)
+            Buffer::device_local_with(device, bytes, usage, what)
         }
     };
     let uniform = vk::BufferUsageFlags::UNIFORM_BUFFER;
@@ -58,9 +69,9 @@ pub fn scene_buffers(device: &Device, scene: &GpuScene) -> Result<(Buffer, Vec<(
     let storage = binding::STORAGE
         .iter()
         .map(|&b| {
-        let what = format!("{} storage buffer", storage_name(b));
-        let usage = vk::BufferUsageFlags::STORAGE_BUFFER;
-        Ok((b, place(scene.storage_bytes(b), usage, &what)?))
+            let what = format!("{} storage buffer", storage_name(b));
+            let usage = vk::BufferUsageFlags::STORAGE_BUFFER;
+            Ok((b, place(scene.storage_bytes(b), usage, &what)?))
         })
         .collect::<Result<Vec<_>>>()?;
     Ok((frame, storage))

@@ -23,7 +23,10 @@ pub struct Surface {
 
 /// The instance extensions this window system needs (VK_KHR_surface + its own).
 pub fn required_extensions(window: &Window) -> Result<&'static [*const c_char]> {
-    let display = window.display_handle().context("getting the window's display handle")?.as_raw();
+    let display = window
+        .display_handle()
+        .context("getting the window's display handle")?
+        .as_raw();
     ash_window::enumerate_required_extensions(display)
         .context("this window system has no Vulkan surface extension (ash-window)")
 }
@@ -32,23 +35,37 @@ impl Surface {
     /// The window must outlive the surface (the windowed app declares it last,
     /// so it is dropped after everything made from it).
     pub fn new(instance: &Instance, window: &Window) -> Result<Surface> {
-        let display = window.display_handle().context("getting the window's display handle")?.as_raw();
-        let handle = window.window_handle().context("getting the window handle")?.as_raw();
+        let display = window
+            .display_handle()
+            .context("getting the window's display handle")?
+            .as_raw();
+        let handle = window
+            .window_handle()
+            .context("getting the window handle")?
+            .as_raw();
         // SAFETY: both handles belong to a live window that outlives the surface.
-        let surface =
-            unsafe { ash_window::create_surface(&instance.entry, &instance.instance, display, handle, None) }
-                .context("creating the window surface")?;
+        let surface = unsafe {
+            ash_window::create_surface(&instance.entry, &instance.instance, display, handle, None)
+        }
+        .context("creating the window surface")?;
         explain::step("VkSurfaceKHR (ash_window::create_surface)", || {
             format!("for the {} window", window_system(&handle))
         });
-        Ok(Surface { loader: khr::surface::Instance::new(&instance.entry, &instance.instance), surface })
+        Ok(Surface {
+            loader: khr::surface::Instance::new(&instance.entry, &instance.instance),
+            surface,
+        })
     }
 
     /// Whether `family` of `physical` can present to this surface: not every
     /// queue that draws can show its results in a window.
     pub fn supports(&self, physical: vk::PhysicalDevice, family: u32) -> bool {
         // SAFETY: both handles are alive; an error counts as "no".
-        unsafe { self.loader.get_physical_device_surface_support(physical, family, self.surface) }.unwrap_or(false)
+        unsafe {
+            self.loader
+                .get_physical_device_surface_support(physical, family, self.surface)
+        }
+        .unwrap_or(false)
     }
 }
 

@@ -34,19 +34,32 @@ use twinray_common::explain;
 /// colour space (see the module comment for why not sRGB).
 pub fn choose_format(device: &Device, surface: &Surface) -> Result<vk::SurfaceFormatKHR> {
     // SAFETY: live physical device and surface.
-    let formats = unsafe { surface.loader.get_physical_device_surface_formats(device.physical, surface.surface) }
-        .context("listing the surface's formats")?;
-    let preferred = [vk::Format::B8G8R8A8_UNORM, vk::Format::R8G8B8A8_UNORM, vk::Format::A8B8G8R8_UNORM_PACK32];
+    let formats = unsafe {
+        surface
+            .loader
+            .get_physical_device_surface_formats(device.physical, surface.surface)
+    }
+    .context("listing the surface's formats")?;
+    let preferred = [
+        vk::Format::B8G8R8A8_UNORM,
+        vk::Format::R8G8B8A8_UNORM,
+        vk::Format::A8B8G8R8_UNORM_PACK32,
+    ];
     let chosen = preferred
         .iter()
         .find_map(|&want| {
-            formats.iter().find(|f| f.format == want && f.color_space == vk::ColorSpaceKHR::SRGB_NONLINEAR)
+            formats
+                .iter()
+                .find(|f| f.format == want && f.color_space == vk::ColorSpaceKHR::SRGB_NONLINEAR)
         })
         .or_else(|| formats.first())
         .copied()
         .context("the surface offers no formats")?;
     explain::step("Surface format chosen", || {
-        let offered: Vec<String> = formats.iter().map(|f| format!("{:?}/{:?}", f.format, f.color_space)).collect();
+        let offered: Vec<String> = formats
+            .iter()
+            .map(|f| format!("{:?}/{:?}", f.format, f.color_space))
+            .collect();
         format!(
             "offered: {}\nchosen: {:?} / {:?}: UNORM, because the tracer's values are stored unencoded\n\
              in the PNGs (image_io quantises without sRGB); an _SRGB format would make the window brighter",
@@ -59,20 +72,33 @@ pub fn choose_format(device: &Device, surface: &Surface) -> Result<vk::SurfaceFo
 }
 
 /// MAILBOX, else IMMEDIATE (both uncapped), else FIFO; FIFO with `--vsync`.
-pub fn choose_present_mode(device: &Device, surface: &Surface, vsync: bool) -> Result<vk::PresentModeKHR> {
+pub fn choose_present_mode(
+    device: &Device,
+    surface: &Surface,
+    vsync: bool,
+) -> Result<vk::PresentModeKHR> {
     // SAFETY: live physical device and surface.
-    let modes = unsafe { surface.loader.get_physical_device_surface_present_modes(device.physical, surface.surface) }
-        .context("listing the surface's present modes")?;
+    let modes = unsafe {
+        surface
+            .loader
+            .get_physical_device_surface_present_modes(device.physical, surface.surface)
+    }
+    .context("listing the surface's present modes")?;
     let uncapped = [vk::PresentModeKHR::MAILBOX, vk::PresentModeKHR::IMMEDIATE];
     let chosen = if vsync {
         vk::PresentModeKHR::FIFO
     } else {
-        uncapped.into_iter().find(|m| modes.contains(m)).unwrap_or(vk::PresentModeKHR::FIFO)
+        uncapped
+            .into_iter()
+            .find(|m| modes.contains(m))
+            .unwrap_or(vk::PresentModeKHR::FIFO)
     };
     explain::step("Present mode chosen", || {
         let why = match (vsync, chosen) {
             (true, _) => "--vsync: FIFO waits for the display's refresh (every device supports it)",
-            (false, vk::PresentModeKHR::FIFO) => "no uncapped mode offered: FIFO, capped at the refresh rate",
+            (false, vk::PresentModeKHR::FIFO) => {
+                "no uncapped mode offered: FIFO, capped at the refresh rate"
+            }
             _ => "uncapped, so the FPS in the title measures the tracer, not the display",
         };
         format!("offered: {modes:?}\nchosen: {chosen:?}: {why}")
@@ -106,15 +132,23 @@ impl Swapchain {
     ) -> Result<Option<Swapchain>> {
         let d = &device.device;
         // SAFETY: live physical device and surface.
-        let caps = unsafe { surface.loader.get_physical_device_surface_capabilities(device.physical, surface.surface) }
-            .context("reading the surface's capabilities")?;
+        let caps = unsafe {
+            surface
+                .loader
+                .get_physical_device_surface_capabilities(device.physical, surface.surface)
+        }
+        .context("reading the surface's capabilities")?;
         // u32::MAX means "the swapchain decides" (Wayland); otherwise it must match the window.
         let extent = if caps.current_extent.width != u32::MAX {
             caps.current_extent
         } else {
             vk::Extent2D {
-                width: window_size.0.clamp(caps.min_image_extent.width, caps.max_image_extent.width),
-                height: window_size.1.clamp(caps.min_image_extent.height, caps.max_image_extent.height),
+                width: window_size
+                    .0
+                    .clamp(caps.min_image_extent.width, caps.max_image_extent.width),
+                height: window_size
+                    .1
+                    .clamp(caps.min_image_extent.height, caps.max_image_extent.height),
             }
         };
         if extent.width == 0 || extent.height == 0 {
@@ -160,8 +194,10 @@ impl Swapchain {
             render_finished: Vec::new(),
         };
         // SAFETY: valid create info; the old swapchain (if any) is retired by this call.
-        this.swapchain = unsafe { loader.create_swapchain(&info, None) }.context("creating the swapchain")?;
-        let images = unsafe { loader.get_swapchain_images(this.swapchain) }.context("getting the swapchain images")?;
+        this.swapchain =
+            unsafe { loader.create_swapchain(&info, None) }.context("creating the swapchain")?;
+        let images = unsafe { loader.get_swapchain_images(this.swapchain) }
+            .context("getting the swapchain images")?;
         explain::step("VkSwapchainKHR", || {
             format!(
                 "{}x{} {:?}, {} images (asked {image_count}: min {} + 1), {present_mode:?}\n\
@@ -172,7 +208,11 @@ impl Swapchain {
                 images.len(),
                 caps.min_image_count,
                 caps.current_transform,
-                if old.is_some() { "; replaces the old swapchain (oldSwapchain)" } else { "" }
+                if old.is_some() {
+                    "; replaces the old swapchain (oldSwapchain)"
+                } else {
+                    ""
+                }
             )
         });
 
@@ -187,7 +227,10 @@ impl Swapchain {
                         .level_count(1)
                         .layer_count(1),
                 );
-            this.views.push(unsafe { d.create_image_view(&info, None) }.context("creating a swapchain image view")?);
+            this.views.push(
+                unsafe { d.create_image_view(&info, None) }
+                    .context("creating a swapchain image view")?,
+            );
             let views = [*this.views.last().expect("just pushed")];
             let info = vk::FramebufferCreateInfo::default()
                 .render_pass(render_pass)
@@ -195,18 +238,24 @@ impl Swapchain {
                 .width(extent.width)
                 .height(extent.height)
                 .layers(1);
-            this.framebuffers
-                .push(unsafe { d.create_framebuffer(&info, None) }.context("creating a swapchain framebuffer")?);
-            let semaphore = unsafe { d.create_semaphore(&vk::SemaphoreCreateInfo::default(), None) }
-                .context("creating a render-finished semaphore")?;
+            this.framebuffers.push(
+                unsafe { d.create_framebuffer(&info, None) }
+                    .context("creating a swapchain framebuffer")?,
+            );
+            let semaphore =
+                unsafe { d.create_semaphore(&vk::SemaphoreCreateInfo::default(), None) }
+                    .context("creating a render-finished semaphore")?;
             this.render_finished.push(semaphore);
         }
-        explain::step("VkImageView + VkFramebuffer + VkSemaphore per swapchain image", || {
-            format!(
+        explain::step(
+            "VkImageView + VkFramebuffer + VkSemaphore per swapchain image",
+            || {
+                format!(
                 "{} of each: the views let the render pass see the images; the semaphores order present after draw",
                 images.len()
             )
-        });
+            },
+        );
         Ok(Some(this))
     }
 }

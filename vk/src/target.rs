@@ -30,15 +30,32 @@ pub struct Target {
 }
 
 impl Target {
-    pub fn new(device: &Device, render_pass: vk::RenderPass, width: u32, height: u32) -> Result<Target> {
+    pub fn new(
+        device: &Device,
+        render_pass: vk::RenderPass,
+        width: u32,
+        height: u32,
+    ) -> Result<Target> {
         let d = &device.device;
         // RGBA32F: 16 bytes a pixel, rows packed tightly in the readback buffer.
         let bytes = width as u64 * height as u64 * 16;
         // The CPU reads this one, and uncached reads of mapped memory are very slow.
-        let wishes = [Flags::HOST_VISIBLE | Flags::HOST_CACHED, Flags::HOST_VISIBLE];
-        let readback = Buffer::new(device, bytes, vk::BufferUsageFlags::TRANSFER_DST, &wishes, "readback buffer")?;
+        let wishes = [
+            Flags::HOST_VISIBLE | Flags::HOST_CACHED,
+            Flags::HOST_VISIBLE,
+        ];
+        let readback = Buffer::new(
+            device,
+            bytes,
+            vk::BufferUsageFlags::TRANSFER_DST,
+            &wishes,
+            "readback buffer",
+        )?;
         explain::step("VkBuffer + VkDeviceMemory: readback buffer", || {
-            format!("{bytes} bytes, TRANSFER_DST, memory {:?} (the CPU reads it)", readback.memory_flags)
+            format!(
+                "{bytes} bytes, TRANSFER_DST, memory {:?} (the CPU reads it)",
+                readback.memory_flags
+            )
         });
         let mut this = Target {
             device: d.clone(),
@@ -53,7 +70,11 @@ impl Target {
         let info = vk::ImageCreateInfo::default()
             .image_type(vk::ImageType::TYPE_2D)
             .format(COLOR_FORMAT)
-            .extent(vk::Extent3D { width, height, depth: 1 })
+            .extent(vk::Extent3D {
+                width,
+                height,
+                depth: 1,
+            })
             .mip_levels(1)
             .array_layers(1)
             .samples(vk::SampleCountFlags::TYPE_1)
@@ -62,8 +83,15 @@ impl Target {
             .initial_layout(vk::ImageLayout::UNDEFINED);
         this.image = unsafe { d.create_image(&info, None) }.context("creating the colour image")?;
         let needs = unsafe { d.get_image_memory_requirements(this.image) };
-        this.memory = memory::allocate(device, needs, &[Flags::DEVICE_LOCAL, Flags::empty()], "colour image")?.0;
-        unsafe { d.bind_image_memory(this.image, this.memory, 0) }.context("binding the colour image's memory")?;
+        this.memory = memory::allocate(
+            device,
+            needs,
+            &[Flags::DEVICE_LOCAL, Flags::empty()],
+            "colour image",
+        )?
+        .0;
+        unsafe { d.bind_image_memory(this.image, this.memory, 0) }
+            .context("binding the colour image's memory")?;
         explain::step("VkImage + VkDeviceMemory: colour target", || {
             format!("{width}x{height} {COLOR_FORMAT:?}, OPTIMAL tiling, usage COLOR_ATTACHMENT|TRANSFER_SRC, {} bytes DEVICE_LOCAL", needs.size)
         });
@@ -78,8 +106,11 @@ impl Target {
                     .level_count(1)
                     .layer_count(1),
             );
-        this.view = unsafe { d.create_image_view(&info, None) }.context("creating the colour image view")?;
-        explain::step("VkImageView", || "2D, COLOR aspect, 1 mip level, 1 layer".into());
+        this.view = unsafe { d.create_image_view(&info, None) }
+            .context("creating the colour image view")?;
+        explain::step("VkImageView", || {
+            "2D, COLOR aspect, 1 mip level, 1 layer".into()
+        });
 
         let views = [this.view];
         let info = vk::FramebufferCreateInfo::default()
@@ -88,8 +119,11 @@ impl Target {
             .width(width)
             .height(height)
             .layers(1);
-        this.framebuffer = unsafe { d.create_framebuffer(&info, None) }.context("creating the framebuffer")?;
-        explain::step("VkFramebuffer", || format!("{width}x{height}, 1 layer, attachment 0 = the view"));
+        this.framebuffer =
+            unsafe { d.create_framebuffer(&info, None) }.context("creating the framebuffer")?;
+        explain::step("VkFramebuffer", || {
+            format!("{width}x{height}, 1 layer, attachment 0 = the view")
+        });
         Ok(this)
     }
 
@@ -104,7 +138,11 @@ impl Target {
                     base_array_layer: 0,
                     layer_count: 1,
                 })
-                .image_extent(vk::Extent3D { width: self.width, height: self.height, depth: 1 });
+                .image_extent(vk::Extent3D {
+                    width: self.width,
+                    height: self.height,
+                    depth: 1,
+                });
             // A queue or fence wait covers only the GPU's side: the copy's writes
             // become visible to the CPU's reads only through a barrier to HOST.
             let to_host = vk::BufferMemoryBarrier::default()
@@ -134,7 +172,10 @@ impl Target {
                 );
             }
         })?;
-        let rgba: Vec<f32> = self.readback.read().context("reading the readback buffer")?;
+        let rgba: Vec<f32> = self
+            .readback
+            .read()
+            .context("reading the readback buffer")?;
         Ok(FloatImage::from_rgba(self.width, self.height, &rgba))
     }
 }

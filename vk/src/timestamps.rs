@@ -28,9 +28,11 @@ impl Timestamps {
         if bits == 0 {
             return Ok(None);
         }
-        let info = vk::QueryPoolCreateInfo::default().query_type(vk::QueryType::TIMESTAMP).query_count(2);
-        let pool =
-            unsafe { device.device.create_query_pool(&info, None) }.context("creating the timestamp query pool")?;
+        let info = vk::QueryPoolCreateInfo::default()
+            .query_type(vk::QueryType::TIMESTAMP)
+            .query_count(2);
+        let pool = unsafe { device.device.create_query_pool(&info, None) }
+            .context("creating the timestamp query pool")?;
         explain::step("VkQueryPool (2 TIMESTAMP queries)", || {
             format!(
                 "timestampPeriod {} ns per tick, timestampValidBits {bits}; results read as 64-bit",
@@ -41,7 +43,11 @@ impl Timestamps {
             device: device.device.clone(),
             pool,
             period_ns: device.properties.limits.timestamp_period as f64,
-            mask: if bits >= 64 { u64::MAX } else { (1u64 << bits) - 1 },
+            mask: if bits >= 64 {
+                u64::MAX
+            } else {
+                (1u64 << bits) - 1
+            },
         }))
     }
 
@@ -54,9 +60,15 @@ impl Timestamps {
     /// Query 0 when the GPU starts the commands after it (TOP_OF_PIPE), query 1
     /// when it has finished everything before it (BOTTOM_OF_PIPE).
     pub fn record(&self, cmd: vk::CommandBuffer, query: u32) {
-        let stage =
-            if query == 0 { vk::PipelineStageFlags::TOP_OF_PIPE } else { vk::PipelineStageFlags::BOTTOM_OF_PIPE };
-        unsafe { self.device.cmd_write_timestamp(cmd, stage, self.pool, query) };
+        let stage = if query == 0 {
+            vk::PipelineStageFlags::TOP_OF_PIPE
+        } else {
+            vk::PipelineStageFlags::BOTTOM_OF_PIPE
+        };
+        unsafe {
+            self.device
+                .cmd_write_timestamp(cmd, stage, self.pool, query)
+        };
     }
 
     /// The frame's GPU time in milliseconds. WAIT makes this block until both
@@ -65,8 +77,11 @@ impl Timestamps {
     pub fn read_ms(&self) -> Result<f64> {
         let mut ticks = [0u64; 2];
         let flags = vk::QueryResultFlags::TYPE_64 | vk::QueryResultFlags::WAIT;
-        unsafe { self.device.get_query_pool_results(self.pool, 0, &mut ticks, flags) }
-            .context("reading the timestamps")?;
+        unsafe {
+            self.device
+                .get_query_pool_results(self.pool, 0, &mut ticks, flags)
+        }
+        .context("reading the timestamps")?;
         let elapsed = ticks[1].wrapping_sub(ticks[0]) & self.mask;
         Ok(elapsed as f64 * self.period_ns / 1e6)
     }

@@ -53,9 +53,10 @@ pub fn run(args: &RenderArgs, started: Instant) -> Result<(WindowedRun, DeviceIn
     let scene = args.load_scene()?;
     let variant = interactive::variant_for(args, &scene);
     let shaders = shader::build(&variant)?;
-    explain::step("Shaders: GLSL -> naga module -> SPIR-V (twinray-common)", || {
-        format!("variant {}", variant.label())
-    });
+    explain::step(
+        "Shaders: GLSL -> naga module -> SPIR-V (twinray-common)",
+        || format!("variant {}", variant.label()),
+    );
 
     let event_loop = interactive::event_loop()?;
     // winit 0.30 prefers windows made inside `resumed` (for Android's and the
@@ -78,10 +79,19 @@ pub fn run(args: &RenderArgs, started: Instant) -> Result<(WindowedRun, DeviceIn
     let render_pass = RenderPass::for_swapchain(&device, format.format)?;
     let size = window.inner_size();
     let gpu = GpuScene::new(&scene, size.width.max(1), size.height.max(1));
-    let scene_resources = SceneResources::new(&device, &gpu, &shaders, render_pass.render_pass, None)?;
+    let scene_resources =
+        SceneResources::new(&device, &gpu, &shaders, render_pass.render_pass, None)?;
     let size = (size.width, size.height);
-    let chain =
-        Swapchain::new(&device, &surface, &loader, render_pass.render_pass, format, present_mode, size, None)?;
+    let chain = Swapchain::new(
+        &device,
+        &surface,
+        &loader,
+        render_pass.render_pass,
+        format,
+        present_mode,
+        size,
+        None,
+    )?;
     let frames = Frames::new(&device)?;
     let info = DeviceInfo {
         name: device.name.clone(),
@@ -107,7 +117,15 @@ pub fn run(args: &RenderArgs, started: Instant) -> Result<(WindowedRun, DeviceIn
     explain::step("Frame loop starts", || {
         "per frame: wait fence, acquire image, re-record, submit (wait image-available, signal render-finished), present".into()
     });
-    let run = interactive::run("twinray-vk", event_loop, renderer, args, scene, variant, started)?;
+    let run = interactive::run(
+        "twinray-vk",
+        event_loop,
+        renderer,
+        args,
+        scene,
+        variant,
+        started,
+    )?;
     Ok((run, info))
 }
 
@@ -122,7 +140,8 @@ impl VkWindow {
     /// Waits for the GPU, then replaces the swapchain (or drops it while minimized).
     fn rebuild_swapchain(&mut self) -> Result<()> {
         // SAFETY: nothing may be destroyed while a frame still uses it.
-        unsafe { self.device.device.device_wait_idle() }.context("waiting for the GPU before a resize")?;
+        unsafe { self.device.device.device_wait_idle() }
+            .context("waiting for the GPU before a resize")?;
         self.stale = false;
         let old = self.swapchain.take();
         if self.size.0 == 0 || self.size.1 == 0 {
@@ -160,9 +179,14 @@ impl Renderer for VkWindow {
         if self.stale {
             self.rebuild_swapchain()?;
         }
-        let Some(chain) = &self.swapchain else { return Ok(None) };
+        let Some(chain) = &self.swapchain else {
+            return Ok(None);
+        };
         let rp = self.render_pass.render_pass;
-        match self.frames.draw(&self.device, &self.loader, chain, rp, &self.scene, frame)? {
+        match self
+            .frames
+            .draw(&self.device, &self.loader, chain, rp, &self.scene, frame)?
+        {
             FrameResult::OutOfDate => {
                 self.stale = true;
                 Ok(None)
@@ -176,7 +200,8 @@ impl Renderer for VkWindow {
 
     fn load_scene(&mut self, scene: &GpuScene, shaders: &Shaders) -> Result<()> {
         // SAFETY: the old scene's buffers and pipeline may still be in use.
-        unsafe { self.device.device.device_wait_idle() }.context("waiting for the GPU before a scene switch")?;
+        unsafe { self.device.device.device_wait_idle() }
+            .context("waiting for the GPU before a scene switch")?;
         let rp = self.render_pass.render_pass;
         self.scene = SceneResources::new(&self.device, scene, shaders, rp, None)?;
         self.shaders = shaders.clone();
@@ -188,11 +213,14 @@ impl Renderer for VkWindow {
     /// is the current view.
     fn capture(&mut self, frame: &GpuFrame, width: u32, height: u32) -> Result<FloatImage> {
         let device = &self.device;
-        unsafe { device.device.device_wait_idle() }.context("waiting for the GPU before a capture")?;
+        unsafe { device.device.device_wait_idle() }
+            .context("waiting for the GPU before a capture")?;
         device.check_size(width, height)?;
         let uniform = self.scene.frame.buffer;
         device.run_once("writing the frame uniform buffer", |cmd| unsafe {
-            device.device.cmd_update_buffer(cmd, uniform, 0, bytemuck::bytes_of(frame));
+            device
+                .device
+                .cmd_update_buffer(cmd, uniform, 0, bytemuck::bytes_of(frame));
             let barrier = vk::BufferMemoryBarrier::default()
                 .src_access_mask(vk::AccessFlags::TRANSFER_WRITE)
                 .dst_access_mask(vk::AccessFlags::UNIFORM_READ)
@@ -212,10 +240,22 @@ impl Renderer for VkWindow {
         })?;
         let render_pass = RenderPass::offscreen(device)?;
         let set_layout = self.scene.descriptors.set_layout;
-        let pipeline = Pipeline::new(device, set_layout, &self.shaders, render_pass.render_pass, Some((width, height)))?;
+        let pipeline = Pipeline::new(
+            device,
+            set_layout,
+            &self.shaders,
+            render_pass.render_pass,
+            Some((width, height)),
+        )?;
         let target = Target::new(device, render_pass.render_pass, width, height)?;
-        let commands =
-            Commands::record(device, render_pass.render_pass, &pipeline, &self.scene.descriptors, &target, None)?;
+        let commands = Commands::record(
+            device,
+            render_pass.render_pass,
+            &pipeline,
+            &self.scene.descriptors,
+            &target,
+            None,
+        )?;
         commands.submit()?;
         commands.wait(false)?;
         target.read_back(device)
