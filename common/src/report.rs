@@ -44,7 +44,59 @@ pub struct RunReport {
     pub validation_messages: u64,
 }
 
+/// What an app says about its device.
+#[derive(Debug, Clone)]
+pub struct DeviceInfo {
+    pub device: String,
+    pub driver: String,
+    pub api_version: String,
+}
+
 impl RunReport {
+    /// A fragment-path report with its summaries filled from `frames`; callers
+    /// override the fields that differ (`path`, NaN count, validation count).
+    #[allow(clippy::too_many_arguments)]
+    pub fn new(
+        api: &str,
+        info: DeviceInfo,
+        scene: SceneStats,
+        variant: String,
+        width: u32,
+        height: u32,
+        frames: Vec<FrameTime>,
+        setup_ms: f64,
+    ) -> RunReport {
+        let mut report = RunReport {
+            api: api.to_string(),
+            device: info.device,
+            driver: info.driver,
+            api_version: info.api_version,
+            os: os_description(),
+            scene,
+            variant,
+            width,
+            height,
+            path: Default::default(),
+            workgroup: None,
+            frames,
+            gpu_ms: None,
+            wall_ms: None,
+            nonfinite_pixels: 0,
+            setup_ms,
+            validation_messages: 0,
+        };
+        report.summarise();
+        report
+    }
+
+    /// The one JSON line on stdout that `--json` promises.
+    pub fn print_json(&self) -> anyhow::Result<()> {
+        let line = serde_json::to_string(self)
+            .map_err(|e| anyhow::anyhow!("serialising the JSON report: {e}"))?;
+        println!("{line}");
+        Ok(())
+    }
+
     /// Fills the summaries from `frames`.
     pub fn summarise(&mut self) {
         let wall: Vec<f64> = self.frames.iter().map(|f| f.wall_ms).collect();

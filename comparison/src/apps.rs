@@ -7,7 +7,7 @@ use std::process::Command;
 use std::time::Instant;
 use twinray_common::cli::RenderArgs;
 use twinray_common::error::{bad_input, Failure, FailureKind};
-use twinray_common::report::{FrameTime, RunReport};
+use twinray_common::report::{DeviceInfo, FrameTime, RunReport};
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
 pub enum Api {
@@ -160,30 +160,30 @@ pub fn render_reference(args: &RenderArgs) -> anyhow::Result<()> {
         img.save_png(out)?;
     }
     if args.json {
-        let mut report = RunReport {
-            api: "reference".into(),
+        let info = DeviceInfo {
             device: format!("CPU, {} threads", rayon_threads()),
             driver: "twinray f64 reference".into(),
             api_version: String::new(),
-            os: twinray_common::report::os_description(),
-            scene: scene.stats(),
-            variant: "f64".into(),
-            width: w,
-            height: h,
-            path: Default::default(),
-            workgroup: None,
-            frames: vec![FrameTime {
-                gpu_ms: None,
-                wall_ms: ms,
-            }],
-            gpu_ms: None,
-            wall_ms: None,
-            nonfinite_pixels: img.nonfinite_pixels(),
-            setup_ms: (t - start).as_secs_f64() * 1e3,
-            validation_messages: 0,
         };
-        report.summarise();
-        println!("{}", serde_json::to_string(&report)?);
+        let frames = vec![FrameTime {
+            gpu_ms: None,
+            wall_ms: ms,
+        }];
+        let setup_ms = (t - start).as_secs_f64() * 1e3;
+        let report = RunReport {
+            nonfinite_pixels: img.nonfinite_pixels(),
+            ..RunReport::new(
+                "reference",
+                info,
+                scene.stats(),
+                "f64".into(),
+                w,
+                h,
+                frames,
+                setup_ms,
+            )
+        };
+        report.print_json()?;
     } else if args.out.is_none() {
         return Err(bad_input(
             "render --api reference needs --out FILE.png or --json",

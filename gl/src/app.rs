@@ -9,7 +9,7 @@ use crate::debug::DebugLog;
 use crate::program::{EmptyVertexArray, Program};
 use crate::target::{self, Target};
 use crate::timer::Timer;
-use anyhow::{anyhow, Context as _};
+use anyhow::anyhow;
 use glow::HasContext;
 use std::time::Instant;
 use twinray_common::cli::{RenderArgs, RenderPath};
@@ -17,7 +17,7 @@ use twinray_common::error::bad_input;
 use twinray_common::explain;
 use twinray_common::gpu::{check_storage_limit, GpuScene};
 use twinray_common::image_io::FloatImage;
-use twinray_common::report::{os_description, FrameTime, RunReport};
+use twinray_common::report::{DeviceInfo, FrameTime, RunReport};
 use twinray_common::shader::{self, Variant};
 
 /// `started` is taken first thing in main, so `setup_ms` includes process,
@@ -137,34 +137,33 @@ pub fn run(args: RenderArgs, started: Instant) -> anyhow::Result<()> {
     }
     let errors = log.errors();
     if args.json {
-        let mut report = RunReport {
-            api: "opengl".into(),
+        let info = DeviceInfo {
             device: renderer,
             driver: format!("{vendor} {version}"),
             api_version: format!("OpenGL {version}"),
-            os: os_description(),
-            scene: scene.stats(),
-            variant: if args.gl_spirv {
-                format!("{} (SPIR-V)", variant.label())
-            } else {
-                variant.label()
-            },
-            width,
-            height,
+        };
+        let label = if args.gl_spirv {
+            format!("{} (SPIR-V)", variant.label())
+        } else {
+            variant.label()
+        };
+        let report = RunReport {
             path: args.path,
             workgroup: (args.path == RenderPath::Compute).then(|| workgroup.to_string()),
-            frames,
-            gpu_ms: None,
-            wall_ms: None,
             nonfinite_pixels: image.nonfinite_pixels(),
-            setup_ms,
             validation_messages: errors,
+            ..RunReport::new(
+                "opengl",
+                info,
+                scene.stats(),
+                label,
+                width,
+                height,
+                frames,
+                setup_ms,
+            )
         };
-        report.summarise();
-        println!(
-            "{}",
-            serde_json::to_string(&report).context("serialising the JSON report")?
-        );
+        report.print_json()?;
     }
     if args.validate && errors > 0 {
         return Err(anyhow!("{errors} GL debug errors (see above)"));
@@ -177,30 +176,25 @@ pub fn run(args: RenderArgs, started: Instant) -> anyhow::Result<()> {
 fn run_windowed(args: &RenderArgs, started: Instant) -> anyhow::Result<()> {
     let (run, info, errors) = crate::window::run(args, started)?;
     if args.json {
-        let mut report = RunReport {
-            api: "opengl".into(),
+        let device = DeviceInfo {
             device: info.renderer,
             driver: format!("{} {}", info.vendor, info.version),
             api_version: format!("OpenGL {}", info.version),
-            os: os_description(),
-            scene: run.scene.stats(),
-            variant: run.variant.label(),
-            width: run.width,
-            height: run.height,
-            path: RenderPath::Fragment,
-            workgroup: None,
-            frames: run.frames,
-            gpu_ms: None,
-            wall_ms: None,
-            nonfinite_pixels: 0,
-            setup_ms: run.setup_ms,
-            validation_messages: errors,
         };
-        report.summarise();
-        println!(
-            "{}",
-            serde_json::to_string(&report).context("serialising the JSON report")?
-        );
+        let report = RunReport {
+            validation_messages: errors,
+            ..RunReport::new(
+                "opengl",
+                device,
+                run.scene.stats(),
+                run.variant.label(),
+                run.width,
+                run.height,
+                run.frames,
+                run.setup_ms,
+            )
+        };
+        report.print_json()?;
     }
     if args.validate && errors > 0 {
         return Err(anyhow!("{errors} GL debug errors (see above)"));

@@ -7,10 +7,10 @@
 //! them before anything else touches the texture, the next dispatch's stores
 //! (SHADER_IMAGE_ACCESS) and the readback (TEXTURE_UPDATE, for glGetTexImage).
 
-use anyhow::{anyhow, Context as _};
+use anyhow::anyhow;
 use glow::HasContext;
 use twinray_common::cli::Workgroup;
-use twinray_common::error::{bad_input, no_device};
+use twinray_common::error::bad_input;
 use twinray_common::gpu::binding;
 use twinray_common::shader::{spirv_for_opengl, ComputeShader};
 
@@ -39,9 +39,18 @@ impl<'gl> Compute<'gl> {
         let program = match spirv_proc {
             Some(proc_address) => link(
                 gl,
-                spirv_shader(gl, proc_address, &spirv_for_opengl(&shader.spirv))?,
+                crate::program::compile_spirv(
+                    gl,
+                    proc_address,
+                    glow::COMPUTE_SHADER,
+                    &spirv_for_opengl(&shader.spirv),
+                    "compute",
+                )?,
             )?,
-            None => link(gl, glsl_shader(gl, &shader.glsl)?)?,
+            // SAFETY: the context is current (the caller made it so).
+            None => link(gl, unsafe {
+                crate::program::compile(gl, glow::COMPUTE_SHADER, &shader.glsl, "compute")
+            }?)?,
         };
         // SAFETY: a fresh texture on the current context; sizes were checked.
         let texture = match unsafe { gl.create_texture() } {
@@ -175,80 +184,6 @@ fn check_limits(
         )));
     }
     Ok(groups)
-}
-
-fn glsl_shader(gl: &glow::Context, source: &str) -> anyhow::Result<glow::Shader> {
-    // SAFETY: a fresh shader on the current context.
-    unsafe {
-        let s = gl
-            .create_shader(glow::COMPUTE_SHADER)
-            .map_err(|e| anyhow!(e))
-            .context("glCreateShader(compute)")?;
-        gl.shader_source(s, source);
-        gl.compile_shader(s);
-        if !gl.get_shader_compile_status(s) {
-            let log = gl.get_shader_info_log(s);
-            gl.delete_shader(s);
-            return Err(anyhow!("the driver rejected naga's compute GLSL:\n{log}"));
-        }
-        Ok(s)
-    }
-}
-
-/// naga's compute SPIR-V through GL_ARB_gl_spirv. glow wraps neither entry point.
-fn spirv_shader(
-    gl: &glow::Context,
-    proc_address: &dyn Fn(&std::ffi::CStr) -> *const std::ffi::c_void,
-    words: &[u32],
-) -> anyhow::Result<glow::Shader> {
-    if !gl.supported_extensions().contains("GL_ARB_gl_spirv") {
-        return Err(no_device(
-            "--gl-spirv: this OpenGL driver does not support GL_ARB_gl_spirv",
-        ));
-    }
-    type ShaderBinary =
-        unsafe extern "system" fn(i32, *const u32, u32, *const std::ffi::c_void, i32);
-    type SpecializeShader =
-        unsafe extern "system" fn(u32, *const std::ffi::c_char, u32, *const u32, *const u32);
-    let get = |name: &std::ffi::CStr| {
-        let p = proc_address(name);
-        if p.is_null() {
-            Err(anyhow!(
-                "the OpenGL driver has no {}",
-                name.to_string_lossy()
-            ))
-        } else {
-            Ok(p)
-        }
-    };
-    // SAFETY: each pointer is the driver's entry point of that name, with the
-    // GL 4.6 core signature the type spells out; the words outlive the calls.
-    unsafe {
-        let shader_binary =
-            std::mem::transmute::<*const std::ffi::c_void, ShaderBinary>(get(c"glShaderBinary")?);
-        let specialize = std::mem::transmute::<*const std::ffi::c_void, SpecializeShader>(get(
-            c"glSpecializeShader",
-        )?);
-        let s = gl
-            .create_shader(glow::COMPUTE_SHADER)
-            .map_err(|e| anyhow!(e))
-            .context("glCreateShader(compute)")?;
-        let id = s.0.get();
-        shader_binary(
-            1,
-            &id,
-            glow::SHADER_BINARY_FORMAT_SPIR_V,
-            words.as_ptr().cast(),
-            (words.len() * 4) as i32,
-        );
-        specialize(id, c"main".as_ptr(), 0, std::ptr::null(), std::ptr::null());
-        if !gl.get_shader_compile_status(s) {
-            let log = gl.get_shader_info_log(s);
-            gl.delete_shader(s);
-            return Err(anyhow!("the driver rejected naga's compute SPIR-V:\n{log}"));
-        }
-        Ok(s)
-    }
 }
 
 /// Links one compiled compute shader into a program; the shader goes either way.

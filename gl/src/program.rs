@@ -24,9 +24,6 @@ struct SeparablePipeline {
 /// GL 4.1/4.6 entry points glow does not wrap.
 #[derive(Clone, Copy)]
 struct PipelineFns {
-    shader_binary: unsafe extern "system" fn(i32, *const u32, u32, *const std::ffi::c_void, i32),
-    specialize_shader:
-        unsafe extern "system" fn(u32, *const std::ffi::c_char, u32, *const u32, *const u32),
     program_parameteri: unsafe extern "system" fn(u32, u32, i32),
     gen_program_pipelines: unsafe extern "system" fn(i32, *mut u32),
     delete_program_pipelines: unsafe extern "system" fn(i32, *const u32),
@@ -38,27 +35,11 @@ impl PipelineFns {
     fn load(
         proc_address: &dyn Fn(&std::ffi::CStr) -> *const std::ffi::c_void,
     ) -> anyhow::Result<PipelineFns> {
-        let get = |name: &std::ffi::CStr| {
-            let p = proc_address(name);
-            if p.is_null() {
-                Err(anyhow!(
-                    "the OpenGL driver has no {}",
-                    name.to_string_lossy()
-                ))
-            } else {
-                Ok(p)
-            }
-        };
+        let get = |name: &std::ffi::CStr| entry_point(proc_address, name);
         // SAFETY: each pointer is the driver's entry point of that name, whose C
         // signature (GL 4.6 core) the field types spell out.
         unsafe {
             Ok(PipelineFns {
-                shader_binary: std::mem::transmute::<*const std::ffi::c_void, _>(get(
-                    c"glShaderBinary",
-                )?),
-                specialize_shader: std::mem::transmute::<*const std::ffi::c_void, _>(get(
-                    c"glSpecializeShader",
-                )?),
                 program_parameteri: std::mem::transmute::<*const std::ffi::c_void, _>(get(
                     c"glProgramParameteri",
                 )?),
@@ -76,6 +57,71 @@ impl PipelineFns {
                 )?),
             })
         }
+    }
+}
+
+/// A GL entry point glow does not wrap, or a clear error naming it.
+fn entry_point(
+    proc_address: &dyn Fn(&std::ffi::CStr) -> *const std::ffi::c_void,
+    name: &std::ffi::CStr,
+) -> anyhow::Result<*const std::ffi::c_void> {
+    let p = proc_address(name);
+    if p.is_null() {
+        Err(anyhow!(
+            "the OpenGL driver has no {}",
+            name.to_string_lossy()
+        ))
+    } else {
+        Ok(p)
+    }
+}
+
+/// Compiles one stage from naga's SPIR-V (adapted by `shader::spirv_for_opengl`)
+/// through GL_ARB_gl_spirv; shared by the fragment and compute paths.
+pub(crate) fn compile_spirv(
+    gl: &glow::Context,
+    proc_address: &dyn Fn(&std::ffi::CStr) -> *const std::ffi::c_void,
+    stage: u32,
+    words: &[u32],
+    name: &str,
+) -> anyhow::Result<glow::Shader> {
+    type ShaderBinary =
+        unsafe extern "system" fn(i32, *const u32, u32, *const std::ffi::c_void, i32);
+    type SpecializeShader =
+        unsafe extern "system" fn(u32, *const std::ffi::c_char, u32, *const u32, *const u32);
+    if !gl.supported_extensions().contains("GL_ARB_gl_spirv") {
+        return Err(twinray_common::error::no_device(
+            "--gl-spirv: this OpenGL driver does not support GL_ARB_gl_spirv",
+        ));
+    }
+    let binary = entry_point(proc_address, c"glShaderBinary")?;
+    let specialize = entry_point(proc_address, c"glSpecializeShader")?;
+    // SAFETY: both pointers are the driver's entry points with the GL 4.6 core
+    // signatures the types spell out; the words outlive the calls; the shader
+    // belongs to the current context.
+    unsafe {
+        let binary = std::mem::transmute::<*const std::ffi::c_void, ShaderBinary>(binary);
+        let specialize =
+            std::mem::transmute::<*const std::ffi::c_void, SpecializeShader>(specialize);
+        let s = gl
+            .create_shader(stage)
+            .map_err(|e| anyhow!(e))
+            .with_context(|| format!("glCreateShader({name})"))?;
+        let id = s.0.get();
+        binary(
+            1,
+            &id,
+            glow::SHADER_BINARY_FORMAT_SPIR_V,
+            words.as_ptr().cast(),
+            (words.len() * 4) as i32,
+        );
+        specialize(id, c"main".as_ptr(), 0, std::ptr::null(), std::ptr::null());
+        if !gl.get_shader_compile_status(s) {
+            let log = gl.get_shader_info_log(s);
+            gl.delete_shader(s);
+            return Err(anyhow!("the driver rejected naga's {name} SPIR-V:\n{log}"));
+        }
+        Ok(s)
     }
 }
 
@@ -172,11 +218,6 @@ impl<'gl> Program<'gl> {
         vertex_glsl: &str,
         fragment: &[u32],
     ) -> anyhow::Result<Program<'gl>> {
-        if !gl.supported_extensions().contains("GL_ARB_gl_spirv") {
-            return Err(twinray_common::error::no_device(
-                "--gl-spirv: this OpenGL driver does not support GL_ARB_gl_spirv",
-            ));
-        }
         let fns = PipelineFns::load(proc_address)?;
         // Separable programs must redeclare the built-in output block they write.
         let vertex_glsl =
@@ -205,26 +246,13 @@ impl<'gl> Program<'gl> {
                 vertex,
             });
 
-            let fs = gl
-                .create_shader(glow::FRAGMENT_SHADER)
-                .map_err(|e| anyhow!(e))
-                .context("glCreateShader")?;
-            let id = fs.0.get();
-            (fns.shader_binary)(
-                1,
-                &id,
-                glow::SHADER_BINARY_FORMAT_SPIR_V,
-                fragment.as_ptr().cast(),
-                (fragment.len() * 4) as i32,
-            );
-            (fns.specialize_shader)(id, c"main".as_ptr(), 0, std::ptr::null(), std::ptr::null());
-            if !gl.get_shader_compile_status(fs) {
-                let log = gl.get_shader_info_log(fs);
-                gl.delete_shader(fs);
-                return Err(anyhow!(
-                    "the driver rejected naga's fragment SPIR-V:\n{log}"
-                ));
-            }
+            let fs = compile_spirv(
+                gl,
+                proc_address,
+                glow::FRAGMENT_SHADER,
+                fragment,
+                "fragment",
+            )?;
             link_separable(gl, &fns, raw, fs, "SPIR-V fragment")?;
             let vs = compile(gl, glow::VERTEX_SHADER, &vertex_glsl, "vertex")?;
             link_separable(gl, &fns, vertex, vs, "GLSL vertex")?;
@@ -252,7 +280,7 @@ impl<'gl> Program<'gl> {
 
 /// # Safety
 /// Needs a current context.
-unsafe fn compile(
+pub(crate) unsafe fn compile(
     gl: &glow::Context,
     stage: u32,
     source: &str,

@@ -24,7 +24,7 @@ use twinray_common::error::bad_input;
 use twinray_common::explain;
 use twinray_common::gpu::GpuScene;
 use twinray_common::image_io::FloatImage;
-use twinray_common::report::{os_description, FrameTime, RunReport};
+use twinray_common::report::{DeviceInfo, FrameTime, RunReport};
 use twinray_common::scene::Scene;
 use twinray_common::shader::{self, Variant};
 
@@ -59,7 +59,7 @@ pub fn run(args: RenderArgs, process_start: Instant) -> Result<()> {
         image.save_png(path)?;
     }
     if args.json {
-        println!("{}", serde_json::to_string(&report)?);
+        report.print_json()?;
     }
     if args.validate && report.validation_messages > 0 {
         bail!(
@@ -77,27 +77,25 @@ fn run_windowed(args: &RenderArgs, process_start: Instant) -> Result<()> {
     // Every Vulkan object is gone by now, so teardown mistakes count too.
     let messages = VALIDATION_MESSAGES.load(Ordering::SeqCst);
     if args.json {
-        let mut report = RunReport {
-            api: "vulkan".into(),
+        let info = DeviceInfo {
             device: device.name,
             driver: device.driver,
             api_version: device.api_version,
-            os: os_description(),
-            scene: run.scene.stats(),
-            variant: run.variant.label(),
-            width: run.width,
-            height: run.height,
-            path: RenderPath::Fragment,
-            workgroup: None,
-            frames: run.frames,
-            gpu_ms: None,
-            wall_ms: None,
-            nonfinite_pixels: 0,
-            setup_ms: run.setup_ms,
-            validation_messages: messages,
         };
-        report.summarise();
-        println!("{}", serde_json::to_string(&report)?);
+        let report = RunReport {
+            validation_messages: messages,
+            ..RunReport::new(
+                "vulkan",
+                info,
+                run.scene.stats(),
+                run.variant.label(),
+                run.width,
+                run.height,
+                run.frames,
+                run.setup_ms,
+            )
+        };
+        report.print_json()?;
     }
     if args.validate && messages > 0 {
         bail!("{messages} validation messages (see above)");
@@ -188,35 +186,36 @@ fn render(
             (frames, setup_ms, compute.read_back(&device)?)
         }
     };
-    let mut report = RunReport {
-        api: "vulkan".into(),
+    let info = DeviceInfo {
         device: device.name.clone(),
         driver: device.driver.clone(),
         api_version: device.api_version(),
-        os: os_description(),
-        scene: scene.stats(),
-        variant: format!(
-            "{}{}{}",
-            variant.label(),
-            if host_memory {
-                " (host-visible buffers)"
-            } else {
-                ""
-            },
-            if idle_wait { " (idle wait)" } else { "" }
-        ),
-        width,
-        height,
+    };
+    let variant_label = format!(
+        "{}{}{}",
+        variant.label(),
+        if host_memory {
+            " (host-visible buffers)"
+        } else {
+            ""
+        },
+        if idle_wait { " (idle wait)" } else { "" }
+    );
+    let report = RunReport {
         path: args.path,
         workgroup: (args.path == RenderPath::Compute).then(|| workgroup.to_string()),
-        frames,
-        gpu_ms: None,
-        wall_ms: None,
         nonfinite_pixels: image.nonfinite_pixels(),
-        setup_ms,
-        validation_messages: 0,
+        ..RunReport::new(
+            "vulkan",
+            info,
+            scene.stats(),
+            variant_label,
+            width,
+            height,
+            frames,
+            setup_ms,
+        )
     };
-    report.summarise();
     Ok((report, image))
     // Every Vulkan object is dropped here, newest first: commands, ..., device, instance.
 }

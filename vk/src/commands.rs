@@ -28,6 +28,8 @@ pub struct Commands {
 }
 
 impl Commands {
+    /// The fragment path's frame: timestamps around one render pass that draws
+    /// the fullscreen triangle.
     pub fn record(
         device: &Device,
         render_pass: vk::RenderPass,
@@ -35,6 +37,63 @@ impl Commands {
         descriptors: &Descriptors,
         target: &Target,
         timestamps: Option<&Timestamps>,
+    ) -> Result<Commands> {
+        let this = Commands::record_with(device, |d, cmd| {
+            if let Some(t) = timestamps {
+                t.record_reset(cmd);
+                t.record(cmd, 0);
+            }
+            let begin = vk::RenderPassBeginInfo::default()
+                .render_pass(render_pass)
+                .framebuffer(target.framebuffer)
+                .render_area(vk::Rect2D {
+                    offset: vk::Offset2D::default(),
+                    extent: vk::Extent2D {
+                        width: target.width,
+                        height: target.height,
+                    },
+                });
+            // SAFETY: every handle is alive and `cmd` is recording.
+            unsafe {
+                d.cmd_begin_render_pass(cmd, &begin, vk::SubpassContents::INLINE);
+                d.cmd_bind_pipeline(cmd, vk::PipelineBindPoint::GRAPHICS, pipeline.pipeline);
+                d.cmd_bind_descriptor_sets(
+                    cmd,
+                    vk::PipelineBindPoint::GRAPHICS,
+                    pipeline.layout,
+                    0,
+                    &[descriptors.set],
+                    &[],
+                );
+                // Three vertices, no vertex buffer: the fullscreen triangle.
+                d.cmd_draw(cmd, 3, 1, 0, 0);
+                d.cmd_end_render_pass(cmd);
+            }
+            if let Some(t) = timestamps {
+                t.record(cmd, 1);
+            }
+        })?;
+        explain::step(
+            "Command buffer recorded once (resubmitted every frame)",
+            || {
+                let ts = if timestamps.is_some() {
+                    "reset queries, timestamp TOP_OF_PIPE, "
+                } else {
+                    ""
+                };
+                format!("{ts}begin render pass {}x{}, bind pipeline, bind descriptor set 0, draw 3 vertices, end pass{}",
+                target.width, target.height, if timestamps.is_some() { ", timestamp BOTTOM_OF_PIPE" } else { "" })
+            },
+        );
+        Ok(this)
+    }
+
+    /// The pool, the one command buffer and the fence, with the frame's
+    /// commands written by `record` (the draw above, or the compute path's
+    /// dispatch). No ONE_TIME_SUBMIT flag: the buffer is resubmitted every frame.
+    pub fn record_with(
+        device: &Device,
+        record: impl FnOnce(&ash::Device, vk::CommandBuffer),
     ) -> Result<Commands> {
         let d = &device.device;
         let mut this = Commands {
@@ -62,84 +121,6 @@ impl Commands {
                 device.queue_family
             )
         });
-
-        // No ONE_TIME_SUBMIT flag: the buffer is resubmitted every frame.
-        let cmd = this.cmd;
-        unsafe { d.begin_command_buffer(cmd, &vk::CommandBufferBeginInfo::default()) }
-            .context("recording the frame")?;
-        if let Some(t) = timestamps {
-            t.record_reset(cmd);
-            t.record(cmd, 0);
-        }
-        let begin = vk::RenderPassBeginInfo::default()
-            .render_pass(render_pass)
-            .framebuffer(target.framebuffer)
-            .render_area(vk::Rect2D {
-                offset: vk::Offset2D::default(),
-                extent: vk::Extent2D {
-                    width: target.width,
-                    height: target.height,
-                },
-            });
-        unsafe {
-            d.cmd_begin_render_pass(cmd, &begin, vk::SubpassContents::INLINE);
-            d.cmd_bind_pipeline(cmd, vk::PipelineBindPoint::GRAPHICS, pipeline.pipeline);
-            d.cmd_bind_descriptor_sets(
-                cmd,
-                vk::PipelineBindPoint::GRAPHICS,
-                pipeline.layout,
-                0,
-                &[descriptors.set],
-                &[],
-            );
-            // Three vertices, no vertex buffer: the fullscreen triangle.
-            d.cmd_draw(cmd, 3, 1, 0, 0);
-            d.cmd_end_render_pass(cmd);
-        }
-        if let Some(t) = timestamps {
-            t.record(cmd, 1);
-        }
-        unsafe { d.end_command_buffer(cmd) }.context("recording the frame")?;
-        explain::step(
-            "Command buffer recorded once (resubmitted every frame)",
-            || {
-                let ts = if timestamps.is_some() {
-                    "reset queries, timestamp TOP_OF_PIPE, "
-                } else {
-                    ""
-                };
-                format!("{ts}begin render pass {}x{}, bind pipeline, bind descriptor set 0, draw 3 vertices, end pass{}",
-                target.width, target.height, if timestamps.is_some() { ", timestamp BOTTOM_OF_PIPE" } else { "" })
-            },
-        );
-        Ok(this)
-    }
-
-    /// A frame whose commands `record` writes (the compute path's dispatch), with
-    /// the same pool, buffer and fence handling as `record`'s render pass.
-    pub fn record_with(
-        device: &Device,
-        record: impl FnOnce(&ash::Device, vk::CommandBuffer),
-    ) -> Result<Commands> {
-        let d = &device.device;
-        let mut this = Commands {
-            device: d.clone(),
-            queue: device.queue,
-            pool: vk::CommandPool::null(),
-            cmd: vk::CommandBuffer::null(),
-            fence: vk::Fence::null(),
-        };
-        let info = vk::CommandPoolCreateInfo::default().queue_family_index(device.queue_family);
-        this.pool =
-            unsafe { d.create_command_pool(&info, None) }.context("creating the command pool")?;
-        let info = vk::CommandBufferAllocateInfo::default()
-            .command_pool(this.pool)
-            .level(vk::CommandBufferLevel::PRIMARY)
-            .command_buffer_count(1);
-        this.cmd = unsafe { d.allocate_command_buffers(&info) }
-            .context("allocating the command buffer")?[0];
-        this.fence = unsafe { d.create_fence(&vk::FenceCreateInfo::default(), None) }
-            .context("creating the fence")?;
         unsafe { d.begin_command_buffer(this.cmd, &vk::CommandBufferBeginInfo::default()) }
             .context("recording the frame")?;
         record(d, this.cmd);

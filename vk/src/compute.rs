@@ -21,6 +21,7 @@ use crate::commands::Commands;
 use crate::descriptors::Descriptors;
 use crate::device::Device;
 use crate::memory::{self, Buffer};
+use crate::target::{read_image, record_copy_to_host};
 use crate::timestamps::Timestamps;
 use anyhow::{Context, Result};
 use ash::vk;
@@ -153,29 +154,9 @@ impl Compute {
                 vk::ImageLayout::GENERAL,
                 vk::ImageLayout::TRANSFER_SRC_OPTIMAL,
             );
-            let region = vk::BufferImageCopy::default()
-                .image_subresource(vk::ImageSubresourceLayers {
-                    aspect_mask: vk::ImageAspectFlags::COLOR,
-                    mip_level: 0,
-                    base_array_layer: 0,
-                    layer_count: 1,
-                })
-                .image_extent(vk::Extent3D {
-                    width: self.width,
-                    height: self.height,
-                    depth: 1,
-                });
-            let to_host = vk::BufferMemoryBarrier::default()
-                .src_access_mask(vk::AccessFlags::TRANSFER_WRITE)
-                .dst_access_mask(vk::AccessFlags::HOST_READ)
-                .src_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
-                .dst_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
-                .buffer(self.readback.buffer)
-                .size(vk::WHOLE_SIZE);
-            let d = &device.device;
             // SAFETY: handles alive, buffer recording; the image is in GENERAL.
             unsafe {
-                d.cmd_pipeline_barrier(
+                device.device.cmd_pipeline_barrier(
                     cmd,
                     vk::PipelineStageFlags::COMPUTE_SHADER,
                     vk::PipelineStageFlags::TRANSFER,
@@ -184,29 +165,17 @@ impl Compute {
                     &[],
                     &[after_dispatch],
                 );
-                d.cmd_copy_image_to_buffer(
-                    cmd,
-                    self.image.image,
-                    vk::ImageLayout::TRANSFER_SRC_OPTIMAL,
-                    self.readback.buffer,
-                    &[region],
-                );
-                d.cmd_pipeline_barrier(
-                    cmd,
-                    vk::PipelineStageFlags::TRANSFER,
-                    vk::PipelineStageFlags::HOST,
-                    vk::DependencyFlags::empty(),
-                    &[],
-                    &[to_host],
-                    &[],
-                );
             }
+            record_copy_to_host(
+                device,
+                cmd,
+                self.image.image,
+                &self.readback,
+                self.width,
+                self.height,
+            );
         })?;
-        let rgba: Vec<f32> = self
-            .readback
-            .read()
-            .context("reading the readback buffer")?;
-        Ok(FloatImage::from_rgba(self.width, self.height, &rgba))
+        read_image(&self.readback, self.width, self.height)
     }
 }
 

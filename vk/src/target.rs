@@ -131,53 +131,76 @@ impl Target {
     /// TRANSFER_SRC_OPTIMAL and its outgoing dependency orders the copy after the draw.
     pub fn read_back(&self, device: &Device) -> Result<FloatImage> {
         device.run_once("reading the image back", |cmd| {
-            let region = vk::BufferImageCopy::default()
-                .image_subresource(vk::ImageSubresourceLayers {
-                    aspect_mask: vk::ImageAspectFlags::COLOR,
-                    mip_level: 0,
-                    base_array_layer: 0,
-                    layer_count: 1,
-                })
-                .image_extent(vk::Extent3D {
-                    width: self.width,
-                    height: self.height,
-                    depth: 1,
-                });
-            // A queue or fence wait covers only the GPU's side: the copy's writes
-            // become visible to the CPU's reads only through a barrier to HOST.
-            let to_host = vk::BufferMemoryBarrier::default()
-                .src_access_mask(vk::AccessFlags::TRANSFER_WRITE)
-                .dst_access_mask(vk::AccessFlags::HOST_READ)
-                .src_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
-                .dst_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
-                .buffer(self.readback.buffer)
-                .size(vk::WHOLE_SIZE);
-            unsafe {
-                let d = &device.device;
-                d.cmd_copy_image_to_buffer(
-                    cmd,
-                    self.image,
-                    vk::ImageLayout::TRANSFER_SRC_OPTIMAL,
-                    self.readback.buffer,
-                    &[region],
-                );
-                d.cmd_pipeline_barrier(
-                    cmd,
-                    vk::PipelineStageFlags::TRANSFER,
-                    vk::PipelineStageFlags::HOST,
-                    vk::DependencyFlags::empty(),
-                    &[],
-                    &[to_host],
-                    &[],
-                );
-            }
+            record_copy_to_host(
+                device,
+                cmd,
+                self.image,
+                &self.readback,
+                self.width,
+                self.height,
+            );
         })?;
-        let rgba: Vec<f32> = self
-            .readback
-            .read()
-            .context("reading the readback buffer")?;
-        Ok(FloatImage::from_rgba(self.width, self.height, &rgba))
+        read_image(&self.readback, self.width, self.height)
     }
+}
+
+/// Records the copy of a `TRANSFER_SRC_OPTIMAL` RGBA32F image into `readback`,
+/// then the barrier that makes it visible to the CPU: a queue or fence wait
+/// covers only the GPU's side, the copy's writes reach the CPU's reads only
+/// through a barrier to HOST. Shared by the fragment and compute paths.
+pub fn record_copy_to_host(
+    device: &Device,
+    cmd: vk::CommandBuffer,
+    image: vk::Image,
+    readback: &Buffer,
+    width: u32,
+    height: u32,
+) {
+    let region = vk::BufferImageCopy::default()
+        .image_subresource(vk::ImageSubresourceLayers {
+            aspect_mask: vk::ImageAspectFlags::COLOR,
+            mip_level: 0,
+            base_array_layer: 0,
+            layer_count: 1,
+        })
+        .image_extent(vk::Extent3D {
+            width,
+            height,
+            depth: 1,
+        });
+    let to_host = vk::BufferMemoryBarrier::default()
+        .src_access_mask(vk::AccessFlags::TRANSFER_WRITE)
+        .dst_access_mask(vk::AccessFlags::HOST_READ)
+        .src_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
+        .dst_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
+        .buffer(readback.buffer)
+        .size(vk::WHOLE_SIZE);
+    // SAFETY: the handles are alive and `cmd` is recording.
+    unsafe {
+        let d = &device.device;
+        d.cmd_copy_image_to_buffer(
+            cmd,
+            image,
+            vk::ImageLayout::TRANSFER_SRC_OPTIMAL,
+            readback.buffer,
+            &[region],
+        );
+        d.cmd_pipeline_barrier(
+            cmd,
+            vk::PipelineStageFlags::TRANSFER,
+            vk::PipelineStageFlags::HOST,
+            vk::DependencyFlags::empty(),
+            &[],
+            &[to_host],
+            &[],
+        );
+    }
+}
+
+/// The readback buffer's RGBA32F rows as an image, top row first.
+pub fn read_image(readback: &Buffer, width: u32, height: u32) -> Result<FloatImage> {
+    let rgba: Vec<f32> = readback.read().context("reading the readback buffer")?;
+    Ok(FloatImage::from_rgba(width, height, &rgba))
 }
 
 impl Drop for Target {
