@@ -20,12 +20,11 @@
 use crate::commands::Commands;
 use crate::descriptors::Descriptors;
 use crate::device::Device;
-use crate::memory::{self, Buffer};
-use crate::target::{read_image, record_copy_to_host};
+use crate::memory::Buffer;
+use crate::target::{create_image_with_view, read_image, readback_buffer, record_copy_to_host};
 use crate::timestamps::Timestamps;
 use anyhow::{Context, Result};
 use ash::vk;
-use ash::vk::MemoryPropertyFlags as Flags;
 use twinray_common::cli::Workgroup;
 use twinray_common::error::bad_input;
 use twinray_common::image_io::FloatImage;
@@ -61,19 +60,7 @@ impl Compute {
         timestamps: Option<&Timestamps>,
     ) -> Result<Compute> {
         let groups = check_limits(device, shader.workgroup, width, height)?;
-        let bytes = width as u64 * height as u64 * 16;
-        // The CPU reads this one, and uncached reads of mapped memory are very slow.
-        let wishes = [
-            Flags::HOST_VISIBLE | Flags::HOST_CACHED,
-            Flags::HOST_VISIBLE,
-        ];
-        let readback = Buffer::new(
-            device,
-            bytes,
-            vk::BufferUsageFlags::TRANSFER_DST,
-            &wishes,
-            "readback buffer",
-        )?;
+        let readback = readback_buffer(device, width, height)?;
         let image = StorageImage::new(device, width, height)?;
         let descriptors = Descriptors::for_stage(
             device,
@@ -274,44 +261,14 @@ impl StorageImage {
             memory: vk::DeviceMemory::null(),
             view: vk::ImageView::null(),
         };
-        let info = vk::ImageCreateInfo::default()
-            .image_type(vk::ImageType::TYPE_2D)
-            .format(IMAGE_FORMAT)
-            .extent(vk::Extent3D {
-                width,
-                height,
-                depth: 1,
-            })
-            .mip_levels(1)
-            .array_layers(1)
-            .samples(vk::SampleCountFlags::TYPE_1)
-            .tiling(vk::ImageTiling::OPTIMAL)
-            .usage(vk::ImageUsageFlags::STORAGE | vk::ImageUsageFlags::TRANSFER_SRC)
-            .initial_layout(vk::ImageLayout::UNDEFINED);
-        this.image =
-            unsafe { d.create_image(&info, None) }.context("creating the storage image")?;
-        let needs = unsafe { d.get_image_memory_requirements(this.image) };
-        this.memory = memory::allocate(
+        create_image_with_view(
             device,
-            needs,
-            &[Flags::DEVICE_LOCAL, Flags::empty()],
+            IMAGE_FORMAT,
+            (width, height),
+            vk::ImageUsageFlags::STORAGE | vk::ImageUsageFlags::TRANSFER_SRC,
             "storage image",
-        )?
-        .0;
-        unsafe { d.bind_image_memory(this.image, this.memory, 0) }
-            .context("binding the storage image's memory")?;
-        let info = vk::ImageViewCreateInfo::default()
-            .image(this.image)
-            .view_type(vk::ImageViewType::TYPE_2D)
-            .format(IMAGE_FORMAT)
-            .subresource_range(
-                vk::ImageSubresourceRange::default()
-                    .aspect_mask(vk::ImageAspectFlags::COLOR)
-                    .level_count(1)
-                    .layer_count(1),
-            );
-        this.view = unsafe { d.create_image_view(&info, None) }
-            .context("creating the storage image view")?;
+            (&mut this.image, &mut this.memory, &mut this.view),
+        )?;
 
         // UNDEFINED → GENERAL once: the old contents (none) may be discarded.
         let to_general = this.barrier(

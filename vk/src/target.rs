@@ -37,20 +37,8 @@ impl Target {
         height: u32,
     ) -> Result<Target> {
         let d = &device.device;
-        // RGBA32F: 16 bytes a pixel, rows packed tightly in the readback buffer.
-        let bytes = width as u64 * height as u64 * 16;
-        // The CPU reads this one, and uncached reads of mapped memory are very slow.
-        let wishes = [
-            Flags::HOST_VISIBLE | Flags::HOST_CACHED,
-            Flags::HOST_VISIBLE,
-        ];
-        let readback = Buffer::new(
-            device,
-            bytes,
-            vk::BufferUsageFlags::TRANSFER_DST,
-            &wishes,
-            "readback buffer",
-        )?;
+        let readback = readback_buffer(device, width, height)?;
+        let bytes = readback.size;
         explain::step("VkBuffer + VkDeviceMemory: readback buffer", || {
             format!(
                 "{bytes} bytes, TRANSFER_DST, memory {:?} (the CPU reads it)",
@@ -67,47 +55,17 @@ impl Target {
             height,
             readback,
         };
-        let info = vk::ImageCreateInfo::default()
-            .image_type(vk::ImageType::TYPE_2D)
-            .format(COLOR_FORMAT)
-            .extent(vk::Extent3D {
-                width,
-                height,
-                depth: 1,
-            })
-            .mip_levels(1)
-            .array_layers(1)
-            .samples(vk::SampleCountFlags::TYPE_1)
-            .tiling(vk::ImageTiling::OPTIMAL)
-            .usage(vk::ImageUsageFlags::COLOR_ATTACHMENT | vk::ImageUsageFlags::TRANSFER_SRC)
-            .initial_layout(vk::ImageLayout::UNDEFINED);
-        this.image = unsafe { d.create_image(&info, None) }.context("creating the colour image")?;
-        let needs = unsafe { d.get_image_memory_requirements(this.image) };
-        this.memory = memory::allocate(
+        let image_bytes = create_image_with_view(
             device,
-            needs,
-            &[Flags::DEVICE_LOCAL, Flags::empty()],
+            COLOR_FORMAT,
+            (width, height),
+            vk::ImageUsageFlags::COLOR_ATTACHMENT | vk::ImageUsageFlags::TRANSFER_SRC,
             "colour image",
-        )?
-        .0;
-        unsafe { d.bind_image_memory(this.image, this.memory, 0) }
-            .context("binding the colour image's memory")?;
+            (&mut this.image, &mut this.memory, &mut this.view),
+        )?;
         explain::step("VkImage + VkDeviceMemory: colour target", || {
-            format!("{width}x{height} {COLOR_FORMAT:?}, OPTIMAL tiling, usage COLOR_ATTACHMENT|TRANSFER_SRC, {} bytes DEVICE_LOCAL", needs.size)
+            format!("{width}x{height} {COLOR_FORMAT:?}, OPTIMAL tiling, usage COLOR_ATTACHMENT|TRANSFER_SRC, {image_bytes} bytes DEVICE_LOCAL")
         });
-
-        let info = vk::ImageViewCreateInfo::default()
-            .image(this.image)
-            .view_type(vk::ImageViewType::TYPE_2D)
-            .format(COLOR_FORMAT)
-            .subresource_range(
-                vk::ImageSubresourceRange::default()
-                    .aspect_mask(vk::ImageAspectFlags::COLOR)
-                    .level_count(1)
-                    .layer_count(1),
-            );
-        this.view = unsafe { d.create_image_view(&info, None) }
-            .context("creating the colour image view")?;
         explain::step("VkImageView", || {
             "2D, COLOR aspect, 1 mip level, 1 layer".into()
         });
@@ -201,6 +159,71 @@ pub fn record_copy_to_host(
 pub fn read_image(readback: &Buffer, width: u32, height: u32) -> Result<FloatImage> {
     let rgba: Vec<f32> = readback.read().context("reading the readback buffer")?;
     Ok(FloatImage::from_rgba(width, height, &rgba))
+}
+
+/// A buffer the CPU reads an RGBA32F image back from: 16 bytes a pixel, rows
+/// packed tightly. Cached memory where there is some: uncached reads of mapped
+/// memory are very slow.
+pub fn readback_buffer(device: &Device, width: u32, height: u32) -> Result<Buffer> {
+    let bytes = width as u64 * height as u64 * 16;
+    let wishes = [
+        Flags::HOST_VISIBLE | Flags::HOST_CACHED,
+        Flags::HOST_VISIBLE,
+    ];
+    Buffer::new(
+        device,
+        bytes,
+        vk::BufferUsageFlags::TRANSFER_DST,
+        &wishes,
+        "readback buffer",
+    )
+}
+
+/// A device-local 2D image with one mip level and its colour view. Each handle
+/// goes into the owner's field as soon as it exists, so the owner's Drop frees
+/// a half-built one. Returns the image's size in bytes.
+pub fn create_image_with_view(
+    device: &Device,
+    format: vk::Format,
+    (width, height): (u32, u32),
+    usage: vk::ImageUsageFlags,
+    what: &str,
+    (image, memory, view): (&mut vk::Image, &mut vk::DeviceMemory, &mut vk::ImageView),
+) -> Result<u64> {
+    let d = &device.device;
+    let info = vk::ImageCreateInfo::default()
+        .image_type(vk::ImageType::TYPE_2D)
+        .format(format)
+        .extent(vk::Extent3D {
+            width,
+            height,
+            depth: 1,
+        })
+        .mip_levels(1)
+        .array_layers(1)
+        .samples(vk::SampleCountFlags::TYPE_1)
+        .tiling(vk::ImageTiling::OPTIMAL)
+        .usage(usage)
+        .initial_layout(vk::ImageLayout::UNDEFINED);
+    *image =
+        unsafe { d.create_image(&info, None) }.with_context(|| format!("creating the {what}"))?;
+    let needs = unsafe { d.get_image_memory_requirements(*image) };
+    *memory = memory::allocate(device, needs, &[Flags::DEVICE_LOCAL, Flags::empty()], what)?.0;
+    unsafe { d.bind_image_memory(*image, *memory, 0) }
+        .with_context(|| format!("binding the {what}'s memory"))?;
+    let info = vk::ImageViewCreateInfo::default()
+        .image(*image)
+        .view_type(vk::ImageViewType::TYPE_2D)
+        .format(format)
+        .subresource_range(
+            vk::ImageSubresourceRange::default()
+                .aspect_mask(vk::ImageAspectFlags::COLOR)
+                .level_count(1)
+                .layer_count(1),
+        );
+    *view = unsafe { d.create_image_view(&info, None) }
+        .with_context(|| format!("creating the {what} view"))?;
+    Ok(needs.size)
 }
 
 impl Drop for Target {
