@@ -6,7 +6,7 @@
 //
 // Features a scene lacks are compiled out through defines chosen in
 // common/src/shader.rs: HAS_SPHERES, HAS_TRIANGLES, HAS_MIRROR, HAS_GLASS,
-// and STACK_SIZE (the ray stack, >= max_depth + 1).
+// and STACK_SIZE (the ray stack: max_depth + 1, or 1 without mirror and glass).
 //
 // Numerical choices are defines too (common/src/numerics.rs), one of each:
 //   OFFSET_RAY | OFFSET_NORMAL | OFFSET_NORMAL_SCALED | OFFSET_ULP | OFFSET_SCALE_AWARE  (secondary-ray origin)
@@ -603,7 +603,17 @@ vec3 trace(vec3 origin, vec3 dir) {
             // A triangle test's error grows with its vertices' magnitude (a floor
             // quad reaching x = 8 seen from a glass sphere at |o| = 1 re-hit itself).
             scale = max(scale, max(max_abs(tri.p0), max(max_abs(tri.p1), max_abs(tri.p2))));
-            ng = normalize(cross(tri.p1 - tri.p0, tri.p2 - tri.p0));
+            vec3 e1 = tri.p1 - tri.p0;
+            vec3 e2 = tri.p2 - tri.p0;
+#if defined(OFFSET_SCALE_AWARE) || defined(OFFSET_ULP)
+            // These offsets assume p lies within a few ULPs of its coordinates
+            // off the plane. o + t d does not: its error grows with t and with
+            // how thin the triangle is (acne on the teapot's spout and handle).
+            // Rebuilt from the barycentrics, an error in u, v only slides p
+            // along the plane (Wachter & Binder, Ray Tracing Gems ch. 6).
+            p = tri.p0 + h.u * e1 + h.v * e2;
+#endif
+            ng = normalize(cross(e1, e2));
             ns = normalize((1.0 - h.u - h.v) * tri.n0 + h.u * tri.n1 + h.v * tri.n2);
             mat_index = tri.material;
         }

@@ -23,13 +23,16 @@ pub enum Offset {
     NormalScaled,
     /// Wächter & Binder (Ray Tracing Gems, ch. 6): 256 f32 ULPs per unit of
     /// normal, component by component, in integer space; a fixed 1/65536 near
-    /// the origin (|p_i| < 1/32). Ignores `epsilon`.
+    /// the origin (|p_i| < 1/32). On triangles it starts from the hit point
+    /// rebuilt from the barycentrics, as the chapter does. Ignores `epsilon`.
     Ulp,
     /// Along the normal, `2^-22 * max(|o|, |p|, |vertices|)` for triangles and
     /// `2^-20 * max(|o|, |p|)` for spheres (max norms, o the ray origin): a few
     /// f32 ULPs of the largest coordinate the hit was computed from (more for
     /// spheres, whose test squares its inputs), with no absolute floor, so it follows the scene's scale both ways
-    /// (far and tiny). Ignores `epsilon`.
+    /// (far and tiny). On triangles it starts from the hit point rebuilt from
+    /// the barycentrics, whose error is a few ULPs of the vertices' coordinates
+    /// wherever the ray came from. Ignores `epsilon`.
     ScaleAware,
 }
 

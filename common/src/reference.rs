@@ -300,7 +300,7 @@ pub fn trace(scene: &Scene, origin: DVec3, dir: DVec3) -> DVec3 {
             color += w * scene.background;
             continue;
         };
-        let p = o + t * d;
+        let mut p = o + t * d;
         let max_abs = |v: DVec3| v.abs().max_element();
         let (mut ng, mut ns, mat, scale) = match hit {
             Hit::Sphere(i) => {
@@ -310,7 +310,12 @@ pub fn trace(scene: &Scene, origin: DVec3, dir: DVec3) -> DVec3 {
             }
             Hit::Triangle(i, u, v) => {
                 let tri = &scene.triangles[i];
-                let ng = (tri.p[1] - tri.p[0]).cross(tri.p[2] - tri.p[0]).normalize();
+                let (e1, e2) = (tri.p[1] - tri.p[0], tri.p[2] - tri.p[0]);
+                // The shader's barycentric hit point for the offsets that assume one.
+                if matches!(scene.numerics.offset, Offset::ScaleAware | Offset::Ulp) {
+                    p = tri.p[0] + u * e1 + v * e2;
+                }
+                let ng = e1.cross(e2).normalize();
                 let ns = ((1.0 - u - v) * tri.n[0] + u * tri.n[1] + v * tri.n[2]).normalize();
                 let prim = max_abs(tri.p[0])
                     .max(max_abs(tri.p[1]))

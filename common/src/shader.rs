@@ -48,7 +48,14 @@ impl Variant {
         flag(f.triangles, "HAS_TRIANGLES");
         flag(f.mirror, "HAS_MIRROR");
         flag(f.glass, "HAS_GLASS");
-        defines.insert("STACK_SIZE".into(), (max_depth.max(1) + 1).to_string());
+        // Without mirrors or glass no ray ever spawns another: the stack holds
+        // the primary ray alone, and every max depth compiles to one shader.
+        let stack = if f.mirror || f.glass {
+            max_depth.max(1) + 1
+        } else {
+            1
+        };
+        defines.insert("STACK_SIZE".into(), stack.to_string());
         for d in numerics.defines() {
             defines.insert(d.to_string(), "1".to_string());
         }

@@ -188,6 +188,12 @@ pub struct Row {
     /// Its numerics render every hard case within tolerance (or no hard cases ran).
     pub sound: bool,
     pub is_default: bool,
+    /// The shader this config compiles to on this scene (its defines). Rows
+    /// with the same program and scene are one point of the front: a max
+    /// depth that no mirror or glass can use changes nothing but the noise.
+    pub program: String,
+    /// More timings of the same config (the default runs again first and last).
+    pub repeats: Vec<f64>,
 }
 
 impl Row {
@@ -233,52 +239,112 @@ fn overrides(set: &[String]) -> Vec<(String, String)> {
         .collect()
 }
 
-/// Times within this factor count as equal: frame times on a shared machine
-/// scatter by a few percent from run to run.
-pub const TIME_TIE: f64 = 1.05;
+/// The smallest time tie: below 1% no measurement here is steadier.
+pub const TIME_TIE_FLOOR: f64 = 0.01;
+/// The time tie when fewer than three timings of the default exist.
+pub const TIME_TIE_FALLBACK: f64 = 0.05;
 /// RMSE within this factor (or 1e-6) counts as equal.
 pub const ERROR_TIE: f64 = 1.01;
 
 /// Whether (t2, e2) dominates (t, e): at least as fast and as accurate, and
-/// clearly better in one, with the tie margins above.
-pub fn dominates(t2: f64, e2: f64, t: f64, e: f64) -> bool {
-    let as_fast = t2 <= t * TIME_TIE;
+/// clearly better in one. Times within the relative `tie` and RMSE within
+/// ERROR_TIE count as equal.
+pub fn dominates(t2: f64, e2: f64, t: f64, e: f64, tie: f64) -> bool {
+    let as_fast = t2 <= t * (1.0 + tie);
     let as_good = e2 <= e * ERROR_TIE + 1e-6;
-    let faster = t2 * TIME_TIE < t;
+    let faster = t2 * (1.0 + tie) < t;
     let better = e2 * ERROR_TIE + 1e-6 < e;
     as_fast && as_good && (faster || better)
 }
 
+fn median(v: &mut [f64]) -> Option<f64> {
+    v.sort_by(f64::total_cmp);
+    let n = v.len();
+    (n > 0).then(|| 0.5 * (v[(n - 1) / 2] + v[n / 2]))
+}
+
+/// Every timing of the rows that run `program` on this scene and API.
+fn timings(rows: &[Row], scene: &str, api: Api, program: &str) -> Vec<f64> {
+    rows.iter()
+        .filter(|r| r.scene == scene && r.api == api && r.program == program)
+        .flat_map(|r| r.time().into_iter().chain(r.repeats.iter().copied()))
+        .collect()
+}
+
+/// One point of the front: the median of all timings of its program, and the
+/// largest RMSE among its rows (they render the same image).
+pub fn point(rows: &[Row], i: usize) -> Option<(f64, f64)> {
+    let r = &rows[i];
+    let t = median(&mut timings(rows, &r.scene, r.api, &r.program))?;
+    let e = rows
+        .iter()
+        .filter(|o| o.scene == r.scene && o.api == r.api && o.program == r.program)
+        .filter_map(|o| o.error().map(|e| e.rmse))
+        .fold(None, |m: Option<f64>, e| Some(m.map_or(e, |m| m.max(e))))?;
+    Some((t, e))
+}
+
+/// The time tie for one scene and API, and the timings it came from: the
+/// relative spread (max/min - 1) of the default program's timings, which
+/// measures how far the same work scatters from run to run on this machine.
+pub fn time_tie(rows: &[Row], scene: &str, api: Api) -> (f64, Vec<f64>) {
+    let Some(def) = rows
+        .iter()
+        .find(|r| r.scene == scene && r.api == api && r.is_default)
+    else {
+        return (TIME_TIE_FALLBACK, Vec::new());
+    };
+    let t = timings(rows, scene, api, &def.program);
+    if t.len() < 3 {
+        return (TIME_TIE_FALLBACK, t);
+    }
+    let (lo, hi) = t
+        .iter()
+        .fold((f64::MAX, f64::MIN), |(lo, hi), &x| (lo.min(x), hi.max(x)));
+    ((hi / lo - 1.0).max(TIME_TIE_FLOOR), t)
+}
+
+/// The rows that dominate row `i`: same scene and API, another program, sound.
+pub fn dominators(rows: &[Row], i: usize) -> Vec<usize> {
+    let r = &rows[i];
+    let Some((t, e)) = point(rows, i) else {
+        return Vec::new();
+    };
+    let (tie, _) = time_tie(rows, &r.scene, r.api);
+    (0..rows.len())
+        .filter(|&j| {
+            let o = &rows[j];
+            o.scene == r.scene && o.api == r.api && o.program != r.program && o.sound
+        })
+        .filter(|&j| matches!(point(rows, j), Some((t2, e2)) if dominates(t2, e2, t, e, tie)))
+        .collect()
+}
+
 /// Marks the rows on the Pareto front of (time, RMSE), per scene and API: no
-/// other row dominates them. A row whose numerics render a hard case wrong
+/// other point dominates theirs. A row whose numerics render a hard case wrong
 /// (`unsound`) is neither on the front nor allowed to dominate: being right on
 /// the hard cases is a constraint, not a cost to trade.
 fn mark_pareto(rows: &mut [Row], unsound: &[Numerics]) {
-    let snapshot: Vec<(String, Api, Option<f64>, Option<f64>)> = rows
-        .iter()
-        .map(|r| {
-            let ok = !unsound.contains(&r.config.numerics);
-            (
-                r.scene.clone(),
-                r.api,
-                r.time().filter(|_| ok),
-                r.error().map(|e| e.rmse).filter(|_| ok),
-            )
-        })
-        .collect();
-    for (i, row) in rows.iter_mut().enumerate() {
-        row.pareto = false;
+    for row in rows.iter_mut() {
         row.sound = !unsound.contains(&row.config.numerics);
-        let (Some(t), Some(e)) = (snapshot[i].2, snapshot[i].3) else {
-            continue;
-        };
-        row.pareto = !snapshot.iter().enumerate().any(|(j, o)| {
-            j != i
-                && o.0 == snapshot[i].0
-                && o.1 == snapshot[i].1
-                && matches!((o.2, o.3), (Some(t2), Some(e2)) if dominates(t2, e2, t, e))
-        });
     }
+    let front: Vec<bool> = (0..rows.len())
+        .map(|i| rows[i].sound && point(rows, i).is_some() && dominators(rows, i).is_empty())
+        .collect();
+    for (row, on) in rows.iter_mut().zip(front) {
+        row.pareto = on;
+    }
+}
+
+/// The shader a config compiles to on a scene, as its sorted defines.
+fn program_of(scene: &str, set: &[String]) -> anyhow::Result<String> {
+    let scene = Scene::load(scene, &overrides(set))?;
+    let v = twinray_common::shader::Variant::for_scene(&scene);
+    Ok(v.defines
+        .iter()
+        .map(|(k, v)| format!("{k}={v}"))
+        .collect::<Vec<_>>()
+        .join(" "))
 }
 
 /// One hard case under one strategy and API.
@@ -315,6 +381,13 @@ pub fn run(args: &AccuracyArgs) -> anyhow::Result<()> {
         let mut list = configs(&default);
         let mid = list.len() / 2;
         list.rotate_left(mid);
+        // The default also runs first and last: the spread of its timings is
+        // the time tie of the front (see `time_tie`).
+        let mut order: Vec<(usize, bool)> = (0..list.len()).map(|k| (k, false)).collect();
+        let def_k = list.iter().position(|c| *c == default).unwrap_or(0);
+        order.insert(0, (def_k, true));
+        order.push((def_k, true));
+        let mut repeats: Vec<(Api, f64)> = Vec::new();
         // One discarded run per API first: the first process to meet a shader
         // variant compiles it into Mesa's cache and warms the driver, and that
         // run would otherwise always be the default's.
@@ -329,17 +402,33 @@ pub fn run(args: &AccuracyArgs) -> anyhow::Result<()> {
             "twinray accuracy: {scene_name} at {size}: {} configurations x 2 APIs",
             list.len()
         );
-        for (k, c) in list.iter().enumerate() {
-            for api in if k % 2 == 0 {
+        for (slot, &(k, repeat)) in order.iter().enumerate() {
+            let c = &list[k];
+            for api in if slot % 2 == 0 {
                 [Api::Vulkan, Api::Opengl]
             } else {
                 [Api::Opengl, Api::Vulkan]
             } {
+                let mut s = set.clone();
+                s.extend(c.set_args());
+                if repeat {
+                    let png = args
+                        .out
+                        .join(format!("images/{scene_name}-{}-repeat.png", api_name(api)));
+                    match render_app(api, scene_name, size, s, frames, &png) {
+                        Ok((g, w, _, _)) => repeats.push((api, g.unwrap_or(w))),
+                        Err(e) => eprintln!(
+                            "  {scene_name} default (repeat) {}: FAILED: {e:#}",
+                            api_name(api)
+                        ),
+                    }
+                    let _ = std::fs::remove_file(&png);
+                    continue;
+                }
                 let png = args
                     .out
                     .join(format!("images/{scene_name}-{}-{k}.png", api_name(api)));
-                let mut s = set.clone();
-                s.extend(c.set_args());
+                let program = program_of(scene_name, &s)?;
                 let result = render_app(api, scene_name, size, s, frames, &png)
                     .and_then(|(g, w, nan, img)| Ok((g, w, error_of(&img, &truth)?, nan)))
                     .map_err(|e| format!("{e:#}"));
@@ -360,8 +449,20 @@ pub fn run(args: &AccuracyArgs) -> anyhow::Result<()> {
                     pareto: false,
                     sound: true,
                     is_default: *c == default,
+                    program,
+                    repeats: Vec::new(),
                 });
             }
+        }
+        for r in rows
+            .iter_mut()
+            .filter(|r| r.scene == scene_name && r.is_default)
+        {
+            r.repeats = repeats
+                .iter()
+                .filter(|(a, _)| *a == r.api)
+                .map(|(_, t)| *t)
+                .collect();
         }
     }
     mark_pareto(&mut rows, &[]);
@@ -520,12 +621,12 @@ fn opt(v: Option<f64>) -> String {
 
 pub fn csv(rows: &[Row]) -> String {
     let mut s = String::from(
-        "scene,width,height,api,max_depth,offset,triangle,sphere,sweeps,default,pareto,status,gpu_min_ms,wall_min_ms,rmse,max_abs,above_1,above_8,flip_mean,nonfinite_pixels\n",
+        "scene,width,height,api,max_depth,offset,triangle,sphere,sweeps,default,pareto,point_ms,repeat_ms,status,gpu_min_ms,wall_min_ms,rmse,max_abs,above_1,above_8,flip_mean,nonfinite_pixels\n",
     );
-    for r in rows {
+    for (i, r) in rows.iter().enumerate() {
         let n = &r.config.numerics;
         let head = format!(
-            "{},{},{},{},{},{},{},{},{},{},{}",
+            "{},{},{},{},{},{},{},{},{},{},{},{},{}",
             r.scene,
             r.size.width,
             r.size.height,
@@ -536,7 +637,13 @@ pub fn csv(rows: &[Row]) -> String {
             n.sphere.name(),
             r.sweeps.join("+"),
             r.is_default,
-            r.pareto
+            r.pareto,
+            opt(point(rows, i).map(|p| p.0)),
+            r.repeats
+                .iter()
+                .map(|t| t.to_string())
+                .collect::<Vec<_>>()
+                .join(";")
         );
         match &r.result {
             Ok((g, w, e, nan)) => {
@@ -628,9 +735,13 @@ fn markdown(
          the mean of NVIDIA's perceptual FLIP error (nv-flip 0.1.2, 67 pixels per degree). Time is the fastest frame's GPU \
          time where the driver has timers, else its wall time (submit + wait); the minimum, because other load on a \
          shared machine only adds time. Every sweep changes one knob from the default; ★ marks the Pareto front of \
-         (time, RMSE) per scene and API, ◆ the default; times within 5% and RMSE within 1% count as ties. Numerical \
-         choices that render any hard case (below) outside its tolerance are not candidates for the front: correctness \
-         on the hard cases is a constraint, not a cost to trade.\n"
+         (time, RMSE) per scene and API, ◆ the default. Configurations that compile to the same shader on a scene \
+         (a max depth that no mirror or glass can use) are one point, marked = when it is the default's, and a point's \
+         time is the median of its timings; the default runs three times (first, in the middle and last), and the \
+         spread of its timings (at least 1%) is the time tie: times closer than what the same work scatters from run \
+         to run count as equal, as do RMSE within 1%. Numerical choices that render any hard case (below) outside its \
+         tolerance are not candidates for the front: correctness on the hard cases is a constraint, not a cost to \
+         trade.\n"
     );
 
     // Summary: where the default stands.
@@ -641,36 +752,32 @@ fn markdown(
             .map(|r| r.scene.clone())
             .collect::<std::collections::BTreeSet<_>>()
         {
-            let these: Vec<&Row> = rows
-                .iter()
-                .filter(|r| r.scene == scene && r.api == api && r.result.is_ok())
+            let these: Vec<usize> = (0..rows.len())
+                .filter(|&i| rows[i].scene == scene && rows[i].api == api && rows[i].result.is_ok())
                 .collect();
-            let Some(def) = these.iter().find(|r| r.is_default) else {
+            let Some(def) = these.iter().copied().find(|&i| rows[i].is_default) else {
                 continue;
             };
-            let Some(cheap) = these.iter().min_by(|a, b| {
-                a.time()
-                    .unwrap_or(f64::MAX)
-                    .total_cmp(&b.time().unwrap_or(f64::MAX))
+            let Some(cheap) = these.iter().copied().min_by(|&a, &b| {
+                let t = |i| point(rows, i).map_or(f64::MAX, |p| p.0);
+                t(a).total_cmp(&t(b))
             }) else {
                 continue;
             };
-            let (dt, de) = (
-                def.time().unwrap_or(f64::NAN),
-                def.error().map(|e| e.rmse).unwrap_or(f64::NAN),
-            );
-            let (ct, ce) = (
-                cheap.time().unwrap_or(f64::NAN),
-                cheap.error().map(|e| e.rmse).unwrap_or(f64::NAN),
-            );
+            let (dt, de) = point(rows, def).unwrap_or((f64::NAN, f64::NAN));
+            let (ct, ce) = point(rows, cheap).unwrap_or((f64::NAN, f64::NAN));
+            let (tie, times) = time_tie(rows, &scene, api);
             let _ = writeln!(
                 s,
-                "- {scene}, {}: default {} ms, RMSE {:.5}{}; cheapest ({}) {} ms, RMSE {:.5}: the default costs {:.2}×.",
+                "- {scene}, {}: default {} ms (median of {}: {}; time tie ±{:.1}%), RMSE {:.5}{}; cheapest ({}) {} ms, RMSE {:.5}: the default costs {:.2}×.",
                 api_name(api),
                 f3(dt),
+                times.len(),
+                times.iter().map(|t| f3(*t)).collect::<Vec<_>>().join(", "),
+                100.0 * tie,
                 de,
-                if def.pareto { " (on the Pareto front)" } else { " (**not** on the Pareto front)" },
-                cheap.config.label(),
+                if rows[def].pareto { " (on the Pareto front)" } else { " (**not** on the Pareto front)" },
+                if rows[cheap].program == rows[def].program { "the default's own shader".to_string() } else { rows[cheap].config.label() },
                 f3(ct),
                 ce,
                 dt / ct
@@ -713,15 +820,14 @@ fn markdown(
         }
         let _ = writeln!(s);
     }
-    for r in rows.iter().filter(|r| r.is_default && r.result.is_ok()) {
-        let (Some(t), Some(e)) = (r.time(), r.error().map(|e| e.rmse)) else {
-            continue;
-        };
-        let by: Vec<String> = rows
-            .iter()
-            .filter(|o| o.scene == r.scene && o.api == r.api && !o.is_default && o.sound)
-            .filter(|o| matches!((o.time(), o.error().map(|e| e.rmse)), (Some(t2), Some(e2)) if dominates(t2, e2, t, e)))
-            .map(|o| o.config.label())
+    for (i, r) in rows
+        .iter()
+        .enumerate()
+        .filter(|(_, r)| r.is_default && r.result.is_ok())
+    {
+        let by: Vec<String> = dominators(rows, i)
+            .into_iter()
+            .map(|j| rows[j].config.label())
             .collect();
         let _ = writeln!(
             s,
@@ -739,8 +845,8 @@ fn markdown(
         s,
         "\nWhere a configuration with a *smaller max depth* dominates, the scene simply needs fewer bounces than it allows \
          (no mirror or glass in view beyond that depth): max depth is a per-scene setting, not part of the numerical \
-         default. Where a numerical choice dominates by a few percent of time at equal error, that is within run-to-run \
-         scatter on a shared software driver; the GPU report is the one to read for speed.\n"
+         default. On a shared software driver the time tie is wide and the timings scatter more than it says; the GPU \
+         report is the one to read for speed.\n"
     );
 
     for scene in rows
@@ -767,10 +873,20 @@ fn markdown(
         let _ = writeln!(s, "| sweep | max depth | offset | triangle | sphere | API | GPU ms (min) | wall ms (min) | RMSE | max abs | >1/255 | wrong | FLIP | NaN | |\n|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|");
         for r in these {
             let n = &r.config.numerics;
+            let same = !r.is_default
+                && rows.iter().any(|d| {
+                    d.is_default && d.scene == r.scene && d.api == r.api && d.program == r.program
+                });
             let mark = format!(
                 "{}{}",
                 if r.pareto { "★" } else { "" },
-                if r.is_default { "◆" } else { "" }
+                if r.is_default {
+                    "◆"
+                } else if same {
+                    "="
+                } else {
+                    ""
+                }
             );
             match &r.result {
                 Ok((g, w, e, nan)) => {
@@ -1034,10 +1150,76 @@ mod tests {
 
     #[test]
     fn ties_do_not_dominate() {
-        assert!(!dominates(10.2, 0.01, 10.0, 0.01), "2% slower, same error");
-        assert!(!dominates(9.8, 0.01, 10.0, 0.01), "2% faster is noise");
-        assert!(dominates(8.0, 0.01, 10.0, 0.01));
-        assert!(dominates(10.2, 0.005, 10.0, 0.01));
-        assert!(!dominates(8.0, 0.02, 10.0, 0.01));
+        let tie = 0.05;
+        assert!(
+            !dominates(10.2, 0.01, 10.0, 0.01, tie),
+            "2% slower, same error"
+        );
+        assert!(!dominates(9.8, 0.01, 10.0, 0.01, tie), "2% faster is noise");
+        assert!(dominates(8.0, 0.01, 10.0, 0.01, tie));
+        assert!(dominates(10.2, 0.005, 10.0, 0.01, tie));
+        assert!(!dominates(8.0, 0.02, 10.0, 0.01, tie));
+        // A tighter tie, measured on a steadier machine, separates 2%.
+        assert!(dominates(9.8, 0.01, 10.0, 0.01, 0.01));
+        assert!(!dominates(10.2, 0.005, 10.0, 0.01, 0.01));
+    }
+
+    fn row(
+        api: Api,
+        program: &str,
+        time: f64,
+        rmse: f64,
+        is_default: bool,
+        repeats: Vec<f64>,
+    ) -> Row {
+        Row {
+            scene: "s".into(),
+            size: Size {
+                width: 1,
+                height: 1,
+            },
+            config: Config {
+                max_depth: 1,
+                numerics: Numerics::default(),
+            },
+            sweeps: vec![],
+            api,
+            result: Ok((
+                Some(time),
+                time,
+                Error {
+                    rmse,
+                    max_abs: 0,
+                    above_1: 0.0,
+                    wrong: 0.0,
+                    flip: None,
+                },
+                0,
+            )),
+            pareto: false,
+            sound: true,
+            is_default,
+            program: program.into(),
+            repeats,
+        }
+    }
+
+    #[test]
+    fn the_default_program_is_one_point_and_its_spread_is_the_tie() {
+        // The default timed 10.0, 10.1, 10.4 ms (median 10.1, spread 4%); a row
+        // with the same shader at 9.0 ms joins its point rather than beating it.
+        let rows = vec![
+            row(Api::Vulkan, "a", 10.0, 0.01, true, vec![10.1, 10.4]),
+            row(Api::Vulkan, "a", 9.0, 0.01, false, vec![]),
+            row(Api::Vulkan, "b", 9.8, 0.01, false, vec![]),
+            row(Api::Vulkan, "c", 10.2, 0.005, false, vec![]),
+            row(Api::Vulkan, "d", 8.0, 0.02, false, vec![]),
+        ];
+        assert_eq!(point(&rows, 0), Some((10.05, 0.01)));
+        let (tie, times) = time_tie(&rows, "s", Api::Vulkan);
+        assert_eq!(times.len(), 4);
+        assert!((tie - (10.4 / 9.0 - 1.0)).abs() < 1e-12);
+        // b ties with the default; c is as fast within the tie and better; d is worse.
+        assert_eq!(dominators(&rows, 0), vec![3]);
     }
 }
