@@ -21,6 +21,25 @@
 #define STACK_SIZE 17
 #endif
 
+// The specialization-constant alternative (`--specialize`, common/src/shader.rs):
+// every feature is compiled in and each becomes a constant_id override, which
+// naga's process_overrides fixes per scene before it writes SPIR-V or GLSL.
+// SPEC(x) guards a feature's code with an `if` on its constant; without
+// SPECIALIZE it expands to nothing and the #ifdef alone decides.
+#ifdef SPECIALIZE
+layout(constant_id = 0) const bool SPEC_SPHERES = true;
+layout(constant_id = 1) const bool SPEC_TRIANGLES = true;
+layout(constant_id = 2) const bool SPEC_MIRROR = true;
+layout(constant_id = 3) const bool SPEC_GLASS = true;
+#define HAS_SPHERES 1
+#define HAS_TRIANGLES 1
+#define HAS_MIRROR 1
+#define HAS_GLASS 1
+#define SPEC(feature) if (feature)
+#else
+#define SPEC(feature)
+#endif
+
 struct Material {
     vec3 ambient;
     float reflectivity;
@@ -429,20 +448,24 @@ Hit closest_hit_brute(vec3 origin, vec3 dir) {
     h.u = 0.0;
     h.v = 0.0;
 #ifdef HAS_SPHERES
-    for (uint i = 0u; i < frame.sphere_count; i += PRIMS_PER_ITERATION) {
-        closest_sphere(h, origin, dir, i);
-        closest_sphere(h, origin, dir, i + 1u);
-        closest_sphere(h, origin, dir, i + 2u);
-        closest_sphere(h, origin, dir, i + 3u);
+    SPEC(SPEC_SPHERES) {
+        for (uint i = 0u; i < frame.sphere_count; i += PRIMS_PER_ITERATION) {
+            closest_sphere(h, origin, dir, i);
+            closest_sphere(h, origin, dir, i + 1u);
+            closest_sphere(h, origin, dir, i + 2u);
+            closest_sphere(h, origin, dir, i + 3u);
+        }
     }
 #endif
 #ifdef HAS_TRIANGLES
-    TriRay ray = tri_ray(origin, dir);
-    for (uint i = 0u; i < frame.triangle_count; i += PRIMS_PER_ITERATION) {
-        closest_triangle(h, ray, i);
-        closest_triangle(h, ray, i + 1u);
-        closest_triangle(h, ray, i + 2u);
-        closest_triangle(h, ray, i + 3u);
+    SPEC(SPEC_TRIANGLES) {
+        TriRay ray = tri_ray(origin, dir);
+        for (uint i = 0u; i < frame.triangle_count; i += PRIMS_PER_ITERATION) {
+            closest_triangle(h, ray, i);
+            closest_triangle(h, ray, i + 1u);
+            closest_triangle(h, ray, i + 2u);
+            closest_triangle(h, ray, i + 3u);
+        }
     }
 #endif
     return h;
@@ -459,19 +482,23 @@ bool triangle_blocks(TriRay ray, float dist, uint i) {
 // Shadow rays need any hit before the light, not the closest one.
 bool occluded_brute(vec3 origin, vec3 dir, float dist) {
 #ifdef HAS_SPHERES
-    for (uint i = 0u; i < frame.sphere_count; i += PRIMS_PER_ITERATION) {
-        if (sphere_blocks(origin, dir, dist, i) || sphere_blocks(origin, dir, dist, i + 1u)
-            || sphere_blocks(origin, dir, dist, i + 2u) || sphere_blocks(origin, dir, dist, i + 3u)) {
-            return true;
+    SPEC(SPEC_SPHERES) {
+        for (uint i = 0u; i < frame.sphere_count; i += PRIMS_PER_ITERATION) {
+            if (sphere_blocks(origin, dir, dist, i) || sphere_blocks(origin, dir, dist, i + 1u)
+                || sphere_blocks(origin, dir, dist, i + 2u) || sphere_blocks(origin, dir, dist, i + 3u)) {
+                return true;
+            }
         }
     }
 #endif
 #ifdef HAS_TRIANGLES
-    TriRay ray = tri_ray(origin, dir);
-    for (uint i = 0u; i < frame.triangle_count; i += PRIMS_PER_ITERATION) {
-        if (triangle_blocks(ray, dist, i) || triangle_blocks(ray, dist, i + 1u)
-            || triangle_blocks(ray, dist, i + 2u) || triangle_blocks(ray, dist, i + 3u)) {
-            return true;
+    SPEC(SPEC_TRIANGLES) {
+        TriRay ray = tri_ray(origin, dir);
+        for (uint i = 0u; i < frame.triangle_count; i += PRIMS_PER_ITERATION) {
+            if (triangle_blocks(ray, dist, i) || triangle_blocks(ray, dist, i + 1u)
+                || triangle_blocks(ray, dist, i + 2u) || triangle_blocks(ray, dist, i + 3u)) {
+                return true;
+            }
         }
     }
 #endif
@@ -651,10 +678,12 @@ vec3 trace(vec3 origin, vec3 dir) {
         color += w * local;
 
 #if defined(HAS_MIRROR) || defined(HAS_GLASS)
+        SPEC(SPEC_MIRROR || SPEC_GLASS)
         if (depth + 1u < max_depth) {
             float kr = m.reflectivity;
 #ifdef HAS_GLASS
             float kt = m.transparency;
+            SPEC(SPEC_GLASS)
             if (kt > 0.0) {
                 float eta = inside ? m.ior : 1.0 / m.ior;
                 float cos_i = -dot(d, ns);

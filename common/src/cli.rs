@@ -34,6 +34,11 @@ pub struct RenderArgs {
     /// Render with the all-features shader instead of the scene's own variant.
     #[arg(long)]
     pub generic: bool,
+    /// Render with one shader for every scene whose feature switches are
+    /// specialization constants set to this scene's features (fixed by naga's
+    /// process_overrides), instead of the scene's own variant of defines.
+    #[arg(long, conflicts_with = "generic")]
+    pub specialize: bool,
     /// Acceleration structure: auto (a BVH for scenes with many primitives), none (test
     /// every primitive, as the 2018 study did) or bvh.
     #[arg(long, value_enum, default_value_t = Accel::Auto)]
@@ -207,6 +212,7 @@ impl RenderArgs {
             set: Vec::new(),
             validate: false,
             generic: false,
+            specialize: false,
             accel: Accel::Auto,
             gl_spirv: false,
             vsync: false,

@@ -151,11 +151,7 @@ pub fn window_attributes(args: &RenderArgs, scene: &str, api: &str) -> WindowAtt
 
 /// The scene and variant a windowed run starts with (the same choice as headless).
 pub fn variant_for(args: &RenderArgs, scene: &Scene) -> Variant {
-    if args.generic {
-        Variant::generic(scene.numerics)
-    } else {
-        Variant::for_scene(scene)
-    }
+    Variant::chosen(scene, args.generic, args.specialize)
 }
 
 /// What the run did, for `--json`.

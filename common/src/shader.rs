@@ -18,12 +18,24 @@ pub const TRACE_COMP: &str = include_str!("../../shaders/trace.comp");
 
 /// The defines that select a shader variant. Same map → same module → same code
 /// in both APIs. `numerics` is what its numerical defines encode, kept so that
-/// the reference can be asked to take the same choices.
+/// the reference can be asked to take the same choices. `constants` are the
+/// specialization constants of `Variant::specialized` (empty otherwise).
 #[derive(Debug, Clone, PartialEq, Eq, serde::Serialize)]
 pub struct Variant {
     pub defines: BTreeMap<String, String>,
     pub numerics: Numerics,
+    pub constants: BTreeMap<String, bool>,
 }
+
+/// The feature switches trace.glsl declares with `layout(constant_id = N)`
+/// under SPECIALIZE: name and id (naga's process_overrides wants the id).
+/// A test checks this table against the parsed module.
+pub const SPEC_CONSTANTS: [(&str, u16); 4] = [
+    ("SPEC_SPHERES", 0),
+    ("SPEC_TRIANGLES", 1),
+    ("SPEC_MIRROR", 2),
+    ("SPEC_GLASS", 3),
+];
 
 impl Variant {
     /// Only what the scene needs: no triangle loop without triangles, no
@@ -59,7 +71,53 @@ impl Variant {
         for d in numerics.defines() {
             defines.insert(d.to_string(), "1".to_string());
         }
-        Variant { defines, numerics }
+        Variant {
+            defines,
+            numerics,
+            constants: BTreeMap::new(),
+        }
+    }
+
+    /// The specialization-constant alternative to `for_scene`, for comparison
+    /// (`--specialize`): one source for every scene, with every feature and the
+    /// deepest stack compiled in, whose feature switches are `constant_id`
+    /// overrides set to the scene's features. naga's SPIR-V and GLSL writers
+    /// take no overrides, so `parse` fixes them with process_overrides: the
+    /// driver then sees constant branches where `for_scene` leaves no code. An
+    /// array size cannot be an override, so the ray stack stays the deepest.
+    pub fn specialized(scene: &Scene) -> Variant {
+        let mut v = Variant::generic(scene.numerics);
+        // trace.glsl defines every HAS_* itself under SPECIALIZE.
+        v.defines.retain(|k, _| !k.starts_with("HAS_"));
+        v.defines.insert("SPECIALIZE".into(), "1".into());
+        if scene.bvh {
+            v.defines.insert("USE_BVH".into(), "1".into());
+        }
+        let f = scene.features();
+        for ((name, _), on) in
+            SPEC_CONSTANTS
+                .iter()
+                .zip([f.spheres, f.triangles, f.mirror, f.glass])
+        {
+            v.constants.insert(name.to_string(), on);
+        }
+        v
+    }
+
+    /// The variant the apps render: `--generic`, `--specialize` or the scene's
+    /// own; each traces through the BVH when the scene has one.
+    pub fn chosen(scene: &Scene, generic: bool, specialize: bool) -> Variant {
+        if generic {
+            let mut v = Variant::generic(scene.numerics);
+            if scene.bvh {
+                v.defines.insert("USE_BVH".into(), "1".into());
+            }
+            v
+        } else if specialize {
+            Variant::specialized(scene)
+        } else {
+            Variant::for_scene(scene)
+        }
     }
 
     /// Every feature on, the deepest stack: renders any scene (with the given numerics).
@@ -89,15 +147,19 @@ impl Variant {
             .filter(|k| k.starts_with("HAS_"))
             .all(|k| self.defines.contains_key(k))
             && stack(self) >= stack(needed)
+            && self.constants == needed.constants
     }
 
     /// A short label such as `spheres+triangles+mirror+glass/stack6/normal-scaled/watertight/stable`
     /// (with `/bvh` at the end when the variant traces through a BVH).
     pub fn label(&self) -> String {
-        let mut parts: Vec<String> = ["HAS_SPHERES", "HAS_TRIANGLES", "HAS_MIRROR", "HAS_GLASS"]
+        let mut parts: Vec<String> = ["SPHERES", "TRIANGLES", "MIRROR", "GLASS"]
             .iter()
-            .filter(|d| self.defines.contains_key(**d))
-            .map(|d| d.trim_start_matches("HAS_").to_lowercase())
+            .filter(|d| {
+                self.defines.contains_key(&format!("HAS_{d}"))
+                    || self.constants.get(&format!("SPEC_{d}")) == Some(&true)
+            })
+            .map(|d| d.to_lowercase())
             .collect();
         if parts.is_empty() {
             parts.push("background".into());
@@ -107,8 +169,13 @@ impl Variant {
         } else {
             ""
         };
+        let spec = if self.constants.is_empty() {
+            ""
+        } else {
+            "/spec"
+        };
         format!(
-            "{}/stack{}/{}{bvh}",
+            "{}/stack{}/{}{bvh}{spec}",
             parts.join("+"),
             self.defines
                 .get("STACK_SIZE")
@@ -155,7 +222,27 @@ pub fn parse(
                 e.emit_to_string(source)
             )
         })?;
-    Ok((module, info))
+    if module.overrides.is_empty() {
+        return Ok((module, info));
+    }
+    // Neither writer takes overrides: fix them now, as a Vulkan driver would
+    // at pipeline creation (ids as decimal keys, booleans as 0 or 1).
+    let mut constants = naga::back::PipelineConstants::default();
+    for (name, id) in SPEC_CONSTANTS {
+        if let Some(&on) = variant.constants.get(name) {
+            constants.insert(id.to_string(), if on { 1.0 } else { 0.0 });
+        }
+    }
+    let (m, i) = naga::back::pipeline_constants::process_overrides(
+        &module,
+        &info,
+        Some((stage, "main")),
+        &constants,
+    )
+    .map_err(|e| {
+        anyhow!("naga could not apply the {stage:?} shader's specialization constants: {e}")
+    })?;
+    Ok((m.into_owned(), i.into_owned()))
 }
 
 /// One variant, compiled for both APIs.
@@ -305,6 +392,48 @@ pub fn spirv_for_opengl(words: &[u32]) -> Vec<u32> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn spec_constant_table_matches_the_shader() {
+        let mut options = naga::front::glsl::Options::from(ShaderStage::Fragment);
+        options.defines.insert("SPECIALIZE".into(), "1".into());
+        let module = naga::front::glsl::Frontend::default()
+            .parse(&options, &fragment_source())
+            .unwrap();
+        let declared: Vec<(String, u16)> = module
+            .overrides
+            .iter()
+            .map(|(_, o)| (o.name.clone().unwrap_or_default(), o.id.unwrap_or(u16::MAX)))
+            .collect();
+        let table: Vec<(String, u16)> = SPEC_CONSTANTS
+            .iter()
+            .map(|(n, id)| (n.to_string(), *id))
+            .collect();
+        assert_eq!(declared, table);
+    }
+
+    #[test]
+    fn specialized_variant_leaves_no_override_for_the_writers() {
+        let scene = Scene::load("spherelist", &[]).unwrap();
+        let v = Variant::specialized(&scene);
+        assert_eq!(v.constants.get("SPEC_GLASS"), Some(&false));
+        assert_eq!(v.constants.get("SPEC_MIRROR"), Some(&true));
+        let (m, _) = parse(&fragment_source(), ShaderStage::Fragment, &v).unwrap();
+        // process_overrides keeps the arena but replaces every use by a constant.
+        let uses = m
+            .functions
+            .iter()
+            .map(|(_, f)| f)
+            .chain(m.entry_points.iter().map(|e| &e.function))
+            .flat_map(|f| f.expressions.iter())
+            .chain(m.global_expressions.iter())
+            .filter(|(_, e)| matches!(e, naga::Expression::Override(_)))
+            .count();
+        assert!(!m.overrides.is_empty(), "the shader declares the switches");
+        assert_eq!(uses, 0, "no override left for the writers");
+        let s = build(&v).unwrap();
+        assert!(!s.fragment_spirv.is_empty() && s.fragment_glsl.contains("void main"));
+    }
 
     #[test]
     fn spirv_for_opengl_drops_sets_and_flips_origin_only() {

@@ -75,6 +75,9 @@ pub fn app_args(args: &RenderArgs) -> Vec<String> {
     if args.generic {
         v.push("--generic".into());
     }
+    if args.specialize {
+        v.push("--specialize".into());
+    }
     if args.gl_spirv {
         v.push("--gl-spirv".into());
     }

@@ -490,7 +490,7 @@ pub struct AccelRun {
     pub scene: &'static str,
     pub size: Size,
     pub set: Vec<String>,
-    /// "generic, brute force", "variant, brute force" or "variant, BVH".
+    /// One of ACCEL_CONFIGS.
     pub config: &'static str,
     pub api: Api,
     pub result: Result<RunReport, String>,
@@ -498,9 +498,13 @@ pub struct AccelRun {
     pub bvh: Option<(usize, usize, f64)>,
 }
 
-pub const ACCEL_CONFIGS: [&str; 3] = [
+/// The all-features shader; the scene's own variant (defines); the one
+/// all-features source specialised to the scene through specialization
+/// constants (`--specialize`); the scene's variant with a BVH.
+pub const ACCEL_CONFIGS: [&str; 4] = [
     "generic, brute force",
     "variant, brute force",
+    "specialized, brute force",
     "variant, BVH",
 ];
 
@@ -634,6 +638,7 @@ pub fn acceleration(plan: &Plan, stop: &AtomicBool) -> Vec<AccelRun> {
                     json: true,
                     set: set.clone(),
                     generic: config.starts_with("generic"),
+                    specialize: config.starts_with("specialized"),
                     accel: if bvh { Accel::Bvh } else { Accel::None },
                     ..RenderArgs::headless(scene, size)
                 };

@@ -610,7 +610,9 @@ pub fn markdown(
         let _ = writeln!(
             s,
             "## Model only what a scene needs\n\nThe same scenes with the all-features shader (`--generic`, brute force, as the study's \
-             tracer), with the scene's own shader variant (features it lacks compiled out), and with that variant tracing through \
+             tracer), with the scene's own shader variant (features it lacks compiled out), with the one all-features source \
+             specialised to the scene through specialization constants (`--specialize`: constant_id overrides fixed by naga's \
+             process_overrides, so the driver sees constant branches and the deepest ray stack), and with the variant tracing through \
              a BVH (`--accel bvh`; binned SAH over spheres and triangles, built on the CPU). Median GPU ms (wall ms where the driver \
              has no GPU timer); speed-up against the generic brute-force shader of the same API.\n"
         );

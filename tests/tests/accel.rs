@@ -1,6 +1,7 @@
 //! Model only what a scene needs: the BVH and the per-scene shader variants
-//! change the speed, never the picture. BVH vs brute force and variant vs
-//! `--generic` agree on ≥ 99.99 % of pixels within 1/255, in both APIs.
+//! change the speed, never the picture. BVH vs brute force, variant vs
+//! `--generic` and variant vs `--specialize` agree on ≥ 99.99 % of pixels
+//! within 1/255, in both APIs.
 
 use twinray_common::metrics::compare;
 use twinray_tests::{render, scratch, App};
@@ -52,6 +53,20 @@ fn every_scene_variant_agrees_with_the_generic_shader() {
                 .chain(["--accel", "none", "--generic"])
                 .collect();
             agree(app, scene, size, &variant, &generic, "generic");
+        }
+    }
+}
+
+#[test]
+fn specialization_constants_render_what_the_scene_variant_renders() {
+    // --specialize: one source whose feature switches are constant_id overrides
+    // set per scene (naga's process_overrides), in both APIs, with and without
+    // the BVH.
+    for app in App::BOTH {
+        for (scene, size, set) in SCENES {
+            let variant: Vec<&str> = set.iter().copied().collect();
+            let spec: Vec<&str> = set.iter().copied().chain(["--specialize"]).collect();
+            agree(app, scene, size, &variant, &spec, "specialize");
         }
     }
 }

@@ -1,0 +1,44 @@
+#!/usr/bin/env bash
+# The runs behind the second GPU session's results in comparison/results/<gpu>/:
+# the full accuracy report again (barycentric hit points, the measured time tie)
+# and the specialization-constant experiment: each scene with its own variant
+# (defines), with the one source specialised through specialization constants
+# (--specialize) and with the all-features shader (--generic), both APIs,
+# two rounds in alternating order.
+# Usage: comparison/gpu-followup.sh BIN_DIR OUT_DIR (BIN_DIR holds release
+# builds of twinray, twinray-vk and twinray-gl).
+set -uo pipefail
+bin=$1
+out=$2
+mkdir -p "$out"
+nvidia-smi --query-gpu=name,driver_version,clocks.max.sm --format=csv > "$out/gpu.txt" 2>&1 || true
+"$bin/twinray" accuracy --out "$out/accuracy" > "$out/accuracy.log" 2>&1
+
+spec="$out/specialize.jsonl"
+run() { # app, then the app's options
+    local app=$1
+    shift
+    echo "{\"cmd\":\"twinray-$app $*\"}" >> "$spec"
+    "$bin/twinray-$app" --headless --json "$@" >> "$spec" 2>> "$out/specialize.log" || echo "{\"failed\":\"twinray-$app $*\"}" >> "$spec"
+}
+cases=(
+    "--scene teapot --size 1000x1000 --accel none --frames 5"
+    "--scene teapot --size 1000x1000 --accel bvh --frames 20"
+    "--scene box --size 1000x1000 --accel none --frames 20"
+    "--scene spherelist --size 300x300 --set extra_spheres=10000 --accel none --frames 10"
+    "--scene spherelist --size 300x300 --set extra_spheres=10000 --accel bvh --frames 20"
+)
+for round in 1 2; do
+    for c in "${cases[@]}"; do
+        if [ $round = 1 ]; then modes=("" "--specialize" "--generic"); else modes=("--generic" "--specialize" ""); fi
+        for m in "${modes[@]}"; do
+            # The all-features shader only matters without the BVH (and costs seconds on the teapot).
+            if [ "$m" = --generic ] && [[ $c == *"accel bvh"* ]]; then continue; fi
+            for app in vk gl; do
+                # shellcheck disable=SC2086
+                run $app $c $m
+            done
+        done
+    done
+done
+touch "$out/done"
