@@ -5,14 +5,19 @@
 # (defines), with the one source specialised through specialization constants
 # (--specialize) and with the all-features shader (--generic), both APIs,
 # two rounds in alternating order.
-# Usage: comparison/gpu-followup.sh BIN_DIR OUT_DIR (BIN_DIR holds release
-# builds of twinray, twinray-vk and twinray-gl).
+# Usage: comparison/gpu-followup.sh BIN_DIR OUT_DIR [accuracy|specialize]
+# (BIN_DIR holds release builds of twinray, twinray-vk and twinray-gl; the
+# third argument runs one half, for machines that limit a command's time).
 set -uo pipefail
 bin=$1
 out=$2
+part=${3:-all}
 mkdir -p "$out"
 nvidia-smi --query-gpu=name,driver_version,clocks.max.sm --format=csv > "$out/gpu.txt" 2>&1 || true
-"$bin/twinray" accuracy --out "$out/accuracy" > "$out/accuracy.log" 2>&1
+if [ "$part" != specialize ]; then
+    "$bin/twinray" accuracy --out "$out/accuracy" > "$out/accuracy.log" 2>&1
+fi
+[ "$part" = accuracy ] && exit 0
 
 spec="$out/specialize.jsonl"
 run() { # app, then the app's options
