@@ -4,20 +4,25 @@
 # and the specialization-constant experiment: each scene with its own variant
 # (defines), with the one source specialised through specialization constants
 # (--specialize) and with the all-features shader (--generic), both APIs,
-# two rounds in alternating order.
-# Usage: comparison/gpu-followup.sh BIN_DIR OUT_DIR [accuracy|specialize]
+# two rounds in alternating order; and the spherelist sweep again, as its
+# variant's ray stack shrank to one slot (no glass) after the first session.
+# Usage: comparison/gpu-followup.sh BIN_DIR OUT_DIR [accuracy|specialize|spherelist]
 # (BIN_DIR holds release builds of twinray, twinray-vk and twinray-gl; the
-# third argument runs one half, for machines that limit a command's time).
+# third argument runs one part, for machines that limit a command's time).
 set -uo pipefail
 bin=$1
 out=$2
 part=${3:-all}
 mkdir -p "$out"
 nvidia-smi --query-gpu=name,driver_version,clocks.max.sm --format=csv > "$out/gpu.txt" 2>&1 || true
-if [ "$part" != specialize ]; then
+if [ "$part" = all ] || [ "$part" = accuracy ]; then
     "$bin/twinray" accuracy --out "$out/accuracy" > "$out/accuracy.log" 2>&1
 fi
 [ "$part" = accuracy ] && exit 0
+if [ "$part" = all ] || [ "$part" = spherelist ]; then
+    "$bin/twinray" compare --full --only spherelist --gl-spirv --seconds-per-point 3 --out "$out/compare-spherelist" > "$out/compare-spherelist.log" 2>&1
+fi
+[ "$part" = spherelist ] && exit 0
 
 spec="$out/specialize.jsonl"
 run() { # app, then the app's options

@@ -6,7 +6,7 @@
 //
 // Features a scene lacks are compiled out through defines chosen in
 // common/src/shader.rs: HAS_SPHERES, HAS_TRIANGLES, HAS_MIRROR, HAS_GLASS,
-// and STACK_SIZE (the ray stack: max_depth + 1, or 1 without mirror and glass).
+// and STACK_SIZE (the ray stack: max_depth + 1 with glass, else 1).
 //
 // Numerical choices are defines too (common/src/numerics.rs), one of each:
 //   OFFSET_RAY | OFFSET_NORMAL | OFFSET_NORMAL_SCALED | OFFSET_ULP | OFFSET_SCALE_AWARE  (secondary-ray origin)
@@ -588,7 +588,13 @@ vec3 trace(vec3 origin, vec3 dir) {
     vec3 st_dir[STACK_SIZE];
     float st_weight[STACK_SIZE];
     uint st_depth[STACK_SIZE];
+#ifdef HAS_GLASS
+    // Glass pushes two rays per hit: the stack's size bounds the depth.
     uint max_depth = min(frame.max_depth, uint(STACK_SIZE - 1));
+#else
+    // A mirror pushes one ray after popping one: one slot serves any depth.
+    uint max_depth = frame.max_depth;
+#endif
 
     vec3 color = vec3(0.0);
     int sp = 0;

@@ -60,13 +60,11 @@ impl Variant {
         flag(f.triangles, "HAS_TRIANGLES");
         flag(f.mirror, "HAS_MIRROR");
         flag(f.glass, "HAS_GLASS");
-        // Without mirrors or glass no ray ever spawns another: the stack holds
-        // the primary ray alone, and every max depth compiles to one shader.
-        let stack = if f.mirror || f.glass {
-            max_depth.max(1) + 1
-        } else {
-            1
-        };
+        // Only glass makes the ray tree branch (reflected and refracted rays):
+        // then the depth-first stack holds one pending ray per level. Without
+        // glass a hit pushes at most one ray after popping one, so one slot
+        // serves every max depth, and every max depth compiles to one shader.
+        let stack = if f.glass { max_depth.max(1) + 1 } else { 1 };
         defines.insert("STACK_SIZE".into(), stack.to_string());
         for d in numerics.defines() {
             defines.insert(d.to_string(), "1".to_string());
