@@ -1,7 +1,9 @@
 #!/usr/bin/env bash
-# The exact runs behind comparison/results/<gpu>/: the full comparison (both
-# APIs, both paths, OpenGL also on naga's SPIR-V), the compute workgroup sizes,
-# and the full accuracy report. Usage: comparison/gpu-run.sh BIN_DIR OUT_DIR
+# The whole GPU run in one go: the full comparison (both APIs, both paths,
+# OpenGL also on naga's SPIR-V), the compute workgroup sizes, and the full
+# accuracy report. It takes about 25 minutes on an H200; where a machine is
+# lent for less, run the parts as comparison/results/nvidia-h200/FINDINGS.md
+# lists them (compare --only ..., gpu-followup.sh). Usage: comparison/gpu-run.sh BIN_DIR OUT_DIR
 # (BIN_DIR holds release builds of twinray, twinray-vk and twinray-gl).
 set -uo pipefail
 bin=$1
