@@ -317,7 +317,8 @@ pub fn run(args: &CompareArgs) -> anyhow::Result<()> {
         }
     }
     bar.finish_and_clear();
-    let accel = if interrupted || !(args.only.is_empty() || args.only.iter().any(|o| o == "accel")) {
+    let accel = if interrupted || !(args.only.is_empty() || args.only.iter().any(|o| o == "accel"))
+    {
         Vec::new()
     } else {
         acceleration(&plan, &stop)

@@ -152,8 +152,7 @@ impl Xvfb {
         }
     }
 
-    /// Runs `program` on this display (and nowhere else: WAYLAND_DISPLAY is cleared).
-    pub fn run(&self, program: &Path, args: &[&str], env: &[(&str, &str)], dir: &Path) -> Output {
+    fn command(&self, program: &Path, args: &[&str], env: &[(&str, &str)], dir: &Path) -> Command {
         let cache = std::env::temp_dir().join("twinray-mesa-cache");
         let mut cmd = Command::new(program);
         cmd.args(args)
@@ -164,8 +163,35 @@ impl Xvfb {
         for (k, v) in env {
             cmd.env(k, v);
         }
-        cmd.output()
+        cmd
+    }
+
+    /// Runs `program` on this display (and nowhere else: WAYLAND_DISPLAY is cleared).
+    pub fn run(&self, program: &Path, args: &[&str], env: &[(&str, &str)], dir: &Path) -> Output {
+        self.command(program, args, env, dir)
+            .output()
             .unwrap_or_else(|e| panic!("starting {}: {e}", program.display()))
+    }
+
+    /// Starts `program` on this display without waiting, its output captured.
+    pub fn spawn(&self, program: &Path, args: &[&str], dir: &Path) -> std::process::Child {
+        self.command(program, args, &[], dir)
+            .stdout(std::process::Stdio::piped())
+            .stderr(std::process::Stdio::piped())
+            .spawn()
+            .unwrap_or_else(|e| panic!("starting {}: {e}", program.display()))
+    }
+
+    /// Real X input through XTEST, as a user's mouse and keyboard make it
+    /// (xdotool; tests/run.sh installs it).
+    pub fn xdotool(&self, args: &[&str]) -> Output {
+        Command::new("xdotool")
+            .args(args)
+            .env("DISPLAY", &self.display)
+            .output()
+            .unwrap_or_else(|e| {
+                panic!("running xdotool ({e}): install xdotool (tests/run.sh does)")
+            })
     }
 }
 
