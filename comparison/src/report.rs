@@ -165,6 +165,62 @@ fn paths_in(outcomes: &[Outcome]) -> Vec<RenderPath> {
         .collect()
 }
 
+/// The sphere-list crossover runs of one API as (primitives, brute-force ms,
+/// BVH ms), fewest primitives first: every count measured both ways.
+pub fn crossover(accel: &[AccelRun], api: Api) -> Vec<(usize, f64, f64)> {
+    let ms = |r: &AccelRun| {
+        r.result.as_ref().ok().and_then(|rep| {
+            let t = rep.gpu_ms.or(rep.wall_ms)?.median;
+            Some((rep.scene.spheres + rep.scene.triangles, t))
+        })
+    };
+    let mut v: Vec<(usize, f64, f64)> = accel
+        .iter()
+        .filter(|r| r.api == api && r.scene == "spherelist" && r.config == "variant, brute force")
+        .filter_map(|brute| {
+            let bvh = accel.iter().find(|o| {
+                o.api == api
+                    && o.scene == brute.scene
+                    && o.size == brute.size
+                    && o.set == brute.set
+                    && o.config == "variant, BVH"
+            })?;
+            let ((n, b), (_, t)) = (ms(brute)?, ms(bvh)?);
+            Some((n, b, t))
+        })
+        .collect();
+    v.sort_by_key(|x| x.0);
+    v
+}
+
+/// "brute force faster up to N primitives, the BVH from M on" for `crossover` rows.
+pub fn crossover_sentence(rows: &[(usize, f64, f64)]) -> String {
+    if rows.is_empty() {
+        return "no crossover runs".into();
+    }
+    let last_brute = rows.iter().filter(|r| r.1 <= r.2).map(|r| r.0).max();
+    // The BVH counts as ahead from the smallest count after which it never loses.
+    let first_bvh = rows
+        .iter()
+        .map(|r| r.0)
+        .filter(|&n| rows.iter().filter(|r| r.0 >= n).all(|r| r.2 < r.1))
+        .min();
+    let counts = rows
+        .iter()
+        .map(|r| format!("{} ({:.3} / {:.3} ms)", r.0, r.1, r.2))
+        .collect::<Vec<_>>()
+        .join(", ");
+    let verdict = match (last_brute, first_bvh) {
+        (Some(b), Some(v)) => {
+            format!("brute force is faster up to {b} primitives, the BVH from {v} on")
+        }
+        (None, Some(v)) => format!("the BVH is faster from the smallest count measured, {v}"),
+        (Some(b), None) => format!("brute force is faster at every count measured, up to {b}"),
+        (None, None) => "no count was measured both ways".into(),
+    };
+    format!("{verdict} (primitives (brute force / BVH): {counts}).")
+}
+
 fn ratio(a: Option<f64>, b: Option<f64>) -> Option<f64> {
     match (a, b) {
         (Some(a), Some(b)) if b > 0.0 => Some(a / b),
@@ -669,6 +725,23 @@ pub fn markdown(
         if plots.iter().any(|p| p == "scaling.svg") {
             let _ = writeln!(s, "\n![frame time against primitive count](scaling.svg)\n");
         }
+        let _ = writeln!(
+            s,
+            "\n**Where `--accel auto` switches.** `auto` traces through a BVH from {} primitives on \
+             (`AUTO_BVH_MIN_PRIMITIVES`, common/src/scene.rs), one threshold for both APIs so that both always run the \
+             same shader. It was set from the sphere-list crossover rows above, measured on an NVIDIA H200 and on Mesa \
+             llvmpipe (comparison/results/). Here:",
+            twinray_common::scene::AUTO_BVH_MIN_PRIMITIVES
+        );
+        for api in [Api::Vulkan, Api::Opengl] {
+            let _ = writeln!(
+                s,
+                "- {}: {}",
+                api_name(api),
+                crossover_sentence(&crossover(accel, api))
+            );
+        }
+        let _ = writeln!(s);
         let failed: Vec<&AccelRun> = accel.iter().filter(|r| r.result.is_err()).collect();
         for r in failed {
             let _ = writeln!(
@@ -1038,6 +1111,27 @@ fn plot_scaling(path: &Path, outcomes: &[Outcome], accel: &[AccelRun]) -> anyhow
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn the_crossover_is_where_the_bvh_stops_losing() {
+        let rows = [
+            (8, 0.2, 0.4),
+            (32, 0.4, 0.5),
+            (57, 0.6, 0.5),
+            (107, 1.0, 1.1),
+            (207, 2.0, 1.5),
+            (507, 5.0, 1.6),
+        ];
+        let s = crossover_sentence(&rows);
+        assert!(
+            s.starts_with("brute force is faster up to 107 primitives, the BVH from 207 on"),
+            "{s}"
+        );
+        assert!(crossover_sentence(&[]).contains("no crossover"));
+        assert!(
+            crossover_sentence(&[(8, 0.5, 0.1)]).contains("from the smallest count measured, 8")
+        );
+    }
     use crate::compare::Point;
     use twinray_common::cli::Size;
 
