@@ -107,6 +107,11 @@ fn closed_mesh_has_no_cracks() {
     check("closed-mesh");
 }
 #[test]
+fn thin_tubes_have_no_shadow_acne() {
+    check("thin-tubes");
+}
+
+#[test]
 fn grazing() {
     check("grazing");
 }
