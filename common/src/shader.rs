@@ -1,6 +1,8 @@
 //! The shader build: concatenates shaders/ (naga has no #include), picks the
-//! scene's variant through defines, validates the naga module once, and writes
-//! SPIR-V for Vulkan and GLSL 450 core for OpenGL from that same module.
+//! scene's variant through defines (or, for comparison, through specialization
+//! constants that naga's process_overrides fixes), validates the naga module
+//! once, and writes SPIR-V for Vulkan and GLSL 450 core for OpenGL from that
+//! same module.
 
 use crate::cli::Workgroup;
 use crate::numerics::Numerics;
