@@ -165,6 +165,31 @@ pub struct WindowedRun {
     pub setup_ms: f64,
 }
 
+impl WindowedRun {
+    /// The `--json` report of a window: the headless shape, with wall time
+    /// frame to frame and no NaN count (nothing is read back).
+    pub fn report(
+        self,
+        api: &str,
+        device: crate::report::DeviceInfo,
+        validation_messages: u64,
+    ) -> crate::report::RunReport {
+        crate::report::RunReport {
+            validation_messages,
+            ..crate::report::RunReport::new(
+                api,
+                device,
+                self.scene.stats(),
+                self.variant.label(),
+                self.width,
+                self.height,
+                self.frames,
+                self.setup_ms,
+            )
+        }
+    }
+}
+
 /// Runs the window until Esc, the close button or `--frames`, then saves `--out`.
 /// The renderer is dropped (every API object destroyed) before this returns.
 pub fn run<R: Renderer>(

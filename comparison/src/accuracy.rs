@@ -888,37 +888,36 @@ fn markdown(
                     ""
                 }
             );
+            let head = format!(
+                "| {} | {} | {} | {} | {} | {} |",
+                r.sweeps.join(", "),
+                r.config.max_depth,
+                n.offset.name(),
+                n.triangle.name(),
+                n.sphere.name(),
+                api_name(r.api)
+            );
             match &r.result {
                 Ok((g, w, e, nan)) => {
                     let _ = writeln!(
                         s,
-                        "| {} | {} | {} | {} | {} | {} | {} | {} | {:.5} | {} | {:.2}% | {:.2}% | {} | {} | {mark} |",
-                        r.sweeps.join(", "),
-                        r.config.max_depth,
-                        n.offset.name(),
-                        n.triangle.name(),
-                        n.sphere.name(),
-                        api_name(r.api),
+                        "{head} {} | {} | {:.5} | {} | {:.2}% | {:.2}% | {} | {} | {mark} |",
                         g.map(f3).unwrap_or_else(|| "–".into()),
                         f3(*w),
                         e.rmse,
                         e.max_abs,
                         100.0 * e.above_1,
                         100.0 * e.wrong,
-                        e.flip.map(|f| format!("{f:.4}")).unwrap_or_else(|| "–".into()),
+                        e.flip
+                            .map(|f| format!("{f:.4}"))
+                            .unwrap_or_else(|| "–".into()),
                         nan
                     );
                 }
                 Err(e) => {
                     let _ = writeln!(
                         s,
-                        "| {} | {} | {} | {} | {} | {} | failed: {} | | | | | | | | |",
-                        r.sweeps.join(", "),
-                        r.config.max_depth,
-                        n.offset.name(),
-                        n.triangle.name(),
-                        n.sphere.name(),
-                        api_name(r.api),
+                        "{head} failed: {} | | | | | | | | |",
                         e.replace('|', "/")
                     );
                 }
@@ -1032,29 +1031,14 @@ fn plot(path: &Path, scene: &str, rows: &[&Row]) -> anyhow::Result<()> {
         root.present()?;
         return Ok(());
     }
-    let (xmin, xmax) = pts
-        .iter()
-        .fold((f64::MAX, f64::MIN), |a, p| (a.0.min(p.0), a.1.max(p.0)));
-    let (ymin, ymax) = pts
-        .iter()
-        .fold((f64::MAX, f64::MIN), |a, p| (a.0.min(p.1), a.1.max(p.1)));
-    let mut chart = ChartBuilder::on(&root)
-        .caption(
-            format!("{scene}: time against error (log scales; ★ Pareto front, ◆ default)"),
-            ("sans-serif", 20),
-        )
-        .margin(12)
-        .x_label_area_size(45)
-        .y_label_area_size(80)
-        .build_cartesian_2d(
-            (xmin * 0.8..xmax * 1.25).log_scale(),
-            (ymin * 0.5..ymax * 2.0).log_scale(),
-        )?;
-    chart
-        .configure_mesh()
-        .x_desc("milliseconds per frame (fastest frame)")
-        .y_desc("RMSE against the f64 truth")
-        .draw()?;
+    let caption = format!("{scene}: time against error (log scales; ★ Pareto front, ◆ default)");
+    let mut chart = crate::report::log_log_chart(
+        &root,
+        &caption,
+        &pts,
+        "milliseconds per frame (fastest frame)",
+        "RMSE against the f64 truth",
+    )?;
     for (api, colour) in [
         (Api::Vulkan, RGBColor(200, 30, 30)),
         (Api::Opengl, RGBColor(30, 80, 200)),
@@ -1119,14 +1103,7 @@ fn plot(path: &Path, scene: &str, rows: &[&Row]) -> anyhow::Result<()> {
             }
         }
     }
-    chart
-        .configure_series_labels()
-        .background_style(WHITE.mix(0.8))
-        .border_style(BLACK)
-        .position(SeriesLabelPosition::UpperRight)
-        .draw()?;
-    root.present()?;
-    Ok(())
+    crate::report::finish_chart(&mut chart, &root, SeriesLabelPosition::UpperRight)
 }
 
 #[cfg(test)]

@@ -919,12 +919,6 @@ fn plot(path: &Path, exp: &str, rows: &[&Outcome], study: &[StudyRow]) -> anyhow
         .flat_map(|s| s.2.iter().copied())
         .filter(|p| p.0 > 0.0 && p.1 > 0.0)
         .collect();
-    let (xmin, xmax) = all
-        .iter()
-        .fold((f64::MAX, f64::MIN), |a, p| (a.0.min(p.0), a.1.max(p.0)));
-    let (ymin, ymax) = all
-        .iter()
-        .fold((f64::MAX, f64::MIN), |a, p| (a.0.min(p.1), a.1.max(p.1)));
     let root = SVGBackend::new(path, (900, 560)).into_drawing_area();
     root.fill(&WHITE)?;
     let xlabel = if exp == "spherelist" {
@@ -932,23 +926,8 @@ fn plot(path: &Path, exp: &str, rows: &[&Outcome], study: &[StudyRow]) -> anyhow
     } else {
         "image width = height (pixels)"
     };
-    let mut chart = ChartBuilder::on(&root)
-        .caption(
-            format!("{exp}: time per frame (log scale)"),
-            ("sans-serif", 22),
-        )
-        .margin(12)
-        .x_label_area_size(45)
-        .y_label_area_size(70)
-        .build_cartesian_2d(
-            (xmin * 0.8..xmax * 1.25).log_scale(),
-            (ymin * 0.5..ymax * 2.0).log_scale(),
-        )?;
-    chart
-        .configure_mesh()
-        .x_desc(xlabel)
-        .y_desc("milliseconds")
-        .draw()?;
+    let caption = format!("{exp}: time per frame (log scale)");
+    let mut chart = log_log_chart(&root, &caption, &all, xlabel, "milliseconds")?;
     for (name, colour, pts) in series {
         let dashed = name.contains("GPU");
         let style = if name.starts_with("study") {
@@ -973,11 +952,52 @@ fn plot(path: &Path, exp: &str, rows: &[&Outcome], study: &[StudyRow]) -> anyhow
             chart.draw_series(pts.iter().map(|p| Circle::new(*p, 3, colour.filled())))?;
         }
     }
+    finish_chart(&mut chart, &root, SeriesLabelPosition::UpperLeft)
+}
+
+/// The chart every plot here draws on: log scales on both axes, padded around
+/// `points` (which must not be empty), a caption and labelled axes.
+pub fn log_log_chart<'a, 'b>(
+    root: &'a DrawingArea<SVGBackend<'b>, plotters::coord::Shift>,
+    caption: &str,
+    points: &[(f64, f64)],
+    x_desc: &str,
+    y_desc: &str,
+) -> anyhow::Result<ChartContext<'a, SVGBackend<'b>, Cartesian2d<LogCoord<f64>, LogCoord<f64>>>> {
+    let (xmin, xmax) = points
+        .iter()
+        .fold((f64::MAX, f64::MIN), |a, p| (a.0.min(p.0), a.1.max(p.0)));
+    let (ymin, ymax) = points
+        .iter()
+        .fold((f64::MAX, f64::MIN), |a, p| (a.0.min(p.1), a.1.max(p.1)));
+    let mut chart = ChartBuilder::on(root)
+        .caption(caption, ("sans-serif", 22))
+        .margin(12)
+        .x_label_area_size(45)
+        .y_label_area_size(80)
+        .build_cartesian_2d(
+            (xmin * 0.8..xmax * 1.25).log_scale(),
+            (ymin * 0.5..ymax * 2.0).log_scale(),
+        )?;
+    chart
+        .configure_mesh()
+        .x_desc(x_desc)
+        .y_desc(y_desc)
+        .draw()?;
+    Ok(chart)
+}
+
+/// Draws the legend at `position` and writes the SVG.
+pub fn finish_chart<'a, 'b: 'a>(
+    chart: &mut ChartContext<'a, SVGBackend<'b>, Cartesian2d<LogCoord<f64>, LogCoord<f64>>>,
+    root: &DrawingArea<SVGBackend<'b>, plotters::coord::Shift>,
+    position: SeriesLabelPosition,
+) -> anyhow::Result<()> {
     chart
         .configure_series_labels()
         .background_style(WHITE.mix(0.8))
         .border_style(BLACK)
-        .position(SeriesLabelPosition::UpperLeft)
+        .position(position)
         .draw()?;
     root.present()?;
     Ok(())
@@ -1063,31 +1083,15 @@ fn plot_scaling(path: &Path, outcomes: &[Outcome], accel: &[AccelRun]) -> anyhow
     if all.is_empty() {
         return Ok(());
     }
-    let (xmin, xmax) = all
-        .iter()
-        .fold((f64::MAX, f64::MIN), |a, p| (a.0.min(p.0), a.1.max(p.0)));
-    let (ymin, ymax) = all
-        .iter()
-        .fold((f64::MAX, f64::MIN), |a, p| (a.0.min(p.1), a.1.max(p.1)));
     let root = SVGBackend::new(path, (900, 560)).into_drawing_area();
     root.fill(&WHITE)?;
-    let mut chart = ChartBuilder::on(&root)
-        .caption(
-            "frame time against primitives (log-log)",
-            ("sans-serif", 22),
-        )
-        .margin(12)
-        .x_label_area_size(45)
-        .y_label_area_size(70)
-        .build_cartesian_2d(
-            (xmin * 0.8..xmax * 1.25).log_scale(),
-            (ymin * 0.5..ymax * 2.0).log_scale(),
-        )?;
-    chart
-        .configure_mesh()
-        .x_desc("spheres + triangles")
-        .y_desc("milliseconds")
-        .draw()?;
+    let mut chart = log_log_chart(
+        &root,
+        "frame time against primitives (log-log)",
+        &all,
+        "spheres + triangles",
+        "milliseconds",
+    )?;
     for (name, colour, mut pts) in series {
         pts.sort_by(|a, b| a.0.total_cmp(&b.0));
         chart
@@ -1098,14 +1102,7 @@ fn plot_scaling(path: &Path, outcomes: &[Outcome], accel: &[AccelRun]) -> anyhow
             });
         chart.draw_series(pts.iter().map(|p| Circle::new(*p, 3, colour.filled())))?;
     }
-    chart
-        .configure_series_labels()
-        .background_style(WHITE.mix(0.8))
-        .border_style(BLACK)
-        .position(SeriesLabelPosition::UpperLeft)
-        .draw()?;
-    root.present()?;
-    Ok(())
+    finish_chart(&mut chart, &root, SeriesLabelPosition::UpperLeft)
 }
 
 #[cfg(test)]

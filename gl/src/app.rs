@@ -177,20 +177,7 @@ fn run_windowed(args: &RenderArgs, started: Instant) -> anyhow::Result<()> {
             driver: format!("{} {}", info.vendor, info.version),
             api_version: format!("OpenGL {}", info.version),
         };
-        let report = RunReport {
-            validation_messages: errors,
-            ..RunReport::new(
-                "opengl",
-                device,
-                run.scene.stats(),
-                run.variant.label(),
-                run.width,
-                run.height,
-                run.frames,
-                run.setup_ms,
-            )
-        };
-        report.print_json()?;
+        run.report("opengl", device, errors).print_json()?;
     }
     if args.validate && errors > 0 {
         return Err(anyhow!("{errors} GL debug errors (see above)"));

@@ -78,20 +78,7 @@ fn run_windowed(args: &RenderArgs, process_start: Instant) -> Result<()> {
             driver: device.driver,
             api_version: device.api_version,
         };
-        let report = RunReport {
-            validation_messages: messages,
-            ..RunReport::new(
-                "vulkan",
-                info,
-                run.scene.stats(),
-                run.variant.label(),
-                run.width,
-                run.height,
-                run.frames,
-                run.setup_ms,
-            )
-        };
-        report.print_json()?;
+        run.report("vulkan", info, messages).print_json()?;
     }
     if args.validate && messages > 0 {
         bail!("{messages} validation messages (see above)");

@@ -209,23 +209,17 @@ impl ComputePipeline {
             layout: vk::PipelineLayout::null(),
             pipeline: vk::Pipeline::null(),
         };
-        let set_layouts = [set_layout];
-        let info = vk::PipelineLayoutCreateInfo::default().set_layouts(&set_layouts);
-        this.layout = unsafe { d.create_pipeline_layout(&info, None) }
-            .context("creating the compute pipeline layout")?;
-        let info = vk::ShaderModuleCreateInfo::default().code(spirv);
-        let module = unsafe { d.create_shader_module(&info, None) }
-            .context("creating the compute shader module")?;
+        this.layout = crate::pipeline::layout(d, set_layout, "compute")?;
+        // Dropped after the pipeline is made: it keeps its own copy of the code.
+        let module = crate::pipeline::module(d, spirv, "compute")?;
         let stage = vk::PipelineShaderStageCreateInfo::default()
             .stage(vk::ShaderStageFlags::COMPUTE)
-            .module(module)
+            .module(module.1)
             .name(c"main");
         let info = vk::ComputePipelineCreateInfo::default()
             .stage(stage)
             .layout(this.layout);
         let made = unsafe { d.create_compute_pipelines(vk::PipelineCache::null(), &[info], None) };
-        // The pipeline keeps its own copy of the code: the module can go now.
-        unsafe { d.destroy_shader_module(module, None) };
         this.pipeline = made
             .map_err(|(_, e)| e)
             .context("creating the compute pipeline")?[0];

@@ -124,7 +124,7 @@ pub struct Pipeline {
 }
 
 /// A shader module is only needed while the pipeline is compiled.
-struct Module(ash::Device, vk::ShaderModule);
+pub(crate) struct Module(ash::Device, pub(crate) vk::ShaderModule);
 
 impl Drop for Module {
     fn drop(&mut self) {
@@ -132,11 +132,23 @@ impl Drop for Module {
     }
 }
 
-fn module(d: &ash::Device, spirv: &[u32], stage: &str) -> Result<Module> {
+pub(crate) fn module(d: &ash::Device, spirv: &[u32], stage: &str) -> Result<Module> {
     let info = vk::ShaderModuleCreateInfo::default().code(spirv);
     let m = unsafe { d.create_shader_module(&info, None) }
         .with_context(|| format!("creating the {stage} shader module"))?;
     Ok(Module(d.clone(), m))
+}
+
+/// The pipeline layout both pipelines use: the one descriptor set, no push constants.
+pub(crate) fn layout(
+    d: &ash::Device,
+    set_layout: vk::DescriptorSetLayout,
+    what: &str,
+) -> Result<vk::PipelineLayout> {
+    let set_layouts = [set_layout];
+    let info = vk::PipelineLayoutCreateInfo::default().set_layouts(&set_layouts);
+    unsafe { d.create_pipeline_layout(&info, None) }
+        .with_context(|| format!("creating the {what} pipeline layout"))
 }
 
 impl Pipeline {
@@ -154,10 +166,7 @@ impl Pipeline {
             pipeline: vk::Pipeline::null(),
         };
 
-        let set_layouts = [set_layout];
-        let info = vk::PipelineLayoutCreateInfo::default().set_layouts(&set_layouts);
-        this.layout = unsafe { d.create_pipeline_layout(&info, None) }
-            .context("creating the pipeline layout")?;
+        this.layout = layout(d, set_layout, "graphics")?;
         explain::step("VkPipelineLayout", || {
             "1 descriptor set layout (set 0), no push constants".into()
         });
