@@ -171,7 +171,23 @@ fn after_gesture(
         cmd.extend(["sleep", "0.5", "key", k]);
     }
     cmd.extend(["sleep", "0.5", "key", "Escape"]);
-    let xd = x.xdotool(&cmd);
+    // Under load (a fresh shader cache, other windows in parallel tests) the
+    // X server now and then refuses xdotool's connection outright ("Can't
+    // open display"): nothing has happened yet, so try again.
+    let mut xd = x.xdotool(&cmd);
+    for _ in 0..10 {
+        if xd.status.success()
+            || !String::from_utf8_lossy(&xd.stderr).contains("Can't open display")
+        {
+            break;
+        }
+        eprintln!(
+            "{app:?}: xdotool could not connect to {}; trying again",
+            x.display
+        );
+        std::thread::sleep(std::time::Duration::from_millis(300));
+        xd = x.xdotool(&cmd);
+    }
     if !xd.status.success() {
         let _ = child.kill();
         let _ = child.wait();
