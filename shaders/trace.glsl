@@ -569,8 +569,9 @@ vec3 spawn_point(vec3 p, vec3 n, vec3 dir, float scale) {
     return p + n * (SCALE_AWARE_REL * max(scale, max_abs(p)));
 #else
     // OFFSET_NORMAL_SCALED: epsilon relative to the largest coordinate, at least absolute.
-    float scale = max(1.0, max(abs(p.x), max(abs(p.y), abs(p.z))));
-    return p + n * (frame.epsilon * scale);
+    // (Its own magnitude, not the parameter: GLSL forbids redeclaring `scale`.)
+    float magnitude = max(1.0, max_abs(p));
+    return p + n * (frame.epsilon * magnitude);
 #endif
 }
 
