@@ -136,7 +136,8 @@ impl TitleClock {
 pub fn event_loop() -> anyhow::Result<EventLoop<()>> {
     EventLoop::new().map_err(|e| {
         no_device(format!(
-            "cannot open a window ({e}): no X display (is DISPLAY set?); run under xvfb-run, or use --headless"
+            "cannot open a window ({}): no X display (is DISPLAY set?); run under xvfb-run, or use --headless",
+            crate::error::without_source_location(&e.to_string())
         ))
     })
 }

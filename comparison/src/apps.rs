@@ -154,13 +154,20 @@ pub fn run_json(api: Api, args: &RenderArgs) -> anyhow::Result<RunReport> {
 /// apps' format (api "reference", CPU time as wall time).
 pub fn render_reference(args: &RenderArgs) -> anyhow::Result<()> {
     let start = Instant::now();
+    if !args.json && args.out.is_none() {
+        return Err(bad_input(
+            "render --api reference needs --out FILE.png or --json",
+        ));
+    }
+    // The reference takes the apps' options; one that cannot apply is refused as they refuse it.
+    args.compute_workgroup()?;
     let scene = args.load_scene()?;
     let (w, h) = (args.size.width, args.size.height);
     let t = Instant::now();
     let img = twinray_common::reference::render(&scene, w, h);
     let ms = t.elapsed().as_secs_f64() * 1e3;
     if let Some(out) = &args.out {
-        img.save_png(out)?;
+        img.save_png_for("--out", out)?;
     }
     if args.json {
         let info = DeviceInfo {
@@ -187,10 +194,6 @@ pub fn render_reference(args: &RenderArgs) -> anyhow::Result<()> {
             )
         };
         report.print_json()?;
-    } else if args.out.is_none() {
-        return Err(bad_input(
-            "render --api reference needs --out FILE.png or --json",
-        ));
     }
     Ok(())
 }

@@ -176,6 +176,8 @@ fn is_software(device: &str) -> bool {
 }
 
 pub fn run(args: &CompareArgs) -> anyhow::Result<()> {
+    // Before the device probe and every render: a bad --out must cost nothing.
+    twinray_common::image_io::prepare_output_dir("--out", &args.out)?;
     let mut args = args.clone();
     if !args.quick && !args.full {
         let probe = RenderArgs {
@@ -204,8 +206,6 @@ pub fn run(args: &CompareArgs) -> anyhow::Result<()> {
     }
     let args = &args;
     let plan = plan(args)?;
-    std::fs::create_dir_all(&args.out)
-        .with_context(|| format!("creating --out folder '{}'", args.out.display()))?;
     let stop = Arc::new(AtomicBool::new(false));
     {
         let stop = stop.clone();

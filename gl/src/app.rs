@@ -129,7 +129,7 @@ pub fn run(args: RenderArgs, started: Instant) -> anyhow::Result<()> {
     log.check(gl, "after the frame loop");
 
     if let Some(out) = &args.out {
-        image.save_png(out)?;
+        image.save_png_for("--out", out)?;
     }
     let errors = log.errors();
     if args.json {
