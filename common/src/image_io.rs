@@ -174,9 +174,11 @@ pub fn check_output_file(option: &str, path: &Path) -> anyhow::Result<PathBuf> {
                 path.join("image.png").display()
             )))
         }
-        Ok(meta) if !meta.is_file() => return Err(bad_input(format!(
+        Ok(meta) if !meta.is_file() => {
+            return Err(bad_input(format!(
             "{option} '{shown}' is not a regular file (a device, pipe or socket); give a file name"
-        ))),
+        )))
+        }
         Ok(_) => std::fs::canonicalize(path).unwrap_or_else(|_| path.to_path_buf()),
         Err(_) => path.to_path_buf(),
     };

@@ -79,6 +79,7 @@ impl<'gl> Compute<'gl> {
                 width as i32,
                 height as i32,
             );
+            crate::target::out_of_memory(gl, "storage image", width, height)?;
             // WRITE_ONLY matches the shader's `writeonly`; the format its `rgba32f`.
             gl.bind_image_texture(
                 binding::IMAGE,
