@@ -40,7 +40,7 @@ pub fn run(args: RenderArgs, started: Instant) -> anyhow::Result<()> {
         return run_windowed(&args, started);
     }
     let scene = args.load_scene()?;
-    let variant = Variant::chosen(&scene, args.generic, args.specialize);
+    let variant = Variant::chosen(&scene, &args);
     let workgroup = args.compute_workgroup()?;
     let (width, height) = (args.size.width, args.size.height);
     let gpu_scene = GpuScene::new(&scene, width, height);

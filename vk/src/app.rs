@@ -46,7 +46,7 @@ pub fn run(args: RenderArgs, process_start: Instant) -> Result<()> {
         return run_windowed(&args, process_start);
     }
     let scene = args.load_scene()?;
-    let variant = Variant::chosen(&scene, args.generic, args.specialize);
+    let variant = Variant::chosen(&scene, &args);
     let (mut report, image) = render(&args, &scene, &variant, process_start)?;
 
     // Counted only now that every Vulkan object is gone, so teardown mistakes count too.
