@@ -84,7 +84,7 @@ pub fn without_source_location(message: &str) -> String {
         Some(i) => {
             let rest = &message[i + 4..];
             let rest = rest.trim_start_matches(|c: char| c.is_ascii_digit() || c == ':');
-            rest.trim().to_string()
+            rest.trim().trim_end_matches('.').to_string()
         }
         None => message.to_string(),
     }
@@ -97,7 +97,7 @@ mod tests {
         let winit = "os error at /root/.cargo/registry/src/index.crates.io-1949cf8c6b5b557f/winit-0.30.12/src/platform_impl/linux/mod.rs:764: neither WAYLAND_DISPLAY nor WAYLAND_SOCKET nor DISPLAY is set.";
         assert_eq!(
             super::without_source_location(winit),
-            "neither WAYLAND_DISPLAY nor WAYLAND_SOCKET nor DISPLAY is set."
+            "neither WAYLAND_DISPLAY nor WAYLAND_SOCKET nor DISPLAY is set"
         );
         assert_eq!(super::without_source_location("plain"), "plain");
     }

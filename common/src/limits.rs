@@ -55,8 +55,9 @@ pub const MAX_MESH_FILE_BYTES: u64 = 1 << 30;
 
 /// Coordinates, radii and distances, in scene units. The shader squares
 /// differences of coordinates in f32 (3.4e38 at most) and treats t above 1e30 as
-/// a miss; 1e12 keeps every square finite and every hit below that horizon.
-pub const MAX_COORDINATE: f64 = 1e12;
+/// a miss: at 4e18 a sum of three squared differences (12 * 1.6e37 = 1.9e38)
+/// stays finite and every hit lies below that horizon.
+pub const MAX_COORDINATE: f64 = 4e18;
 
 /// Colour components (ambient, diffuse, specular, light colour, background):
 /// products of a light colour, a diffuse colour and a few hundred lights stay finite in f32.
