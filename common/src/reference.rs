@@ -31,20 +31,26 @@ pub fn render(scene: &Scene, width: u32, height: u32) -> FloatImage {
 
 /// Renders `scene` with the given numerical choices instead of the scene's.
 pub fn render_with(scene: &Scene, width: u32, height: u32, numerics: &Numerics) -> FloatImage {
-    render_counting(scene, width, height, numerics, &AtomicUsize::new(0))
+    render_counting(scene, width, height, numerics, true, &AtomicUsize::new(0))
 }
 
-/// `render_with`, adding 1 to `rows_done` as each row finishes (for a progress bar).
+/// `render_with`, through the BVH or (`bvh` false: `--accel none`) testing
+/// every primitive, adding 1 to `rows_done` as each row finishes (for a progress bar).
 pub fn render_counting(
     scene: &Scene,
     width: u32,
     height: u32,
     numerics: &Numerics,
+    bvh: bool,
     rows_done: &AtomicUsize,
 ) -> FloatImage {
     let mut scene = scene.rounded_to_f32();
     scene.numerics = *numerics;
-    let tracer = Tracer::new(&scene);
+    let tracer = if bvh {
+        Tracer::new(&scene)
+    } else {
+        Tracer::brute_force(&scene)
+    };
     let frame = RayFrame::new(&scene.camera, width, height).rounded_to_f32();
     let w = width as usize;
     let mut pixels = vec![[0f32; 3]; crate::limits::pixel_count(width, height)];

@@ -5,7 +5,7 @@ use anyhow::Context;
 use std::path::PathBuf;
 use std::process::Command;
 use std::time::Instant;
-use twinray_common::cli::RenderArgs;
+use twinray_common::cli::{Accel, RenderArgs};
 use twinray_common::error::{bad_input, Failure, FailureKind};
 use twinray_common::report::{DeviceInfo, FrameTime, RunReport};
 
@@ -170,7 +170,8 @@ pub fn render_reference(args: &RenderArgs) -> anyhow::Result<()> {
     let scene = args.load_scene()?;
     let (w, h) = (args.size.width, args.size.height);
     let t = Instant::now();
-    let img = render_with_progress(&scene, w, h);
+    // --accel none: brute force, a reference independent of the BVH code.
+    let img = render_with_progress(&scene, w, h, args.accel != Accel::None);
     let ms = t.elapsed().as_secs_f64() * 1e3;
     if let Some(out) = &args.out {
         img.save_png_for("--out", out)?;
@@ -211,6 +212,7 @@ fn render_with_progress(
     scene: &twinray_common::scene::Scene,
     w: u32,
     h: u32,
+    bvh: bool,
 ) -> twinray_common::image_io::FloatImage {
     use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
     let rows = AtomicUsize::new(0);
@@ -241,7 +243,8 @@ fn render_with_progress(
                 b.finish_and_clear();
             }
         });
-        let img = twinray_common::reference::render_counting(scene, w, h, &scene.numerics, &rows);
+        let img =
+            twinray_common::reference::render_counting(scene, w, h, &scene.numerics, bvh, &rows);
         finished.store(true, Ordering::Relaxed);
         img
     })
