@@ -328,7 +328,13 @@ pub fn run(args: &CompareArgs) -> anyhow::Result<()> {
     } else {
         agreement(&args.out, &plan, &paths, args.workgroup, &stop)
     };
+    let shader_rows = if interrupted || stop.load(Ordering::SeqCst) {
+        Vec::new()
+    } else {
+        crate::shaders::collect(&args.out, &paths, &stop)
+    };
     crate::report::write_all(&args.out, &plan, &outcomes, &accel, &agreement, interrupted)?;
+    crate::shaders::append_to_report(&args.out.join("report.md"), &shader_rows)?;
     eprintln!(
         "twinray compare: {} of {} runs done{}; report: {}",
         outcomes.iter().filter(|o| o.result.is_ok()).count(),
