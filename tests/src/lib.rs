@@ -174,8 +174,14 @@ impl Xvfb {
     }
 
     /// Starts `program` on this display without waiting, its output captured.
-    pub fn spawn(&self, program: &Path, args: &[&str], dir: &Path) -> std::process::Child {
-        self.command(program, args, &[], dir)
+    pub fn spawn(
+        &self,
+        program: &Path,
+        args: &[&str],
+        env: &[(&str, &str)],
+        dir: &Path,
+    ) -> std::process::Child {
+        self.command(program, args, env, dir)
             .stdout(std::process::Stdio::piped())
             .stderr(std::process::Stdio::piped())
             .spawn()
@@ -183,9 +189,13 @@ impl Xvfb {
     }
 
     /// Real X input through XTEST, as a user's mouse and keyboard make it
-    /// (xdotool; tests/run.sh installs it).
+    /// (xdotool; tests/run.sh installs it). A window or title that never comes
+    /// would leave `search --sync` waiting for ever, so 120 s at most
+    /// (coreutils' `timeout`, exit 124).
     pub fn xdotool(&self, args: &[&str]) -> Output {
-        Command::new("xdotool")
+        Command::new("timeout")
+            .arg("120")
+            .arg("xdotool")
             .args(args)
             .env("DISPLAY", &self.display)
             .output()
