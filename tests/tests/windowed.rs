@@ -545,10 +545,11 @@ fn compute_path_survives_a_resize_storm_with_scene_and_path_switches() {
     }
 }
 
-/// Real keyboard input: the title names the running path and its FPS, and the
-/// C key (xdotool through XTEST) switches it.
+/// Real keyboard input and what the window really shows: the title names the
+/// running path and its FPS, the C key (xdotool through XTEST) switches the
+/// path, and on each path the pixels on the X screen equal the headless image.
 #[test]
-fn c_key_switches_the_path_and_the_title_follows() {
+fn c_key_switches_the_path_the_title_follows_and_the_screen_equals_headless() {
     let x = Xvfb::start();
     let dir = scratch("window-c-key");
     for app in App::BOTH {
@@ -569,11 +570,42 @@ fn c_key_switches_the_path_and_the_title_follows() {
             "--validate",
         ];
         let mut child = x.spawn(&app.exe(), &args, &[SYNC_VALIDATION], &dir);
-        // xdotool's --name is a regular expression; --sync waits until a
-        // window's title matches, so each step waits for the title to show FPS.
-        let compute = format!("{api} compute — [0-9.]+ FPS");
-        let fragment = format!("{api} fragment — [0-9.]+ FPS");
-        let cmd = [
+        // xdotool's --name is a regular expression, and --sync waits until a
+        // title matches: FPS in the title means frames of that path were shown.
+        let mut step = |cmd: &[&str]| {
+            let xd = xdotool_retrying(&x, app, cmd);
+            if !xd.status.success() {
+                let _ = child.kill();
+                panic!(
+                    "{app:?}: xdotool {cmd:?} ({}): {}",
+                    xd.status,
+                    String::from_utf8_lossy(&xd.stderr)
+                );
+            }
+            String::from_utf8_lossy(&xd.stdout).into_owned()
+        };
+        let shown = |geometry: &str| {
+            // "Position: X,Y (screen: 0)"
+            let pos = geometry
+                .split("Position:")
+                .nth(1)
+                .and_then(|r| r.split_whitespace().next())
+                .unwrap_or_else(|| panic!("{app:?}: no position in {geometry}"));
+            let (px, py) = pos.split_once(',').unwrap();
+            x.screen(px.parse().unwrap(), py.parse().unwrap(), 64, 48)
+        };
+        // xdotool matches the title in the C locale, where "—" is no character: `.*`.
+        let compute = format!("^twinray .* box .* {api} compute .* [0-9.]+ FPS");
+        let fragment = format!("^twinray .* box .* {api} fragment .* [0-9.]+ FPS");
+        let on_compute = shown(&step(&[
+            "search",
+            "--sync",
+            "--name",
+            &compute,
+            "getwindowgeometry",
+            "%1",
+        ]));
+        step(&[
             "search",
             "--sync",
             "--name",
@@ -583,30 +615,35 @@ fn c_key_switches_the_path_and_the_title_follows() {
             "%1",
             "key",
             "c",
+        ]);
+        let on_fragment = shown(&step(&[
             "search",
             "--sync",
             "--name",
             &fragment,
+            "getwindowgeometry",
+            "%1",
+        ]));
+        step(&[
+            "search",
+            "--sync",
+            "--name",
+            "^twinray",
+            "windowfocus",
+            "--sync",
+            "%1",
             "key",
             "Escape",
-        ];
-        let xd = xdotool_retrying(&x, app, &cmd);
-        if !xd.status.success() {
-            let _ = child.kill();
-            let o = child.wait_with_output().unwrap();
-            panic!(
-                "{app:?}: no title '{compute}' then '{fragment}' ({}): {}\n{}",
-                xd.status,
-                String::from_utf8_lossy(&xd.stderr),
-                stderr(&o)
-            );
-        }
+        ]);
         let o = child.wait_with_output().unwrap();
         assert!(o.status.success(), "{app:?}: {}", stderr(&o));
         assert!(
-            stderr(&o).contains("path fragment"),
-            "{app:?}: {}",
-            stderr(&o)
+            on_compute == headless(app, "box", RenderPath::Compute, &dir),
+            "{app:?}: the compute window shows other pixels than --headless --path compute"
+        );
+        assert!(
+            on_fragment == headless(app, "box", RenderPath::Fragment, &dir),
+            "{app:?}: after C the window shows other pixels than --headless --path fragment"
         );
     }
 }

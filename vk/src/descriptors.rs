@@ -133,7 +133,7 @@ impl Descriptors {
                 }]
             })
             .collect();
-        let mut writes: Vec<_> = all
+        let writes: Vec<_> = all
             .iter()
             .zip(&infos)
             .map(|(&(b, ty, _), info)| {
