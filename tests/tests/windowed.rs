@@ -557,7 +557,13 @@ fn c_key_switches_the_path_the_title_follows_and_the_screen_equals_headless() {
             App::Vulkan => "Vulkan",
             App::OpenGl => "OpenGL",
         };
-        // A cap, not the plan: Escape ends the run (lavapipe leaks per frame).
+        // A cap, not the plan: Escape ends the run. It must outlast the
+        // steps below on a loaded machine (llvmpipe draws this window at
+        // ~100 FPS), yet stay bounded for lavapipe, which leaks per frame.
+        let cap = match app {
+            App::Vulkan => "1000",
+            App::OpenGl => "20000",
+        };
         let args = [
             "--path",
             "compute",
@@ -566,7 +572,7 @@ fn c_key_switches_the_path_the_title_follows_and_the_screen_equals_headless() {
             "--size",
             "64x48",
             "--frames",
-            "600",
+            cap,
             "--validate",
         ];
         let mut child = x.spawn(&app.exe(), &args, &[SYNC_VALIDATION], &dir);
