@@ -12,7 +12,7 @@
 //!
 //! `VkWindow` owns every object. Its fields are declared newest first, so Rust
 //! drops them in the reverse order of creation, which is the order Vulkan
-//! needs: frames, swapchain, scene, render pass, device, surface, instance,
+//! needs: frames, swapchain, the path's per-scene objects, render pass, device, surface, instance,
 //! and the window last of all (the surface refers to it).
 
 use crate::commands::Commands;
