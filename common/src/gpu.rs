@@ -175,11 +175,8 @@ impl GpuFrame {
 
 impl GpuScene {
     pub fn new(scene: &Scene, width: u32, height: u32) -> GpuScene {
-        let bvh = if scene.bvh {
-            crate::bvh::Bvh::build(scene)
-        } else {
-            crate::bvh::Bvh::default()
-        };
+        let empty = crate::bvh::Bvh::default();
+        let bvh = scene.bvh_tree().unwrap_or(&empty);
         GpuScene {
             frame: GpuFrame::new(scene, &scene.camera, width, height),
             spheres: scene
@@ -229,8 +226,8 @@ impl GpuScene {
                     ..Default::default()
                 })
                 .collect(),
-            bvh_nodes: bvh.nodes,
-            bvh_prims: bvh.prims,
+            bvh_nodes: bvh.nodes.clone(),
+            bvh_prims: bvh.prims.clone(),
         }
     }
 
