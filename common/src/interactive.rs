@@ -644,7 +644,14 @@ impl<R: Renderer> ApplicationHandler for Session<R> {
             }
             WindowEvent::Resized(size) => self.resize(size),
             WindowEvent::RedrawRequested => self.redraw(event_loop),
-            WindowEvent::KeyboardInput { event, .. } if event.state == ElementState::Pressed => {
+            // winit invents a press for each key held while the window gains
+            // focus (`is_synthetic`): a key pressed as the window was focused
+            // would act twice, and C would switch the path and back again.
+            WindowEvent::KeyboardInput {
+                event,
+                is_synthetic: false,
+                ..
+            } if event.state == ElementState::Pressed => {
                 match action_for_key(&event.logical_key) {
                     // Holding +/- repeats; holding a scene key would rebuild it over and over.
                     Some(a @ (Action::DepthUp | Action::DepthDown)) => self.act(event_loop, a),
