@@ -82,12 +82,22 @@ pub struct RenderArgs {
 pub enum Experiment {
     /// Keep naga's zero initialisers on function-local arrays.
     NagaZeroInit,
-    /// Keep naga's loop bounding (a 64-bit counter in every SPIR-V loop).
+    /// Keep naga's loop bounding (a 64-bit counter in every SPIR-V loop) on the BVH variants too.
     NagaLoopBounding,
-    /// Compute path: keep the BVH stack in local memory even where it fits in shared memory.
-    LocalBvhStack,
+    /// Drop naga's loop bounding from the brute-force variants too.
+    NoLoopBounding,
     /// Compute path: put the BVH stack in shared memory wherever it fits (the default keeps it local).
     SharedBvhStack,
+    /// Traverse the BVH without a stack (parent links), on both paths.
+    StacklessBvh,
+    /// One BVH stack entry per array element (uvec2) instead of two per uvec4.
+    UnpairedBvhStack,
+    /// Read the primitive and light counts from a storage buffer instead of
+    /// baking them into the shader.
+    StorageCounts,
+    /// Read the primitive and light counts from the Frame uniform instead of
+    /// baking them into the shader (what made lavapipe grow per frame).
+    UniformCounts,
 }
 
 impl Experiment {
@@ -95,8 +105,12 @@ impl Experiment {
         match self {
             Experiment::NagaZeroInit => "naga-zero-init",
             Experiment::NagaLoopBounding => "naga-loop-bounding",
-            Experiment::LocalBvhStack => "local-bvh-stack",
+            Experiment::NoLoopBounding => "no-loop-bounding",
             Experiment::SharedBvhStack => "shared-bvh-stack",
+            Experiment::UniformCounts => "uniform-counts",
+            Experiment::StacklessBvh => "stackless-bvh",
+            Experiment::UnpairedBvhStack => "unpaired-bvh-stack",
+            Experiment::StorageCounts => "storage-counts",
         }
     }
 }

@@ -135,6 +135,24 @@ impl Variant {
         v.experiments = args.experiment.clone();
         v.experiments.sort();
         v.experiments.dedup();
+        if v.defines.contains_key("USE_BVH") {
+            if v.experiments.contains(&Experiment::StacklessBvh) {
+                v.defines.insert("BVH_STACKLESS".into(), "1".into());
+            }
+            if v.experiments.contains(&Experiment::UnpairedBvhStack) {
+                v.defines.insert("BVH_STACK_UNPAIRED".into(), "1".into());
+            }
+        }
+        if v.experiments.contains(&Experiment::UniformCounts)
+            || v.experiments.contains(&Experiment::StorageCounts)
+        {
+            for k in ["SPHERE_COUNT", "TRIANGLE_COUNT", "LIGHT_COUNT"] {
+                v.defines.remove(k);
+            }
+        }
+        if v.experiments.contains(&Experiment::StorageCounts) {
+            v.defines.insert("COUNTS_FROM_STORAGE".into(), "1".into());
+        }
         v
     }
 
@@ -346,9 +364,7 @@ pub fn bvh_stack_in_shared_memory(variant: &Variant, workgroup: Workgroup) -> bo
         return false;
     };
     let bytes = entries * (workgroup.x * workgroup.y) as usize * 8;
-    variant.experiments.contains(&Experiment::SharedBvhStack)
-        && !variant.experiments.contains(&Experiment::LocalBvhStack)
-        && bytes <= SHARED_BVH_STACK_BUDGET
+    variant.experiments.contains(&Experiment::SharedBvhStack) && bytes <= SHARED_BVH_STACK_BUDGET
 }
 
 pub fn to_spirv(
@@ -362,12 +378,25 @@ pub fn to_spirv(
     //
     // naga's loop bounding gives every loop a 64-bit counter that breaks out
     // after 2^64 iterations, so that a driver cannot assume an infinite loop
-    // away. The GLSL writer adds no such counter, so it would be a cost only
-    // Vulkan pays; every loop of trace.glsl ends (the ray stack and the BVH
-    // stack shrink, the primitive loops count up to a constant).
+    // away; the GLSL writer adds none, so it is a cost only Vulkan pays. Every
+    // loop of trace.glsl ends (the stacks shrink, the primitive loops count up
+    // to a constant), so it is never needed for correctness. Measured on an
+    // H100 (comparison/results/nvidia-h100/FINDINGS.md), it costs the BVH
+    // variants 4-17 % in Vulkan and the box 7 %, but without it NVIDIA's
+    // Vulkan compiler, given the constant trip count of the brute-force sphere
+    // loop, made the 10,000-sphere list 1.7x slower (227 ms against 135). So the
+    // BVH variants go without it and the brute-force ones keep it, until the
+    // counts reach the shader in a way no driver specialises on.
+    let loop_bounding = if variant.experiments.contains(&Experiment::NagaLoopBounding) {
+        true
+    } else if variant.experiments.contains(&Experiment::NoLoopBounding) {
+        false
+    } else {
+        !variant.defines.contains_key("USE_BVH")
+    };
     let options = spv::Options {
         flags: spv::WriterFlags::LABEL_VARYINGS,
-        force_loop_bounding: variant.experiments.contains(&Experiment::NagaLoopBounding),
+        force_loop_bounding: loop_bounding,
         ..Default::default()
     };
     let pipeline = spv::PipelineOptions {
