@@ -32,11 +32,6 @@ pub fn run(args: RenderArgs, started: Instant) -> anyhow::Result<()> {
                 "--gl-spirv is a headless measurement option; run it with --headless",
             ));
         }
-        if args.path == RenderPath::Compute {
-            return Err(bad_input(
-                "--path compute runs headless only; add --headless",
-            ));
-        }
         return run_windowed(&args, started);
     }
     let scene = args.load_scene()?;

@@ -38,11 +38,6 @@ pub fn run(args: RenderArgs, process_start: Instant) -> Result<()> {
         ));
     }
     if !args.headless {
-        if args.path == RenderPath::Compute {
-            return Err(bad_input(
-                "--path compute runs headless only; add --headless",
-            ));
-        }
         return run_windowed(&args, process_start);
     }
     let scene = args.load_scene()?;
