@@ -82,14 +82,15 @@ impl<'gl> Compute<'gl> {
             width,
             height,
         };
-        this.storage();
+        this.storage()?;
         // SAFETY: the program is alive on the current context.
         unsafe { gl.use_program(Some(program)) };
         Ok(this)
     }
 
-    /// Gives the texture its storage and binds it to the shader's image unit.
-    fn storage(&self) {
+    /// Gives the texture its storage and binds it to the shader's image unit;
+    /// a size the driver cannot hold is bad input naming --size.
+    fn storage(&self) -> anyhow::Result<()> {
         // SAFETY: the texture is alive on the current context; sizes were checked.
         unsafe {
             let gl = self.gl;
@@ -102,7 +103,7 @@ impl<'gl> Compute<'gl> {
                 self.width as i32,
                 self.height as i32,
             );
-            crate::target::out_of_memory(gl, "storage image", width, height)?;
+            crate::target::out_of_memory(gl, "storage image", self.width, self.height)?;
             // WRITE_ONLY matches the shader's `writeonly`; the format its `rgba32f`.
             gl.bind_image_texture(
                 binding::IMAGE,
@@ -114,6 +115,7 @@ impl<'gl> Compute<'gl> {
                 glow::RGBA32F,
             );
         }
+        Ok(())
     }
 
     /// Windowed: a texture of the new size (storage is immutable, so a new
@@ -128,7 +130,7 @@ impl<'gl> Compute<'gl> {
         unsafe { gl.delete_texture(self.texture) };
         self.texture = texture;
         (self.width, self.height) = (width, height);
-        self.storage();
+        self.storage()?;
         if self.read_fbo.is_some() {
             self.attach()?;
         }
