@@ -91,8 +91,15 @@ fn quick_comparison_writes_every_api_experiment_and_point() {
         .split("## What the drivers compiled")
         .nth(1)
         .expect("the report has the drivers' section");
-    let rows = section.lines().filter(|l| l.starts_with("| ") && !l.starts_with("| scene")).count();
-    assert_eq!(rows, 4 * 2 * 2, "scene x accel (4) x path x API rows: {section}");
+    let rows = section
+        .lines()
+        .filter(|l| l.starts_with("| ") && !l.starts_with("| scene"))
+        .count();
+    assert_eq!(
+        rows,
+        4 * 2 * 2,
+        "scene x accel (4) x path x API rows: {section}"
+    );
     assert!(!section.contains("failed"), "{section}");
     for api in ["vulkan", "opengl"] {
         let dir = out.join(format!("shaders/teapot-bvh-{api}-compute"));
