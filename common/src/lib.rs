@@ -13,6 +13,7 @@ pub mod image_io;
 pub mod interactive;
 pub mod metrics;
 pub mod numerics;
+pub mod random_scene;
 pub mod reference;
 pub mod report;
 pub mod scene;

@@ -2,10 +2,11 @@
 //! rayon task. Same ray stack, same push order, same offsets and tests — the
 //! shader's compile-time numerical choices (numerics.rs) are run-time branches
 //! here — so the GPU images differ from it only by f32 arithmetic.
-//! It traces the scene as the GPU holds it (inputs rounded to f32, see
-//! `Scene::rounded_to_f32`). Change both together.
+//! It traces the scene as the GPU holds it (in the local frame of
+//! `camera::in_local_frame`, inputs rounded to f32, see `Scene::rounded_to_f32`).
+//! Change both together.
 
-use crate::camera::RayFrame;
+use crate::camera::{in_local_frame, RayFrame};
 use crate::image_io::FloatImage;
 use crate::numerics::{Numerics, Offset, SphereTest, TriangleTest};
 use crate::scene::{Scene, Sphere, Triangle};
@@ -23,9 +24,10 @@ pub fn render(scene: &Scene, width: u32, height: u32) -> FloatImage {
 
 /// Renders `scene` with the given numerical choices instead of the scene's.
 pub fn render_with(scene: &Scene, width: u32, height: u32, numerics: &Numerics) -> FloatImage {
-    let mut scene = scene.rounded_to_f32();
+    // The GPU's frame: positions relative to the local origin, then rounded to f32.
+    let frame = RayFrame::local(scene, &scene.camera, width, height).rounded_to_f32();
+    let mut scene = in_local_frame(scene).rounded_to_f32();
     scene.numerics = *numerics;
-    let frame = RayFrame::new(&scene.camera, width, height).rounded_to_f32();
     let pixels: Vec<[f32; 3]> = (0..width * height)
         .into_par_iter()
         .map(|i| {

@@ -32,6 +32,7 @@ pub const OVERRIDE_KEYS: &[&str] = &[
     "offset",
     "triangle",
     "sphere",
+    "origin",
 ];
 
 /// The finest `tessellation` accepted per direction (400 x 400 quads per patch is
@@ -99,6 +100,8 @@ struct RenderDef {
     offset: Option<String>,
     triangle: Option<String>,
     sphere: Option<String>,
+    /// `local` (default) or `world`: see `camera::local_origin`.
+    origin: Option<String>,
 }
 
 impl Default for RenderDef {
@@ -111,6 +114,7 @@ impl Default for RenderDef {
             offset: None,
             triangle: None,
             sphere: None,
+            origin: None,
         }
     }
 }
@@ -273,6 +277,8 @@ pub struct Scene {
     pub epsilon: f64,
     /// Secondary-ray offset, triangle and sphere tests: the shader variant and the reference follow it.
     pub numerics: Numerics,
+    /// Where the GPU's f32 coordinates are measured from (camera.rs, `local_origin`).
+    pub origin: crate::camera::OriginMode,
     pub materials: Vec<Material>,
     pub lights: Vec<Light>,
     pub spheres: Vec<Sphere>,
@@ -315,6 +321,16 @@ enum FileSource {
 impl Scene {
     /// Loads a built-in scene by name, or a scene file by path, and applies `--set` overrides.
     pub fn load(name_or_path: &str, overrides: &[(String, String)]) -> anyhow::Result<Scene> {
+        if let Some(seed) = crate::random_scene::seed_of(name_or_path) {
+            let seed = seed?;
+            return Scene::parse(
+                &format!("random-{seed}"),
+                &crate::random_scene::toml(seed),
+                &format!("random scene {seed}"),
+                FileSource::Builtin,
+                overrides,
+            );
+        }
         if let Some((name, text)) = BUILTIN_SCENES.iter().find(|(n, _)| *n == name_or_path) {
             return Scene::parse(
                 name,
@@ -530,6 +546,10 @@ fn apply_overrides(def: &mut SceneFile, overrides: &[(String, String)]) -> anyho
                     _ => def.render.sphere = Some(value.clone()),
                 }
             }
+            "origin" => {
+                crate::camera::OriginMode::parse(value, "--set origin")?;
+                def.render.origin = Some(value.clone());
+            }
             "extra_spheres" => {
                 let n = int(MAX_EXTRA_SPHERES)?;
                 match def.extra_spheres.as_mut() {
@@ -625,6 +645,11 @@ fn resolve(name: &str, def: SceneFile, origin: &str, files: &FileSource) -> anyh
             numerics.set(key, v, &format!("{origin}: render.{key}"))?;
         }
     }
+
+    let origin_mode = match &r.origin {
+        Some(v) => crate::camera::OriginMode::parse(v, &format!("{origin}: render.origin"))?,
+        None => Default::default(),
+    };
 
     if def.materials.is_empty() {
         return Err(bad_input(format!(
@@ -832,6 +857,7 @@ fn resolve(name: &str, def: SceneFile, origin: &str, files: &FileSource) -> anyh
         min_weight,
         epsilon,
         numerics,
+        origin: origin_mode,
         materials,
         lights,
         bvh: spheres.len() + triangles.len() >= AUTO_BVH_MIN_PRIMITIVES,

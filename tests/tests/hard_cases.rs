@@ -95,6 +95,10 @@ fn far_1e6() {
     check("far-1e6");
 }
 #[test]
+fn far_1e7() {
+    check("far-1e7");
+}
+#[test]
 fn tiny_1e_3() {
     check("tiny-1e-3");
 }
