@@ -12,15 +12,18 @@ use std::fmt::Write as _;
 /// `--scene random:SEED` (SEED a whole number).
 pub const PREFIX: &str = "random:";
 
-/// The most pixels per image that may be off by more than 8/255
-/// between two renders of a random scene (Vulkan, OpenGL, the f64 reference),
-/// as a share. Random glass paths bounce up to eight times, and a ray that
-/// grazes an edge or a silhouette may take the other side in f32, so a few
-/// pixels per scene may differ by much; more is a bug, not rounding.
-pub const MAX_OFF_SHARE: f64 = 0.005;
+/// The most pixels per image that may be off by more than 8/255 between two
+/// renders of a random scene (Vulkan, OpenGL, the f64 reference), as a share.
+/// On lavapipe and llvmpipe 20 seeds at 48x36 measured 0; a ray that grazes
+/// an edge or a glass silhouette may take the other side in f32 on another
+/// driver (an NVIDIA GPU's Vulkan and OpenGL differ on 0.1% of the box
+/// scene's pixels, at its glass sphere's rim), so 3 of 1728 pixels may.
+pub const MAX_OFF_SHARE: f64 = 0.002;
 
-/// The least share of pixels within 1/255 between two renders of a random scene.
-pub const MIN_WITHIN_1: f64 = 0.98;
+/// The least share of pixels within 1/255 between two renders of a random
+/// scene: the worst of 20 seeds x 3 pairs on lavapipe and llvmpipe measured
+/// 99.65%; this allows twice that shortfall.
+pub const MIN_WITHIN_1: f64 = 0.993;
 
 /// Why two renders of a random scene disagree beyond the thresholds, or `None`.
 pub fn disagreement(m: &crate::metrics::Metrics) -> Option<String> {
@@ -45,11 +48,17 @@ pub fn disagreement(m: &crate::metrics::Metrics) -> Option<String> {
     (!why.is_empty()).then(|| why.join(", "))
 }
 
-/// The commands that reproduce a seed's three renders and their comparison.
-pub fn reproduce(seed: u64, width: u32, height: u32) -> String {
+/// The commands that reproduce a seed's three renders and their comparison;
+/// `extra` holds the apps' further options (e.g. `--generic`).
+pub fn reproduce(seed: u64, width: u32, height: u32, extra: &str) -> String {
     let a = format!("--scene random:{seed} --size {width}x{height}");
+    let x = if extra.is_empty() {
+        String::new()
+    } else {
+        format!(" {extra}")
+    };
     format!(
-        "twinray-vk --headless {a} --out vk.png && twinray-gl --headless {a} --out gl.png && \
+        "twinray-vk --headless {a}{x} --out vk.png && twinray-gl --headless {a}{x} --out gl.png && \
          twinray render --api reference {a} --out ref.png && twinray diff vk.png ref.png && \
          twinray diff gl.png ref.png && twinray diff vk.png gl.png"
     )

@@ -120,7 +120,7 @@ fn run_random(n: u64, size: Size, out: &Path) -> anyhow::Result<Vec<RandomRow>> 
             if let Some(why) = bad {
                 eprintln!(
                     "  random:{seed} {pair}: {why}\n  reproduce: {}",
-                    random_scene::reproduce(seed, size.width, size.height)
+                    random_scene::reproduce(seed, size.width, size.height, "")
                 );
             }
             rows.push(RandomRow { seed, pair, result });
@@ -220,7 +220,7 @@ fn random_markdown(rows: &[RandomRow], size: Size) -> String {
                     Ok(m) => random_scene::disagreement(m).unwrap_or_default(),
                     Err(e) => e.replace('\n', " "),
                 },
-                random_scene::reproduce(r.seed, size.width, size.height)
+                random_scene::reproduce(r.seed, size.width, size.height, "")
             ));
         }
         let _ = writeln!(

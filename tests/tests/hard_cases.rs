@@ -116,6 +116,11 @@ fn thin_tubes_have_no_shadow_acne() {
 }
 
 #[test]
+fn small_spheres_have_no_shadow_acne() {
+    check("small-spheres");
+}
+
+#[test]
 fn grazing() {
     check("grazing");
 }
