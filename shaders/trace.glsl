@@ -8,6 +8,11 @@
 // common/src/shader.rs: HAS_SPHERES, HAS_TRIANGLES, HAS_MIRROR, HAS_GLASS,
 // and STACK_SIZE (the ray stack: max_depth + 1 with glass, else 1).
 //
+// The primitive and light counts are defines too (SPHERE_COUNT, TRIANGLE_COUNT,
+// LIGHT_COUNT): they bound the loops, and a loop bound read from
+// a uniform made Mesa's lavapipe compile and keep a new copy of the shader at
+// every draw (about 3 MB a frame). The scene's variant knows them anyway.
+//
 // Numerical choices are defines too (common/src/numerics.rs), one of each:
 //   OFFSET_RAY | OFFSET_NORMAL | OFFSET_NORMAL_SCALED | OFFSET_ULP | OFFSET_SCALE_AWARE  (secondary-ray origin)
 //   TRIANGLE_MOLLER_TRUMBORE | TRIANGLE_WATERTIGHT                    (ray-triangle test)
@@ -95,7 +100,7 @@ layout(std140, set = 0, binding = 0) uniform Frame {
     vec3 step_x;
     uint max_depth;
     vec3 step_y;
-    uint sphere_count;
+    uint sphere_count;    // read only where SPHERE_COUNT is not given (see below)
     vec3 background;
     uint triangle_count;
     uint light_count;
@@ -103,6 +108,14 @@ layout(std140, set = 0, binding = 0) uniform Frame {
     uint height;
     uint pad;
 } frame;
+
+// Every variant an app runs bakes the counts in (shader.rs, Variant::chosen);
+// only the scene-independent generic variant of the tests reads them here.
+#ifndef SPHERE_COUNT
+#define SPHERE_COUNT frame.sphere_count
+#define TRIANGLE_COUNT frame.triangle_count
+#define LIGHT_COUNT frame.light_count
+#endif
 
 layout(std430, set = 0, binding = 1) readonly buffer Spheres {
     Sphere spheres[];
@@ -306,7 +319,7 @@ struct Hit {
 #define PRIMS_PER_ITERATION 4u
 
 void closest_sphere(inout Hit h, vec3 origin, vec3 dir, uint i) {
-    if (i < frame.sphere_count) {
+    if (i < SPHERE_COUNT) {
         float t = hit_sphere(origin, dir, sphere_buf.spheres[i], 0.0, h.t);
         if (t > 0.0) {
             h.t = t;
@@ -317,7 +330,7 @@ void closest_sphere(inout Hit h, vec3 origin, vec3 dir, uint i) {
 }
 
 void closest_triangle(inout Hit h, TriRay ray, uint i) {
-    if (i < frame.triangle_count) {
+    if (i < TRIANGLE_COUNT) {
         vec3 r = hit_triangle(ray, triangle_buf.triangles[i], 0.0, h.t);
         if (r.x > 0.0) {
             h.t = r.x;
@@ -330,10 +343,23 @@ void closest_triangle(inout Hit h, TriRay ray, uint i) {
 }
 
 #ifdef USE_BVH
-#ifndef BVH_STACK
-#define BVH_STACK 64
-#endif
 const uint SPHERE_BIT = 0x80000000u;
+
+// The traversal stack holds the far children still to visit, each packed as
+// uvec2(node, floatBitsToUint(entry t)): one array instead of two halves the
+// slots NVIDIA's OpenGL compiler gives it (a whole 16-byte slot per scalar
+// element). BVH_STACK is the built tree's depth - 1 (common/src/shader.rs):
+// the traversal pushes at most one child per level of the current path, so no
+// push is ever dropped and no slot is wasted.
+//
+// BVH_STACK_SHARED (compute only, when it fits) keeps the stack in shared
+// memory instead, entry-major so that a warp's pushes hit distinct banks.
+#ifdef BVH_STACK_SHARED
+shared uvec2 bvh_stack[BVH_STACK * WG_X * WG_Y];
+#define BVH_STACK_AT(i) bvh_stack[(i) * uint(WG_X * WG_Y) + gl_LocalInvocationIndex]
+#else
+#define BVH_STACK_AT(i) stack[i]
+#endif
 
 // Where the ray enters the box, or -1 if it misses it before t_max. Zero
 // direction components are nudged so 0 * inf never makes a NaN.
@@ -364,9 +390,10 @@ Hit traverse(vec3 origin, vec3 dir, float t_max, bool any_hit) {
     h.v = 0.0;
     vec3 inv_dir = inverse_dir(dir);
     TriRay ray = tri_ray(origin, dir);
-    uint stack_node[BVH_STACK];
-    float stack_t[BVH_STACK];
-    int sp = 0;
+#ifndef BVH_STACK_SHARED
+    uvec2 stack[BVH_STACK];
+#endif
+    uint sp = 0u;
     if (enter_box(origin, inv_dir, 0u, t_max) < 0.0) {
         return h;
     }
@@ -407,11 +434,9 @@ Hit traverse(vec3 origin, vec3 dir, float t_max, bool any_hit) {
             if (tl >= 0.0 && tr >= 0.0) {
                 bool left_first = tl <= tr;
                 node = left_first ? left : right;
-                if (sp < BVH_STACK) {
-                    stack_node[sp] = left_first ? right : left;
-                    stack_t[sp] = left_first ? tr : tl;
-                    sp += 1;
-                }
+                // sp < BVH_STACK here: the stack is as deep as the tree.
+                BVH_STACK_AT(sp) = uvec2(left_first ? right : left, floatBitsToUint(left_first ? tr : tl));
+                sp += 1u;
                 continue;
             }
             if (tl >= 0.0) {
@@ -425,10 +450,11 @@ Hit traverse(vec3 origin, vec3 dir, float t_max, bool any_hit) {
         }
         // Pop the nearest pending subtree that can still hold a closer hit.
         bool found = false;
-        while (sp > 0 && !found) {
-            sp -= 1;
-            if (stack_t[sp] < h.t) {
-                node = stack_node[sp];
+        while (sp > 0u && !found) {
+            sp -= 1u;
+            uvec2 entry = BVH_STACK_AT(sp);
+            if (uintBitsToFloat(entry.y) < h.t) {
+                node = entry.x;
                 found = true;
             }
         }
@@ -449,7 +475,7 @@ Hit closest_hit_brute(vec3 origin, vec3 dir) {
     h.v = 0.0;
 #ifdef HAS_SPHERES
     SPEC(SPEC_SPHERES) {
-        for (uint i = 0u; i < frame.sphere_count; i += PRIMS_PER_ITERATION) {
+        for (uint i = 0u; i < SPHERE_COUNT; i += PRIMS_PER_ITERATION) {
             closest_sphere(h, origin, dir, i);
             closest_sphere(h, origin, dir, i + 1u);
             closest_sphere(h, origin, dir, i + 2u);
@@ -460,7 +486,7 @@ Hit closest_hit_brute(vec3 origin, vec3 dir) {
 #ifdef HAS_TRIANGLES
     SPEC(SPEC_TRIANGLES) {
         TriRay ray = tri_ray(origin, dir);
-        for (uint i = 0u; i < frame.triangle_count; i += PRIMS_PER_ITERATION) {
+        for (uint i = 0u; i < TRIANGLE_COUNT; i += PRIMS_PER_ITERATION) {
             closest_triangle(h, ray, i);
             closest_triangle(h, ray, i + 1u);
             closest_triangle(h, ray, i + 2u);
@@ -472,18 +498,18 @@ Hit closest_hit_brute(vec3 origin, vec3 dir) {
 }
 
 bool sphere_blocks(vec3 origin, vec3 dir, float dist, uint i) {
-    return i < frame.sphere_count && hit_sphere(origin, dir, sphere_buf.spheres[i], 0.0, dist) > 0.0;
+    return i < SPHERE_COUNT && hit_sphere(origin, dir, sphere_buf.spheres[i], 0.0, dist) > 0.0;
 }
 
 bool triangle_blocks(TriRay ray, float dist, uint i) {
-    return i < frame.triangle_count && hit_triangle(ray, triangle_buf.triangles[i], 0.0, dist).x > 0.0;
+    return i < TRIANGLE_COUNT && hit_triangle(ray, triangle_buf.triangles[i], 0.0, dist).x > 0.0;
 }
 
 // Shadow rays need any hit before the light, not the closest one.
 bool occluded_brute(vec3 origin, vec3 dir, float dist) {
 #ifdef HAS_SPHERES
     SPEC(SPEC_SPHERES) {
-        for (uint i = 0u; i < frame.sphere_count; i += PRIMS_PER_ITERATION) {
+        for (uint i = 0u; i < SPHERE_COUNT; i += PRIMS_PER_ITERATION) {
             if (sphere_blocks(origin, dir, dist, i) || sphere_blocks(origin, dir, dist, i + 1u)
                 || sphere_blocks(origin, dir, dist, i + 2u) || sphere_blocks(origin, dir, dist, i + 3u)) {
                 return true;
@@ -494,7 +520,7 @@ bool occluded_brute(vec3 origin, vec3 dir, float dist) {
 #ifdef HAS_TRIANGLES
     SPEC(SPEC_TRIANGLES) {
         TriRay ray = tri_ray(origin, dir);
-        for (uint i = 0u; i < frame.triangle_count; i += PRIMS_PER_ITERATION) {
+        for (uint i = 0u; i < TRIANGLE_COUNT; i += PRIMS_PER_ITERATION) {
             if (triangle_blocks(ray, dist, i) || triangle_blocks(ray, dist, i + 1u)
                 || triangle_blocks(ray, dist, i + 2u) || triangle_blocks(ray, dist, i + 3u)) {
                 return true;
@@ -662,7 +688,7 @@ vec3 trace(vec3 origin, vec3 dir) {
         Material m = material_buf.materials[mat_index];
 
         vec3 local = m.ambient;
-        for (uint li = 0u; li < frame.light_count; li++) {
+        for (uint li = 0u; li < LIGHT_COUNT; li++) {
             Light light = light_buf.lights[li];
             // The offset may depend on the direction (OFFSET_RAY): aim from p first.
             vec3 p_out = spawn_point(p, ng, normalize(light.position - p), scale);

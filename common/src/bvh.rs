@@ -93,6 +93,14 @@ impl Bvh {
         bvh
     }
 
+    /// The traversal stack this tree needs (the shader's BVH_STACK): the
+    /// traversal pushes at most one far child per interior level of the path
+    /// it is on, so depth - 1 entries always suffice. At least 1, as GLSL has
+    /// no empty arrays.
+    pub fn stack_entries(&self) -> u32 {
+        self.depth.saturating_sub(1).max(1)
+    }
+
     /// Bytes on the GPU: nodes plus the leaf primitive list.
     pub fn bytes(&self) -> usize {
         std::mem::size_of_val(self.nodes.as_slice()) + std::mem::size_of_val(self.prims.as_slice())

@@ -62,6 +62,50 @@ pub struct RenderArgs {
     /// Compute path only: the workgroup size WxH (e.g. 8x8, 16x8, 16x16) [default: 16x8].
     #[arg(long, value_name = "WxH", value_parser = parse_workgroup)]
     pub workgroup: Option<Workgroup>,
+    /// For experiments only (repeatable): put back a cost the shader build
+    /// removes, or move the compute path's BVH stack, to measure its effect.
+    #[arg(long, value_enum, value_name = "NAME")]
+    pub experiment: Vec<Experiment>,
+    /// Write the shaders this run compiles (naga's SPIR-V and GLSL) and what
+    /// the driver reports of them (OpenGL's program binary, Vulkan's pipeline
+    /// executable statistics where offered) into this folder.
+    #[arg(long, value_name = "DIR")]
+    pub dump_shaders: Option<PathBuf>,
+}
+/// Knobs that put back what the build normally removes, so that each removal's
+/// effect can be measured in both APIs (`--experiment`, for the comparison's
+/// investigation; never needed to render correctly).
+#[derive(
+    Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Hash, clap::ValueEnum, serde::Serialize,
+)]
+#[serde(rename_all = "kebab-case")]
+pub enum Experiment {
+    /// Keep naga's zero initialisers on function-local arrays.
+    NagaZeroInit,
+    /// Keep naga's loop bounding (a 64-bit counter in every SPIR-V loop) on the BVH variants too.
+    NagaLoopBounding,
+    /// Drop naga's loop bounding from the brute-force variants too.
+    NoLoopBounding,
+    /// Compute path: keep the BVH stack in local memory even where it fits in shared memory.
+    LocalBvhStack,
+    /// Compute path: put the BVH stack in shared memory wherever it fits (the default keeps it local).
+    SharedBvhStack,
+    /// Read the primitive and light counts from the Frame uniform instead of
+    /// baking them into the shader (what made lavapipe grow per frame).
+    UniformCounts,
+}
+
+impl Experiment {
+    pub fn name(self) -> &'static str {
+        match self {
+            Experiment::NagaZeroInit => "naga-zero-init",
+            Experiment::NagaLoopBounding => "naga-loop-bounding",
+            Experiment::NoLoopBounding => "no-loop-bounding",
+            Experiment::LocalBvhStack => "local-bvh-stack",
+            Experiment::SharedBvhStack => "shared-bvh-stack",
+            Experiment::UniformCounts => "uniform-counts",
+        }
+    }
 }
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
@@ -219,6 +263,8 @@ impl RenderArgs {
             explain: false,
             path: RenderPath::Fragment,
             workgroup: None,
+            experiment: Vec::new(),
+            dump_shaders: None,
         }
     }
 

@@ -177,15 +177,13 @@ impl GpuFrame {
 
 impl GpuScene {
     /// The buffers of `scene` in its local frame: positions have the local origin
-    /// subtracted in f64 before they become f32, and the BVH is built over those
-    /// translated primitives, so its boxes are rounded in the same frame.
+    /// subtracted in f64 before they become f32, and the BVH (`Scene::bvh_tree`)
+    /// is built over those translated primitives, so its boxes are rounded in
+    /// the same frame.
     pub fn new(world: &Scene, width: u32, height: u32) -> GpuScene {
         let scene = &*in_local_frame(world);
-        let bvh = if scene.bvh {
-            crate::bvh::Bvh::build(scene)
-        } else {
-            crate::bvh::Bvh::default()
-        };
+        let empty = crate::bvh::Bvh::default();
+        let bvh = world.bvh_tree().unwrap_or(&empty);
         GpuScene {
             frame: GpuFrame::new(world, &world.camera, width, height),
             spheres: scene
@@ -235,8 +233,8 @@ impl GpuScene {
                     ..Default::default()
                 })
                 .collect(),
-            bvh_nodes: bvh.nodes,
-            bvh_prims: bvh.prims,
+            bvh_nodes: bvh.nodes.clone(),
+            bvh_prims: bvh.prims.clone(),
         }
     }
 

@@ -151,7 +151,7 @@ pub fn window_attributes(args: &RenderArgs, scene: &str, api: &str) -> WindowAtt
 
 /// The scene and variant a windowed run starts with (the same choice as headless).
 pub fn variant_for(args: &RenderArgs, scene: &Scene) -> Variant {
-    Variant::chosen(scene, args.generic, args.specialize)
+    Variant::chosen(scene, args)
 }
 
 /// What the run did, for `--json`.
@@ -686,6 +686,20 @@ mod tests {
             !flat.covers(&shallow),
             "depth 1 compiles mirror and glass out"
         );
-        assert!(Variant::generic(Default::default()).covers(&deep));
+        let mut generic = crate::cli::RenderArgs::headless("box", scene_size());
+        generic.generic = true;
+        assert!(Variant::chosen(&scene, &generic).covers(&deep));
+        let teapot = Scene::load("teapot", &[]).unwrap();
+        assert!(
+            !Variant::chosen(&teapot, &generic).covers(&deep),
+            "the counts are baked in: another scene's shader cannot draw this one"
+        );
+    }
+
+    fn scene_size() -> crate::cli::Size {
+        crate::cli::Size {
+            width: 8,
+            height: 8,
+        }
     }
 }

@@ -42,6 +42,21 @@ pub struct RunReport {
     pub setup_ms: f64,
     /// Messages from the validation layer / GL debug output (errors and warnings).
     pub validation_messages: u64,
+    /// With `--dump-shaders`: what the driver reported of the compiled tracer
+    /// (Vulkan's pipeline executable statistics, OpenGL's program binary).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub shader_stats: Vec<ShaderStats>,
+}
+
+/// One compiled stage and the figures its driver gives for it, as the driver
+/// names them (registers, local memory, instructions...).
+#[derive(Debug, Clone, Serialize, Deserialize)]
+pub struct ShaderStats {
+    /// "graphics", "compute" or "program".
+    pub pipeline: String,
+    /// The driver's name for the stage ("Fragment Shader", "NV assembly"...).
+    pub stage: String,
+    pub statistics: Vec<(String, String)>,
 }
 
 /// What an app says about its device.
@@ -84,6 +99,7 @@ impl RunReport {
             nonfinite_pixels: 0,
             setup_ms,
             validation_messages: 0,
+            shader_stats: Vec::new(),
         };
         report.summarise();
         report
@@ -104,6 +120,34 @@ impl RunReport {
         let gpu: Option<Vec<f64>> = self.frames.iter().map(|f| f.gpu_ms).collect();
         self.gpu_ms = gpu.and_then(|g| summarize(&g));
     }
+}
+
+/// Writes what `--dump-shaders DIR` promises of naga's output: the SPIR-V and
+/// the GLSL of each stage this run compiled, named `<stage>.spv` and
+/// `<stage>.glsl` (the apps add what their driver reports).
+pub fn dump_shaders(dir: &std::path::Path, stages: &[(&str, &[u32], &str)]) -> anyhow::Result<()> {
+    use anyhow::Context;
+    std::fs::create_dir_all(dir)
+        .with_context(|| format!("--dump-shaders: cannot create '{}'", dir.display()))?;
+    for (stage, spirv, glsl) in stages {
+        let write = |name: String, bytes: &[u8]| {
+            let path = dir.join(name);
+            std::fs::write(&path, bytes)
+                .with_context(|| format!("--dump-shaders: cannot write '{}'", path.display()))
+        };
+        write(format!("{stage}.spv"), bytemuck::cast_slice(spirv))?;
+        write(format!("{stage}.glsl"), glsl.as_bytes())?;
+    }
+    Ok(())
+}
+
+/// Writes the driver's figures beside the dumped shaders as `statistics.json`.
+pub fn dump_statistics(dir: &std::path::Path, stats: &[ShaderStats]) -> anyhow::Result<()> {
+    use anyhow::Context;
+    let path = dir.join("statistics.json");
+    let text = serde_json::to_string_pretty(stats).context("serialising shader statistics")?;
+    std::fs::write(&path, text)
+        .with_context(|| format!("--dump-shaders: cannot write '{}'", path.display()))
 }
 
 /// "Debian GNU/Linux 12 (bookworm), Linux 6.1" — for reports.

@@ -286,6 +286,31 @@ pub struct Scene {
     /// Trace through a BVH (common/src/bvh.rs) instead of testing every primitive.
     /// `--accel` decides; `auto` (the default) uses one from `AUTO_BVH_MIN_PRIMITIVES` on.
     pub bvh: bool,
+    /// The BVH once built (`bvh_tree`): both the shader variant (its stack
+    /// depth) and the GPU buffers need it, and building it twice costs seconds
+    /// for a million triangles.
+    bvh_cache: BvhCache,
+}
+
+/// A built BVH carried with its scene. Derived data, not part of the scene's
+/// identity: two scenes compare equal whether or not either was built.
+#[derive(Clone, Default)]
+struct BvhCache(std::sync::OnceLock<std::sync::Arc<crate::bvh::Bvh>>);
+
+impl PartialEq for BvhCache {
+    fn eq(&self, _: &BvhCache) -> bool {
+        true
+    }
+}
+
+impl std::fmt::Debug for BvhCache {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(if self.0.get().is_some() {
+            "built"
+        } else {
+            "not built"
+        })
+    }
 }
 
 /// `--accel auto` builds a BVH for scenes with at least this many primitives.
@@ -422,8 +447,25 @@ impl Scene {
         self.spheres.len() + self.triangles.len()
     }
 
+    /// The scene's BVH where it traces through one (built on first use, then
+    /// kept). Primitives changed after that call would not be seen: scenes are
+    /// not edited once loaded, except for `--accel` and the ray depth.
+    pub fn bvh_tree(&self) -> Option<&crate::bvh::Bvh> {
+        self.bvh.then(|| {
+            &**self
+                .bvh_cache
+                .0
+                // Over the primitives as the GPU holds them: relative to the local origin.
+                .get_or_init(|| {
+                    let local = crate::camera::in_local_frame(self);
+                    std::sync::Arc::new(crate::bvh::Bvh::build(&local))
+                })
+        })
+    }
+
     /// Applies `--accel` (none: brute force; bvh: a BVH; auto: a BVH from the threshold on).
     pub fn set_accel(&mut self, accel: crate::cli::Accel) {
+        self.bvh_cache = BvhCache::default();
         self.bvh = match accel {
             crate::cli::Accel::None => false,
             crate::cli::Accel::Bvh => self.primitive_count() > 0,
@@ -440,6 +482,7 @@ impl Scene {
         let r = |x: f64| x as f32 as f64;
         let v = |x: DVec3| x.as_vec3().as_dvec3();
         let mut s = self.clone();
+        s.bvh_cache = BvhCache::default();
         s.background = v(s.background);
         s.min_weight = r(s.min_weight);
         s.epsilon = r(s.epsilon);
@@ -861,6 +904,7 @@ fn resolve(name: &str, def: SceneFile, origin: &str, files: &FileSource) -> anyh
         materials,
         lights,
         bvh: spheres.len() + triangles.len() >= AUTO_BVH_MIN_PRIMITIVES,
+        bvh_cache: BvhCache::default(),
         spheres,
         triangles,
     })

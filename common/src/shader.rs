@@ -2,9 +2,10 @@
 //! scene's variant through defines (or, for comparison, through specialization
 //! constants that naga's process_overrides fixes), validates the naga module
 //! once, and writes SPIR-V for Vulkan and GLSL 450 core for OpenGL from that
-//! same module.
+//! same module — then takes out two costs naga adds on its own (see
+//! `strip_local_array_zero_init` and `spv::Options::force_loop_bounding`).
 
-use crate::cli::Workgroup;
+use crate::cli::{Experiment, RenderArgs, Workgroup};
 use crate::numerics::Numerics;
 use crate::scene::{Features, Scene, MAX_DEPTH_LIMIT};
 use anyhow::{anyhow, Context};
@@ -22,11 +23,13 @@ pub const TRACE_COMP: &str = include_str!("../../shaders/trace.comp");
 /// in both APIs. `numerics` is what its numerical defines encode, kept so that
 /// the reference can be asked to take the same choices. `constants` are the
 /// specialization constants of `Variant::specialized` (empty otherwise).
+/// `experiments` undo the build's own optimisations, to measure them.
 #[derive(Debug, Clone, PartialEq, Eq, serde::Serialize)]
 pub struct Variant {
     pub defines: BTreeMap<String, String>,
     pub numerics: Numerics,
     pub constants: BTreeMap<String, bool>,
+    pub experiments: Vec<Experiment>,
 }
 
 /// The feature switches trace.glsl declares with `layout(constant_id = N)`
@@ -45,10 +48,23 @@ impl Variant {
     /// and the scene's numerical choices (offset, triangle and sphere tests).
     pub fn for_scene(scene: &Scene) -> Variant {
         let mut v = Variant::from_features(scene.features(), scene.max_depth, scene.numerics);
-        if scene.bvh {
-            v.defines.insert("USE_BVH".into(), "1".into());
-        }
+        v.add_scene_data(scene);
         v
+    }
+
+    /// What every variant built for one scene bakes in: the primitive and light
+    /// counts that bound the shader's loops (a bound read from a uniform made
+    /// lavapipe compile and keep a new shader at every draw), and, with a BVH,
+    /// a traversal stack exactly as deep as the built tree needs.
+    fn add_scene_data(&mut self, scene: &Scene) {
+        let mut set = |k: &str, v: String| self.defines.insert(k.to_string(), v);
+        set("SPHERE_COUNT", format!("{}u", scene.spheres.len()));
+        set("TRIANGLE_COUNT", format!("{}u", scene.triangles.len()));
+        set("LIGHT_COUNT", format!("{}u", scene.lights.len()));
+        if let Some(bvh) = scene.bvh_tree() {
+            set("USE_BVH", "1".into());
+            set("BVH_STACK", bvh.stack_entries().to_string());
+        }
     }
 
     pub fn from_features(f: Features, max_depth: u32, numerics: Numerics) -> Variant {
@@ -75,6 +91,7 @@ impl Variant {
             defines,
             numerics,
             constants: BTreeMap::new(),
+            experiments: Vec::new(),
         }
     }
 
@@ -90,9 +107,7 @@ impl Variant {
         // trace.glsl defines every HAS_* itself under SPECIALIZE.
         v.defines.retain(|k, _| !k.starts_with("HAS_"));
         v.defines.insert("SPECIALIZE".into(), "1".into());
-        if scene.bvh {
-            v.defines.insert("USE_BVH".into(), "1".into());
-        }
+        v.add_scene_data(scene);
         let f = scene.features();
         for ((name, _), on) in
             SPEC_CONSTANTS
@@ -105,22 +120,32 @@ impl Variant {
     }
 
     /// The variant the apps render: `--generic`, `--specialize` or the scene's
-    /// own; each traces through the BVH when the scene has one.
-    pub fn chosen(scene: &Scene, generic: bool, specialize: bool) -> Variant {
-        if generic {
+    /// own; each traces through the BVH when the scene has one. The one place
+    /// both apps (and the windowed ones) choose what to compile.
+    pub fn chosen(scene: &Scene, args: &RenderArgs) -> Variant {
+        let mut v = if args.generic {
             let mut v = Variant::generic(scene.numerics);
-            if scene.bvh {
-                v.defines.insert("USE_BVH".into(), "1".into());
-            }
+            v.add_scene_data(scene);
             v
-        } else if specialize {
+        } else if args.specialize {
             Variant::specialized(scene)
         } else {
             Variant::for_scene(scene)
+        };
+        v.experiments = args.experiment.clone();
+        v.experiments.sort();
+        v.experiments.dedup();
+        if v.experiments.contains(&Experiment::UniformCounts) {
+            for k in ["SPHERE_COUNT", "TRIANGLE_COUNT", "LIGHT_COUNT"] {
+                v.defines.remove(k);
+            }
         }
+        v
     }
 
-    /// Every feature on, the deepest stack: renders any scene (with the given numerics).
+    /// Every feature on, the deepest stack, the counts read from the `Frame`
+    /// uniform: renders any scene (with the given numerics). The apps never run
+    /// it as it is: `chosen` bakes the scene's counts into every variant.
     pub fn generic(numerics: Numerics) -> Variant {
         let all = Features {
             spheres: true,
@@ -148,10 +173,21 @@ impl Variant {
             .all(|k| self.defines.contains_key(k))
             && stack(self) >= stack(needed)
             && self.constants == needed.constants
+            && self.experiments == needed.experiments
+            && [
+                "SPHERE_COUNT",
+                "TRIANGLE_COUNT",
+                "LIGHT_COUNT",
+                "USE_BVH",
+                "BVH_STACK",
+            ]
+            .iter()
+            .all(|k| self.defines.get(*k) == needed.defines.get(*k))
     }
 
     /// A short label such as `spheres+triangles+mirror+glass/stack6/normal-scaled/watertight/stable`
-    /// (with `/bvh` at the end when the variant traces through a BVH).
+    /// (with `/bvhN` at the end when the variant traces through a BVH with an
+    /// N-entry stack, then any `--experiment`).
     pub fn label(&self) -> String {
         let mut parts: Vec<String> = ["SPHERES", "TRIANGLES", "MIRROR", "GLASS"]
             .iter()
@@ -164,18 +200,22 @@ impl Variant {
         if parts.is_empty() {
             parts.push("background".into());
         }
-        let bvh = if self.defines.contains_key("USE_BVH") {
-            "/bvh"
-        } else {
-            ""
+        let bvh = match self.defines.get("BVH_STACK") {
+            Some(n) => format!("/bvh{n}"),
+            None => String::new(),
         };
         let spec = if self.constants.is_empty() {
             ""
         } else {
             "/spec"
         };
+        let experiments: String = self
+            .experiments
+            .iter()
+            .map(|e| format!("/{}", e.name()))
+            .collect();
         format!(
-            "{}/stack{}/{}{bvh}{spec}",
+            "{}/stack{}/{}{bvh}{spec}{experiments}",
             parts.join("+"),
             self.defines
                 .get("STACK_SIZE")
@@ -260,10 +300,10 @@ pub fn build(variant: &Variant) -> anyhow::Result<Shaders> {
     let (fm, fi) = parse(&fragment_source(), ShaderStage::Fragment, variant)?;
     Ok(Shaders {
         variant: variant.clone(),
-        vertex_spirv: to_spirv(&vm, &vi, ShaderStage::Vertex)?,
-        fragment_spirv: to_spirv(&fm, &fi, ShaderStage::Fragment)?,
-        vertex_glsl: to_glsl(&vm, &vi, ShaderStage::Vertex)?,
-        fragment_glsl: to_glsl(&fm, &fi, ShaderStage::Fragment)?,
+        vertex_spirv: to_spirv(&vm, &vi, ShaderStage::Vertex, variant)?,
+        fragment_spirv: to_spirv(&fm, &fi, ShaderStage::Fragment, variant)?,
+        vertex_glsl: to_glsl(&vm, &vi, ShaderStage::Vertex, variant)?,
+        fragment_glsl: to_glsl(&fm, &fi, ShaderStage::Fragment, variant)?,
     })
 }
 
@@ -283,35 +323,90 @@ pub fn build_compute(variant: &Variant, workgroup: Workgroup) -> anyhow::Result<
     let mut v = variant.clone();
     v.defines.insert("WG_X".into(), workgroup.x.to_string());
     v.defines.insert("WG_Y".into(), workgroup.y.to_string());
+    if bvh_stack_in_shared_memory(variant, workgroup) {
+        v.defines.insert("BVH_STACK_SHARED".into(), "1".into());
+    }
     let (m, i) = parse(&compute_source(), ShaderStage::Compute, &v)?;
     Ok(ComputeShader {
-        variant: variant.clone(),
+        variant: v.clone(),
         workgroup,
-        spirv: to_spirv(&m, &i, ShaderStage::Compute)?,
-        glsl: to_glsl(&m, &i, ShaderStage::Compute)?,
+        spirv: to_spirv(&m, &i, ShaderStage::Compute, &v)?,
+        glsl: to_glsl(&m, &i, ShaderStage::Compute, &v)?,
     })
+}
+
+/// The most shared memory the compute path's BVH stack may take: OpenGL
+/// guarantees a workgroup 32 KiB (Vulkan only 16 KiB, but lavapipe, llvmpipe
+/// and NVIDIA offer 32 KiB or more). Only `--experiment shared-bvh-stack` uses it.
+pub const SHARED_BVH_STACK_BUDGET: usize = 32 * 1024;
+
+/// Whether the compute tracer keeps its BVH stack in shared memory: only with
+/// `--experiment shared-bvh-stack`, and only where the stack fits in the budget.
+pub fn bvh_stack_in_shared_memory(variant: &Variant, workgroup: Workgroup) -> bool {
+    let Some(entries) = variant
+        .defines
+        .get("BVH_STACK")
+        .and_then(|n| n.parse::<usize>().ok())
+    else {
+        return false;
+    };
+    let bytes = entries * (workgroup.x * workgroup.y) as usize * 8;
+    variant.experiments.contains(&Experiment::SharedBvhStack)
+        && !variant.experiments.contains(&Experiment::LocalBvhStack)
+        && bytes <= SHARED_BVH_STACK_BUDGET
 }
 
 pub fn to_spirv(
     module: &Module,
     info: &ModuleInfo,
     stage: ShaderStage,
+    variant: &Variant,
 ) -> anyhow::Result<Vec<u32>> {
     // No ADJUST_COORDINATE_SPACE (y stays as written, see trace.frag) and no DEBUG,
     // so debug and release builds emit identical SPIR-V.
+    //
+    // naga's loop bounding gives every loop a 64-bit counter that breaks out
+    // after 2^64 iterations, so that a driver cannot assume an infinite loop
+    // away; the GLSL writer adds none, so it is a cost only Vulkan pays. Every
+    // loop of trace.glsl ends (the stacks shrink, the primitive loops count up
+    // to a constant), so it is never needed for correctness. Measured on an
+    // H100 (comparison/results/nvidia-h100/FINDINGS.md), it costs the BVH
+    // variants 4-17 % in Vulkan and the box 7 %, but without it NVIDIA's
+    // Vulkan compiler, given the constant trip count of the brute-force sphere
+    // loop, made the 10,000-sphere list 1.7x slower (227 ms against 135). So the
+    // BVH variants go without it and the brute-force ones keep it, until the
+    // counts reach the shader in a way no driver specialises on.
+    let loop_bounding = if variant.experiments.contains(&Experiment::NagaLoopBounding) {
+        true
+    } else if variant.experiments.contains(&Experiment::NoLoopBounding) {
+        false
+    } else {
+        !variant.defines.contains_key("USE_BVH")
+    };
     let options = spv::Options {
         flags: spv::WriterFlags::LABEL_VARYINGS,
+        force_loop_bounding: loop_bounding,
         ..Default::default()
     };
     let pipeline = spv::PipelineOptions {
         shader_stage: stage,
         entry_point: "main".into(),
     };
-    spv::write_vec(module, info, &options, Some(&pipeline))
-        .with_context(|| format!("writing {stage:?} SPIR-V"))
+    let words = spv::write_vec(module, info, &options, Some(&pipeline))
+        .with_context(|| format!("writing {stage:?} SPIR-V"))?;
+    Ok(if variant.experiments.contains(&Experiment::NagaZeroInit) {
+        words
+    } else {
+        strip_local_array_zero_init_spirv(&words)
+    })
 }
 
-pub fn to_glsl(module: &Module, info: &ModuleInfo, stage: ShaderStage) -> anyhow::Result<String> {
+pub fn to_glsl(
+    module: &Module,
+    info: &ModuleInfo,
+    stage: ShaderStage,
+    variant: &Variant,
+) -> anyhow::Result<String> {
     // naga renames blocks and members, so OpenGL binds by number: give every
     // resource its (set 0) binding explicitly. UBOs and SSBOs have separate
     // binding spaces in GL, so the numbers carry over unchanged.
@@ -327,11 +422,12 @@ pub fn to_glsl(module: &Module, info: &ModuleInfo, stage: ShaderStage) -> anyhow
             b as u8,
         );
     }
+    // The only workgroup memory is the BVH stack, written before it is read.
     let options = glsl::Options {
         version: glsl::Version::Desktop(450),
         writer_flags: glsl::WriterFlags::empty(),
         binding_map,
-        zero_initialize_workgroup_memory: true,
+        zero_initialize_workgroup_memory: false,
     };
     let pipeline = glsl::PipelineOptions {
         shader_stage: stage,
@@ -351,7 +447,139 @@ pub fn to_glsl(module: &Module, info: &ModuleInfo, stage: ShaderStage) -> anyhow
     writer
         .write()
         .with_context(|| format!("writing {stage:?} GLSL"))?;
-    Ok(out)
+    Ok(if variant.experiments.contains(&Experiment::NagaZeroInit) {
+        out
+    } else {
+        strip_local_array_zero_init_glsl(&out)
+    })
+}
+
+// naga zero-initialises every function-local variable it writes, in both back
+// ends: an `OpConstantNull` initialiser in SPIR-V, `T a[N] = T[N](0, ...)` in
+// GLSL. For a scalar the driver drops the dead store; for an array it cannot
+// prove every element is written before it is read, so it stores N zeros at
+// every call: the tracer's ray stack at every pixel and the BVH stack at every
+// traversal (128 stores into NVIDIA's local memory per traversal, 1.2-1.85x the
+// BVH time on an H100). trace.glsl only reads stack entries below the stack
+// pointer, each written by a push first, so the zeros are never read: both
+// passes remove the initialisers of function-local arrays, and only those.
+// trace.glsl gives no array an explicit initialiser (a test holds it to that),
+// so every initialiser removed here is naga's.
+
+/// Removes the `OpConstantNull` initialiser of every `Function`-storage
+/// `OpVariable` whose type is an array.
+pub fn strip_local_array_zero_init_spirv(words: &[u32]) -> Vec<u32> {
+    const OP_TYPE_ARRAY: u32 = 28;
+    const OP_TYPE_POINTER: u32 = 32;
+    const OP_CONSTANT_NULL: u32 = 46;
+    const OP_VARIABLE: u32 = 59;
+    const STORAGE_FUNCTION: u32 = 7;
+    let instructions = || spirv_instructions(words);
+    let arrays: std::collections::HashSet<u32> = instructions()
+        .filter(|i| i[0] & 0xffff == OP_TYPE_ARRAY && i.len() >= 2)
+        .map(|i| i[1])
+        .collect();
+    let nulls: std::collections::HashSet<u32> = instructions()
+        .filter(|i| i[0] & 0xffff == OP_CONSTANT_NULL && i.len() >= 3)
+        .map(|i| i[2])
+        .collect();
+    let array_pointers: std::collections::HashSet<u32> = instructions()
+        .filter(|i| {
+            i[0] & 0xffff == OP_TYPE_POINTER
+                && i.len() >= 4
+                && i[2] == STORAGE_FUNCTION
+                && arrays.contains(&i[3])
+        })
+        .map(|i| i[1])
+        .collect();
+    let mut out = words[..5.min(words.len())].to_vec();
+    for i in instructions() {
+        let strip = i[0] & 0xffff == OP_VARIABLE
+            && i.len() == 5
+            && i[3] == STORAGE_FUNCTION
+            && array_pointers.contains(&i[1])
+            && nulls.contains(&i[4]);
+        if strip {
+            out.push((4 << 16) | OP_VARIABLE);
+            out.extend_from_slice(&i[1..4]);
+        } else {
+            out.extend_from_slice(i);
+        }
+    }
+    out
+}
+
+/// The instructions of a SPIR-V module after its 5-word header; a malformed
+/// tail is returned as one last slice so nothing is lost.
+fn spirv_instructions(words: &[u32]) -> impl Iterator<Item = &[u32]> {
+    let mut i = 5.min(words.len());
+    std::iter::from_fn(move || {
+        if i >= words.len() {
+            return None;
+        }
+        let count = (words[i] >> 16) as usize;
+        let end = if count == 0 || i + count > words.len() {
+            words.len()
+        } else {
+            i + count
+        };
+        let inst = &words[i..end];
+        i = end;
+        Some(inst)
+    })
+}
+
+/// Removes naga's zero initialiser from every function-local array declaration
+/// (`    T name[N] = T[N](zeros);` becomes `    T name[N];`). Only initialisers
+/// made of zero literals and constructors are touched.
+pub fn strip_local_array_zero_init_glsl(glsl: &str) -> String {
+    let mut out = String::with_capacity(glsl.len());
+    for line in glsl.split_inclusive('\n') {
+        match local_array_zero_init(line) {
+            Some(decl) => {
+                out.push_str(decl);
+                out.push_str(";\n");
+            }
+            None => out.push_str(line),
+        }
+    }
+    out
+}
+
+/// For an indented `T name[N] = T[N](...);` line whose initialiser holds only
+/// zeros, the declaration part `    T name[N]`.
+fn local_array_zero_init(line: &str) -> Option<&str> {
+    let body = line.trim_end();
+    if !line.starts_with(' ') || !body.ends_with(");") {
+        return None;
+    }
+    let (decl, init) = body.split_once(" = ")?;
+    let ty = decl.split_whitespace().next()?;
+    let size = &decl[decl.find('[')?..];
+    if !decl.ends_with(']') {
+        return None;
+    }
+    let args = init
+        .strip_prefix(&format!("{ty}{size}("))?
+        .strip_suffix(");")?;
+    let zeros_only = args
+        .split(|c: char| "(), ".contains(c))
+        .filter(|t| !t.is_empty())
+        .all(|t| t == ty || t == "false" || is_glsl_type(t) || is_zero_literal(t));
+    zeros_only.then_some(decl)
+}
+
+fn is_zero_literal(t: &str) -> bool {
+    let digits = t.trim_end_matches(['u', 'f']);
+    !digits.is_empty() && digits.chars().all(|c| c == '0' || c == '.') && digits.contains('0')
+}
+
+fn is_glsl_type(t: &str) -> bool {
+    matches!(t, "float" | "int" | "uint" | "bool")
+        || ["vec", "ivec", "uvec", "bvec", "mat"].iter().any(|p| {
+            t.strip_prefix(p)
+                .is_some_and(|n| n.chars().all(|c| c.is_ascii_digit() || c == 'x'))
+        })
 }
 
 /// naga's Vulkan SPIR-V made loadable by OpenGL (GL_ARB_gl_spirv), so both APIs

@@ -86,6 +86,12 @@ pub fn app_args(args: &RenderArgs) -> Vec<String> {
     if let Some(wg) = args.workgroup {
         v.extend(["--workgroup".into(), wg.to_string()]);
     }
+    for e in &args.experiment {
+        v.extend(["--experiment".into(), e.name().into()]);
+    }
+    if let Some(dir) = &args.dump_shaders {
+        v.extend(["--dump-shaders".into(), dir.display().to_string()]);
+    }
     v
 }
 

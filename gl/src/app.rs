@@ -6,7 +6,7 @@ use crate::buffers::SceneBuffers;
 use crate::compute::Compute;
 use crate::context::Gl;
 use crate::debug::DebugLog;
-use crate::program::{EmptyVertexArray, Program};
+use crate::program::{self, EmptyVertexArray, Program};
 use crate::target::{self, Target};
 use crate::timer::Timer;
 use anyhow::anyhow;
@@ -17,7 +17,7 @@ use twinray_common::error::bad_input;
 use twinray_common::explain;
 use twinray_common::gpu::{check_storage_limit, GpuScene};
 use twinray_common::image_io::FloatImage;
-use twinray_common::report::{DeviceInfo, FrameTime, RunReport};
+use twinray_common::report::{dump_shaders, dump_statistics, DeviceInfo, FrameTime, RunReport};
 use twinray_common::shader::{self, Variant};
 
 /// `started` is taken first thing in main, so `setup_ms` includes process,
@@ -40,7 +40,7 @@ pub fn run(args: RenderArgs, started: Instant) -> anyhow::Result<()> {
         return run_windowed(&args, started);
     }
     let scene = args.load_scene()?;
-    let variant = Variant::chosen(&scene, args.generic, args.specialize);
+    let variant = Variant::chosen(&scene, &args);
     let workgroup = args.compute_workgroup()?;
     let (width, height) = (args.size.width, args.size.height);
     let gpu_scene = GpuScene::new(&scene, width, height);
@@ -67,9 +67,19 @@ pub fn run(args: RenderArgs, started: Instant) -> anyhow::Result<()> {
 
     // Declaration order is creation order; Rust drops locals in reverse, so GL
     // objects are deleted in reverse order on success and on every error path.
+    let mut shader_stats = Vec::new();
     let (frames, setup_ms, pixels) = match args.path {
         RenderPath::Fragment => {
             let shaders = shader::build(&variant)?;
+            if let Some(dir) = &args.dump_shaders {
+                dump_shaders(
+                    dir,
+                    &[
+                        ("vertex", &shaders.vertex_spirv, &shaders.vertex_glsl),
+                        ("fragment", &shaders.fragment_spirv, &shaders.fragment_glsl),
+                    ],
+                )?;
+            }
             explain::step(
                 "Shaders: GLSL -> naga module -> GLSL 450 core (twinray-common)",
                 || format!("variant {}", variant.label()),
@@ -85,6 +95,9 @@ pub fn run(args: RenderArgs, started: Instant) -> anyhow::Result<()> {
             } else {
                 Program::new(gl, &shaders.vertex_glsl, &shaders.fragment_glsl)?
             };
+            if let Some(dir) = &args.dump_shaders {
+                shader_stats.push(program::dump_binary(gl, program.raw(), dir, "gl-program")?);
+            }
             let _buffers = SceneBuffers::new(gl, &gpu_scene)?;
             let target = Target::new(gl, width, height)?;
             let vao = EmptyVertexArray::new(gl)?;
@@ -104,6 +117,15 @@ pub fn run(args: RenderArgs, started: Instant) -> anyhow::Result<()> {
                 .gl_spirv
                 .then_some(&proc_address as &dyn Fn(&std::ffi::CStr) -> *const std::ffi::c_void);
             let compute = Compute::new(gl, &shader, spirv, width, height)?;
+            if let Some(dir) = &args.dump_shaders {
+                dump_shaders(dir, &[("compute", &shader.spirv, &shader.glsl)])?;
+                shader_stats.push(program::dump_binary(
+                    gl,
+                    compute.program(),
+                    dir,
+                    "gl-program",
+                )?);
+            }
             let _buffers = SceneBuffers::new(gl, &gpu_scene)?;
             let timer = Timer::new(gl, &renderer)?;
             log.check(gl, "after setup");
@@ -115,6 +137,9 @@ pub fn run(args: RenderArgs, started: Instant) -> anyhow::Result<()> {
             (frames, setup_ms, compute.read())
         }
     };
+    if let Some(dir) = &args.dump_shaders {
+        dump_statistics(dir, &shader_stats)?;
+    }
     explain::step("Frames: the draw or dispatch + glFinish each", || {
         format!(
             "{} frame(s); first wall {:.3} ms",
@@ -148,6 +173,7 @@ pub fn run(args: RenderArgs, started: Instant) -> anyhow::Result<()> {
             workgroup: (args.path == RenderPath::Compute).then(|| workgroup.to_string()),
             nonfinite_pixels: image.nonfinite_pixels(),
             validation_messages: errors,
+            shader_stats,
             ..RunReport::new(
                 "opengl",
                 info,

@@ -26,6 +26,11 @@ pub struct Compute<'gl> {
 }
 
 impl<'gl> Compute<'gl> {
+    /// The linked compute program (for `--dump-shaders`).
+    pub fn program(&self) -> glow::Program {
+        self.program
+    }
+
     /// Builds the program (GLSL, or SPIR-V when `spirv_proc` is given), makes the
     /// texture, and leaves both bound: nothing else changes them during the run.
     pub fn new(

@@ -151,7 +151,69 @@ unsafe fn link_separable(
     }
 }
 
+/// What `--dump-shaders` keeps of a linked program: the driver's program
+/// binary, written to `dir/<name>.bin`, and the figures read off it. NVIDIA's
+/// binary holds the program as readable NV assembly (`!!NVfp5.0`,
+/// `!!NVcp5.0`), whose `TEMP lmem0[N]` is the local memory of one invocation
+/// in 16-byte slots. Other drivers' binaries are opaque: then only the size.
+pub fn dump_binary(
+    gl: &glow::Context,
+    program: glow::Program,
+    dir: &std::path::Path,
+    name: &str,
+) -> anyhow::Result<twinray_common::report::ShaderStats> {
+    // SAFETY: a linked program of the current context.
+    let binary = unsafe { gl.get_program_binary(program) };
+    let mut statistics = Vec::new();
+    if let Some(b) = binary.filter(|b| !b.buffer.is_empty()) {
+        let path = dir.join(format!("{name}.bin"));
+        std::fs::write(&path, &b.buffer)
+            .with_context(|| format!("--dump-shaders: cannot write '{}'", path.display()))?;
+        statistics.push((
+            "program binary bytes".to_string(),
+            b.buffer.len().to_string(),
+        ));
+        if let Some(slots) = nv_local_memory_slots(&b.buffer) {
+            statistics.push(("NV lmem0 slots (16 B each)".to_string(), slots.to_string()));
+            statistics.push(("local memory bytes".to_string(), (slots * 16).to_string()));
+        }
+    } else {
+        statistics.push((
+            "program binary bytes".to_string(),
+            "0 (not offered)".to_string(),
+        ));
+    }
+    Ok(twinray_common::report::ShaderStats {
+        pipeline: "program".to_string(),
+        stage: name.to_string(),
+        statistics,
+    })
+}
+
+/// The N of the largest `TEMP lmem0[N]` in NV assembly, or 0 for NV assembly
+/// that declares none; None where the binary holds no NV assembly.
+pub fn nv_local_memory_slots(binary: &[u8]) -> Option<u64> {
+    let text = String::from_utf8_lossy(binary);
+    if !text.contains("!!NV") {
+        return None;
+    }
+    let slots = text
+        .match_indices("lmem0[")
+        .filter_map(|(i, m)| {
+            let rest = &text[i + m.len()..];
+            rest[..rest.find(']')?].trim().parse::<u64>().ok()
+        })
+        .max()
+        .unwrap_or(0);
+    Some(slots)
+}
+
 impl<'gl> Program<'gl> {
+    /// The linked tracer program (the SPIR-V stage's program on `--gl-spirv`).
+    pub fn raw(&self) -> glow::Program {
+        self.raw
+    }
+
     pub fn new(
         gl: &'gl glow::Context,
         vertex: &str,

@@ -76,14 +76,98 @@ fn auto_uses_the_bvh_only_for_large_scenes() {
     let dir = scratch("accel-auto");
     let (small, _) = render(App::Vulkan, "box", "16x16", &[], &dir.join("a.png"));
     assert!(
-        !small.variant.ends_with("/bvh"),
+        !small.variant.contains("/bvh"),
         "box (32 primitives): {}",
         small.variant
     );
     let (large, _) = render(App::Vulkan, "teapot", "16x16", &[], &dir.join("b.png"));
     assert!(
-        large.variant.ends_with("/bvh"),
+        large.variant.contains("/bvh"),
         "teapot (19,201 primitives): {}",
         large.variant
     );
+}
+
+/// A scene whose BVH is deeper than the small fixed stacks that were measured
+/// as cheaper defaults (8, 16 or 24 entries): spheres along the view axis, each
+/// 1.3 times larger and farther than the last, so that the binned SAH peels a
+/// few off the row at each level. A ray that passes by the small spheres keeps
+/// one far child per level on its stack; a fixed stack smaller than that
+/// dropped pushes and lost whole subtrees (visible as missing spheres). The
+/// traversal stack is now as deep as the tree built. (Binned SAH over f32
+/// geometry cannot be driven past ~64 levels: each level must shrink the
+/// centroid range by the bin count, so the old fixed 64 was never exceeded.)
+fn deep_bvh_scene(dir: &std::path::Path) -> std::path::PathBuf {
+    let mut toml = String::from(
+        "description = \"160 spheres in a geometric row: a deep BVH\"\n\
+         [camera]\neye = [-0.5, 0.6, 0.7]\nlook_at = [60.0, 0.0, 0.0]\nup = [0.0, 0.0, 1.0]\nfov_y = 60.0\n\
+         [[materials]]\nname = \"m\"\ndiffuse = [0.8, 0.6, 0.4]\nambient = [0.1, 0.1, 0.1]\n\
+         [[lights]]\nposition = [-2.0, 3.0, 4.0]\ncolor = [1.0, 1.0, 1.0]\n",
+    );
+    for k in 0..160 {
+        let x = 1.3f64.powi(k);
+        toml += &format!(
+            "[[spheres]]\ncenter = [{x}, 0.0, 0.0]\nradius = {}\nmaterial = \"m\"\n",
+            0.2 * x
+        );
+    }
+    let path = dir.join("deep-bvh.toml");
+    std::fs::write(&path, toml).unwrap();
+    path
+}
+
+#[test]
+fn a_bvh_deeper_than_the_small_fixed_stacks_renders_every_primitive() {
+    let dir = scratch("accel-deep");
+    let scene = deep_bvh_scene(&dir);
+    let scene = scene.to_str().unwrap();
+    let reference = dir.join("ref.png");
+    let r = twinray_tests::run(
+        &twinray_tests::bin("twinray"),
+        &[
+            "render",
+            "--api",
+            "reference",
+            "--scene",
+            scene,
+            "--size",
+            "64x48",
+            "--accel",
+            "none",
+            "--out",
+            reference.to_str().unwrap(),
+        ],
+        &[],
+    );
+    assert!(r.status.success(), "{}", String::from_utf8_lossy(&r.stderr));
+    let truth = twinray_common::image_io::load_png(&reference).unwrap();
+    for app in App::BOTH {
+        for path in ["fragment", "compute"] {
+            let (report, img) = render(
+                app,
+                scene,
+                "64x48",
+                &["--accel", "bvh", "--path", path],
+                &dir.join(format!("{app:?}-{path}.png")),
+            );
+            let stack: u32 = report
+                .variant
+                .rsplit_once("/bvh")
+                .and_then(|(_, n)| n.split('/').next()?.parse().ok())
+                .unwrap_or_else(|| panic!("no BVH stack in {}", report.variant));
+            assert!(
+                stack > 24,
+                "the test needs a tree deeper than 24 levels: {}",
+                report.variant
+            );
+            let m = compare(&img, &truth).unwrap();
+            assert!(
+                m.above_8 <= 0.001,
+                "{app:?} {path} ({}): {:.3}% of pixels off the reference by more than 8/255 (at most 0.1% allowed)",
+                report.variant,
+                100.0 * m.above_8
+            );
+        }
+    }
+    std::fs::remove_dir_all(dir).ok();
 }

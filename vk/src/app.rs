@@ -24,7 +24,7 @@ use twinray_common::error::bad_input;
 use twinray_common::explain;
 use twinray_common::gpu::GpuScene;
 use twinray_common::image_io::FloatImage;
-use twinray_common::report::{DeviceInfo, FrameTime, RunReport};
+use twinray_common::report::{dump_shaders, dump_statistics, DeviceInfo, FrameTime, RunReport};
 use twinray_common::scene::Scene;
 use twinray_common::shader::{self, Variant};
 
@@ -46,7 +46,7 @@ pub fn run(args: RenderArgs, process_start: Instant) -> Result<()> {
         return run_windowed(&args, process_start);
     }
     let scene = args.load_scene()?;
-    let variant = Variant::chosen(&scene, args.generic, args.specialize);
+    let variant = Variant::chosen(&scene, &args);
     let (mut report, image) = render(&args, &scene, &variant, process_start)?;
 
     // Counted only now that every Vulkan object is gone, so teardown mistakes count too.
@@ -97,6 +97,9 @@ fn render(
     let (width, height) = (args.size.width, args.size.height);
     let workgroup = args.compute_workgroup()?;
     let shaders = shader::build(variant)?;
+    if args.dump_shaders.is_some() {
+        crate::statistics::enable();
+    }
     explain::step(
         "Shaders: GLSL -> naga module -> SPIR-V (twinray-common)",
         || format!("variant {}", variant.label()),
@@ -130,6 +133,15 @@ fn render(
     };
     let (frames, setup_ms, image) = match args.path {
         RenderPath::Fragment => {
+            if let Some(dir) = &args.dump_shaders {
+                dump_shaders(
+                    dir,
+                    &[
+                        ("vertex", &shaders.vertex_spirv, &shaders.vertex_glsl),
+                        ("fragment", &shaders.fragment_spirv, &shaders.fragment_glsl),
+                    ],
+                )?;
+            }
             let render_pass = RenderPass::offscreen(&device)?;
             let rp = render_pass.render_pass;
             let resources =
@@ -155,6 +167,9 @@ fn render(
         // The same tracer as a compute shader: compute.rs owns its pipeline and storage image.
         RenderPath::Compute => {
             let shader = shader::build_compute(variant, workgroup)?;
+            if let Some(dir) = &args.dump_shaders {
+                dump_shaders(dir, &[("compute", &shader.spirv, &shader.glsl)])?;
+            }
             let (frame, storage) = crate::scene::scene_buffers(&device, &gpu_scene)?;
             let compute = Compute::new(
                 &device,
@@ -184,7 +199,12 @@ fn render(
         },
         if idle_wait { " (idle wait)" } else { "" }
     );
+    let shader_stats = crate::statistics::captured();
+    if let Some(dir) = &args.dump_shaders {
+        dump_statistics(dir, &shader_stats)?;
+    }
     let report = RunReport {
+        shader_stats,
         path: args.path,
         workgroup: (args.path == RenderPath::Compute).then(|| workgroup.to_string()),
         nonfinite_pixels: image.nonfinite_pixels(),

@@ -217,12 +217,14 @@ impl ComputePipeline {
             .module(module.1)
             .name(c"main");
         let info = vk::ComputePipelineCreateInfo::default()
+            .flags(crate::statistics::pipeline_flags(device))
             .stage(stage)
             .layout(this.layout);
         let made = unsafe { d.create_compute_pipelines(vk::PipelineCache::null(), &[info], None) };
         this.pipeline = made
             .map_err(|(_, e)| e)
             .context("creating the compute pipeline")?[0];
+        crate::statistics::capture(device, this.pipeline, "compute");
         Ok(this)
     }
 }

@@ -27,6 +27,9 @@ pub struct Device {
     pub timestamp_valid_bits: u32,
     pub device: ash::Device,
     pub queue: vk::Queue,
+    /// VK_KHR_pipeline_executable_properties, where offered: `--dump-shaders`
+    /// reads what the driver compiled (statistics.rs).
+    pub executable_properties: Option<khr::pipeline_executable_properties::Device>,
 }
 
 /// One physical device as the chooser sees it.
@@ -120,14 +123,29 @@ queue family {queue_family}: {flags:?}, timestampValidBits {timestamp_valid_bits
             .queue_family_index(queue_family)
             .queue_priorities(&priorities)];
         // A window needs the swapchain, a device extension; headless needs none.
-        let extensions = if surface.is_some() {
+        let mut extensions = if surface.is_some() {
             vec![khr::swapchain::NAME.as_ptr()]
         } else {
             vec![]
         };
-        let info = vk::DeviceCreateInfo::default()
+        // Optional, for --dump-shaders only: what the driver made of the shader.
+        let executable_info = has_extension(
+            &instance.instance,
+            chosen.physical,
+            khr::pipeline_executable_properties::NAME,
+        );
+        if executable_info {
+            extensions.push(khr::pipeline_executable_properties::NAME.as_ptr());
+        }
+        let mut executable_features =
+            vk::PhysicalDevicePipelineExecutablePropertiesFeaturesKHR::default()
+                .pipeline_executable_info(true);
+        let mut info = vk::DeviceCreateInfo::default()
             .queue_create_infos(&queue_infos)
             .enabled_extension_names(&extensions);
+        if executable_info {
+            info = info.push_next(&mut executable_features);
+        }
         let device = unsafe { vk_instance.create_device(chosen.physical, &info, None) }
             .with_context(|| format!("opening the Vulkan device '{}'", chosen.name))?;
         let queue = unsafe { device.get_device_queue(queue_family, 0) };
@@ -142,7 +160,10 @@ queue family {queue_family}: {flags:?}, timestampValidBits {timestamp_valid_bits
                 format!("1 queue from family {queue_family}, priority 1.0; device extensions: {ext}; no optional features")
             },
         );
+        let executable_properties = executable_info
+            .then(|| khr::pipeline_executable_properties::Device::new(&instance.instance, &device));
         Ok(Device {
+            executable_properties,
             physical: chosen.physical,
             properties: chosen.properties,
             memory_properties: unsafe {
@@ -228,11 +249,18 @@ queue family {queue_family}: {flags:?}, timestampValidBits {timestamp_valid_bits
 
 /// Whether the device can make swapchains at all.
 fn has_swapchain(instance: &ash::Instance, physical: vk::PhysicalDevice) -> bool {
+    has_extension(instance, physical, khr::swapchain::NAME)
+}
+
+fn has_extension(
+    instance: &ash::Instance,
+    physical: vk::PhysicalDevice,
+    name: &std::ffi::CStr,
+) -> bool {
     // SAFETY: a valid physical device of this instance.
     let exts =
         unsafe { instance.enumerate_device_extension_properties(physical) }.unwrap_or_default();
-    exts.iter()
-        .any(|e| e.extension_name_as_c_str() == Ok(khr::swapchain::NAME))
+    exts.iter().any(|e| e.extension_name_as_c_str() == Ok(name))
 }
 
 /// `TWINRAY_VK_DEVICE` (an index or part of a name) wins; otherwise the kind of

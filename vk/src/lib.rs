@@ -15,6 +15,7 @@ pub mod instance;
 pub mod memory;
 pub mod pipeline;
 pub mod scene;
+pub mod statistics;
 pub mod surface;
 pub mod swapchain;
 pub mod target;

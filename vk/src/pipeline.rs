@@ -233,6 +233,7 @@ impl Pipeline {
         let blend =
             vk::PipelineColorBlendStateCreateInfo::default().attachments(&blend_attachments);
         let info = vk::GraphicsPipelineCreateInfo::default()
+            .flags(crate::statistics::pipeline_flags(device))
             .stages(&stages)
             .vertex_input_state(&vertex_input)
             .input_assembly_state(&assembly)
@@ -249,6 +250,7 @@ impl Pipeline {
                 .map_err(|(_, e)| e)
                 .context("creating the graphics pipeline")?;
         this.pipeline = pipelines[0];
+        crate::statistics::capture(device, this.pipeline, "graphics");
         explain::step(
             "VkPipeline (vkCreateGraphicsPipelines: the driver compiles the tracer here)",
             || {

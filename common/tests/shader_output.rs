@@ -1,0 +1,133 @@
+//! What the shader build hands the drivers: no function-local array keeps
+//! naga's zero initialiser (it costs every pixel a store per element, and on
+//! NVIDIA's OpenGL a trip to local memory), in any variant, for either API,
+//! on either path; and trace.glsl itself gives no array an initialiser, so the
+//! post-passes only ever remove naga's.
+
+use twinray_common::cli::{Experiment, Workgroup};
+use twinray_common::numerics::{Numerics, Offset, SphereTest, TriangleTest};
+use twinray_common::scene::{Scene, BUILTIN_SCENES};
+use twinray_common::shader::{self, Variant};
+
+fn variants() -> Vec<Variant> {
+    let mut v = Vec::new();
+    for (name, _) in BUILTIN_SCENES {
+        let mut scene = Scene::load(name, &[]).unwrap();
+        for bvh in [false, true] {
+            scene.bvh = bvh;
+            v.push(Variant::for_scene(&scene));
+            v.push(Variant::specialized(&scene));
+        }
+    }
+    for offset in Offset::ALL {
+        for triangle in TriangleTest::ALL {
+            for sphere in SphereTest::ALL {
+                v.push(Variant::generic(Numerics {
+                    offset,
+                    triangle,
+                    sphere,
+                }));
+            }
+        }
+    }
+    v
+}
+
+/// Function-storage OpVariables with an initialiser whose type is an array.
+fn initialised_local_arrays(words: &[u32]) -> usize {
+    let mut arrays = std::collections::HashSet::new();
+    let mut array_pointers = std::collections::HashSet::new();
+    let mut found = 0;
+    let mut i = 5;
+    while i < words.len() {
+        let count = (words[i] >> 16) as usize;
+        let inst = &words[i..i + count];
+        match inst[0] & 0xffff {
+            28 => {
+                arrays.insert(inst[1]);
+            }
+            32 if inst[2] == 7 && arrays.contains(&inst[3]) => {
+                array_pointers.insert(inst[1]);
+            }
+            59 if inst[3] == 7 && count == 5 && array_pointers.contains(&inst[1]) => found += 1,
+            _ => {}
+        }
+        i += count;
+    }
+    found
+}
+
+/// GLSL lines that declare a local array with an initialiser.
+fn initialised_glsl_arrays(glsl: &str) -> Vec<String> {
+    glsl.lines()
+        .filter(|l| l.starts_with("    ") && l.contains("] = ") && l.trim_end().ends_with(");"))
+        .filter(|l| {
+            // A declaration is `T name[N]`; an element store is `name[i]`.
+            let decl = l.split(" = ").next().unwrap_or("").trim();
+            decl.ends_with(']') && decl.split_whitespace().count() == 2
+        })
+        .map(str::to_string)
+        .collect()
+}
+
+#[test]
+fn no_local_array_keeps_an_initialiser() {
+    let variants = variants();
+    assert!(variants.len() > 20);
+    let mut arrays_seen = 0;
+    for v in &variants {
+        let s = shader::build(v).unwrap_or_else(|e| panic!("{}: {e:#}", v.label()));
+        let c = shader::build_compute(v, Workgroup::DEFAULT).unwrap();
+        for (what, words, glsl) in [
+            ("fragment", &s.fragment_spirv, &s.fragment_glsl),
+            ("compute", &c.spirv, &c.glsl),
+        ] {
+            assert_eq!(
+                initialised_local_arrays(words),
+                0,
+                "{} {what} SPIR-V",
+                v.label()
+            );
+            let lines = initialised_glsl_arrays(glsl);
+            assert!(lines.is_empty(), "{} {what} GLSL: {lines:?}", v.label());
+            arrays_seen += glsl
+                .lines()
+                .filter(|l| l.starts_with("    ") && l.trim_end().ends_with("];"))
+                .count();
+        }
+    }
+    assert!(arrays_seen > 0, "the tracer has local arrays to check");
+}
+
+#[test]
+fn the_experiment_puts_the_initialisers_back() {
+    // Proves the checks above can fail: naga's own output has them.
+    let mut scene = Scene::load("teapot", &[]).unwrap();
+    scene.bvh = true;
+    let mut v = Variant::for_scene(&scene);
+    v.experiments = vec![Experiment::NagaZeroInit];
+    let s = shader::build(&v).unwrap();
+    assert!(initialised_local_arrays(&s.fragment_spirv) > 0);
+    assert!(!initialised_glsl_arrays(&s.fragment_glsl).is_empty());
+}
+
+#[test]
+fn trace_glsl_initialises_no_array_itself() {
+    for (name, src) in [
+        ("trace.glsl", shader::TRACE_GLSL),
+        ("trace.frag", shader::TRACE_FRAG),
+        ("trace.comp", shader::TRACE_COMP),
+    ] {
+        for (n, line) in src.lines().enumerate() {
+            let code = line.split("//").next().unwrap_or("");
+            if let Some((decl, _)) = code.split_once('=') {
+                let decl = decl.trim();
+                assert!(
+                    !(decl.ends_with(']') && decl.split_whitespace().count() == 2),
+                    "{name}:{}: an array with an initialiser: {line}",
+                    n + 1
+                );
+            }
+        }
+    }
+}
