@@ -11,7 +11,7 @@
 use std::path::{Path, PathBuf};
 use std::process::Command;
 use std::sync::Mutex;
-use twinray_common::cli::Workgroup;
+use twinray_common::cli::{Accel, Experiment, RenderArgs, Size, Workgroup};
 use twinray_common::numerics::{Numerics, Offset, SphereTest, TriangleTest};
 use twinray_common::scene::{Features, Scene};
 use twinray_common::shader::{self, Variant};
@@ -34,14 +34,36 @@ fn words_to_bytes(words: &[u32]) -> Vec<u8> {
     words.iter().flat_map(|w| w.to_le_bytes()).collect()
 }
 
-/// The variants to check: every numerical choice with the generic shader, with
-/// and without the BVH, as fragment and compute; every feature subset of the
-/// scene-specific variants; the specialization-constant form.
+/// The variants the apps build (`Variant::chosen`) for the box scene — every
+/// numerical choice with the generic shader (`--generic`) and the BVH, and
+/// with specialization constants (`--specialize`) — plus the generic shader
+/// with the counts read from the uniform (`Variant::generic`) for every
+/// numerical choice, every feature subset of the scene-specific variants, and
+/// the `--experiment` switches that change naga's output.
 fn variants() -> Vec<(String, Variant)> {
     let mut v = Vec::new();
-    let with_bvh = |mut x: Variant| {
-        x.defines.insert("USE_BVH".into(), "1".into());
-        x
+    let chosen = |n: Numerics, accel: Accel, generic: bool, experiment: Vec<Experiment>| {
+        let set: Vec<(String, String)> = n
+            .set_args()
+            .iter()
+            .filter_map(|kv| kv.split_once('='))
+            .map(|(k, v)| (k.to_string(), v.to_string()))
+            .collect();
+        let mut scene = Scene::load("box", &set).unwrap();
+        scene.set_accel(accel);
+        let args = RenderArgs {
+            generic,
+            specialize: !generic,
+            experiment,
+            ..RenderArgs::headless(
+                "box",
+                Size {
+                    width: 8,
+                    height: 8,
+                },
+            )
+        };
+        Variant::chosen(&scene, &args)
     };
     for offset in Offset::ALL {
         for triangle in TriangleTest::ALL {
@@ -51,9 +73,11 @@ fn variants() -> Vec<(String, Variant)> {
                     triangle,
                     sphere,
                 };
-                let g = Variant::generic(n);
-                v.push((format!("generic {}", n.label()), g.clone()));
-                v.push((format!("generic+bvh {}", n.label()), with_bvh(g)));
+                v.push((format!("generic {}", n.label()), Variant::generic(n)));
+                v.push((
+                    format!("generic+bvh {}", n.label()),
+                    chosen(n, Accel::Bvh, true, vec![]),
+                ));
             }
         }
     }
@@ -64,20 +88,35 @@ fn variants() -> Vec<(String, Variant)> {
             mirror: bits & 4 != 0,
             glass: bits & 8 != 0,
         };
-        // The BVH on every other subset: its traversal is the same code in each.
-        let x = Variant::from_features(f, 5, Numerics::default());
-        if bits % 2 == 0 {
-            v.push((format!("features {bits:04b}"), x));
-        } else {
-            v.push((format!("features {bits:04b}+bvh"), with_bvh(x)));
-        }
-    }
-    for accel in [false, true] {
-        let mut scene = Scene::load("box", &[]).unwrap();
-        scene.bvh = accel;
         v.push((
-            format!("specialize{}", if accel { "+bvh" } else { "" }),
-            Variant::specialized(&scene),
+            format!("features {bits:04b}"),
+            Variant::from_features(f, 5, Numerics::default()),
+        ));
+    }
+    let d = Numerics::default();
+    v.push(("specialize".into(), chosen(d, Accel::None, false, vec![])));
+    v.push((
+        "specialize+bvh".into(),
+        chosen(d, Accel::Bvh, false, vec![]),
+    ));
+    use Experiment::*;
+    for experiments in [
+        vec![
+            NagaZeroInit,
+            NagaLoopBounding,
+            SharedBvhStack,
+            UniformCounts,
+        ],
+        vec![NoLoopBounding, LocalBvhStack],
+    ] {
+        let label = experiments
+            .iter()
+            .map(|e| e.name())
+            .collect::<Vec<_>>()
+            .join(",");
+        v.push((
+            format!("generic+bvh experiments {label}"),
+            chosen(d, Accel::Bvh, true, experiments),
         ));
     }
     v
@@ -131,14 +170,11 @@ fn glslang_and_spirv_val_accept_every_variant() {
                     s.fragment_glsl,
                 )
             } else {
-                let wg = Workgroup::DEFAULT;
-                let s = shader::build_compute(variant, wg)
+                let s = shader::build_compute(variant, Workgroup::DEFAULT)
                     .unwrap_or_else(|e| panic!("{label} compute: {e:#}"));
-                let mut d = variant.defines.clone();
-                d.insert("WG_X".into(), wg.x.to_string());
-                d.insert("WG_Y".into(), wg.y.to_string());
                 compute_sources += 1;
-                (shader::compute_source(), d, s.spirv, s.glsl)
+                // The compute variant adds WG_X, WG_Y (and BVH_STACK_SHARED).
+                (shader::compute_source(), s.variant.defines, s.spirv, s.glsl)
             };
             let what = format!("{label} ({stage})");
             let base = dir.join(format!("v{i}"));
@@ -181,7 +217,7 @@ fn glslang_and_spirv_val_accept_every_variant() {
             });
         }
     }
-    assert!(fragment_sources >= 58 && compute_sources >= 22);
+    assert!(fragment_sources >= 60 && compute_sources >= 24);
 
     let total = jobs.len();
     let queue = Mutex::new(jobs);
