@@ -109,9 +109,22 @@ layout(std140, set = 0, binding = 0) uniform Frame {
     uint pad;
 } frame;
 
-// Every variant an app runs bakes the counts in (shader.rs, Variant::chosen);
-// only the scene-independent generic variant of the tests reads them here.
-#ifndef SPHERE_COUNT
+// The counts as a storage buffer: read at run time, yet no driver inlines
+// them into a new shader the way lavapipe does with uniform values.
+layout(std430, set = 0, binding = 9) readonly buffer Counts {
+    uint spheres;
+    uint triangles;
+    uint lights;
+} count_buf;
+
+// Every variant an app runs bakes the counts in (shader.rs, Variant::chosen)
+// or reads them from Counts; only the scene-independent generic variant of the
+// tests reads them from the uniform.
+#if defined(COUNTS_FROM_STORAGE)
+#define SPHERE_COUNT count_buf.spheres
+#define TRIANGLE_COUNT count_buf.triangles
+#define LIGHT_COUNT count_buf.lights
+#elif !defined(SPHERE_COUNT)
 #define SPHERE_COUNT frame.sphere_count
 #define TRIANGLE_COUNT frame.triangle_count
 #define LIGHT_COUNT frame.light_count
@@ -151,6 +164,12 @@ layout(std430, set = 0, binding = 6) readonly buffer BvhNodes {
 layout(std430, set = 0, binding = 7) readonly buffer BvhPrims {
     uint prims[];
 } prim_buf;
+
+// Per node: the parent's index (low 30 bits) and the axis the node's children
+// were split on (top 2 bits). Read only by the BVH_STACKLESS traversal.
+layout(std430, set = 0, binding = 8) readonly buffer BvhLinks {
+    uint links[];
+} link_buf;
 
 const float T_MAX = 1.0e30;
 
@@ -345,20 +364,31 @@ void closest_triangle(inout Hit h, TriRay ray, uint i) {
 #ifdef USE_BVH
 const uint SPHERE_BIT = 0x80000000u;
 
-// The traversal stack holds the far children still to visit, each packed as
-// uvec2(node, floatBitsToUint(entry t)): one array instead of two halves the
-// slots NVIDIA's OpenGL compiler gives it (a whole 16-byte slot per scalar
-// element). BVH_STACK is the built tree's depth - 1 (common/src/shader.rs):
-// the traversal pushes at most one child per level of the current path, so no
-// push is ever dropped and no slot is wasted.
+// The traversal stack holds the far children still to visit, each entry
+// uvec2(node, floatBitsToUint(entry t)), two entries to a uvec4: NVIDIA's
+// OpenGL compiler gives every element of a local array a whole 16-byte slot,
+// so two scalar arrays cost it four times the memory of these pairs (on an
+// H100 its teapot BVH tracer went from 259 slots to 21, and from 6.2 to
+// 0.54 ms on the compute path). BVH_STACK is the built tree's depth - 1
+// (common/src/shader.rs): the traversal pushes at most one child per level of
+// the current path, so no push is ever dropped and no slot is wasted.
 //
-// BVH_STACK_SHARED (compute only, when it fits) keeps the stack in shared
-// memory instead, entry-major so that a warp's pushes hit distinct banks.
-#ifdef BVH_STACK_SHARED
+// Experiments (--experiment, common/src/cli.rs): BVH_STACK_UNPAIRED keeps
+// one uvec2 per element; BVH_STACK_SHARED (compute only, where it fits)
+// keeps the stack in shared memory, entry-major so that a warp's pushes hit
+// distinct banks; BVH_STACKLESS below has no stack at all.
+#if defined(BVH_STACK_SHARED)
 shared uvec2 bvh_stack[BVH_STACK * WG_X * WG_Y];
-#define BVH_STACK_AT(i) bvh_stack[(i) * uint(WG_X * WG_Y) + gl_LocalInvocationIndex]
+#define BVH_PUSH(i, e) bvh_stack[(i) * uint(WG_X * WG_Y) + gl_LocalInvocationIndex] = (e)
+#define BVH_POP(i) bvh_stack[(i) * uint(WG_X * WG_Y) + gl_LocalInvocationIndex]
+#elif defined(BVH_STACK_UNPAIRED)
+#define BVH_STACK_DECLARE uvec2 stack[BVH_STACK]
+#define BVH_PUSH(i, e) stack[i] = (e)
+#define BVH_POP(i) stack[i]
 #else
-#define BVH_STACK_AT(i) stack[i]
+#define BVH_STACK_DECLARE uvec4 stack[(BVH_STACK + 1) / 2]
+#define BVH_PUSH(i, e) if (((i) & 1u) == 0u) { stack[(i) >> 1u].xy = (e); } else { stack[(i) >> 1u].zw = (e); }
+#define BVH_POP(i) (((i) & 1u) == 0u ? stack[(i) >> 1u].xy : stack[(i) >> 1u].zw)
 #endif
 
 // Where the ray enters the box, or -1 if it misses it before t_max. Zero
@@ -378,6 +408,115 @@ vec3 inverse_dir(vec3 dir) {
     return sign(dir + vec3(1.0e-38)) / d;
 }
 
+// Tests a leaf's primitives against the ray, keeping the closest hit in h.
+// True when an any-hit query (shadow rays) may stop.
+bool hit_leaf(inout Hit h, vec3 origin, vec3 dir, TriRay ray, uint first, uint count, bool any_hit) {
+    for (uint k = 0u; k < count; k++) {
+        uint prim = prim_buf.prims[first + k];
+        if ((prim & SPHERE_BIT) != 0u) {
+            uint i = prim & ~SPHERE_BIT;
+            float t = hit_sphere(origin, dir, sphere_buf.spheres[i], 0.0, h.t);
+            if (t > 0.0) {
+                h.t = t;
+                h.kind = 1u;
+                h.index = i;
+            }
+        } else {
+            vec3 r = hit_triangle(ray, triangle_buf.triangles[prim], 0.0, h.t);
+            if (r.x > 0.0) {
+                h.t = r.x;
+                h.kind = 2u;
+                h.index = prim;
+                h.u = r.y;
+                h.v = r.z;
+            }
+        }
+        if (any_hit && h.kind != 0u) {
+            return true;
+        }
+    }
+    return false;
+}
+
+#ifdef BVH_STACKLESS
+// The stackless alternative (Hapala, Davidovic, Wald, Havran 2011): no array
+// at all. From each node's parent link and split axis the traversal knows
+// where to go next: down to the near child (the lower side when the ray runs
+// towards +axis), across to the sibling, or back up. Each box is tested at
+// most once; going up costs a link read instead of a stack pop.
+const uint FROM_PARENT = 0u;
+const uint FROM_SIBLING = 1u;
+const uint FROM_CHILD = 2u;
+
+uint parent_of(uint node) {
+    return link_buf.links[node] & 0x3FFFFFFFu;
+}
+
+uint near_child(uint node, vec3 dir) {
+    uint axis = link_buf.links[node] >> 30u;
+    return dir[axis] >= 0.0 ? node + 1u : bvh_buf.nodes[node].left_or_first;
+}
+
+uint sibling_of(uint node, uint parent) {
+    return node == parent + 1u ? bvh_buf.nodes[parent].left_or_first : parent + 1u;
+}
+
+Hit traverse(vec3 origin, vec3 dir, float t_max, bool any_hit) {
+    Hit h;
+    h.t = t_max;
+    h.kind = 0u;
+    h.index = 0u;
+    h.u = 0.0;
+    h.v = 0.0;
+    vec3 inv_dir = inverse_dir(dir);
+    TriRay ray = tri_ray(origin, dir);
+    if (enter_box(origin, inv_dir, 0u, t_max) < 0.0) {
+        return h;
+    }
+    if (bvh_buf.nodes[0].count > 0u) {
+        hit_leaf(h, origin, dir, ray, bvh_buf.nodes[0].left_or_first, bvh_buf.nodes[0].count, any_hit);
+        return h;
+    }
+    uint node = near_child(0u, dir);
+    uint state = FROM_PARENT;
+    while (true) {
+        if (state == FROM_CHILD) {
+            if (node == 0u) {
+                break;
+            }
+            uint parent = parent_of(node);
+            if (node == near_child(parent, dir)) {
+                node = sibling_of(node, parent);
+                state = FROM_SIBLING;
+            } else {
+                node = parent;
+            }
+            continue;
+        }
+        bool enter = enter_box(origin, inv_dir, node, h.t) >= 0.0;
+        uint count = bvh_buf.nodes[node].count;
+        if (enter && count == 0u) {
+            node = near_child(node, dir);
+            state = FROM_PARENT;
+            continue;
+        }
+        if (enter && hit_leaf(h, origin, dir, ray, bvh_buf.nodes[node].left_or_first, count, any_hit)) {
+            return h;
+        }
+        // Done with this subtree: the far sibling is next after the near
+        // child, the parent after the far one.
+        uint parent = parent_of(node);
+        if (state == FROM_PARENT) {
+            node = sibling_of(node, parent);
+            state = FROM_SIBLING;
+        } else {
+            node = parent;
+            state = FROM_CHILD;
+        }
+    }
+    return h;
+}
+#else
 // Visits the tree near child first and skips subtrees that start beyond the
 // closest hit so far. With `any_hit` (shadow rays) it stops at the first hit
 // before t_max and reports it with kind != 0.
@@ -391,7 +530,7 @@ Hit traverse(vec3 origin, vec3 dir, float t_max, bool any_hit) {
     vec3 inv_dir = inverse_dir(dir);
     TriRay ray = tri_ray(origin, dir);
 #ifndef BVH_STACK_SHARED
-    uvec2 stack[BVH_STACK];
+    BVH_STACK_DECLARE;
 #endif
     uint sp = 0u;
     if (enter_box(origin, inv_dir, 0u, t_max) < 0.0) {
@@ -402,29 +541,8 @@ Hit traverse(vec3 origin, vec3 dir, float t_max, bool any_hit) {
         uint count = bvh_buf.nodes[node].count;
         uint first = bvh_buf.nodes[node].left_or_first;
         if (count > 0u) {
-            for (uint k = 0u; k < count; k++) {
-                uint prim = prim_buf.prims[first + k];
-                if ((prim & SPHERE_BIT) != 0u) {
-                    uint i = prim & ~SPHERE_BIT;
-                    float t = hit_sphere(origin, dir, sphere_buf.spheres[i], 0.0, h.t);
-                    if (t > 0.0) {
-                        h.t = t;
-                        h.kind = 1u;
-                        h.index = i;
-                    }
-                } else {
-                    vec3 r = hit_triangle(ray, triangle_buf.triangles[prim], 0.0, h.t);
-                    if (r.x > 0.0) {
-                        h.t = r.x;
-                        h.kind = 2u;
-                        h.index = prim;
-                        h.u = r.y;
-                        h.v = r.z;
-                    }
-                }
-                if (any_hit && h.kind != 0u) {
-                    return h;
-                }
+            if (hit_leaf(h, origin, dir, ray, first, count, any_hit)) {
+                return h;
             }
         } else {
             uint left = node + 1u;
@@ -435,7 +553,7 @@ Hit traverse(vec3 origin, vec3 dir, float t_max, bool any_hit) {
                 bool left_first = tl <= tr;
                 node = left_first ? left : right;
                 // sp < BVH_STACK here: the stack is as deep as the tree.
-                BVH_STACK_AT(sp) = uvec2(left_first ? right : left, floatBitsToUint(left_first ? tr : tl));
+                BVH_PUSH(sp, uvec2(left_first ? right : left, floatBitsToUint(left_first ? tr : tl)));
                 sp += 1u;
                 continue;
             }
@@ -452,7 +570,7 @@ Hit traverse(vec3 origin, vec3 dir, float t_max, bool any_hit) {
         bool found = false;
         while (sp > 0u && !found) {
             sp -= 1u;
-            uvec2 entry = BVH_STACK_AT(sp);
+            uvec2 entry = BVH_POP(sp);
             if (uintBitsToFloat(entry.y) < h.t) {
                 node = entry.x;
                 found = true;
@@ -464,6 +582,7 @@ Hit traverse(vec3 origin, vec3 dir, float t_max, bool any_hit) {
     }
     return h;
 }
+#endif
 #endif
 
 Hit closest_hit_brute(vec3 origin, vec3 dir) {

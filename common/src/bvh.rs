@@ -3,7 +3,7 @@
 //! walks (`GpuBvhNode`, mirrored in shaders/trace.glsl and layout-tested), plus
 //! the primitive list its leaves point into.
 
-use crate::gpu::{GpuBvhNode, PRIM_SPHERE_BIT};
+use crate::gpu::{GpuBvhNode, LINK_AXIS_SHIFT, LINK_PARENT_MASK, PRIM_SPHERE_BIT};
 use crate::scene::Scene;
 use glam::DVec3;
 
@@ -51,6 +51,8 @@ pub struct Bvh {
     pub nodes: Vec<GpuBvhNode>,
     /// Leaf contents: a sphere index with `PRIM_SPHERE_BIT` set, or a triangle index.
     pub prims: Vec<u32>,
+    /// Per node: parent index and split axis (`LINK_*`), for the stackless traversal.
+    pub links: Vec<u32>,
     pub build_ms: f64,
     pub depth: u32,
 }
@@ -87,7 +89,7 @@ impl Bvh {
         if !refs.is_empty() {
             let n = refs.len();
             bvh.nodes.reserve(2 * n / MAX_LEAF + 1);
-            build_node(&mut bvh, &mut refs, 0, n, 1);
+            build_node(&mut bvh, &mut refs, 0, n, 1, 0);
         }
         bvh.build_ms = start.elapsed().as_secs_f64() * 1e3;
         bvh
@@ -123,11 +125,19 @@ fn bounds_of(refs: &[PrimRef]) -> (Aabb, Aabb) {
 /// Builds the subtree over refs[lo..hi] at the next free node index; returns it.
 /// Depth-first order: an interior node's left child is the next node, its right
 /// child's index is stored in the node.
-fn build_node(bvh: &mut Bvh, refs: &mut [PrimRef], lo: usize, hi: usize, depth: u32) -> usize {
+fn build_node(
+    bvh: &mut Bvh,
+    refs: &mut [PrimRef],
+    lo: usize,
+    hi: usize,
+    depth: u32,
+    parent: usize,
+) -> usize {
     bvh.depth = bvh.depth.max(depth);
     let index = bvh.nodes.len();
     let (bounds, centroids) = bounds_of(&refs[lo..hi]);
     bvh.nodes.push(GpuBvhNode::default());
+    bvh.links.push(parent as u32 & LINK_PARENT_MASK);
     let count = hi - lo;
     let split = if count <= 1 {
         None
@@ -161,8 +171,11 @@ fn build_node(bvh: &mut Bvh, refs: &mut [PrimRef], lo: usize, hi: usize, depth: 
                 debug_assert_eq!(i, mid);
             }
             let mid = lo + mid;
-            build_node(bvh, refs, lo, mid, depth + 1);
-            let right = build_node(bvh, refs, mid, hi, depth + 1);
+            // A median split has no axis; any order serves it.
+            let axis = plane.map_or(0, |p| p.axis as u32);
+            bvh.links[index] |= axis << LINK_AXIS_SHIFT;
+            build_node(bvh, refs, lo, mid, depth + 1, index);
+            let right = build_node(bvh, refs, mid, hi, depth + 1, index);
             GpuBvhNode::interior(bounds_f32(&bounds), right as u32)
         }
     };

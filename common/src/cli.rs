@@ -86,10 +86,15 @@ pub enum Experiment {
     NagaLoopBounding,
     /// Drop naga's loop bounding from the brute-force variants too.
     NoLoopBounding,
-    /// Compute path: keep the BVH stack in local memory even where it fits in shared memory.
-    LocalBvhStack,
     /// Compute path: put the BVH stack in shared memory wherever it fits (the default keeps it local).
     SharedBvhStack,
+    /// Traverse the BVH without a stack (parent links), on both paths.
+    StacklessBvh,
+    /// One BVH stack entry per array element (uvec2) instead of two per uvec4.
+    UnpairedBvhStack,
+    /// Read the primitive and light counts from a storage buffer instead of
+    /// baking them into the shader.
+    StorageCounts,
     /// Read the primitive and light counts from the Frame uniform instead of
     /// baking them into the shader (what made lavapipe grow per frame).
     UniformCounts,
@@ -101,9 +106,11 @@ impl Experiment {
             Experiment::NagaZeroInit => "naga-zero-init",
             Experiment::NagaLoopBounding => "naga-loop-bounding",
             Experiment::NoLoopBounding => "no-loop-bounding",
-            Experiment::LocalBvhStack => "local-bvh-stack",
             Experiment::SharedBvhStack => "shared-bvh-stack",
             Experiment::UniformCounts => "uniform-counts",
+            Experiment::StacklessBvh => "stackless-bvh",
+            Experiment::UnpairedBvhStack => "unpaired-bvh-stack",
+            Experiment::StorageCounts => "storage-counts",
         }
     }
 }

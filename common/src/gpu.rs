@@ -116,6 +116,12 @@ impl GpuBvhNode {
 /// In the BVH's primitive list (binding 7): set for a sphere index, clear for a triangle index.
 pub const PRIM_SPHERE_BIT: u32 = 1 << 31;
 
+/// Per BVH node (binding 8), for the stackless traversal: the parent's index
+/// in the low bits and, for an interior node, the axis its children were split
+/// on in the top two (the left child holds the lower side).
+pub const LINK_AXIS_SHIFT: u32 = 30;
+pub const LINK_PARENT_MASK: u32 = (1 << LINK_AXIS_SHIFT) - 1;
+
 /// Binding numbers, shared by the shader build (GLSL binding map) and both apps.
 pub mod binding {
     pub const FRAME: u32 = 0;
@@ -128,9 +134,15 @@ pub mod binding {
     /// 5 is the compute path's output image.
     pub const BVH_NODES: u32 = 6;
     pub const BVH_PRIMS: u32 = 7;
-    pub const LAST: u32 = BVH_PRIMS;
+    pub const BVH_LINKS: u32 = 8;
+    /// The sphere, triangle and light counts, where the shader reads them at
+    /// run time (`--experiment storage-counts`) instead of baking them in.
+    pub const COUNTS: u32 = 9;
+    pub const LAST: u32 = COUNTS;
     /// The storage buffers in binding order.
-    pub const STORAGE: [u32; 6] = [SPHERES, TRIANGLES, MATERIALS, LIGHTS, BVH_NODES, BVH_PRIMS];
+    pub const STORAGE: [u32; 8] = [
+        SPHERES, TRIANGLES, MATERIALS, LIGHTS, BVH_NODES, BVH_PRIMS, BVH_LINKS, COUNTS,
+    ];
 }
 
 /// Everything a frame needs on the GPU, as bytes. Both apps upload exactly these.
@@ -144,6 +156,9 @@ pub struct GpuScene {
     /// Empty unless the scene traces through a BVH.
     pub bvh_nodes: Vec<GpuBvhNode>,
     pub bvh_prims: Vec<u32>,
+    pub bvh_links: Vec<u32>,
+    /// Spheres, triangles, lights, and a pad word.
+    pub counts: [u32; 4],
 }
 
 fn v3(v: glam::DVec3) -> [f32; 3] {
@@ -235,6 +250,13 @@ impl GpuScene {
                 .collect(),
             bvh_nodes: bvh.nodes.clone(),
             bvh_prims: bvh.prims.clone(),
+            bvh_links: bvh.links.clone(),
+            counts: [
+                scene.spheres.len() as u32,
+                scene.triangles.len() as u32,
+                scene.lights.len() as u32,
+                0,
+            ],
         }
     }
 
@@ -263,6 +285,8 @@ impl GpuScene {
             binding::LIGHTS => bytes(&self.lights),
             binding::BVH_NODES => bytes(&self.bvh_nodes),
             binding::BVH_PRIMS => bytes(&self.bvh_prims),
+            binding::BVH_LINKS => bytes(&self.bvh_links),
+            binding::COUNTS => bytes(&self.counts),
             _ => panic!("binding {binding} is not a storage buffer"),
         }
     }
@@ -285,6 +309,8 @@ pub fn storage_name(binding: u32) -> &'static str {
         binding::LIGHTS => "lights",
         binding::BVH_NODES => "BVH node",
         binding::BVH_PRIMS => "BVH primitive",
+        binding::BVH_LINKS => "BVH link",
+        binding::COUNTS => "counts",
         _ => "frame",
     }
 }

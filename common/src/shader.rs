@@ -135,10 +135,23 @@ impl Variant {
         v.experiments = args.experiment.clone();
         v.experiments.sort();
         v.experiments.dedup();
-        if v.experiments.contains(&Experiment::UniformCounts) {
+        if v.defines.contains_key("USE_BVH") {
+            if v.experiments.contains(&Experiment::StacklessBvh) {
+                v.defines.insert("BVH_STACKLESS".into(), "1".into());
+            }
+            if v.experiments.contains(&Experiment::UnpairedBvhStack) {
+                v.defines.insert("BVH_STACK_UNPAIRED".into(), "1".into());
+            }
+        }
+        if v.experiments.contains(&Experiment::UniformCounts)
+            || v.experiments.contains(&Experiment::StorageCounts)
+        {
             for k in ["SPHERE_COUNT", "TRIANGLE_COUNT", "LIGHT_COUNT"] {
                 v.defines.remove(k);
             }
+        }
+        if v.experiments.contains(&Experiment::StorageCounts) {
+            v.defines.insert("COUNTS_FROM_STORAGE".into(), "1".into());
         }
         v
     }
@@ -351,9 +364,7 @@ pub fn bvh_stack_in_shared_memory(variant: &Variant, workgroup: Workgroup) -> bo
         return false;
     };
     let bytes = entries * (workgroup.x * workgroup.y) as usize * 8;
-    variant.experiments.contains(&Experiment::SharedBvhStack)
-        && !variant.experiments.contains(&Experiment::LocalBvhStack)
-        && bytes <= SHARED_BVH_STACK_BUDGET
+    variant.experiments.contains(&Experiment::SharedBvhStack) && bytes <= SHARED_BVH_STACK_BUDGET
 }
 
 pub fn to_spirv(
