@@ -16,8 +16,68 @@ OUT = os.path.join(os.path.dirname(__file__), "..", "scenes", "hard")
 def v(x):
     return "[" + ", ".join(repr(float(c)) for c in x) + "]"
 
+# Measured share of wrong pixels (off by more than 8/255 against the f64 truth,
+# 64x64, default configuration), in %: lavapipe (Vulkan) and llvmpipe (OpenGL)
+# from tests/tests/hard_cases.rs, and the GPU's Vulkan / OpenGL from
+# comparison/results/<gpu>/accuracy/hard_cases.csv. Each tolerance is twice
+# the largest of them, but never below FLOOR, and never above the case's
+# earlier tolerance (the argument written at the case).
+# gpu: None where the H200 run predates the case, its geometry or its local
+# origin (the lead's next GPU run fills these in).
+H200 = "H200"
+def m(lavapipe, llvmpipe, gpu=None, why=""):
+    return dict(lavapipe=lavapipe, llvmpipe=llvmpipe, gpu=gpu,
+                gpu_name=H200 if gpu else f"GPU not yet measured ({why})")
+NEW_ORIGIN = "its H200 run predates the local origin"
+MEASURED = {
+    "closed-mesh": m(0.0, 0.0, why=NEW_ORIGIN),
+    "coplanar": m(4.614, 4.614, (5.298, 5.322)),
+    "degenerate": m(0.0, 0.0, (0.0, 0.0)),
+    "far-1e4": m(0.0, 0.0, why=NEW_ORIGIN),
+    "far-1e5": m(0.0, 0.0, why=NEW_ORIGIN),
+    "far-1e6": m(0.0, 0.0, why=NEW_ORIGIN),
+    "far-1e7": m(0.0, 0.0, why="a new case"),
+    "far-tiny-sphere": m(0.024, 0.024, (0.024, 0.220)),
+    "grazing": m(0.0, 0.0, (0.0, 0.0)),
+    "huge-ground": m(0.049, 0.049, (0.049, 0.049)),
+    "inside-glass": m(0.0, 0.0, (0.0, 0.0)),
+    "light-inside-sphere": m(0.0, 0.0, (0.0, 0.0)),
+    "light-on-surface": m(0.0, 0.0, (0.0, 0.0)),
+    "nested-glass": m(0.024, 0.024, (0.342, 0.439)),
+    "small-spheres": m(0.0, 0.0, why="a new case"),
+    "thin-tubes": m(0.0, 0.0, why="its H200 run predates the case"),
+    "tiny-1e-3": m(0.0, 0.0, (0.0, 0.0)),
+    "tiny-1e-4": m(0.0, 0.0, (0.0, 0.0)),
+    "total-internal-reflection": m(0.0, 0.0, why="its H200 run predates lifting the cube"),
+}
+
+# One pixel of the 64x64 image is 0.0244%. Where every renderer measured 0,
+# twice 0 would fail on the first pixel that another driver's rounding flips
+# (an edge pixel whose centre ray grazes a silhouette), so the tolerance keeps
+# one pixel.
+FLOOR = 0.025
+
+def tolerance_of(name, fallback):
+    m = MEASURED.get(name)
+    if m is None:
+        return fallback
+    values = [m["lavapipe"], m["llvmpipe"], *(m.get("gpu") or ())]
+    return min(fallback, max(FLOOR, math.floor(2000 * max(values)) / 1000))
+
+def measured_line(name, tolerance):
+    m = MEASURED.get(name)
+    if m is None:
+        return []
+    rule = (f"# tolerance rule: 2x the largest measured, at least {FLOOR}% (one pixel: see FLOOR in the generator)"
+            if tolerance > 0 else
+            "# tolerance rule: none; no pixel may change, as every renderer measured")
+    gpu = m.get("gpu")
+    g = f", {m['gpu_name']} {gpu[0]:.3f}% / {gpu[1]:.3f}% (Vulkan / OpenGL)" if gpu else f", {m['gpu_name']}"
+    return [f"# measured: lavapipe {m['lavapipe']:.3f}%, llvmpipe {m['llvmpipe']:.3f}%{g}", rule]
+
 def header(name, checks, tolerance, extra=(), note=""):
-    lines = [f"# hard case: {name}", f"# checks: {checks}", f"# tolerance: {tolerance}%"]
+    tolerance = tolerance_of(name, tolerance)
+    lines = [f"# hard case: {name}", f"# checks: {checks}", f"# tolerance: {tolerance}%", *measured_line(name, tolerance)]
     lines += [f"# check: {e}" for e in extra]
     if note:
         lines += ["#", *[f"# {l}" for l in note.strip().splitlines()]]
@@ -61,18 +121,17 @@ def write(name, text):
         f.write(text)
 
 FAR_NOTE = """A sphere and a cube resting on a ground quad, lit from above, moved {what}.
-f32 coordinates there are {ulp} apart, so hit points lie off the surface by
-about that much: a secondary-ray offset much smaller gives shadow acne, one
-much larger detaches the contact shadows. At 1e6 (1/16 apart) even the best
-offset leaves ~13% of pixels off by more than 8/255: sphere normals come from
-hit points quantised to 1/16 (a blocky highlight) and contact shadows detach by
-a few ULPs (a fixed 1e-4 offset has fewer wrong pixels here, 7.5%, but
-visible acne, and fails at 1e4 and 1e5; 1e-4 * |p| loses the shadows, 54%)."""
+In world coordinates f32 values there are {ulp} apart, so hit points would lie
+off the surface by about that much (at 1e6, 10.6% of pixels came out wrong on
+lavapipe: blocky highlights and detached contact shadows). The GPU gets every
+position relative to the local origin (the camera's look-at point on a
+power-of-two grid, subtracted in f64), so it traces this scene as if it lay
+near the world origin; `--set origin=world` shows what that saves."""
 
-for d in (1e4, 1e5, 1e6):
+for d in (1e4, 1e5, 1e6, 1e7):
     ulp = 2.0 ** (math.floor(math.log2(d)) - 23)
     exp = int(round(math.log10(d)))
-    tol = {4: 0.5, 5: 1.0, 6: 15.0}[exp]
+    tol = 0.1 if exp >= 6 else 0.05
     write(f"far-1e{exp}", small_scene(1.0, [d, d, d], f"far-1e{exp}",
           f"the same object at ({d:g}, {d:g}, {d:g}): no shadow acne, no detached shadows", tol,
           FAR_NOTE.format(what=f"to ({d:g}, {d:g}, {d:g})", ulp=f"{ulp:g}")))
@@ -173,17 +232,17 @@ refracted ray must start outside, the reflected one inside; a wrong side on
 either shows as noise all over the image.""")
 
 simple("total-internal-reflection", "total internal reflection inside a glass cube seen past its critical angle", 8.0,
-       '\n[[meshes]]\nobj = "../cube.obj"\nmaterial = "glass"\nscale = 1.6\nrotate_y = 35.0\ntranslate = [0.0, 0.8, 0.0]\nsmooth = false\n'
+       '\n[[meshes]]\nobj = "../cube.obj"\nmaterial = "glass"\nscale = 1.6\nrotate_y = 35.0\ntranslate = [0.0, 0.81, 0.0]\nsmooth = false\n'
        '\n[[spheres]]\ncenter = [0.0, 0.5, -2.5]\nradius = 0.5\nmaterial = "red"\n'
        '\n[[quads]]\ncorners = [[-8.0, 0.0, -8.0], [-8.0, 0.0, 8.0], [8.0, 0.0, 8.0], [8.0, 0.0, -8.0]]\nmaterial = "ground"\n',
        'eye = [2.5, 3.5, 4.0]\nlook_at = [0.0, 0.7, 0.0]\nfov_y = 40.0', render="max_depth = 4",
        materials=MATERIALS + GLASS.replace("ior = 1.5", "ior = 2.0"),
        note="""Rays entering the top of a cube of index 2 (critical angle 30 degrees) meet the
 sides beyond it: every such ray reflects inside (k < 0 in the shader) and must
-stay inside, without NaN. Paths that bounce inside are chaotic: at 64x64 the
-top and bottom faces alias into speckle even in the f64 reference, and f32
-rounding flips the exit face of ~6% of pixels under every strategy, hence the
-tolerance.""")
+stay inside, without NaN. The cube floats 0.01 above the ground: with its
+bottom face on the ground plane the two coplanar faces z-fought, and that
+speckle (3.5% of pixels, in the f64 reference too) was what the case measured;
+coplanar faces have their own case, `coplanar`.""")
 
 simple("thin-tubes", "the teapot's spout and handle, thin tubes of small triangles seen from 9 units: no shadow acne", 0.2,
        '\n[[meshes]]\nbpt = "../teapot.bpt"\ntessellation = [20, 15]\nmaterial = "red"\nsmooth = true\n',
@@ -198,6 +257,22 @@ with t and with how thin the triangle is; an offset of a few ULPs of the
 coordinates from it re-hits the surface (speckled shadow acne). Rebuilt from
 the barycentrics, the point's error stays within a few ULPs of the vertices.
 With the default offset from o + t d, 0.56% of pixels came out wrong here.""")
+
+SMALL = "".join(
+    f'\n[[spheres]]\ncenter = [{-1.2 + 1.2 * j + 0.15 * i:.2f}, {0.22 + 0.04 * ((i * 3 + j) % 3) + 0.15 * ((i + j) % 2):.2f}, {-1.2 + 1.2 * i:.2f}]\n'
+    f'radius = {0.22 + 0.04 * ((i * 3 + j) % 3):.2f}\nmaterial = "{"blue" if (i + j) % 2 else "red"}"\n'
+    for i in range(3) for j in range(3))
+simple("small-spheres", "nine spheres of radius 0.22-0.30 seen from 9.6 units, at ordinary scale: no shadow acne", 0.1,
+       SMALL + '\n[[quads]]\ncorners = [[-5.0, 0.0, -5.0], [-5.0, 0.0, 5.0], [5.0, 0.0, 5.0], [5.0, 0.0, -5.0]]\nmaterial = "ground"\n',
+       'eye = [1.0, 3.5, 9.0]\nlook_at = [0.0, 0.3, 0.0]\nfov_y = 22.0', render="max_depth = 1",
+       lights='\n[[lights]]\nposition = [3.0, 5.0, 2.0]\ncolor = [0.6, 0.6, 0.6]\n'
+              '\n[[lights]]\nposition = [-4.0, 3.0, 3.0]\ncolor = [0.5, 0.5, 0.5]\n',
+       note="""Nothing here is far or tiny: spheres a few tenths across, 9.6 units from the
+eye. The textbook quadratic forms b^2 - 4ac from b^2 ~ 4 D^2 (D the distance
+to the sphere), so its hit point is off the surface by ~1e-7 D^2 / r, more
+than the scale-aware offset (~1e-6 D) where D / r exceeds ~10: speckled
+shadow acne on the spheres (4.8% of pixels wrong on lavapipe with
+`--set sphere=quadratic`, 0 with the stable test).""")
 
 simple("nested-glass", "adjacent (touching) and nested glass spheres", 1.5,
        '\n[[spheres]]\ncenter = [-0.7, 0.7, 0.0]\nradius = 0.7\nmaterial = "glass"\n'

@@ -1,10 +1,13 @@
 //! Camera → the per-pixel ray frame the shader and the reference both use, the
 //! view frustum (to check, e.g., that the teapot scene's sphere is out of view),
 //! and the orbit camera of the windowed apps (drag orbits, wheel zooms, R resets):
-//! one implementation, so both APIs move the camera identically.
+//! one implementation, so both APIs move the camera identically; and the local
+//! origin: the point subtracted in f64 from every position before the GPU's f32
+//! conversion, so that a scene far from the world origin is traced as if near it.
 
-use crate::scene::Camera;
+use crate::scene::{Camera, Scene};
 use glam::DVec3;
+use std::borrow::Cow;
 
 /// Primary ray for pixel (x, y), counted from the top-left: from `eye` along
 /// `top_left + x * step_x + y * step_y` (pixel centres; `step_y` points down).
@@ -48,10 +51,108 @@ impl RayFrame {
         }
     }
 
+    /// The frame of `camera` with its eye relative to `scene`'s local origin:
+    /// what the GPU and the reference trace. The directions are computed from
+    /// the world-space camera first, so a translation never changes their rounding.
+    pub fn local(scene: &Scene, camera: &Camera, width: u32, height: u32) -> RayFrame {
+        let mut frame = RayFrame::new(camera, width, height);
+        frame.eye -= local_origin(scene);
+        frame
+    }
+
     /// Unit direction through the centre of pixel (x, y).
     pub fn dir(&self, x: f64, y: f64) -> DVec3 {
         (self.top_left + x * self.step_x + y * self.step_y).normalize()
     }
+}
+
+/// Where the GPU's coordinates are measured from (`--set origin=`, `[render] origin`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default, serde::Serialize)]
+pub enum OriginMode {
+    /// The camera's look-at point, snapped to a power-of-two grid (`local_origin`).
+    #[default]
+    Local,
+    /// The world origin: every coordinate converted to f32 as written (the
+    /// behaviour before local origins, kept to measure what they gain).
+    World,
+}
+
+impl OriginMode {
+    pub const ALL: [OriginMode; 2] = [OriginMode::Local, OriginMode::World];
+
+    pub fn name(self) -> &'static str {
+        match self {
+            OriginMode::Local => "local",
+            OriginMode::World => "world",
+        }
+    }
+
+    /// Parses `local` or `world`; `what` names the source in the error.
+    pub fn parse(value: &str, what: &str) -> anyhow::Result<OriginMode> {
+        let v = value.trim().to_ascii_lowercase();
+        OriginMode::ALL
+            .into_iter()
+            .find(|m| m.name() == v)
+            .ok_or_else(|| {
+                crate::error::bad_input(format!("{what}: '{value}' is not one of local, world"))
+            })
+    }
+}
+
+/// The local origin's grid, in view distances: the origin is the look-at point
+/// rounded to a multiple of the smallest power of two at or above this many
+/// times the eye's distance from it.
+pub const LOCAL_ORIGIN_GRID_VIEWS: f64 = 16.0;
+
+/// The point subtracted (in f64) from every position of `scene` before the
+/// f32 conversion. The scene's own camera decides it, not the orbit camera of
+/// a window, so orbiting and zooming never move it: the window keeps the
+/// buffers it uploaded and shows what `--headless` renders for the same view.
+///
+/// The look-at point is rounded to a power-of-two grid at least 16 view
+/// distances wide: the coordinates the GPU sees then stay within about 16 view
+/// distances of zero wherever the scene lies, and a scene whose target already
+/// lies within 8 view distances of the world origin (every built-in scene and
+/// most hard cases) gets exactly zero, so its buffers and images do not change
+/// by a single bit. A power of two also keeps the subtraction exact in f64 for
+/// coordinates of similar magnitude.
+pub fn local_origin(scene: &Scene) -> DVec3 {
+    match scene.origin {
+        OriginMode::World => DVec3::ZERO,
+        OriginMode::Local => {
+            let cam = &scene.camera;
+            let view = (cam.eye - cam.look_at).length();
+            let grid = (LOCAL_ORIGIN_GRID_VIEWS * view).log2().ceil().exp2();
+            if !(grid.is_finite() && grid > 0.0) {
+                return DVec3::ZERO;
+            }
+            // `+ 0.0` turns a -0.0 into 0.0, so a near scene's origin is exactly zero.
+            (cam.look_at / grid).round() * grid + DVec3::ZERO
+        }
+    }
+}
+
+/// `scene` with `local_origin` subtracted from its camera, lights, spheres and
+/// triangles, still in f64: what the GPU buffers are made from and what the
+/// reference traces. Borrowed unchanged when the origin is zero.
+pub fn in_local_frame(scene: &Scene) -> Cow<'_, Scene> {
+    let o = local_origin(scene);
+    if o == DVec3::ZERO {
+        return Cow::Borrowed(scene);
+    }
+    let mut s = scene.clone();
+    s.camera.eye -= o;
+    s.camera.look_at -= o;
+    for l in &mut s.lights {
+        l.position -= o;
+    }
+    for sp in &mut s.spheres {
+        sp.center -= o;
+    }
+    for t in &mut s.triangles {
+        t.p = t.p.map(|p| p - o);
+    }
+    Cow::Owned(s)
 }
 
 /// The four side planes of the view pyramid, normals pointing inwards.
@@ -258,6 +359,74 @@ mod tests {
         o.reset();
         assert_eq!(o, Orbit::new(&cam()));
         assert!(close(o.camera().eye, cam().eye));
+    }
+
+    #[test]
+    fn near_scenes_keep_a_zero_origin_and_far_ones_trace_near_zero() {
+        use crate::gpu::GpuScene;
+        for (name, _) in crate::scene::BUILTIN_SCENES {
+            let s = Scene::load(name, &[]).unwrap();
+            assert_eq!(local_origin(&s), DVec3::ZERO, "{name}");
+            assert!(matches!(in_local_frame(&s), Cow::Borrowed(_)), "{name}");
+        }
+        let dir = std::path::Path::new(crate::hard::SOURCE_DIR);
+        let mut moved = Vec::new();
+        for case in crate::hard::list(dir).unwrap() {
+            let s = Scene::load(case.path.to_str().unwrap(), &[]).unwrap();
+            let o = local_origin(&s);
+            if o == DVec3::ZERO {
+                continue;
+            }
+            moved.push(case.name.clone());
+            // On the grid: a power of two times a whole number per axis.
+            let view = (s.camera.eye - s.camera.look_at).length();
+            let grid = (LOCAL_ORIGIN_GRID_VIEWS * view).log2().ceil().exp2();
+            assert_eq!(o / grid, (o / grid).round(), "{}", case.name);
+            // What the GPU holds lies within a few view distances of zero, and
+            // `origin=world` gives the world coordinates back.
+            let g = GpuScene::new(&s, 8, 8);
+            let far = g
+                .spheres
+                .iter()
+                .map(|x| x.center)
+                .chain(g.triangles.iter().map(|t| t.p0))
+                .chain(std::iter::once(g.frame.eye))
+                .flat_map(|v| v.map(f32::abs))
+                .fold(0.0f32, f32::max);
+            assert!(far < 40.0 * view as f32, "{}: {far}", case.name);
+            let mut world = s.clone();
+            world.origin = OriginMode::World;
+            assert_eq!(local_origin(&world), DVec3::ZERO);
+            assert_eq!(
+                GpuScene::new(&world, 8, 8).frame.eye,
+                s.camera.eye.as_vec3().to_array()
+            );
+        }
+        moved.sort();
+        assert_eq!(
+            moved,
+            ["closed-mesh", "far-1e4", "far-1e5", "far-1e6", "far-1e7"],
+            "the cases README.md names as moved"
+        );
+    }
+
+    #[test]
+    fn the_orbit_never_moves_the_origin() {
+        let s = Scene::load(
+            concat!(env!("CARGO_MANIFEST_DIR"), "/../scenes/hard/far-1e6.toml"),
+            &[],
+        )
+        .unwrap();
+        let o = local_origin(&s);
+        let mut orbit = Orbit::new(&s.camera);
+        orbit.drag(40.0, 25.0, 100);
+        orbit.zoom(-5.0);
+        let frame = crate::gpu::GpuFrame::new(&s, &orbit.camera(), 8, 8);
+        let expect = (orbit.camera().eye - o).as_vec3().to_array();
+        assert_eq!(frame.eye, expect);
+        // The origin comes from the scene's own camera, never the orbit's: a
+        // zoom changes the view distance and so the grid, which would move it.
+        assert_eq!(local_origin(&s), o);
     }
 
     fn cam() -> Camera {

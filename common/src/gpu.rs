@@ -1,8 +1,9 @@
 //! GPU buffer layouts: the one Rust mirror of every struct in shaders/trace.glsl
 //! (`#[repr(C)]` + bytemuck), and the conversion of a `Scene` into the exact bytes
-//! both apps upload. A test checks these layouts against naga's view of the GLSL.
+//! both apps upload, every position relative to the scene's local origin
+//! (`camera::local_origin`). A test checks these layouts against naga's view of the GLSL.
 
-use crate::camera::RayFrame;
+use crate::camera::{in_local_frame, RayFrame};
 use crate::scene::{Camera, Scene};
 use bytemuck::{Pod, Zeroable};
 
@@ -166,9 +167,10 @@ fn v3(v: glam::DVec3) -> [f32; 3] {
 
 impl GpuFrame {
     /// The uniform block for `scene` seen through `camera` (the windowed apps
-    /// pass the orbit camera; everything else passes `scene.camera`).
+    /// pass the orbit camera; everything else passes `scene.camera`), the eye
+    /// relative to the scene's local origin like the buffers of `GpuScene::new`.
     pub fn new(scene: &Scene, camera: &Camera, width: u32, height: u32) -> GpuFrame {
-        let rf = RayFrame::new(camera, width, height);
+        let rf = RayFrame::local(scene, camera, width, height);
         GpuFrame {
             eye: v3(rf.eye),
             min_weight: scene.min_weight as f32,
@@ -189,11 +191,16 @@ impl GpuFrame {
 }
 
 impl GpuScene {
-    pub fn new(scene: &Scene, width: u32, height: u32) -> GpuScene {
+    /// The buffers of `scene` in its local frame: positions have the local origin
+    /// subtracted in f64 before they become f32, and the BVH (`Scene::bvh_tree`)
+    /// is built over those translated primitives, so its boxes are rounded in
+    /// the same frame.
+    pub fn new(world: &Scene, width: u32, height: u32) -> GpuScene {
+        let scene = &*in_local_frame(world);
         let empty = crate::bvh::Bvh::default();
-        let bvh = scene.bvh_tree().unwrap_or(&empty);
+        let bvh = world.bvh_tree().unwrap_or(&empty);
         GpuScene {
-            frame: GpuFrame::new(scene, &scene.camera, width, height),
+            frame: GpuFrame::new(world, &world.camera, width, height),
             spheres: scene
                 .spheres
                 .iter()

@@ -14,6 +14,7 @@ pub mod interactive;
 pub mod limits;
 pub mod metrics;
 pub mod numerics;
+pub mod random_scene;
 pub mod reference;
 pub mod report;
 pub mod scene;

@@ -2,16 +2,17 @@
 //! rayon task. Same ray stack, same push order, same offsets and tests — the
 //! shader's compile-time numerical choices (numerics.rs) are run-time branches
 //! here — so the GPU images differ from it only by f32 arithmetic.
-//! It traces the scene as the GPU holds it (inputs rounded to f32, see
-//! `Scene::rounded_to_f32`). Change both together.
+//! It traces the scene as the GPU holds it (in the local frame of
+//! `camera::in_local_frame`, inputs rounded to f32, see `Scene::rounded_to_f32`).
+//! Change both together.
 //!
 //! Rays traverse a BVH built by the GPU's own builder (bvh.rs) over the
-//! reference's world-space primitives, so a 2-million-triangle mesh takes
-//! seconds, not hours. The traversal keeps brute force's answer exactly: the
-//! closest hit, ties going to the primitive brute force tests first.
+//! reference's primitives, so a 2-million-triangle mesh takes seconds, not
+//! hours. The traversal keeps brute force's answer exactly: the closest hit,
+//! ties going to the primitive brute force tests first.
 
 use crate::bvh::Bvh;
-use crate::camera::RayFrame;
+use crate::camera::{in_local_frame, RayFrame};
 use crate::gpu::PRIM_SPHERE_BIT;
 use crate::image_io::FloatImage;
 use crate::numerics::{Numerics, Offset, SphereTest, TriangleTest};
@@ -44,14 +45,15 @@ pub fn render_counting(
     bvh: bool,
     rows_done: &AtomicUsize,
 ) -> FloatImage {
-    let mut scene = scene.rounded_to_f32();
+    // The GPU's frame: positions relative to the local origin, then rounded to f32.
+    let frame = RayFrame::local(scene, &scene.camera, width, height).rounded_to_f32();
+    let mut scene = in_local_frame(scene).rounded_to_f32();
     scene.numerics = *numerics;
     let tracer = if bvh {
         Tracer::new(&scene)
     } else {
         Tracer::brute_force(&scene)
     };
-    let frame = RayFrame::new(&scene.camera, width, height).rounded_to_f32();
     let w = width as usize;
     let mut pixels = vec![[0f32; 3]; crate::limits::pixel_count(width, height)];
     pixels.par_chunks_mut(w).enumerate().for_each(|(y, row)| {

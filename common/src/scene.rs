@@ -34,6 +34,7 @@ pub const OVERRIDE_KEYS: &[&str] = &[
     "offset",
     "triangle",
     "sphere",
+    "origin",
 ];
 
 /// The largest `max_depth` a scene may ask for (`limits::MAX_DEPTH`); the shader's generic ray stack holds this + 1.
@@ -130,6 +131,8 @@ struct RenderDef {
     offset: Option<String>,
     triangle: Option<String>,
     sphere: Option<String>,
+    /// `local` (default) or `world`: see `camera::local_origin`.
+    origin: Option<String>,
 }
 
 impl Default for RenderDef {
@@ -142,6 +145,7 @@ impl Default for RenderDef {
             offset: None,
             triangle: None,
             sphere: None,
+            origin: None,
         }
     }
 }
@@ -307,6 +311,8 @@ pub struct Scene {
     pub epsilon: f64,
     /// Secondary-ray offset, triangle and sphere tests: the shader variant and the reference follow it.
     pub numerics: Numerics,
+    /// Where the GPU's f32 coordinates are measured from (camera.rs, `local_origin`).
+    pub origin: crate::camera::OriginMode,
     pub materials: Vec<Material>,
     pub lights: Vec<Light>,
     pub spheres: Vec<Sphere>,
@@ -374,6 +380,16 @@ enum FileSource {
 impl Scene {
     /// Loads a built-in scene by name, or a scene file by path, and applies `--set` overrides.
     pub fn load(name_or_path: &str, overrides: &[(String, String)]) -> anyhow::Result<Scene> {
+        if let Some(seed) = crate::random_scene::seed_of(name_or_path) {
+            let seed = seed?;
+            return Scene::parse(
+                &format!("random-{seed}"),
+                &crate::random_scene::toml(seed),
+                &format!("random scene {seed}"),
+                FileSource::Builtin,
+                overrides,
+            );
+        }
         if let Some((name, text)) = BUILTIN_SCENES.iter().find(|(n, _)| *n == name_or_path) {
             return Scene::parse(
                 name,
@@ -476,7 +492,11 @@ impl Scene {
             &**self
                 .bvh_cache
                 .0
-                .get_or_init(|| std::sync::Arc::new(crate::bvh::Bvh::build(self)))
+                // Over the primitives as the GPU holds them: relative to the local origin.
+                .get_or_init(|| {
+                    let local = crate::camera::in_local_frame(self);
+                    std::sync::Arc::new(crate::bvh::Bvh::build(&local))
+                })
         })
     }
 
@@ -609,6 +629,10 @@ fn apply_overrides(
                     "triangle" => def.render.triangle = Some(value.clone()),
                     _ => def.render.sphere = Some(value.clone()),
                 }
+            }
+            "origin" => {
+                crate::camera::OriginMode::parse(value, "--set origin")?;
+                def.render.origin = Some(value.clone());
             }
             "extra_spheres" => {
                 let n = int()?;
@@ -808,6 +832,11 @@ fn resolve(
             numerics.set(key, v, &format!("{origin}: render.{key}"))?;
         }
     }
+
+    let origin_mode = match &r.origin {
+        Some(v) => crate::camera::OriginMode::parse(v, &format!("{origin}: render.origin"))?,
+        None => Default::default(),
+    };
 
     if def.materials.is_empty() {
         return Err(bad_input(format!(
@@ -1036,6 +1065,7 @@ fn resolve(
         min_weight,
         epsilon,
         numerics,
+        origin: origin_mode,
         materials,
         lights,
         bvh: primitives >= AUTO_BVH_MIN_PRIMITIVES,

@@ -12,10 +12,12 @@ use anyhow::Context;
 use plotters::prelude::*;
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
+use twinray_common::camera::OriginMode;
 use twinray_common::cli::{RenderArgs, Size};
 use twinray_common::hard::{self, HardCase, WRONG_ABOVE};
 use twinray_common::metrics;
 use twinray_common::numerics::{Numerics, Offset, SphereTest, TriangleTest};
+use twinray_common::random_scene;
 use twinray_common::reference;
 use twinray_common::scene::{Scene, MAX_DEPTH_LIMIT};
 
@@ -33,6 +35,216 @@ pub struct AccuracyArgs {
     /// Skip the hard cases.
     #[arg(long)]
     pub no_hard: bool,
+    /// Random scenes (`--scene random:SEED`, seeds 0..N) rendered by both
+    /// apps and the reference; default 100, 10 with --quick, 0 skips them.
+    #[arg(long, value_name = "N")]
+    pub random: Option<u64>,
+}
+
+/// One random scene's three renders compared pairwise.
+#[derive(Debug, Clone)]
+pub struct RandomRow {
+    pub seed: u64,
+    /// "Vulkan vs reference", "OpenGL vs reference", "Vulkan vs OpenGL".
+    pub pair: &'static str,
+    pub result: Result<metrics::Metrics, String>,
+}
+
+const RANDOM_PAIRS: [&str; 3] = [
+    "Vulkan vs reference",
+    "OpenGL vs reference",
+    "Vulkan vs OpenGL",
+];
+
+fn random_size(quick: bool) -> Size {
+    if quick {
+        Size {
+            width: 48,
+            height: 36,
+        }
+    } else {
+        Size {
+            width: 160,
+            height: 120,
+        }
+    }
+}
+
+/// Renders seeds 0..n with both apps and the reference (the scene's own
+/// numerics, so the three should differ by f32 rounding only).
+fn run_random(n: u64, size: Size, out: &Path) -> anyhow::Result<Vec<RandomRow>> {
+    let mut rows = Vec::new();
+    for seed in 0..n {
+        let name = format!("{}{seed}", random_scene::PREFIX);
+        let scene = Scene::load(&name, &[])?;
+        let reference = reference::render(&scene, size.width, size.height);
+        let ref_nan = reference.nonfinite_pixels() as u64;
+        let reference = reference.to_rgb8();
+        let mut imgs = Vec::new();
+        for api in [Api::Vulkan, Api::Opengl] {
+            let png = out.join(format!("images/random-{seed}-{}.png", api_name(api)));
+            imgs.push(
+                render_app(api, &name, size, Vec::new(), 1, &png)
+                    .map_err(|e| format!("{e:#}"))
+                    .map(|(_, _, nan, img)| {
+                        let _ = std::fs::remove_file(&png);
+                        (nan, img)
+                    }),
+            );
+        }
+        let cmp = |a: &Result<(u64, image::RgbImage), String>,
+                   b: Option<&Result<(u64, image::RgbImage), String>>|
+         -> Result<metrics::Metrics, String> {
+            let (na, a) = a.as_ref().map_err(Clone::clone)?;
+            let (nb, b) = match b {
+                Some(b) => {
+                    let (n, i) = b.as_ref().map_err(Clone::clone)?;
+                    (*n, i)
+                }
+                None => (ref_nan, &reference),
+            };
+            let mut m = metrics::compare(a, b).map_err(|e| format!("{e:#}"))?;
+            m.nan_pixels = na + nb;
+            Ok(m)
+        };
+        let results = [
+            cmp(&imgs[0], None),
+            cmp(&imgs[1], None),
+            cmp(&imgs[0], Some(&imgs[1])),
+        ];
+        for (pair, result) in RANDOM_PAIRS.into_iter().zip(results) {
+            let bad = match &result {
+                Ok(m) => random_scene::disagreement(m),
+                Err(e) => Some(e.clone()),
+            };
+            if let Some(why) = bad {
+                eprintln!(
+                    "  random:{seed} {pair}: {why}\n  reproduce: {}",
+                    random_scene::reproduce(seed, size.width, size.height, "")
+                );
+            }
+            rows.push(RandomRow { seed, pair, result });
+        }
+    }
+    Ok(rows)
+}
+
+fn random_csv(rows: &[RandomRow]) -> String {
+    let mut s =
+        String::from("seed,pair,status,off_8_pct,within_1_pct,max_abs,rmse,nonfinite_pixels\n");
+    for r in rows {
+        match &r.result {
+            Ok(m) => {
+                let _ = writeln!(
+                    s,
+                    "{},{},{},{},{},{},{},{}",
+                    r.seed,
+                    q(r.pair),
+                    if random_scene::disagreement(m).is_some() {
+                        "disagree"
+                    } else {
+                        "ok"
+                    },
+                    100.0 * m.above_8,
+                    100.0 * m.within_1(),
+                    m.max_abs,
+                    m.rmse,
+                    m.nan_pixels
+                );
+            }
+            Err(e) => {
+                let _ = writeln!(
+                    s,
+                    "{},{},{},,,,,",
+                    r.seed,
+                    q(r.pair),
+                    q(&format!("failed: {e}"))
+                );
+            }
+        }
+    }
+    s
+}
+
+/// The value at quantile `p` (0..1) of sorted `v` (nearest rank).
+fn quantile(v: &[f64], p: f64) -> f64 {
+    if v.is_empty() {
+        return f64::NAN;
+    }
+    v[((p * v.len() as f64).ceil() as usize).clamp(1, v.len()) - 1]
+}
+
+fn random_markdown(rows: &[RandomRow], size: Size) -> String {
+    let mut s = String::new();
+    let seeds = rows.iter().map(|r| r.seed).max().map_or(0, |m| m + 1);
+    let _ = writeln!(
+        s,
+        "## Random scenes ({seeds} seeds, {size})\n\n`--scene random:SEED` for seeds 0..{seeds} (common/src/random_scene.rs: spheres, triangles, \
+         a mesh, diffuse, mirror and glass with glass inside glass, 1–4 lights, random cameras), each rendered by both apps and \
+         the f64 reference with the scene's own numerics. A pair disagrees when more than {:.2}% of its pixels are off by more \
+         than 8/255 or fewer than {:.0}% are within 1/255 (the thresholds tests/tests/random_scenes.rs applies to 20 seeds). \
+         Distribution over the seeds:\n",
+        100.0 * random_scene::MAX_OFF_SHARE,
+        100.0 * random_scene::MIN_WITHIN_1
+    );
+    let _ = writeln!(
+        s,
+        "| pair | seeds | disagree | off by >8/255: median / 90% / 99% / max | within 1/255: min / 1% / median | max abs: median / max |\n|---|---|---|---|---|---|"
+    );
+    let mut failing = Vec::new();
+    for pair in RANDOM_PAIRS {
+        let these: Vec<&RandomRow> = rows.iter().filter(|r| r.pair == pair).collect();
+        let ok: Vec<&metrics::Metrics> = these
+            .iter()
+            .filter_map(|r| r.result.as_ref().ok())
+            .collect();
+        let mut off: Vec<f64> = ok.iter().map(|m| 100.0 * m.above_8).collect();
+        let mut within: Vec<f64> = ok.iter().map(|m| 100.0 * m.within_1()).collect();
+        let mut max_abs: Vec<f64> = ok.iter().map(|m| f64::from(m.max_abs)).collect();
+        for v in [&mut off, &mut within, &mut max_abs] {
+            v.sort_by(f64::total_cmp);
+        }
+        let bad: Vec<&&RandomRow> = these
+            .iter()
+            .filter(|r| {
+                r.result
+                    .as_ref()
+                    .map_or(true, |m| random_scene::disagreement(m).is_some())
+            })
+            .collect();
+        for r in &bad {
+            failing.push(format!(
+                "- random:{} {pair}: {}. Reproduce: `{}`",
+                r.seed,
+                match &r.result {
+                    Ok(m) => random_scene::disagreement(m).unwrap_or_default(),
+                    Err(e) => e.replace('\n', " "),
+                },
+                random_scene::reproduce(r.seed, size.width, size.height, "")
+            ));
+        }
+        let _ = writeln!(
+            s,
+            "| {pair} | {} | {} | {:.3}% / {:.3}% / {:.3}% / {:.3}% | {:.2}% / {:.2}% / {:.2}% | {:.0} / {:.0} |",
+            these.len(),
+            bad.len(),
+            quantile(&off, 0.5),
+            quantile(&off, 0.9),
+            quantile(&off, 0.99),
+            quantile(&off, 1.0),
+            quantile(&within, 0.0),
+            quantile(&within, 0.01),
+            quantile(&within, 0.5),
+            quantile(&max_abs, 0.5),
+            quantile(&max_abs, 1.0),
+        );
+    }
+    if failing.is_empty() {
+        let _ = writeln!(s, "\nEvery seed agrees within the thresholds.\n");
+    } else {
+        let _ = writeln!(s, "\nDisagreeing seeds:\n\n{}\n", failing.join("\n"));
+    }
+    s
 }
 
 /// One point of a sweep: a maximum depth and a numerical configuration.
@@ -493,18 +705,33 @@ pub fn run(args: &AccuracyArgs) -> anyhow::Result<()> {
         }
     }
 
+    let random_n = args.random.unwrap_or(if args.quick { 10 } else { 100 });
+    let random_rows = if random_n > 0 {
+        let size = random_size(args.quick);
+        eprintln!("twinray accuracy: {random_n} random scenes at {size} x (2 APIs + reference)");
+        let r = run_random(random_n, size, &args.out)?;
+        std::fs::write(args.out.join("random.csv"), random_csv(&r))
+            .context("writing random.csv")?;
+        r
+    } else {
+        Vec::new()
+    };
+
     let cpu = crate::report::cpu_model();
     std::fs::write(args.out.join("hard_cases.csv"), hard_csv(&hard_rows))
         .context("writing hard_cases.csv")?;
     // With the hard cases known, numerics that fail any of them leave the front.
+    // (The world-origin column is not a numerical choice of the sweeps: every
+    // sweep runs with the local origin.)
     let unsound: Vec<Numerics> = hard_strategies()
         .into_iter()
-        .filter(|(label, _)| {
-            hard_rows.iter().filter(|r| &r.strategy == label).any(|r| {
+        .filter(|st| st.origin == OriginMode::Local)
+        .filter(|st| {
+            hard_rows.iter().filter(|r| r.strategy == st.label).any(|r| {
                 !matches!(&r.result, Ok((w, _, _, nan)) if 100.0 * w <= r.tolerance_pct && *nan == 0)
             })
         })
-        .map(|(_, n)| n)
+        .map(|st| st.numerics)
         .collect();
     mark_pareto(&mut rows, &unsound);
     std::fs::write(args.out.join("accuracy.csv"), csv(&rows)).context("writing accuracy.csv")?;
@@ -516,7 +743,7 @@ pub fn run(args: &AccuracyArgs) -> anyhow::Result<()> {
             .with_context(|| format!("plotting {file}"))?;
         plots.push(file);
     }
-    let md = markdown(
+    let mut md = markdown(
         args,
         &rows,
         &hard_rows,
@@ -525,6 +752,9 @@ pub fn run(args: &AccuracyArgs) -> anyhow::Result<()> {
         &cpu,
         started.elapsed().as_secs_f64(),
     );
+    if !random_rows.is_empty() {
+        md.push_str(&random_markdown(&random_rows, random_size(args.quick)));
+    }
     std::fs::write(args.out.join("report.md"), md).context("writing report.md")?;
     eprintln!(
         "twinray accuracy: report: {}",
@@ -533,13 +763,45 @@ pub fn run(args: &AccuracyArgs) -> anyhow::Result<()> {
     Ok(())
 }
 
-/// The strategies of the hard-case table: the default, then one knob changed.
-pub fn hard_strategies() -> Vec<(String, Numerics)> {
+/// One column of the hard-case table: numerical choices and where the GPU's
+/// coordinates are measured from.
+#[derive(Debug, Clone, PartialEq)]
+pub struct HardStrategy {
+    pub label: String,
+    pub numerics: Numerics,
+    pub origin: OriginMode,
+}
+
+impl HardStrategy {
+    /// `--set` overrides whatever the scene file's [render] section chose.
+    pub fn set_args(&self) -> Vec<String> {
+        let mut v = self.numerics.set_args();
+        v.push(format!("origin={}", self.origin.name()));
+        v
+    }
+}
+
+/// The strategies of the hard-case table: the default, the default without
+/// the local origin (what f32 world coordinates cost: the "before" of
+/// camera-relative rendering), then one numerical knob changed.
+pub fn hard_strategies() -> Vec<HardStrategy> {
     let d = Numerics::default();
-    let mut v = vec![("default".to_string(), d)];
+    let st = |label: String, numerics: Numerics| HardStrategy {
+        label,
+        numerics,
+        origin: OriginMode::Local,
+    };
+    let mut v = vec![
+        st("default".into(), d),
+        HardStrategy {
+            label: format!("origin={}", OriginMode::World.name()),
+            numerics: d,
+            origin: OriginMode::World,
+        },
+    ];
     for offset in Offset::ALL {
         if offset != d.offset {
-            v.push((
+            v.push(st(
                 format!("offset={}", offset.name()),
                 Numerics { offset, ..d },
             ));
@@ -547,7 +809,7 @@ pub fn hard_strategies() -> Vec<(String, Numerics)> {
     }
     for triangle in TriangleTest::ALL {
         if triangle != d.triangle {
-            v.push((
+            v.push(st(
                 format!("triangle={}", triangle.name()),
                 Numerics { triangle, ..d },
             ));
@@ -555,7 +817,7 @@ pub fn hard_strategies() -> Vec<(String, Numerics)> {
     }
     for sphere in SphereTest::ALL {
         if sphere != d.sphere {
-            v.push((
+            v.push(st(
                 format!("sphere={}", sphere.name()),
                 Numerics { sphere, ..d },
             ));
@@ -579,9 +841,8 @@ fn run_hard(case: &HardCase, size: Size, out: &Path) -> anyhow::Result<Vec<HardR
     let background = bg.get_pixel(0, 0).0;
     let cracks = case.extra.iter().any(|e| e == "cracks");
     let mut rows = Vec::new();
-    for (label, numerics) in hard_strategies() {
-        // --set overrides whatever the scene file's [render] section chose.
-        let n = numerics;
+    for strategy in hard_strategies() {
+        let label = &strategy.label;
         for api in [Api::Vulkan, Api::Opengl] {
             let png = out.join(format!(
                 "images/hard-{}-{}-{}.png",
@@ -589,7 +850,7 @@ fn run_hard(case: &HardCase, size: Size, out: &Path) -> anyhow::Result<Vec<HardR
                 label.replace('=', "-"),
                 api_name(api)
             ));
-            let result = render_app(api, &path, size, n.set_args(), 1, &png)
+            let result = render_app(api, &path, size, strategy.set_args(), 1, &png)
                 .map(|(g, w, nan, img)| {
                     let crack = cracks.then(|| hard::crack_pixels(&img, &truth, background));
                     (hard::wrong_share(&img, &truth), crack, g.unwrap_or(w), nan)
@@ -794,7 +1055,7 @@ fn markdown(
          hard cases right, and each scene keeps its own max depth.\n"
     );
     if !hard_rows.is_empty() {
-        for (label, _) in hard_strategies() {
+        for HardStrategy { label, .. } in hard_strategies() {
             let these: Vec<&HardRow> = hard_rows.iter().filter(|r| r.strategy == label).collect();
             let ok = these.iter().filter(|r| matches!(&r.result, Ok((w, _, _, nan)) if 100.0 * w <= r.tolerance_pct && *nan == 0)).count();
             let failed: Vec<String> = these
@@ -927,7 +1188,7 @@ fn markdown(
     }
 
     if !hard_rows.is_empty() {
-        let strategies: Vec<String> = hard_strategies().into_iter().map(|(l, _)| l).collect();
+        let strategies: Vec<String> = hard_strategies().into_iter().map(|st| st.label).collect();
         let _ = writeln!(
             s,
             "## Hard cases (scenes/hard/, 64x64)\n\nShare of wrong pixels (off by more than {WRONG_ABOVE}/255 against the truth) per case, \
@@ -974,6 +1235,7 @@ fn markdown(
             }
             let _ = writeln!(s);
         }
+        let _ = write!(s, "{}", origin_table(hard_rows, cases));
         // What each strategy costs: total time over all cases, and how many cases it fails.
         let _ = writeln!(s, "\n| strategy | cases within tolerance (VK / GL) | total time over the cases, ms (VK / GL) | worst case |\n|---|---|---|---|");
         for st in &strategies {
@@ -1011,6 +1273,63 @@ fn markdown(
         s,
         "Every row is in `accuracy.csv` and `hard_cases.csv`; the images are in `images/`."
     );
+    s
+}
+
+/// Before / after camera-relative rendering: the cases whose local origin is
+/// not zero, rendered with world coordinates in f32 (`origin=world`, before)
+/// and relative to the local origin (the default, after), measured as rows.
+fn origin_table(hard_rows: &[HardRow], cases: &[HardCase]) -> String {
+    let mut s = String::new();
+    let moved: Vec<(&HardCase, [f64; 3])> = cases
+        .iter()
+        .filter_map(|c| {
+            let scene = Scene::load(&c.path.to_string_lossy(), &[]).ok()?;
+            let o = twinray_common::camera::local_origin(&scene).to_array();
+            (o != [0.0; 3]).then_some((c, o))
+        })
+        .collect();
+    if moved.is_empty() {
+        return s;
+    }
+    let _ = writeln!(
+        s,
+        "\n### Local origin: before and after\n\nThe cases whose local origin (the camera's look-at point on a power-of-two \
+         grid, `camera::local_origin`) is not zero; every other case has origin zero and identical images in both columns. \
+         Wrong pixels (off by more than {WRONG_ABOVE}/255), Vulkan / OpenGL, against the one truth: the f64 reference in the local frame.\n\n\
+         | case | local origin | tolerance | before: world coordinates in f32 (`origin=world`) | after: relative to the local origin (default) |\n|---|---|---|---|---|"
+    );
+    let cell = |case: &str, st: &str| -> String {
+        [Api::Vulkan, Api::Opengl]
+            .iter()
+            .map(|api| {
+                match hard_rows
+                    .iter()
+                    .find(|r| r.case == case && r.strategy == st && r.api == *api)
+                    .map(|r| &r.result)
+                {
+                    Some(Ok((w, _, _, _))) => format!("{:.3}%", 100.0 * w),
+                    Some(Err(_)) => "failed".into(),
+                    None => "–".into(),
+                }
+            })
+            .collect::<Vec<_>>()
+            .join(" / ")
+    };
+    for (c, o) in moved {
+        let _ = writeln!(
+            s,
+            "| {} | ({:e}, {:e}, {:e}) | {}% | {} | {} |",
+            c.name,
+            o[0],
+            o[1],
+            o[2],
+            c.tolerance_pct,
+            cell(&c.name, &format!("origin={}", OriginMode::World.name())),
+            cell(&c.name, "default")
+        );
+    }
+    let _ = writeln!(s);
     s
 }
 

@@ -1,6 +1,8 @@
 //! `twinray accuracy --quick` end to end on the installed driver: every scene ×
 //! API × configuration renders, the default is among them once per scene and
-//! API, and every hard case passes with the default configuration on both APIs.
+//! API, every hard case passes with the default configuration on both APIs,
+//! the local origin's before/after rows are measured, and random scenes are
+//! compared three ways.
 
 use twinray_tests::{bin, run, scratch};
 
@@ -26,7 +28,14 @@ fn quick_accuracy_report_covers_every_configuration_and_the_default_passes_the_h
     let out = scratch("accuracy-quick");
     let o = run(
         &bin("twinray"),
-        &["accuracy", "--quick", "--out", out.to_str().unwrap()],
+        &[
+            "accuracy",
+            "--quick",
+            "--random",
+            "3",
+            "--out",
+            out.to_str().unwrap(),
+        ],
         &[],
     );
     assert!(
@@ -92,10 +101,40 @@ fn quick_accuracy_report_covers_every_configuration_and_the_default_passes_the_h
             r[col("api")]
         );
     }
+    // Before / after the local origin, both measured: world coordinates in f32
+    // lose far-1e6 (10% of its pixels), the local origin keeps it within tolerance.
+    let far = |strategy: &str| -> Vec<f64> {
+        body.iter()
+            .filter(|r| r[col("case")] == "far-1e6" && r[col("strategy")] == strategy)
+            .map(|r| r[col("wrong_pct")].parse().unwrap())
+            .collect()
+    };
+    let (before, after) = (far("origin=world"), far("default"));
+    assert_eq!((before.len(), after.len()), (2, 2));
+    assert!(
+        before.iter().all(|w| *w > 1.0) && after.iter().all(|w| *w <= 0.1),
+        "far-1e6: before {before:?}%, after {after:?}%"
+    );
+
+    let random = std::fs::read_to_string(out.join("random.csv")).unwrap();
+    let (h, body) = rows(&random);
+    let col = |n: &str| h.iter().position(|c| c == n).unwrap();
+    assert_eq!(body.len(), 9, "3 seeds x 3 pairs:\n{random}");
+    assert!(
+        body.iter().all(|r| r[col("status")] == "ok"),
+        "random scenes disagree:\n{random}"
+    );
+
     let report = std::fs::read_to_string(out.join("report.md")).unwrap();
     assert!(
         report.contains("Default configuration"),
         "report names the default"
     );
+    for section in [
+        "Local origin: before and after",
+        "## Random scenes (3 seeds",
+    ] {
+        assert!(report.contains(section), "report has no '{section}'");
+    }
     std::fs::remove_dir_all(out).ok();
 }

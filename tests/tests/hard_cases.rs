@@ -95,6 +95,10 @@ fn far_1e6() {
     check("far-1e6");
 }
 #[test]
+fn far_1e7() {
+    check("far-1e7");
+}
+#[test]
 fn tiny_1e_3() {
     check("tiny-1e-3");
 }
@@ -109,6 +113,11 @@ fn closed_mesh_has_no_cracks() {
 #[test]
 fn thin_tubes_have_no_shadow_acne() {
     check("thin-tubes");
+}
+
+#[test]
+fn small_spheres_have_no_shadow_acne() {
+    check("small-spheres");
 }
 
 #[test]
