@@ -107,7 +107,8 @@ fn variants() -> Vec<(String, Variant)> {
             SharedBvhStack,
             UniformCounts,
         ],
-        vec![NoLoopBounding, LocalBvhStack],
+        vec![NoLoopBounding, UnpairedBvhStack, StorageCounts],
+        vec![StacklessBvh],
     ] {
         let label = experiments
             .iter()
