@@ -377,6 +377,14 @@ const uint SPHERE_BIT = 0x80000000u;
 // one uvec2 per element; BVH_STACK_SHARED (compute only, where it fits)
 // keeps the stack in shared memory, entry-major so that a warp's pushes hit
 // distinct banks; BVH_STACKLESS below has no stack at all.
+#ifndef BVH_STACK
+// Only a source compiled without the build's defines (an external compiler
+// checking trace.glsl on its own) gets here: the apps always size the stack
+// from the tree. A fixed stack cannot know the tree, so it drops what does
+// not fit rather than write past its end.
+#define BVH_STACK 64
+#define BVH_STACK_FIXED 1
+#endif
 #if defined(BVH_STACK_SHARED)
 shared uvec2 bvh_stack[BVH_STACK * WG_X * WG_Y];
 #define BVH_PUSH(i, e) bvh_stack[(i) * uint(WG_X * WG_Y) + gl_LocalInvocationIndex] = (e)
@@ -553,8 +561,13 @@ Hit traverse(vec3 origin, vec3 dir, float t_max, bool any_hit) {
                 bool left_first = tl <= tr;
                 node = left_first ? left : right;
                 // sp < BVH_STACK here: the stack is as deep as the tree.
-                BVH_PUSH(sp, uvec2(left_first ? right : left, floatBitsToUint(left_first ? tr : tl)));
-                sp += 1u;
+#ifdef BVH_STACK_FIXED
+                if (sp < uint(BVH_STACK))
+#endif
+                {
+                    BVH_PUSH(sp, uvec2(left_first ? right : left, floatBitsToUint(left_first ? tr : tl)));
+                    sp += 1u;
+                }
                 continue;
             }
             if (tl >= 0.0) {
