@@ -11,7 +11,8 @@ pub struct RenderArgs {
     #[arg(long, default_value = "box")]
     pub scene: String,
     /// Image size as WxH.
-    #[arg(long, default_value = "800x600", value_parser = parse_size)]
+    // Hyphen values reach parse_size, so `-64x48` is refused as a size, not as an unknown option.
+    #[arg(long, default_value = "800x600", value_parser = parse_size, allow_hyphen_values = true)]
     pub size: Size,
     /// Render offscreen, without a window.
     #[arg(long)]
@@ -225,18 +226,27 @@ impl std::fmt::Display for Size {
     }
 }
 
-/// The largest size the parser accepts (beyond any GPU's framebuffer); each app
-/// then checks its device's own limit.
-pub const MAX_SIZE: u32 = 65536;
-
+/// `WxH`, each from 1 to `limits::MAX_IMAGE_DIMENSION`, and an image whose
+/// buffers fit the memory available (`limits::check_image_size`). Each app then
+/// checks its device's own limits.
 pub fn parse_size(s: &str) -> Result<Size, String> {
     let (w, h) = s
         .split_once(['x', 'X'])
         .ok_or_else(|| format!("'{s}' is not WxH (for example 800x600)"))?;
     let parse = |v: &str, what: &str| -> Result<u32, String> {
-        v.trim()
-            .parse::<u32>()
-            .map_err(|_| format!("the {what} in '{s}' is not a whole number"))
+        let v = v.trim();
+        if v.starts_with('-') {
+            return Err(format!(
+                "the {what} in '{s}' is negative; width and height must be at least 1"
+            ));
+        }
+        v.parse::<u32>().map_err(|e| match e.kind() {
+            std::num::IntErrorKind::PosOverflow => format!(
+                "the {what} in '{s}' is larger than {}",
+                crate::limits::MAX_IMAGE_DIMENSION
+            ),
+            _ => format!("the {what} in '{s}' is not a whole number"),
+        })
     };
     let (width, height) = (parse(w, "width")?, parse(h, "height")?);
     if width == 0 || height == 0 {
@@ -244,9 +254,7 @@ pub fn parse_size(s: &str) -> Result<Size, String> {
             "'{s}' has a zero dimension; width and height must be at least 1"
         ));
     }
-    if width > MAX_SIZE || height > MAX_SIZE {
-        return Err(format!("'{s}' is larger than {MAX_SIZE} in one dimension"));
-    }
+    crate::limits::check_image_size(width, height).map_err(|e| e.to_string())?;
     Ok(Size { width, height })
 }
 
@@ -317,8 +325,19 @@ impl RenderArgs {
             .collect()
     }
 
+    /// Checks every output path (`--out`) before any work: a typo must not cost a render.
+    pub fn check_outputs(&self) -> anyhow::Result<()> {
+        if let Some(out) = &self.out {
+            crate::image_io::check_output_file("--out", out)?;
+        }
+        Ok(())
+    }
+
     /// Loads the scene named by `--scene` with the `--set` overrides applied.
+    /// Every run (headless, windowed, reference) loads its scene before any GPU
+    /// work, so the output paths are checked here too.
     pub fn load_scene(&self) -> anyhow::Result<crate::scene::Scene> {
+        self.check_outputs()?;
         let mut scene = crate::scene::Scene::load(&self.scene, &self.overrides()?)?;
         scene.set_accel(self.accel);
         Ok(scene)

@@ -75,3 +75,30 @@ pub fn exit_with(program: &str, err: anyhow::Error) -> ! {
     eprintln!("{program}: error: {msg}");
     std::process::exit(exit_code_of(&err));
 }
+
+/// A dependency's error text without the source location some crates put in
+/// their Display (winit: "os error at /root/.cargo/registry/src/…/mod.rs:760: …"):
+/// the user needs the reason, not where in a crate it was raised.
+pub fn without_source_location(message: &str) -> String {
+    match message.rfind(".rs:") {
+        Some(i) => {
+            let rest = &message[i + 4..];
+            let rest = rest.trim_start_matches(|c: char| c.is_ascii_digit() || c == ':');
+            rest.trim().trim_end_matches('.').to_string()
+        }
+        None => message.to_string(),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    #[test]
+    fn source_location_is_dropped() {
+        let winit = "os error at /root/.cargo/registry/src/index.crates.io-1949cf8c6b5b557f/winit-0.30.12/src/platform_impl/linux/mod.rs:764: neither WAYLAND_DISPLAY nor WAYLAND_SOCKET nor DISPLAY is set.";
+        assert_eq!(
+            super::without_source_location(winit),
+            "neither WAYLAND_DISPLAY nor WAYLAND_SOCKET nor DISPLAY is set"
+        );
+        assert_eq!(super::without_source_location("plain"), "plain");
+    }
+}

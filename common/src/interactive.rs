@@ -1,6 +1,6 @@
 //! The windowed apps' shared behaviour: the winit event loop, what every key
-//! and mouse gesture does, the window title, the camera, scene and depth
-//! switches, screenshots and `--frames`. Both apps hand this module a
+//! and mouse gesture does, the window title, the camera, scene, depth and
+//! path (fragment / compute) switches, screenshots and `--frames`. Both apps hand this module a
 //! [`Renderer`] (their API-specific half) and nothing else, so the two windows
 //! cannot behave differently: only the drawing differs.
 //!
@@ -10,13 +10,13 @@
 //! those keys' actions, one per frame.
 
 use crate::camera::Orbit;
-use crate::cli::RenderArgs;
+use crate::cli::{RenderArgs, RenderPath, Workgroup};
 use crate::error::{bad_input, no_device};
 use crate::gpu::{GpuFrame, GpuScene};
 use crate::image_io::FloatImage;
 use crate::report::FrameTime;
 use crate::scene::{Scene, MAX_DEPTH_LIMIT};
-use crate::shader::{self, Shaders, Variant};
+use crate::shader::{self, ComputeShader, Shaders, Variant};
 use anyhow::Context;
 use std::path::PathBuf;
 use std::time::{Duration, Instant};
@@ -38,17 +38,48 @@ pub trait Renderer {
     /// frame could be drawn (e.g. a swapchain that must first be rebuilt);
     /// otherwise the GPU time of the most recent frame whose timing is known.
     fn draw(&mut self, frame: &GpuFrame) -> anyhow::Result<Option<Drawn>>;
-    /// A new scene or shader variant: rebuild buffers, descriptors and program.
-    fn load_scene(&mut self, scene: &GpuScene, shaders: &Shaders) -> anyhow::Result<()>;
-    /// Renders `frame` at `width`×`height` into the RGBA32F target the headless
-    /// path uses and reads it back, top row first, so that a screenshot is
-    /// quantised by `image_io` exactly like `--headless --out`.
+    /// A new scene, shader variant or path: rebuild buffers, descriptors and
+    /// program (or pipeline) for the path `shaders` belongs to, and draw with
+    /// that path from now on.
+    fn load_scene(&mut self, scene: &GpuScene, shaders: &PathShaders) -> anyhow::Result<()>;
+    /// Renders `frame` at `width`×`height` (the window's size) with the current
+    /// path into the RGBA32F image the headless path uses and reads it back, top
+    /// row first, so that a screenshot is quantised by `image_io` exactly like
+    /// `--headless --out`.
     fn capture(&mut self, frame: &GpuFrame, width: u32, height: u32) -> anyhow::Result<FloatImage>;
 }
 
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Drawn {
     pub gpu_ms: Option<f64>,
+}
+
+/// The shaders of the path a window draws with: the fullscreen pair, or the
+/// compute entry point with its workgroup.
+#[derive(Clone)]
+pub enum PathShaders {
+    Fragment(Shaders),
+    Compute(ComputeShader),
+}
+
+impl PathShaders {
+    pub fn build(
+        variant: &Variant,
+        path: RenderPath,
+        workgroup: Workgroup,
+    ) -> anyhow::Result<PathShaders> {
+        Ok(match path {
+            RenderPath::Fragment => PathShaders::Fragment(shader::build(variant)?),
+            RenderPath::Compute => PathShaders::Compute(shader::build_compute(variant, workgroup)?),
+        })
+    }
+
+    pub fn path(&self) -> RenderPath {
+        match self {
+            PathShaders::Fragment(_) => RenderPath::Fragment,
+            PathShaders::Compute(_) => RenderPath::Compute,
+        }
+    }
 }
 
 /// What a key or gesture asks for.
@@ -60,6 +91,8 @@ pub enum Action {
     Screenshot,
     DepthUp,
     DepthDown,
+    /// Fragment ↔ compute.
+    SwitchPath,
 }
 
 /// The keys of the README's Controls section. `=` counts as `+` (same key
@@ -81,16 +114,29 @@ fn action_for_char(c: &str) -> Option<Action> {
         "p" | "P" => Action::Screenshot,
         "+" | "=" => Action::DepthUp,
         "-" | "_" => Action::DepthDown,
+        "c" | "C" => Action::SwitchPath,
         _ => return None,
     })
 }
 
 /// The window title, identical in both apps:
-/// `twinray — box — Vulkan — 61.3 FPS — 12.41 ms` (`n/a ms` where the GPU time
-/// is unknown, e.g. OpenGL on llvmpipe).
-pub fn window_title(scene: &str, api: &str, fps: f64, gpu_ms: Option<f64>) -> String {
-    let gpu = gpu_ms.map_or_else(|| "n/a".to_string(), |ms| format!("{ms:.2}"));
-    format!("twinray — {scene} — {api} — {fps:.1} FPS — {gpu} ms")
+/// `twinray — box — Vulkan compute — 61.3 FPS — 12.41 ms` (`n/a ms` where the
+/// GPU time is unknown, e.g. OpenGL on llvmpipe; `— starting` until the first
+/// figures, and after a switch until new ones).
+pub fn window_title(
+    scene: &str,
+    api: &str,
+    path: RenderPath,
+    fps_gpu: Option<(f64, Option<f64>)>,
+) -> String {
+    let head = format!("twinray — {scene} — {api} {path}");
+    match fps_gpu {
+        None => format!("{head} — starting"),
+        Some((fps, gpu_ms)) => {
+            let gpu = gpu_ms.map_or_else(|| "n/a".to_string(), |ms| format!("{ms:.2}"));
+            format!("{head} — {fps:.1} FPS — {gpu} ms")
+        }
+    }
 }
 
 /// Averages frames over half-second windows for the title.
@@ -136,7 +182,8 @@ impl TitleClock {
 pub fn event_loop() -> anyhow::Result<EventLoop<()>> {
     EventLoop::new().map_err(|e| {
         no_device(format!(
-            "cannot open a window ({e}): no X display (is DISPLAY set?); run under xvfb-run, or use --headless"
+            "cannot open a window ({}): no X display (is DISPLAY set?); run under xvfb-run, or use --headless",
+            crate::error::without_source_location(&e.to_string())
         ))
     })
 }
@@ -145,7 +192,7 @@ pub fn event_loop() -> anyhow::Result<EventLoop<()>> {
 /// the first FPS figure.
 pub fn window_attributes(args: &RenderArgs, scene: &str, api: &str) -> WindowAttributes {
     Window::default_attributes()
-        .with_title(format!("twinray — {scene} — {api} — starting"))
+        .with_title(window_title(scene, api, args.path, None))
         .with_inner_size(PhysicalSize::new(args.size.width, args.size.height))
 }
 
@@ -154,11 +201,23 @@ pub fn variant_for(args: &RenderArgs, scene: &Scene) -> Variant {
     Variant::chosen(scene, args)
 }
 
+/// The shaders a window starts with: `--path`'s, for the scene's variant.
+pub fn first_shaders(args: &RenderArgs, scene: &Scene) -> anyhow::Result<PathShaders> {
+    PathShaders::build(
+        &variant_for(args, scene),
+        args.path,
+        args.compute_workgroup()?,
+    )
+}
+
 /// What the run did, for `--json`.
 pub struct WindowedRun {
     pub frames: Vec<FrameTime>,
     pub scene: Scene,
     pub variant: Variant,
+    /// The path drawing at exit (`C` may have switched it).
+    pub path: RenderPath,
+    pub workgroup: Workgroup,
     pub width: u32,
     pub height: u32,
     /// Milliseconds from `started` to the end of the first frame.
@@ -176,6 +235,8 @@ impl WindowedRun {
     ) -> crate::report::RunReport {
         crate::report::RunReport {
             validation_messages,
+            path: self.path,
+            workgroup: (self.path == RenderPath::Compute).then(|| self.workgroup.to_string()),
             ..crate::report::RunReport::new(
                 api,
                 device,
@@ -203,6 +264,7 @@ pub fn run<R: Renderer>(
 ) -> anyhow::Result<WindowedRun> {
     let size = renderer.window().inner_size();
     let now = Instant::now();
+    let workgroup = args.compute_workgroup()?;
     let mut session = Session {
         program,
         orbit: Orbit::new(&scene.camera),
@@ -210,6 +272,8 @@ pub fn run<R: Renderer>(
         args: args.clone(),
         scene,
         variant,
+        path: args.path,
+        workgroup,
         size,
         clock: TitleClock::new(now),
         frames: Vec::new(),
@@ -245,6 +309,8 @@ pub fn run<R: Renderer>(
         frames: session.frames,
         scene: session.scene,
         variant: session.variant,
+        path: session.path,
+        workgroup: session.workgroup,
         width: session.size.width,
         height: session.size.height,
         setup_ms: session.setup_ms,
@@ -276,6 +342,9 @@ struct Session<R: Renderer> {
     args: RenderArgs,
     scene: Scene,
     variant: Variant,
+    path: RenderPath,
+    /// The compute path's, also kept while the fragment path draws.
+    workgroup: Workgroup,
     orbit: Orbit,
     size: PhysicalSize<u32>,
     clock: TitleClock,
@@ -403,7 +472,16 @@ impl<R: Renderer> Session<R> {
                 self.variant = variant_for(&self.args, &scene);
                 self.scene = scene;
                 self.rebuild()?;
-                self.set_title(None, None);
+                self.restart_title();
+            }
+            Action::SwitchPath => {
+                self.path = match self.path {
+                    RenderPath::Fragment => RenderPath::Compute,
+                    RenderPath::Compute => RenderPath::Fragment,
+                };
+                self.rebuild()?;
+                self.restart_title();
+                eprintln!("{}: path {}", self.program, self.path);
             }
             Action::DepthUp | Action::DepthDown => {
                 let d = self.scene.max_depth;
@@ -437,7 +515,7 @@ impl<R: Renderer> Session<R> {
     }
 
     fn rebuild(&mut self) -> anyhow::Result<()> {
-        let shaders = shader::build(&self.variant)?;
+        let shaders = PathShaders::build(&self.variant, self.path, self.workgroup)?;
         let gpu = GpuScene::new(&self.scene, self.size.width.max(1), self.size.height.max(1));
         if let Some(r) = self.renderer.as_mut() {
             r.load_scene(&gpu, &shaders)?;
@@ -445,14 +523,17 @@ impl<R: Renderer> Session<R> {
         Ok(())
     }
 
-    fn set_title(&self, fps: Option<f64>, gpu_ms: Option<f64>) {
+    fn set_title(&self, fps_gpu: Option<(f64, Option<f64>)>) {
         if let Some(r) = &self.renderer {
-            let title = match fps {
-                Some(fps) => window_title(&self.scene.name, r.api(), fps, gpu_ms),
-                None => format!("twinray — {} — {} — starting", self.scene.name, r.api()),
-            };
+            let title = window_title(&self.scene.name, r.api(), self.path, fps_gpu);
             r.window().set_title(&title);
         }
+    }
+
+    /// After a switch: the old figures belong to the old scene or path.
+    fn restart_title(&mut self) {
+        self.clock = TitleClock::new(Instant::now());
+        self.set_title(None);
     }
 
     fn redraw(&mut self, event_loop: &ActiveEventLoop) -> anyhow::Result<()> {
@@ -473,8 +554,8 @@ impl<R: Renderer> Session<R> {
                 });
                 self.last_frame_end = now;
                 self.drawn += 1;
-                if let Some((fps, gpu)) = self.clock.frame(now, d.gpu_ms) {
-                    self.set_title(Some(fps), gpu);
+                if let Some(figures) = self.clock.frame(now, d.gpu_ms) {
+                    self.set_title(Some(figures));
                 }
                 if let Some(a) = self.test_keys.pop() {
                     self.act(event_loop, a)?;
@@ -564,7 +645,14 @@ impl<R: Renderer> ApplicationHandler for Session<R> {
             }
             WindowEvent::Resized(size) => self.resize(size),
             WindowEvent::RedrawRequested => self.redraw(event_loop),
-            WindowEvent::KeyboardInput { event, .. } if event.state == ElementState::Pressed => {
+            // winit invents a press for each key held while the window gains
+            // focus (`is_synthetic`): a key pressed as the window was focused
+            // would act twice, and C would switch the path and back again.
+            WindowEvent::KeyboardInput {
+                event,
+                is_synthetic: false,
+                ..
+            } if event.state == ElementState::Pressed => {
                 match action_for_key(&event.logical_key) {
                     // Holding +/- repeats; holding a scene key would rebuild it over and over.
                     Some(a @ (Action::DepthUp | Action::DepthDown)) => self.act(event_loop, a),
@@ -636,6 +724,8 @@ mod tests {
         assert_eq!(ch("+"), Some(Action::DepthUp));
         assert_eq!(ch("="), Some(Action::DepthUp));
         assert_eq!(ch("-"), Some(Action::DepthDown));
+        assert_eq!(ch("c"), Some(Action::SwitchPath));
+        assert_eq!(ch("C"), Some(Action::SwitchPath));
         assert_eq!(ch("x"), None);
         assert_eq!(action_for_key(&Key::Named(NamedKey::Enter)), None);
     }
@@ -643,12 +733,21 @@ mod tests {
     #[test]
     fn title_format_is_fixed() {
         assert_eq!(
-            window_title("box", "Vulkan", 61.26, Some(12.414)),
-            "twinray — box — Vulkan — 61.3 FPS — 12.41 ms"
+            window_title(
+                "box",
+                "Vulkan",
+                RenderPath::Compute,
+                Some((61.26, Some(12.414)))
+            ),
+            "twinray — box — Vulkan compute — 61.3 FPS — 12.41 ms"
         );
         assert_eq!(
-            window_title("teapot", "OpenGL", 5.0, None),
-            "twinray — teapot — OpenGL — 5.0 FPS — n/a ms"
+            window_title("teapot", "OpenGL", RenderPath::Fragment, Some((5.0, None))),
+            "twinray — teapot — OpenGL fragment — 5.0 FPS — n/a ms"
+        );
+        assert_eq!(
+            window_title("box", "OpenGL", RenderPath::Compute, None),
+            "twinray — box — OpenGL compute — starting"
         );
     }
 

@@ -11,6 +11,7 @@ pub mod gpu;
 pub mod hard;
 pub mod image_io;
 pub mod interactive;
+pub mod limits;
 pub mod metrics;
 pub mod numerics;
 pub mod random_scene;

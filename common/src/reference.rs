@@ -5,13 +5,21 @@
 //! It traces the scene as the GPU holds it (in the local frame of
 //! `camera::in_local_frame`, inputs rounded to f32, see `Scene::rounded_to_f32`).
 //! Change both together.
+//!
+//! Rays traverse a BVH built by the GPU's own builder (bvh.rs) over the
+//! reference's primitives, so a 2-million-triangle mesh takes seconds, not
+//! hours. The traversal keeps brute force's answer exactly: the closest hit,
+//! ties going to the primitive brute force tests first.
 
+use crate::bvh::Bvh;
 use crate::camera::{in_local_frame, RayFrame};
+use crate::gpu::PRIM_SPHERE_BIT;
 use crate::image_io::FloatImage;
 use crate::numerics::{Numerics, Offset, SphereTest, TriangleTest};
 use crate::scene::{Scene, Sphere, Triangle};
 use glam::DVec3;
 use rayon::prelude::*;
+use std::sync::atomic::{AtomicUsize, Ordering};
 
 const T_MAX: f64 = 1.0e30;
 
@@ -24,22 +32,147 @@ pub fn render(scene: &Scene, width: u32, height: u32) -> FloatImage {
 
 /// Renders `scene` with the given numerical choices instead of the scene's.
 pub fn render_with(scene: &Scene, width: u32, height: u32, numerics: &Numerics) -> FloatImage {
+    render_counting(scene, width, height, numerics, true, &AtomicUsize::new(0))
+}
+
+/// `render_with`, through the BVH or (`bvh` false: `--accel none`) testing
+/// every primitive, adding 1 to `rows_done` as each row finishes (for a progress bar).
+pub fn render_counting(
+    scene: &Scene,
+    width: u32,
+    height: u32,
+    numerics: &Numerics,
+    bvh: bool,
+    rows_done: &AtomicUsize,
+) -> FloatImage {
     // The GPU's frame: positions relative to the local origin, then rounded to f32.
     let frame = RayFrame::local(scene, &scene.camera, width, height).rounded_to_f32();
     let mut scene = in_local_frame(scene).rounded_to_f32();
     scene.numerics = *numerics;
-    let pixels: Vec<[f32; 3]> = (0..width * height)
-        .into_par_iter()
-        .map(|i| {
-            let (x, y) = ((i % width) as f64, (i / width) as f64);
-            let c = trace(&scene, frame.eye, frame.dir(x, y));
-            [c.x as f32, c.y as f32, c.z as f32]
-        })
-        .collect();
+    let tracer = if bvh {
+        Tracer::new(&scene)
+    } else {
+        Tracer::brute_force(&scene)
+    };
+    let w = width as usize;
+    let mut pixels = vec![[0f32; 3]; crate::limits::pixel_count(width, height)];
+    pixels.par_chunks_mut(w).enumerate().for_each(|(y, row)| {
+        for (x, px) in row.iter_mut().enumerate() {
+            let c = tracer.trace(frame.eye, frame.dir(x as f64, y as f64));
+            *px = [c.x as f32, c.y as f32, c.z as f32];
+        }
+        rows_done.fetch_add(1, Ordering::Relaxed);
+    });
     FloatImage {
         width,
         height,
         pixels,
+    }
+}
+
+/// A scene and, above a few primitives, its BVH.
+pub struct Tracer<'a> {
+    scene: &'a Scene,
+    bvh: Option<Bvh>,
+}
+
+/// Brute force below this many primitives: one leaf's worth.
+const BVH_FROM: usize = crate::bvh::MAX_LEAF + 1;
+
+impl<'a> Tracer<'a> {
+    /// `scene` as the reference traces it (already rounded to f32, see `render_with`).
+    pub fn new(scene: &'a Scene) -> Tracer<'a> {
+        let bvh = (scene.primitive_count() >= BVH_FROM).then(|| Bvh::build(scene));
+        Tracer { scene, bvh }
+    }
+
+    /// Brute force only, for the tests that check the BVH changes nothing.
+    pub fn brute_force(scene: &'a Scene) -> Tracer<'a> {
+        Tracer { scene, bvh: None }
+    }
+
+    pub fn trace(&self, origin: DVec3, dir: DVec3) -> DVec3 {
+        trace_with(self, origin, dir)
+    }
+}
+
+/// Where brute force would test a primitive: spheres first, then triangles, in
+/// order. Among hits at the same t the earliest wins, as in brute force.
+fn order(code: u32) -> u64 {
+    if code & PRIM_SPHERE_BIT != 0 {
+        (code & !PRIM_SPHERE_BIT) as u64
+    } else {
+        (1u64 << 32) + code as u64
+    }
+}
+
+/// The ray against a node's box, padded: the f32 bounds already contain the
+/// primitives (rounded outwards), and the pad covers the f64 slab arithmetic and
+/// the intersection tests' own rounding, so no node holding a hit is skipped.
+/// Returns the entry distance, or None for a miss or a box beyond `t_max`.
+fn enter_box(min: [f32; 3], max: [f32; 3], o: DVec3, d: DVec3, t_max: f64) -> Option<f64> {
+    let (mut t0, mut t1) = (0.0f64, t_max);
+    for a in 0..3 {
+        let (lo, hi) = (min[a] as f64, max[a] as f64);
+        let pad = 1e-9 * lo.abs().max(hi.abs()).max(o[a].abs()) + 1e-300;
+        let (lo, hi) = (lo - pad, hi + pad);
+        if d[a] == 0.0 {
+            if o[a] < lo || o[a] > hi {
+                return None;
+            }
+            continue;
+        }
+        let inv = 1.0 / d[a];
+        let (mut near, mut far) = ((lo - o[a]) * inv, (hi - o[a]) * inv);
+        if near > far {
+            std::mem::swap(&mut near, &mut far);
+        }
+        // A relative margin on the distances themselves, for the same reason.
+        t0 = t0.max(near - 1e-9 * near.abs());
+        t1 = t1.min(far + 1e-9 * far.abs());
+        if !(t0 <= t1) {
+            return None;
+        }
+    }
+    Some(t0)
+}
+
+/// Visits the BVH's leaves along a ray, near child first, calling `leaf` with
+/// each leaf's primitive codes and the current bound; `leaf` returns the new
+/// bound (or None to stop: a shadow ray's first hit).
+fn walk(
+    bvh: &Bvh,
+    o: DVec3,
+    d: DVec3,
+    mut t_max: f64,
+    mut leaf: impl FnMut(&[u32], f64) -> Option<f64>,
+) {
+    let mut stack = vec![(0usize, 0.0f64)];
+    while let Some((index, t_enter)) = stack.pop() {
+        // Equal distances must be visited: a tie may go to a later leaf.
+        if t_enter > t_max {
+            continue;
+        }
+        let node = &bvh.nodes[index];
+        if node.count > 0 {
+            let first = node.left_or_first as usize;
+            match leaf(&bvh.prims[first..first + node.count as usize], t_max) {
+                Some(t) => t_max = t,
+                None => return,
+            }
+            continue;
+        }
+        let child = |c: usize| {
+            let n = &bvh.nodes[c];
+            enter_box(n.min, n.max, o, d, t_max).map(|t| (c, t))
+        };
+        // Far child pushed first, so the near one is visited first.
+        match (child(index + 1), child(node.left_or_first as usize)) {
+            (Some(a), Some(b)) if a.1 <= b.1 => stack.extend([b, a]),
+            (Some(a), Some(b)) => stack.extend([a, b]),
+            (Some(a), None) | (None, Some(a)) => stack.push(a),
+            (None, None) => {}
+        }
     }
 }
 
@@ -191,42 +324,107 @@ fn hit_triangle(
     }
 }
 
+#[derive(Debug, PartialEq)]
 enum Hit {
     Sphere(usize),
     Triangle(usize, f64, f64),
 }
 
-fn closest_hit(scene: &Scene, o: DVec3, d: DVec3) -> Option<(f64, Hit)> {
-    let mut best_t = T_MAX;
-    let mut best = None;
+fn closest_hit(tracer: &Tracer, o: DVec3, d: DVec3) -> Option<(f64, Hit)> {
+    let scene = tracer.scene;
     let n = &scene.numerics;
-    for (i, s) in scene.spheres.iter().enumerate() {
-        if let Some(t) = hit_sphere(n.sphere, o, d, s, 0.0, best_t) {
-            best_t = t;
-            best = Some(Hit::Sphere(i));
-        }
-    }
     let r = tri_ray(n.triangle, o, d);
-    for (i, tri) in scene.triangles.iter().enumerate() {
-        if let Some((t, u, v)) = hit_triangle(n.triangle, &r, tri, 0.0, best_t) {
-            best_t = t;
-            best = Some(Hit::Triangle(i, u, v));
+    let Some(bvh) = &tracer.bvh else {
+        let mut best_t = T_MAX;
+        let mut best = None;
+        for (i, s) in scene.spheres.iter().enumerate() {
+            if let Some(t) = hit_sphere(n.sphere, o, d, s, 0.0, best_t) {
+                best_t = t;
+                best = Some(Hit::Sphere(i));
+            }
         }
+        for (i, tri) in scene.triangles.iter().enumerate() {
+            if let Some((t, u, v)) = hit_triangle(n.triangle, &r, tri, 0.0, best_t) {
+                best_t = t;
+                best = Some(Hit::Triangle(i, u, v));
+            }
+        }
+        return best.map(|h| (best_t, h));
+    };
+    if bvh.nodes.is_empty() || enter_box(bvh.nodes[0].min, bvh.nodes[0].max, o, d, T_MAX).is_none()
+    {
+        return None;
     }
-    best.map(|h| (best_t, h))
+    // (t, brute-force order, hit): the least t, and among equal t the least order.
+    let mut best: Option<(f64, u64, Hit)> = None;
+    walk(bvh, o, d, T_MAX, |prims, _| {
+        for &code in prims {
+            let best_t = best.as_ref().map_or(T_MAX, |b| b.0);
+            // Up to and including best_t: an equal t may still win on order.
+            let limit = if best.is_some() {
+                best_t.next_up()
+            } else {
+                T_MAX
+            };
+            let hit = if code & PRIM_SPHERE_BIT != 0 {
+                let i = (code & !PRIM_SPHERE_BIT) as usize;
+                hit_sphere(n.sphere, o, d, &scene.spheres[i], 0.0, limit)
+                    .map(|t| (t, Hit::Sphere(i)))
+            } else {
+                let i = code as usize;
+                hit_triangle(n.triangle, &r, &scene.triangles[i], 0.0, limit)
+                    .map(|(t, u, v)| (t, Hit::Triangle(i, u, v)))
+            };
+            if let Some((t, h)) = hit {
+                let key = order(code);
+                if best
+                    .as_ref()
+                    .is_none_or(|b| t < b.0 || (t == b.0 && key < b.1))
+                {
+                    best = Some((t, key, h));
+                }
+            }
+        }
+        Some(best.as_ref().map_or(T_MAX, |b| b.0))
+    });
+    best.map(|(t, _, h)| (t, h))
 }
 
-fn occluded(scene: &Scene, o: DVec3, d: DVec3, dist: f64) -> bool {
+fn occluded(tracer: &Tracer, o: DVec3, d: DVec3, dist: f64) -> bool {
+    let scene = tracer.scene;
     let n = &scene.numerics;
     let r = tri_ray(n.triangle, o, d);
-    scene
-        .spheres
-        .iter()
-        .any(|s| hit_sphere(n.sphere, o, d, s, 0.0, dist).is_some())
-        || scene
-            .triangles
+    let blocks = |code: u32| {
+        if code & PRIM_SPHERE_BIT != 0 {
+            let s = &scene.spheres[(code & !PRIM_SPHERE_BIT) as usize];
+            hit_sphere(n.sphere, o, d, s, 0.0, dist).is_some()
+        } else {
+            hit_triangle(n.triangle, &r, &scene.triangles[code as usize], 0.0, dist).is_some()
+        }
+    };
+    let Some(bvh) = &tracer.bvh else {
+        return scene
+            .spheres
             .iter()
-            .any(|t| hit_triangle(n.triangle, &r, t, 0.0, dist).is_some())
+            .any(|s| hit_sphere(n.sphere, o, d, s, 0.0, dist).is_some())
+            || scene
+                .triangles
+                .iter()
+                .any(|t| hit_triangle(n.triangle, &r, t, 0.0, dist).is_some());
+    };
+    if bvh.nodes.is_empty() || enter_box(bvh.nodes[0].min, bvh.nodes[0].max, o, d, dist).is_none() {
+        return false;
+    }
+    let mut hit = false;
+    walk(bvh, o, d, dist, |prims, t_max| {
+        if prims.iter().any(|&c| blocks(c)) {
+            hit = true;
+            None
+        } else {
+            Some(t_max)
+        }
+    });
+    hit
 }
 
 /// The shader's `ulp_offset_1`. The offset is a distance on the f32 grid (256
@@ -287,7 +485,8 @@ struct Ray {
 }
 
 /// One pixel: the shader's `trace`, with its stack capacity of max_depth + 1.
-pub fn trace(scene: &Scene, origin: DVec3, dir: DVec3) -> DVec3 {
+fn trace_with(tracer: &Tracer, origin: DVec3, dir: DVec3) -> DVec3 {
+    let scene = tracer.scene;
     let capacity = scene.max_depth as usize + 1;
     let mut stack = Vec::with_capacity(capacity);
     stack.push(Ray {
@@ -298,7 +497,7 @@ pub fn trace(scene: &Scene, origin: DVec3, dir: DVec3) -> DVec3 {
     });
     let mut color = DVec3::ZERO;
     while let Some(Ray { o, d, w, depth }) = stack.pop() {
-        let Some((t, hit)) = closest_hit(scene, o, d) else {
+        let Some((t, hit)) = closest_hit(tracer, o, d) else {
             color += w * scene.background;
             continue;
         };
@@ -341,7 +540,7 @@ pub fn trace(scene: &Scene, origin: DVec3, dir: DVec3) -> DVec3 {
             let dist = to_light.length();
             let l = to_light / dist;
             let ndl = ns.dot(l);
-            if ndl > 0.0 && ng.dot(l) > 0.0 && !occluded(scene, p_out, l, dist * SHADOW_REACH) {
+            if ndl > 0.0 && ng.dot(l) > 0.0 && !occluded(tracer, p_out, l, dist * SHADOW_REACH) {
                 let r = reflect(-l, ns);
                 let spec = r.dot(-d).max(0.0).powf(m.shininess);
                 local += light.color * (m.diffuse * ndl + m.specular * spec);
@@ -409,4 +608,80 @@ pub fn render_truth(scene: &Scene, width: u32, height: u32) -> FloatImage {
     let mut s = scene.clone();
     s.epsilon = TRUTH_EPSILON;
     render_with(&s, width, height, &truth_numerics())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Every pixel through the BVH equals brute force, bit for bit.
+    fn same_as_brute_force(scene: &Scene, width: u32, height: u32) {
+        let scene = scene.rounded_to_f32();
+        let frame = RayFrame::new(&scene.camera, width, height).rounded_to_f32();
+        // A BVH even where `Tracer::new` would not build one (under BVH_FROM primitives).
+        let bvh = Tracer {
+            scene: &scene,
+            bvh: Some(Bvh::build(&scene)),
+        };
+        let brute = Tracer::brute_force(&scene);
+        let mismatches = (0..width * height)
+            .into_par_iter()
+            .filter(|i| {
+                let dir = frame.dir((i % width) as f64, (i / width) as f64);
+                // The same primitive, not only the same colour: identical
+                // spheres would hide a tie broken the other way.
+                closest_hit(&bvh, frame.eye, dir) != closest_hit(&brute, frame.eye, dir)
+                    || bvh.trace(frame.eye, dir) != brute.trace(frame.eye, dir)
+            })
+            .count();
+        assert_eq!(
+            mismatches, 0,
+            "{}: pixels differ from brute force",
+            scene.name
+        );
+    }
+
+    #[test]
+    fn bvh_gives_the_brute_force_image() {
+        let hard = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../scenes/hard");
+        for (name, set) in [
+            ("box", vec![]),
+            // 100 identical spheres: every hit is a tie, which brute force gives to the first.
+            (
+                "spherelist",
+                vec![("extra_spheres".to_string(), "100".to_string())],
+            ),
+            ("teapot", vec![]),
+        ] {
+            let scene = Scene::load(name, &set).unwrap();
+            same_as_brute_force(&scene, 40, 30);
+        }
+        // Eight coincident spheres of two colours: every primary hit is a tie
+        // that brute force gives to spheres[0], and the image shows which won.
+        let mut ties = String::from(
+            "[camera]\neye = [0.0, 0.0, 5.0]\nlook_at = [0.0, 0.0, 0.0]\n\
+             [[materials]]\nname = \"red\"\ndiffuse = [1.0, 0.0, 0.0]\n\
+             [[materials]]\nname = \"green\"\ndiffuse = [0.0, 1.0, 0.0]\n\
+             [[lights]]\nposition = [0.0, 5.0, 5.0]\n",
+        );
+        for i in 0..8 {
+            let m = if i % 2 == 0 { "green" } else { "red" };
+            ties += &format!(
+                "[[spheres]]\ncenter = [0.0, 0.0, 0.0]\nradius = 1.0\nmaterial = \"{m}\"\n"
+            );
+        }
+        let scene = Scene::from_toml("ties", &ties, std::path::Path::new("."), &[]).unwrap();
+        same_as_brute_force(&scene, 16, 16);
+        for case in [
+            "coplanar",
+            "far-1e6",
+            "closed-mesh",
+            "nested-glass",
+            "grazing",
+        ] {
+            let path = hard.join(format!("{case}.toml"));
+            let scene = Scene::load(path.to_str().unwrap(), &[]).unwrap();
+            same_as_brute_force(&scene, 32, 32);
+        }
+    }
 }

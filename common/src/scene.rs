@@ -3,10 +3,12 @@
 //! through tobj. Everything downstream sees one resolved, validated `Scene` in f64.
 
 use crate::error::bad_input;
+use crate::limits;
 use crate::numerics::Numerics;
 use glam::{DMat3, DVec3};
+use serde::de::{self, Deserializer, SeqAccess, Visitor};
 use serde::Deserialize;
-use std::collections::HashMap;
+use std::collections::{HashMap, HashSet};
 use std::path::{Path, PathBuf};
 
 /// Built-in scenes: (name, scene TOML). Their OBJ files come from `BUILTIN_FILES`.
@@ -35,18 +37,47 @@ pub const OVERRIDE_KEYS: &[&str] = &[
     "origin",
 ];
 
-/// The finest `tessellation` accepted per direction (400 x 400 quads per patch is
-/// 10 million triangles for the 32-patch teapot).
-pub const MAX_TESSELLATION: u32 = 400;
-
-/// More hidden spheres than any storage buffer needs to hold for the study (10,000),
-/// yet enough to exceed a device's storage-buffer limit on purpose.
-pub const MAX_EXTRA_SPHERES: u32 = 10_000_000;
-
-/// The largest `max_depth` a scene may ask for; the shader's generic ray stack holds this + 1.
-pub const MAX_DEPTH_LIMIT: u32 = 16;
+/// The largest `max_depth` a scene may ask for (`limits::MAX_DEPTH`); the shader's generic ray stack holds this + 1.
+pub use crate::limits::MAX_DEPTH as MAX_DEPTH_LIMIT;
 
 // ---------------------------------------------------------------- file format
+
+/// A fixed-size array that refuses a wrong number of elements. serde's own
+/// `[T; N]` stops reading after N and drops the rest, so `eye = [0, 1, 5, 1]`
+/// or a quad with five corners would be cut short without a word.
+#[derive(Debug, Clone, Copy)]
+struct Exact<T, const N: usize>([T; N]);
+
+type V3 = Exact<f64, 3>;
+
+impl<'de, T: Deserialize<'de>, const N: usize> Deserialize<'de> for Exact<T, N> {
+    fn deserialize<D: Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        struct Elements<T, const N: usize>(std::marker::PhantomData<T>);
+        impl<'de, T: Deserialize<'de>, const N: usize> Visitor<'de> for Elements<T, N> {
+            type Value = Exact<T, N>;
+            fn expecting(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
+                write!(f, "an array of exactly {N} elements")
+            }
+            fn visit_seq<A: SeqAccess<'de>>(self, mut seq: A) -> Result<Self::Value, A::Error> {
+                let mut v = Vec::with_capacity(N);
+                while let Some(x) = seq.next_element::<T>()? {
+                    v.push(x);
+                }
+                let n = v.len();
+                <[T; N]>::try_from(v)
+                    .map(Exact)
+                    .map_err(|_| de::Error::invalid_length(n, &self))
+            }
+        }
+        d.deserialize_seq(Elements::<T, N>(std::marker::PhantomData))
+    }
+}
+
+impl<const N: usize> Exact<Exact<f64, 3>, N> {
+    fn rows(&self) -> [[f64; 3]; N] {
+        self.0.map(|r| r.0)
+    }
+}
 
 #[derive(Deserialize, Debug, Clone)]
 #[serde(deny_unknown_fields)]
@@ -74,16 +105,16 @@ struct SceneFile {
 #[derive(Deserialize, Debug, Clone)]
 #[serde(deny_unknown_fields)]
 struct CameraDef {
-    eye: [f64; 3],
-    look_at: [f64; 3],
+    eye: V3,
+    look_at: V3,
     #[serde(default = "default_up")]
-    up: [f64; 3],
+    up: V3,
     #[serde(default = "default_fov")]
     fov_y: f64,
 }
 
-fn default_up() -> [f64; 3] {
-    [0.0, 1.0, 0.0]
+fn default_up() -> V3 {
+    Exact([0.0, 1.0, 0.0])
 }
 fn default_fov() -> f64 {
     45.0
@@ -92,7 +123,7 @@ fn default_fov() -> f64 {
 #[derive(Deserialize, Debug, Clone)]
 #[serde(deny_unknown_fields, default)]
 struct RenderDef {
-    background: [f64; 3],
+    background: V3,
     max_depth: u32,
     min_weight: f64,
     epsilon: f64,
@@ -107,7 +138,7 @@ struct RenderDef {
 impl Default for RenderDef {
     fn default() -> Self {
         RenderDef {
-            background: [0.0; 3],
+            background: Exact([0.0; 3]),
             max_depth: 5,
             min_weight: 0.01,
             epsilon: 1e-4,
@@ -123,12 +154,12 @@ impl Default for RenderDef {
 #[serde(deny_unknown_fields)]
 struct MaterialDef {
     name: String,
-    #[serde(default)]
-    ambient: [f64; 3],
-    #[serde(default)]
-    diffuse: [f64; 3],
-    #[serde(default)]
-    specular: [f64; 3],
+    #[serde(default = "zero3")]
+    ambient: V3,
+    #[serde(default = "zero3")]
+    diffuse: V3,
+    #[serde(default = "zero3")]
+    specular: V3,
     #[serde(default = "default_shininess")]
     shininess: f64,
     #[serde(default)]
@@ -139,6 +170,9 @@ struct MaterialDef {
     ior: f64,
 }
 
+fn zero3() -> V3 {
+    Exact([0.0; 3])
+}
 fn default_shininess() -> f64 {
     32.0
 }
@@ -149,19 +183,19 @@ fn default_ior() -> f64 {
 #[derive(Deserialize, Debug, Clone)]
 #[serde(deny_unknown_fields)]
 struct LightDef {
-    position: [f64; 3],
+    position: V3,
     #[serde(default = "default_light")]
-    color: [f64; 3],
+    color: V3,
 }
 
-fn default_light() -> [f64; 3] {
-    [1.0; 3]
+fn default_light() -> V3 {
+    Exact([1.0; 3])
 }
 
 #[derive(Deserialize, Debug, Clone)]
 #[serde(deny_unknown_fields)]
 struct SphereDef {
-    center: [f64; 3],
+    center: V3,
     radius: f64,
     material: String,
 }
@@ -169,16 +203,16 @@ struct SphereDef {
 #[derive(Deserialize, Debug, Clone)]
 #[serde(deny_unknown_fields)]
 struct TriangleDef {
-    vertices: [[f64; 3]; 3],
+    vertices: Exact<V3, 3>,
     #[serde(default)]
-    normals: Option<[[f64; 3]; 3]>,
+    normals: Option<Exact<V3, 3>>,
     material: String,
 }
 
 #[derive(Deserialize, Debug, Clone)]
 #[serde(deny_unknown_fields)]
 struct QuadDef {
-    corners: [[f64; 3]; 4],
+    corners: Exact<V3, 4>,
     material: String,
 }
 
@@ -193,14 +227,14 @@ struct MeshDef {
     bpt: Option<String>,
     /// Quads per patch in u and v for `bpt` (2 triangles each); default 20 x 15.
     #[serde(default)]
-    tessellation: Option<[u32; 2]>,
+    tessellation: Option<Exact<u32, 2>>,
     material: String,
     #[serde(default = "one")]
     scale: f64,
     #[serde(default)]
     rotate_y: f64,
-    #[serde(default)]
-    translate: [f64; 3],
+    #[serde(default = "zero3")]
+    translate: V3,
     #[serde(default = "yes")]
     smooth: bool,
 }
@@ -216,7 +250,7 @@ fn yes() -> bool {
 #[serde(deny_unknown_fields)]
 struct ExtraSpheresDef {
     count: u32,
-    center: [f64; 3],
+    center: V3,
     radius: f64,
     material: String,
 }
@@ -378,8 +412,11 @@ impl Scene {
                 "scene file '{name_or_path}' does not exist"
             )));
         }
-        let text = std::fs::read_to_string(path)
-            .map_err(|e| bad_input(format!("scene file '{name_or_path}' cannot be read: {e}")))?;
+        let text = read_file(
+            &format!("scene file '{name_or_path}'"),
+            path,
+            limits::MAX_SCENE_FILE_BYTES,
+        )?;
         let name = path
             .file_stem()
             .and_then(|s| s.to_str())
@@ -423,8 +460,8 @@ impl Scene {
             let msg = e.message().trim().replace('\n', " ");
             bad_input(format!("{origin}, line {line}, column {col}: {msg}"))
         })?;
-        apply_overrides(&mut def, overrides)?;
-        resolve(name, def, origin, &files)
+        let set = apply_overrides(&mut def, overrides)?;
+        resolve(name, def, &Labels { origin, set }, &files)
     }
 
     pub fn features(&self) -> Features {
@@ -532,32 +569,36 @@ fn line_col(text: &str, offset: usize) -> (usize, usize) {
     (line, col)
 }
 
-fn apply_overrides(def: &mut SceneFile, overrides: &[(String, String)]) -> anyhow::Result<()> {
+/// Applies `--set` overrides to the parsed file. Only the syntax of each value
+/// is checked here; its range is checked once, in `resolve`, with the same
+/// limits as a value from the file. Returns the keys set, so that `resolve`
+/// names `--set KEY` rather than the file when such a value is refused.
+fn apply_overrides(
+    def: &mut SceneFile,
+    overrides: &[(String, String)],
+) -> anyhow::Result<HashSet<String>> {
+    let mut set = HashSet::new();
     for (key, value) in overrides {
         let num = || -> anyhow::Result<f64> {
             value
                 .parse::<f64>()
-                .ok()
-                .filter(|v| v.is_finite())
-                .ok_or_else(|| {
-                    bad_input(format!(
-                        "--set {key}={value}: '{value}' is not a finite number"
-                    ))
-                })
+                .map_err(|_| bad_input(format!("--set {key}={value}: '{value}' is not a number")))
         };
-        let int = |max: u32| -> anyhow::Result<u32> {
-            value
-                .parse::<u32>()
-                .ok()
-                .filter(|v| *v <= max)
-                .ok_or_else(|| {
-                    bad_input(format!(
-                        "--set {key}={value}: '{value}' is not a whole number from 0 to {max}"
-                    ))
+        let int = || -> anyhow::Result<u32> {
+            value.parse::<u32>().map_err(|e| {
+                bad_input(match e.kind() {
+                    std::num::IntErrorKind::PosOverflow => {
+                        format!(
+                            "--set {key}={value}: '{value}' is more than the limit of {}",
+                            u32::MAX
+                        )
+                    }
+                    _ => format!("--set {key}={value}: '{value}' is not a whole number"),
                 })
+            })
         };
         match key.as_str() {
-            "max_depth" => def.render.max_depth = int(MAX_DEPTH_LIMIT)?,
+            "max_depth" => def.render.max_depth = int()?,
             "min_weight" => def.render.min_weight = num()?,
             "epsilon" => def.render.epsilon = num()?,
             "fov_y" => def.camera.fov_y = num()?,
@@ -565,15 +606,15 @@ fn apply_overrides(def: &mut SceneFile, overrides: &[(String, String)]) -> anyho
                 let t = value
                     .split_once(['x', 'X'])
                     .and_then(|(u, v)| Some([u.trim().parse::<u32>().ok()?, v.trim().parse::<u32>().ok()?]))
-                    .filter(|t| t.iter().all(|n| (1..=MAX_TESSELLATION).contains(n)))
                     .ok_or_else(|| {
                         bad_input(format!(
-                            "--set tessellation={value}: give quads per patch as NUxNV, each from 1 to {MAX_TESSELLATION} (the study: 20x15)"
+                            "--set tessellation={value}: give quads per patch as NUxNV, each from 1 to {} (the study: 20x15)",
+                            limits::MAX_TESSELLATION
                         ))
                     })?;
                 let mut any = false;
                 for m in def.meshes.iter_mut().filter(|m| m.bpt.is_some()) {
-                    m.tessellation = Some(t);
+                    m.tessellation = Some(Exact(t));
                     any = true;
                 }
                 if !any {
@@ -594,13 +635,13 @@ fn apply_overrides(def: &mut SceneFile, overrides: &[(String, String)]) -> anyho
                 def.render.origin = Some(value.clone());
             }
             "extra_spheres" => {
-                let n = int(MAX_EXTRA_SPHERES)?;
+                let n = int()?;
                 match def.extra_spheres.as_mut() {
                     Some(e) => e.count = n,
                     None => {
-                        return Err(bad_input(format!(
-                            "--set extra_spheres: this scene has no [extra_spheres] section (try --scene spherelist)"
-                        )))
+                        return Err(bad_input(
+                            "--set extra_spheres: this scene has no [extra_spheres] section (try --scene spherelist)",
+                        ))
                     }
                 }
             }
@@ -611,41 +652,140 @@ fn apply_overrides(def: &mut SceneFile, overrides: &[(String, String)]) -> anyho
                 )))
             }
         }
+        set.insert(key.clone());
     }
-    Ok(())
+    Ok(set)
 }
 
-fn finite3(origin: &str, what: &str, v: [f64; 3]) -> anyhow::Result<DVec3> {
-    if v.iter().all(|x| x.is_finite()) {
-        Ok(DVec3::from_array(v))
-    } else {
-        Err(bad_input(format!(
-            "{origin}: {what} = {v:?} is not finite (NaN or infinity)"
-        )))
+/// Names the source of each value in error messages: the scene file and field,
+/// or `--set KEY` for a value that an override replaced.
+struct Labels<'a> {
+    origin: &'a str,
+    set: HashSet<String>,
+}
+
+impl Labels<'_> {
+    /// A field of the file: "scene file 'a.toml': spheres[2].radius".
+    fn field(&self, field: &str) -> String {
+        format!("{}: {field}", self.origin)
+    }
+
+    /// A field that `--set key` may have replaced.
+    fn settable(&self, key: &str, field: &str) -> String {
+        if self.set.contains(key) {
+            format!("--set {key}")
+        } else {
+            self.field(field)
+        }
     }
 }
 
-fn finite(origin: &str, what: &str, v: f64) -> anyhow::Result<f64> {
-    if v.is_finite() {
+// Every value is checked against what the GPU receives: an f32. A value finite
+// in f64 may overflow f32 (1e300 becomes infinity) or underflow to zero
+// (1e-300), so each check looks at the f32 as well.
+
+/// Finite in f32.
+fn finite(at: &str, v: f64) -> anyhow::Result<f64> {
+    if v.is_finite() && (v as f32).is_finite() {
         Ok(v)
     } else {
         Err(bad_input(format!(
-            "{origin}: {what} = {v} is not finite (NaN or infinity)"
+            "{at} = {v:?} is not finite in f32 (the GPU's precision)"
         )))
     }
 }
 
-fn resolve(name: &str, def: SceneFile, origin: &str, files: &FileSource) -> anyhow::Result<Scene> {
+/// From `lo` to `hi` (both finite in f32).
+fn within(at: &str, v: f64, lo: f64, hi: f64) -> anyhow::Result<f64> {
+    if !(lo..=hi).contains(&v) {
+        return Err(bad_input(format!("{at} = {v:?} must be from {lo} to {hi}")));
+    }
+    Ok(v)
+}
+
+/// Above zero in f32 too (no zero or subnormal after rounding), and at most `hi`.
+fn positive(at: &str, v: f64, hi: f64) -> anyhow::Result<f64> {
+    let v = finite(at, v)?;
+    if !(v > 0.0 && (v as f32) >= f32::MIN_POSITIVE) {
+        return Err(bad_input(format!(
+            "{at} = {v:?} must be positive (at least {:e} in f32)",
+            f32::MIN_POSITIVE
+        )));
+    }
+    if v > hi {
+        return Err(bad_input(format!("{at} = {v:?} must be at most {hi:e}")));
+    }
+    Ok(v)
+}
+
+/// Finite and within `limits::MAX_COORDINATE`; for the hot loops over mesh
+/// vertices, which format a label only for a vertex that fails.
+fn coord_ok(p: DVec3) -> bool {
+    p.is_finite() && p.abs().max_element() <= limits::MAX_COORDINATE
+}
+
+/// A point or offset within `limits::MAX_COORDINATE`.
+fn coord3(at: &str, v: [f64; 3]) -> anyhow::Result<DVec3> {
+    let p = DVec3::from_array(v);
+    if !p.is_finite() {
+        return Err(bad_input(format!(
+            "{at} = {v:?} is not finite (NaN or infinity)"
+        )));
+    }
+    if p.abs().max_element() > limits::MAX_COORDINATE {
+        return Err(bad_input(format!(
+            "{at} = {v:?} lies beyond the coordinate limit of {:e}",
+            limits::MAX_COORDINATE
+        )));
+    }
+    Ok(p)
+}
+
+/// A colour: each component from 0 to `limits::MAX_COLOUR`.
+fn colour3(at: &str, v: [f64; 3]) -> anyhow::Result<DVec3> {
+    let c = DVec3::from_array(v);
+    if !c.is_finite() {
+        return Err(bad_input(format!(
+            "{at} = {v:?} is not finite (NaN or infinity)"
+        )));
+    }
+    if c.min_element() < 0.0 {
+        return Err(bad_input(format!("{at} = {v:?} has a negative component")));
+    }
+    if c.max_element() > limits::MAX_COLOUR {
+        return Err(bad_input(format!(
+            "{at} = {v:?} has a component above the limit of {:e}",
+            limits::MAX_COLOUR
+        )));
+    }
+    Ok(c)
+}
+
+/// A count against its limit, as a usize.
+fn count(at: &str, n: u32, max: u32) -> anyhow::Result<usize> {
+    limits::check_count(at, n as usize, max as usize)?;
+    Ok(n as usize)
+}
+
+fn resolve(
+    name: &str,
+    def: SceneFile,
+    labels: &Labels,
+    files: &FileSource,
+) -> anyhow::Result<Scene> {
+    let origin = labels.origin;
+    let field = |f: &str| labels.field(f);
     let cam = &def.camera;
     let camera = Camera {
-        eye: finite3(origin, "camera.eye", cam.eye)?,
-        look_at: finite3(origin, "camera.look_at", cam.look_at)?,
-        up: finite3(origin, "camera.up", cam.up)?,
-        fov_y: finite(origin, "camera.fov_y", cam.fov_y)?,
+        eye: coord3(&field("camera.eye"), cam.eye.0)?,
+        look_at: coord3(&field("camera.look_at"), cam.look_at.0)?,
+        up: coord3(&field("camera.up"), cam.up.0)?,
+        fov_y: finite(&labels.settable("fov_y", "camera.fov_y"), cam.fov_y)?,
     };
-    if !(camera.fov_y > 0.0 && camera.fov_y < 180.0) {
+    if !(camera.fov_y >= 1e-3 && camera.fov_y < 180.0) {
         return Err(bad_input(format!(
-            "{origin}: camera.fov_y = {} must lie between 0 and 180 degrees",
+            "{} = {:?} must lie between 0.001 and 180 degrees",
+            labels.settable("fov_y", "camera.fov_y"),
             camera.fov_y
         )));
     }
@@ -658,23 +798,27 @@ fn resolve(name: &str, def: SceneFile, origin: &str, files: &FileSource) -> anyh
         )));
     }
     let r = &def.render;
-    let background = finite3(origin, "render.background", r.background)?;
-    if !(1..=MAX_DEPTH_LIMIT).contains(&r.max_depth) {
+    let background = colour3(&field("render.background"), r.background.0)?;
+    let depth_at = labels.settable("max_depth", "render.max_depth");
+    if !(1..=limits::MAX_DEPTH).contains(&r.max_depth) {
         return Err(bad_input(format!(
-            "{origin}: render.max_depth = {} must be from 1 to {MAX_DEPTH_LIMIT}",
-            r.max_depth
+            "{depth_at} = {} must be from 1 to {}",
+            r.max_depth,
+            limits::MAX_DEPTH
         )));
     }
-    let min_weight = finite(origin, "render.min_weight", r.min_weight)?;
+    let weight_at = labels.settable("min_weight", "render.min_weight");
+    let min_weight = finite(&weight_at, r.min_weight)?;
     if min_weight < 0.0 {
         return Err(bad_input(format!(
-            "{origin}: render.min_weight = {min_weight} must not be negative"
+            "{weight_at} = {min_weight:?} must not be negative"
         )));
     }
-    let epsilon = finite(origin, "render.epsilon", r.epsilon)?;
-    if !(epsilon > 0.0 && epsilon < 1.0) {
+    let epsilon_at = labels.settable("epsilon", "render.epsilon");
+    let epsilon = positive(&epsilon_at, r.epsilon, 1.0)?;
+    if epsilon >= 1.0 {
         return Err(bad_input(format!(
-            "{origin}: render.epsilon = {epsilon} must lie between 0 and 1"
+            "{epsilon_at} = {epsilon:?} must lie between 0 and 1"
         )));
     }
 
@@ -699,53 +843,48 @@ fn resolve(name: &str, def: SceneFile, origin: &str, files: &FileSource) -> anyh
             "{origin}: the scene defines no [[materials]]"
         )));
     }
+    limits::check_count(
+        &field("materials (count)"),
+        def.materials.len(),
+        limits::MAX_MATERIALS,
+    )?;
     let mut materials = Vec::new();
     let mut by_name: HashMap<String, u32> = HashMap::new();
     for (i, m) in def.materials.iter().enumerate() {
-        let at = format!("materials[{i}] ('{}')", m.name);
+        let at = field(&format!("materials[{i}] ('{}')", m.name));
         let mat = Material {
             name: m.name.clone(),
-            ambient: finite3(origin, &format!("{at}.ambient"), m.ambient)?,
-            diffuse: finite3(origin, &format!("{at}.diffuse"), m.diffuse)?,
-            specular: finite3(origin, &format!("{at}.specular"), m.specular)?,
-            shininess: finite(origin, &format!("{at}.shininess"), m.shininess)?,
-            reflectivity: finite(origin, &format!("{at}.reflectivity"), m.reflectivity)?,
-            transparency: finite(origin, &format!("{at}.transparency"), m.transparency)?,
-            ior: finite(origin, &format!("{at}.ior"), m.ior)?,
+            ambient: colour3(&format!("{at}.ambient"), m.ambient.0)?,
+            diffuse: colour3(&format!("{at}.diffuse"), m.diffuse.0)?,
+            specular: colour3(&format!("{at}.specular"), m.specular.0)?,
+            shininess: finite(&format!("{at}.shininess"), m.shininess)?,
+            reflectivity: within(&format!("{at}.reflectivity"), m.reflectivity, 0.0, 1.0)?,
+            transparency: within(&format!("{at}.transparency"), m.transparency, 0.0, 1.0)?,
+            ior: finite(&format!("{at}.ior"), m.ior)?,
         };
-        let colours = [mat.ambient, mat.diffuse, mat.specular];
-        if colours.iter().any(|c| c.min_element() < 0.0) {
-            return Err(bad_input(format!(
-                "{origin}: {at} has a negative colour component"
-            )));
-        }
         if mat.shininess < 0.0 {
             return Err(bad_input(format!(
-                "{origin}: {at}.shininess = {} must not be negative",
+                "{at}.shininess = {:?} must not be negative",
                 mat.shininess
             )));
         }
-        for (what, v) in [
-            ("reflectivity", mat.reflectivity),
-            ("transparency", mat.transparency),
-        ] {
-            if !(0.0..=1.0).contains(&v) {
-                return Err(bad_input(format!(
-                    "{origin}: {at}.{what} = {v} must lie between 0 and 1"
-                )));
-            }
-        }
         if mat.reflectivity + mat.transparency > 1.0 {
             return Err(bad_input(format!(
-                "{origin}: {at}: reflectivity + transparency must not exceed 1"
+                "{at}: reflectivity + transparency must not exceed 1"
             )));
         }
         if mat.ior <= 0.0 {
             return Err(bad_input(format!(
-                "{origin}: {at}.ior = {} must be positive",
+                "{at}.ior = {:?} must be positive",
                 mat.ior
             )));
         }
+        within(
+            &format!("{at}.ior"),
+            mat.ior,
+            limits::MIN_IOR,
+            limits::MAX_IOR,
+        )?;
         if by_name.insert(m.name.clone(), i as u32).is_some() {
             return Err(bad_input(format!(
                 "{origin}: material '{}' is defined twice",
@@ -759,7 +898,7 @@ fn resolve(name: &str, def: SceneFile, origin: &str, files: &FileSource) -> anyh
             let mut known: Vec<&String> = by_name.keys().collect();
             known.sort();
             bad_input(format!(
-                "{origin}: {at}.material '{name}' is not a defined material (defined: {})",
+                "{at}.material '{name}' is not a defined material (defined: {})",
                 known
                     .iter()
                     .map(|s| s.as_str())
@@ -769,60 +908,71 @@ fn resolve(name: &str, def: SceneFile, origin: &str, files: &FileSource) -> anyh
         })
     };
 
+    limits::check_count(
+        &field("lights (count)"),
+        def.lights.len(),
+        limits::MAX_LIGHTS,
+    )?;
     let mut lights = Vec::new();
     for (i, l) in def.lights.iter().enumerate() {
-        let color = finite3(origin, &format!("lights[{i}].color"), l.color)?;
-        if color.min_element() < 0.0 {
-            return Err(bad_input(format!(
-                "{origin}: lights[{i}].color has a negative component"
-            )));
-        }
         lights.push(Light {
-            position: finite3(origin, &format!("lights[{i}].position"), l.position)?,
-            color,
+            position: coord3(&field(&format!("lights[{i}].position")), l.position.0)?,
+            color: colour3(&field(&format!("lights[{i}].color")), l.color.0)?,
         });
     }
 
-    let mut spheres = Vec::new();
     let sphere = |at: &str, center: [f64; 3], radius: f64, mat: &str| -> anyhow::Result<Sphere> {
-        let center = finite3(origin, &format!("{at}.center"), center)?;
-        let radius = finite(origin, &format!("{at}.radius"), radius)?;
-        if radius <= 0.0 {
-            return Err(bad_input(format!(
-                "{origin}: {at}.radius = {radius} must be positive"
-            )));
-        }
         Ok(Sphere {
-            center,
-            radius,
+            center: coord3(&format!("{at}.center"), center)?,
+            radius: positive(&format!("{at}.radius"), radius, limits::MAX_COORDINATE)?,
             material: material(at, mat)?,
         })
     };
+    let extra = match &def.extra_spheres {
+        Some(e) => {
+            let n = count(
+                &labels.settable("extra_spheres", "extra_spheres.count"),
+                e.count,
+                limits::MAX_EXTRA_SPHERES,
+            )?;
+            Some((
+                sphere(&field("extra_spheres"), e.center.0, e.radius, &e.material)?,
+                n,
+            ))
+        }
+        None => None,
+    };
+    let sphere_count = def.spheres.len() + extra.as_ref().map_or(0, |e| e.1);
+    limits::check_count(
+        &field("spheres + extra_spheres.count"),
+        sphere_count,
+        limits::MAX_SPHERES,
+    )?;
+    let mut spheres = Vec::with_capacity(sphere_count);
     for (i, s) in def.spheres.iter().enumerate() {
         spheres.push(sphere(
-            &format!("spheres[{i}]"),
-            s.center,
+            &field(&format!("spheres[{i}]")),
+            s.center.0,
             s.radius,
             &s.material,
         )?);
     }
-    if let Some(e) = &def.extra_spheres {
-        let s = sphere("extra_spheres", e.center, e.radius, &e.material)?;
-        spheres.extend(std::iter::repeat_n(s, e.count as usize));
+    if let Some((s, n)) = extra {
+        spheres.extend(std::iter::repeat_n(s, n));
     }
 
     let mut triangles = Vec::new();
     for (i, t) in def.triangles.iter().enumerate() {
-        let at = format!("triangles[{i}]");
+        let at = field(&format!("triangles[{i}]"));
         let mut p = [DVec3::ZERO; 3];
-        for k in 0..3 {
-            p[k] = finite3(origin, &format!("{at}.vertices[{k}]"), t.vertices[k])?;
+        for (k, v) in t.vertices.rows().into_iter().enumerate() {
+            p[k] = coord3(&format!("{at}.vertices[{k}]"), v)?;
         }
-        let n = match t.normals {
+        let n = match &t.normals {
             Some(ns) => {
                 let mut n = [DVec3::ZERO; 3];
-                for k in 0..3 {
-                    n[k] = unit_normal(origin, &format!("{at}.normals[{k}]"), ns[k])?;
+                for (k, v) in ns.rows().into_iter().enumerate() {
+                    n[k] = unit_normal(&format!("{at}.normals[{k}]"), v)?;
                 }
                 n
             }
@@ -835,10 +985,10 @@ fn resolve(name: &str, def: SceneFile, origin: &str, files: &FileSource) -> anyh
         });
     }
     for (i, q) in def.quads.iter().enumerate() {
-        let at = format!("quads[{i}]");
+        let at = field(&format!("quads[{i}]"));
         let mut c = [DVec3::ZERO; 4];
-        for k in 0..4 {
-            c[k] = finite3(origin, &format!("{at}.corners[{k}]"), q.corners[k])?;
+        for (k, v) in q.corners.rows().into_iter().enumerate() {
+            c[k] = coord3(&format!("{at}.corners[{k}]"), v)?;
         }
         let m = material(&at, &q.material)?;
         for p in [[c[0], c[1], c[2]], [c[0], c[2], c[3]]] {
@@ -850,30 +1000,41 @@ fn resolve(name: &str, def: SceneFile, origin: &str, files: &FileSource) -> anyh
         }
     }
     for (i, m) in def.meshes.iter().enumerate() {
-        let at = format!("meshes[{i}]");
+        let at = field(&format!("meshes[{i}]"));
         let mat = material(&at, &m.material)?;
-        let scale = finite(origin, &format!("{at}.scale"), m.scale)?;
-        if scale <= 0.0 {
-            return Err(bad_input(format!(
-                "{origin}: {at}.scale = {scale} must be positive"
-            )));
-        }
-        let rot = DMat3::from_rotation_y(
-            finite(origin, &format!("{at}.rotate_y"), m.rotate_y)?.to_radians(),
-        );
-        let translate = finite3(origin, &format!("{at}.translate"), m.translate)?;
+        let scale = positive(&format!("{at}.scale"), m.scale, limits::MAX_COORDINATE)?;
+        let rot =
+            DMat3::from_rotation_y(finite(&format!("{at}.rotate_y"), m.rotate_y)?.to_radians());
+        let translate = coord3(&format!("{at}.translate"), m.translate.0)?;
+        // The room left under the triangle limit, so that no mesh is expanded beyond it.
+        let room = limits::MAX_TRIANGLES - triangles.len().min(limits::MAX_TRIANGLES);
         let (obj, file) = match (&m.obj, &m.bpt) {
-            (Some(obj), None) if m.tessellation.is_none() => (load_obj(origin, &at, obj, files)?, obj),
-            (None, Some(bpt)) => (load_bpt(origin, &at, bpt, m.tessellation.unwrap_or([20, 15]), files)?, bpt),
+            (Some(obj), None) if m.tessellation.is_none() => (load_obj(&at, obj, files)?, obj),
+            (None, Some(bpt)) => {
+                let t = m.tessellation.map_or([20, 15], |t| t.0);
+                let t_at = labels.settable("tessellation", &format!("meshes[{i}].tessellation"));
+                (load_bpt(&at, &t_at, bpt, t, room, files)?, bpt)
+            }
             _ => {
                 return Err(bad_input(format!(
-                    "{origin}: {at} needs either `obj` or `bpt` (with an optional `tessellation`), not both"
+                    "{at} needs either `obj` or `bpt` (with an optional `tessellation`), not both"
                 )))
             }
         };
+        limits::check_count(
+            &format!("{at}: triangles of '{file}' with those before it"),
+            triangles.len() + obj.len(),
+            limits::MAX_TRIANGLES,
+        )?;
         let before = triangles.len();
-        for (p, n) in obj {
+        for (f, (p, n)) in obj.into_iter().enumerate() {
             let p = p.map(|v| rot * (v * scale) + translate);
+            for v in p.iter().filter(|v| !coord_ok(**v)) {
+                coord3(
+                    &format!("{at}: '{file}' face {} after scale and translate", f + 1),
+                    v.to_array(),
+                )?;
+            }
             let n = match (m.smooth, n) {
                 (true, Some(n)) => n.map(|v| rot * v),
                 _ => [flat_normal(&p); 3],
@@ -885,11 +1046,15 @@ fn resolve(name: &str, def: SceneFile, origin: &str, files: &FileSource) -> anyh
             });
         }
         if triangles.len() == before {
-            return Err(bad_input(format!(
-                "{origin}: {at}: '{file}' contains no faces"
-            )));
+            return Err(bad_input(format!("{at}: '{file}' contains no faces")));
         }
     }
+    let primitives = spheres.len() + triangles.len();
+    limits::check_count(
+        &field("spheres + triangles (the BVH's primitives)"),
+        primitives,
+        limits::MAX_BVH_PRIMITIVES,
+    )?;
 
     Ok(Scene {
         name: name.to_string(),
@@ -903,20 +1068,23 @@ fn resolve(name: &str, def: SceneFile, origin: &str, files: &FileSource) -> anyh
         origin: origin_mode,
         materials,
         lights,
-        bvh: spheres.len() + triangles.len() >= AUTO_BVH_MIN_PRIMITIVES,
+        bvh: primitives >= AUTO_BVH_MIN_PRIMITIVES,
         bvh_cache: BvhCache::default(),
         spheres,
         triangles,
     })
 }
 
-fn unit_normal(origin: &str, what: &str, v: [f64; 3]) -> anyhow::Result<DVec3> {
-    let n = finite3(origin, what, v)?;
-    let len = n.length();
-    if !(len > 1e-12) {
+fn unit_normal(at: &str, v: [f64; 3]) -> anyhow::Result<DVec3> {
+    let n = DVec3::from_array(v);
+    if !n.is_finite() {
         return Err(bad_input(format!(
-            "{origin}: {what} = {v:?} has zero length"
+            "{at} = {v:?} is not finite (NaN or infinity)"
         )));
+    }
+    let len = n.length();
+    if !(len > 1e-12 && len.is_finite()) {
+        return Err(bad_input(format!("{at} = {v:?} has zero length")));
     }
     Ok(n / len)
 }
@@ -929,45 +1097,98 @@ fn flat_normal(p: &[DVec3; 3]) -> DVec3 {
 
 type ObjTriangle = ([DVec3; 3], Option<[DVec3; 3]>);
 
+/// A file's text, refused with a message naming `what` when it is not a regular
+/// file (`/dev/zero`, a pipe, a folder), is larger than `max` bytes, or is not
+/// UTF-8 (with the line and column of the first bad byte).
+pub fn read_file(what: &str, path: &Path, max: u64) -> anyhow::Result<String> {
+    use std::io::Read;
+    let cannot = |e: std::io::Error| bad_input(format!("{what} cannot be read: {e}"));
+    let meta = std::fs::metadata(path).map_err(cannot)?;
+    if !meta.is_file() {
+        return Err(bad_input(format!(
+            "{what} is not a regular file (a folder, device or pipe)"
+        )));
+    }
+    let too_big = || {
+        bad_input(format!(
+            "{what} is larger than the limit of {max} bytes ({})",
+            limits::gib(max)
+        ))
+    };
+    if meta.len() > max {
+        return Err(too_big());
+    }
+    // Read at most max + 1 bytes: the file may grow between the check and the read.
+    let mut bytes = Vec::with_capacity(meta.len() as usize);
+    std::fs::File::open(path)
+        .and_then(|f| f.take(max + 1).read_to_end(&mut bytes))
+        .map_err(cannot)?;
+    if bytes.len() as u64 > max {
+        return Err(too_big());
+    }
+    String::from_utf8(bytes).map_err(|e| {
+        let bad = e.utf8_error().valid_up_to();
+        let good = std::str::from_utf8(&e.as_bytes()[..bad]).unwrap_or("");
+        let (line, col) = line_col(good, good.len());
+        bad_input(format!(
+            "{what}, line {line}, column {col}: not UTF-8 text (byte 0x{:02x})",
+            e.as_bytes()[bad]
+        ))
+    })
+}
+
 /// The text of a file a scene names: built in, or next to the scene file.
-fn read_text(origin: &str, what: &str, file: &str, files: &FileSource) -> anyhow::Result<String> {
+fn read_text(what: &str, file: &str, files: &FileSource) -> anyhow::Result<String> {
     match files {
         FileSource::Builtin => BUILTIN_FILES
             .iter()
             .find(|(n, _)| *n == file)
             .map(|(_, t)| t.to_string())
-            .ok_or_else(|| bad_input(format!("{origin}: {what} '{file}' is not a built-in file"))),
+            .ok_or_else(|| bad_input(format!("{what} '{file}' is not a built-in file"))),
         FileSource::Dir(dir) => {
             let path = dir.join(file);
-            std::fs::read_to_string(&path).map_err(|e| {
-                bad_input(format!(
-                    "{origin}: {what} '{}' cannot be read: {e}",
-                    path.display()
-                ))
-            })
+            read_file(
+                &format!("{what} '{}'", path.display()),
+                &path,
+                limits::MAX_MESH_FILE_BYTES,
+            )
         }
     }
 }
 
 /// Newell-style Bezier patches, tessellated by the generator that wrote teapot.obj.
+/// `t_at` names the tessellation's source; `room` is how many triangles may still be added.
 fn load_bpt(
-    origin: &str,
     at: &str,
+    t_at: &str,
     file: &str,
     [nu, nv]: [u32; 2],
+    room: usize,
     files: &FileSource,
 ) -> anyhow::Result<Vec<ObjTriangle>> {
-    if !(1..=MAX_TESSELLATION).contains(&nu) || !(1..=MAX_TESSELLATION).contains(&nv) {
+    let max = limits::MAX_TESSELLATION;
+    if !(1..=max).contains(&nu) || !(1..=max).contains(&nv) {
         return Err(bad_input(format!(
-            "{origin}: {at}.tessellation = [{nu}, {nv}]: each must be from 1 to {MAX_TESSELLATION}"
+            "{t_at} = {nu}x{nv}: each must be from 1 to {max}"
         )));
     }
-    let text = read_text(origin, &format!("{at}.bpt"), file, files)?;
-    let patches = crate::teapot::parse_bpt(&text).map_err(|e| {
-        bad_input(format!(
-            "{origin}: {at}.bpt '{file}' is not a valid patch file: {e}"
-        ))
-    })?;
+    let text = read_text(&format!("{at}.bpt"), file, files)?;
+    let patches = crate::teapot::parse_bpt(&text)
+        .map_err(|e| bad_input(format!("{at}.bpt '{file}' is not a valid patch file: {e}")))?;
+    // Counted before tessellating: a large patch count times a fine
+    // tessellation must be refused, not allocated.
+    let n = patches
+        .len()
+        .checked_mul(nu as usize * nv as usize * 2)
+        .unwrap_or(usize::MAX);
+    limits::check_count(
+        &format!(
+            "{at}: triangles of '{file}' ({} patches at {t_at} = {nu}x{nv}) with those before it",
+            patches.len()
+        ),
+        n,
+        room,
+    )?;
     let mesh = crate::teapot::tessellate(&patches, nu, nv);
     let v = |i: u32| DVec3::from_array(mesh.positions[i as usize]);
     let n = |i: u32| DVec3::from_array(mesh.normals[i as usize]);
@@ -983,13 +1204,8 @@ fn load_bpt(
         .collect())
 }
 
-fn load_obj(
-    origin: &str,
-    at: &str,
-    file: &str,
-    files: &FileSource,
-) -> anyhow::Result<Vec<ObjTriangle>> {
-    let text = read_text(origin, &format!("{at}.obj"), file, files)?;
+fn load_obj(at: &str, file: &str, files: &FileSource) -> anyhow::Result<Vec<ObjTriangle>> {
+    let text = read_text(&format!("{at}.obj"), file, files)?;
     let opts = tobj::LoadOptions {
         triangulate: true,
         single_index: true,
@@ -999,11 +1215,7 @@ fn load_obj(
         // Materials come from the scene file, never from an OBJ's mtllib.
         Err(tobj::LoadError::OpenFileFailed)
     })
-    .map_err(|e| {
-        bad_input(format!(
-            "{origin}: {at}.obj '{file}' is not a valid OBJ file: {e}"
-        ))
-    })?;
+    .map_err(|e| bad_input(format!("{at}.obj '{file}' is not a valid OBJ file: {e}")))?;
     let mut out = Vec::new();
     for model in &models {
         let mesh = &model.mesh;
@@ -1011,20 +1223,23 @@ fn load_obj(
             let i = i as usize * 3;
             let v = mesh.positions.get(i..i + 3).ok_or_else(|| {
                 bad_input(format!(
-                    "{origin}: {at}.obj '{file}' has a face index beyond its vertex list"
+                    "{at}.obj '{file}' has a face index beyond its vertex list"
                 ))
             })?;
-            finite3(
-                origin,
-                &format!("{at}.obj '{file}' vertex"),
-                [v[0] as f64, v[1] as f64, v[2] as f64],
+            let p = DVec3::new(v[0] as f64, v[1] as f64, v[2] as f64);
+            if coord_ok(p) {
+                return Ok(p);
+            }
+            coord3(
+                &format!("{at}.obj '{file}' vertex {}", i / 3 + 1),
+                p.to_array(),
             )
         };
         let has_normals = !mesh.normals.is_empty();
         for (f, tri) in mesh.indices.chunks(3).enumerate() {
             if tri.len() != 3 {
                 return Err(bad_input(format!(
-                    "{origin}: {at}.obj '{file}' has an incomplete face"
+                    "{at}.obj '{file}' has an incomplete face"
                 )));
             }
             let p = [pos(tri[0])?, pos(tri[1])?, pos(tri[2])?];
@@ -1034,14 +1249,19 @@ fn load_obj(
                     let i = tri[k] as usize * 3;
                     let v = mesh.normals.get(i..i + 3).ok_or_else(|| {
                         bad_input(format!(
-                            "{origin}: {at}.obj '{file}' has a normal index beyond its normal list"
+                            "{at}.obj '{file}' has a normal index beyond its normal list"
                         ))
                     })?;
-                    n[k] = unit_normal(
-                        origin,
-                        &format!("{at}.obj '{file}' face {} normal {k}", f + 1),
-                        [v[0] as f64, v[1] as f64, v[2] as f64],
-                    )?;
+                    let raw = DVec3::new(v[0] as f64, v[1] as f64, v[2] as f64);
+                    let len = raw.length();
+                    n[k] = if len > 1e-12 && len.is_finite() {
+                        raw / len
+                    } else {
+                        unit_normal(
+                            &format!("{at}.obj '{file}' face {} normal {k}", f + 1),
+                            raw.to_array(),
+                        )?
+                    };
                 }
                 Some(n)
             } else {

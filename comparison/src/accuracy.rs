@@ -573,8 +573,8 @@ pub struct HardRow {
 }
 
 pub fn run(args: &AccuracyArgs) -> anyhow::Result<()> {
-    std::fs::create_dir_all(args.out.join("images"))
-        .with_context(|| format!("creating --out folder '{}'", args.out.display()))?;
+    twinray_common::image_io::prepare_output_dir("--out", &args.out)?;
+    twinray_common::image_io::prepare_output_dir("--out", &args.out.join("images"))?;
     let frames = if args.quick { 5 } else { 30 };
     let mut rows: Vec<Row> = Vec::new();
     let started = std::time::Instant::now();

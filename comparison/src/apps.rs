@@ -5,7 +5,7 @@ use anyhow::Context;
 use std::path::PathBuf;
 use std::process::Command;
 use std::time::Instant;
-use twinray_common::cli::RenderArgs;
+use twinray_common::cli::{Accel, RenderArgs};
 use twinray_common::error::{bad_input, Failure, FailureKind};
 use twinray_common::report::{DeviceInfo, FrameTime, RunReport};
 
@@ -160,13 +160,21 @@ pub fn run_json(api: Api, args: &RenderArgs) -> anyhow::Result<RunReport> {
 /// apps' format (api "reference", CPU time as wall time).
 pub fn render_reference(args: &RenderArgs) -> anyhow::Result<()> {
     let start = Instant::now();
+    if !args.json && args.out.is_none() {
+        return Err(bad_input(
+            "render --api reference needs --out FILE.png or --json",
+        ));
+    }
+    // The reference takes the apps' options; one that cannot apply is refused as they refuse it.
+    args.compute_workgroup()?;
     let scene = args.load_scene()?;
     let (w, h) = (args.size.width, args.size.height);
     let t = Instant::now();
-    let img = twinray_common::reference::render(&scene, w, h);
+    // --accel none: brute force, a reference independent of the BVH code.
+    let img = render_with_progress(&scene, w, h, args.accel != Accel::None);
     let ms = t.elapsed().as_secs_f64() * 1e3;
     if let Some(out) = &args.out {
-        img.save_png(out)?;
+        img.save_png_for("--out", out)?;
     }
     if args.json {
         let info = DeviceInfo {
@@ -193,12 +201,53 @@ pub fn render_reference(args: &RenderArgs) -> anyhow::Result<()> {
             )
         };
         report.print_json()?;
-    } else if args.out.is_none() {
-        return Err(bad_input(
-            "render --api reference needs --out FILE.png or --json",
-        ));
     }
     Ok(())
+}
+
+/// The reference render, with a progress bar on stderr once it has run for a
+/// second (short renders stay quiet; indicatif draws nothing when stderr is not
+/// a terminal, so logs and pipes get no bar).
+fn render_with_progress(
+    scene: &twinray_common::scene::Scene,
+    w: u32,
+    h: u32,
+    bvh: bool,
+) -> twinray_common::image_io::FloatImage {
+    use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
+    let rows = AtomicUsize::new(0);
+    let finished = AtomicBool::new(false);
+    std::thread::scope(|s| {
+        s.spawn(|| {
+            let started = Instant::now();
+            let mut bar: Option<indicatif::ProgressBar> = None;
+            while !finished.load(Ordering::Relaxed) {
+                std::thread::sleep(std::time::Duration::from_millis(100));
+                if bar.is_none() && started.elapsed().as_secs_f64() >= 1.0 {
+                    let b = indicatif::ProgressBar::with_draw_target(
+                        Some(h as u64),
+                        indicatif::ProgressDrawTarget::stderr(),
+                    );
+                    if let Ok(style) = indicatif::ProgressStyle::with_template(
+                        "reference {bar:40} {pos}/{len} rows, {elapsed} elapsed, about {eta} left",
+                    ) {
+                        b.set_style(style);
+                    }
+                    bar = Some(b);
+                }
+                if let Some(b) = &bar {
+                    b.set_position(rows.load(Ordering::Relaxed) as u64);
+                }
+            }
+            if let Some(b) = bar {
+                b.finish_and_clear();
+            }
+        });
+        let img =
+            twinray_common::reference::render_counting(scene, w, h, &scene.numerics, bvh, &rows);
+        finished.store(true, Ordering::Relaxed);
+        img
+    })
 }
 
 fn rayon_threads() -> usize {

@@ -176,6 +176,8 @@ fn is_software(device: &str) -> bool {
 }
 
 pub fn run(args: &CompareArgs) -> anyhow::Result<()> {
+    // Before the device probe and every render: a bad --out must cost nothing.
+    twinray_common::image_io::prepare_output_dir("--out", &args.out)?;
     let mut args = args.clone();
     if !args.quick && !args.full {
         let probe = RenderArgs {
@@ -204,8 +206,6 @@ pub fn run(args: &CompareArgs) -> anyhow::Result<()> {
     }
     let args = &args;
     let plan = plan(args)?;
-    std::fs::create_dir_all(&args.out)
-        .with_context(|| format!("creating --out folder '{}'", args.out.display()))?;
     let stop = Arc::new(AtomicBool::new(false));
     {
         let stop = stop.clone();
@@ -328,7 +328,13 @@ pub fn run(args: &CompareArgs) -> anyhow::Result<()> {
     } else {
         agreement(&args.out, &plan, &paths, args.workgroup, &stop)
     };
+    let shader_rows = if interrupted || stop.load(Ordering::SeqCst) {
+        Vec::new()
+    } else {
+        crate::shaders::collect(&args.out, &paths, &stop)
+    };
     crate::report::write_all(&args.out, &plan, &outcomes, &accel, &agreement, interrupted)?;
+    crate::shaders::append_to_report(&args.out.join("report.md"), &shader_rows)?;
     eprintln!(
         "twinray compare: {} of {} runs done{}; report: {}",
         outcomes.iter().filter(|o| o.result.is_ok()).count(),

@@ -7,6 +7,7 @@ mod apps;
 mod compare;
 mod diff;
 mod report;
+mod shaders;
 mod study;
 
 use clap::{Parser, Subcommand};

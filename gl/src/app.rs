@@ -32,11 +32,6 @@ pub fn run(args: RenderArgs, started: Instant) -> anyhow::Result<()> {
                 "--gl-spirv is a headless measurement option; run it with --headless",
             ));
         }
-        if args.path == RenderPath::Compute {
-            return Err(bad_input(
-                "--path compute runs headless only; add --headless",
-            ));
-        }
         return run_windowed(&args, started);
     }
     let scene = args.load_scene()?;
@@ -154,7 +149,7 @@ pub fn run(args: RenderArgs, started: Instant) -> anyhow::Result<()> {
     log.check(gl, "after the frame loop");
 
     if let Some(out) = &args.out {
-        image.save_png(out)?;
+        image.save_png_for("--out", out)?;
     }
     let errors = log.errors();
     if args.json {

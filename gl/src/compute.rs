@@ -6,8 +6,13 @@
 //! here: `imageStore` writes are *incoherent*, so a `glMemoryBarrier` must order
 //! them before anything else touches the texture, the next dispatch's stores
 //! (SHADER_IMAGE_ACCESS) and the readback (TEXTURE_UPDATE, for glGetTexImage).
+//!
+//! In the window the texture is also the colour attachment of a read
+//! framebuffer, and each frame blits it into the window's default framebuffer
+//! (`glBlitFramebuffer`, after a FRAMEBUFFER barrier: the blit reads through a
+//! framebuffer); a new window size makes a new texture.
 
-use anyhow::anyhow;
+use anyhow::{anyhow, bail, Context as _};
 use glow::HasContext;
 use twinray_common::cli::Workgroup;
 use twinray_common::error::bad_input;
@@ -15,11 +20,13 @@ use twinray_common::gpu::binding;
 use twinray_common::shader::{spirv_for_opengl, ComputeShader};
 
 /// The compute program, the storage texture and the dispatch grid.
-/// Field order is drop order: program, then texture.
 pub struct Compute<'gl> {
     gl: &'gl glow::Context,
     program: glow::Program,
     texture: glow::Texture,
+    /// Windowed only: the framebuffer the blit reads the texture through.
+    read_fbo: Option<glow::Framebuffer>,
+    workgroup: Workgroup,
     groups: (u32, u32),
     pub width: u32,
     pub height: u32,
@@ -69,34 +76,139 @@ impl<'gl> Compute<'gl> {
             gl,
             program,
             texture,
+            read_fbo: None,
+            workgroup: shader.workgroup,
             groups,
             width,
             height,
         };
-        // SAFETY: both objects are alive on the current context.
+        this.storage()?;
+        // SAFETY: the program is alive on the current context.
+        unsafe { gl.use_program(Some(program)) };
+        Ok(this)
+    }
+
+    /// Gives the texture its storage and binds it to the shader's image unit;
+    /// a size the driver cannot hold is bad input naming --size.
+    fn storage(&self) -> anyhow::Result<()> {
+        // SAFETY: the texture is alive on the current context; sizes were checked.
         unsafe {
-            gl.bind_texture(glow::TEXTURE_2D, Some(texture));
+            let gl = self.gl;
+            gl.bind_texture(glow::TEXTURE_2D, Some(self.texture));
             // Immutable storage, one level: image units need a complete texture.
             gl.tex_storage_2d(
                 glow::TEXTURE_2D,
                 1,
                 glow::RGBA32F,
-                width as i32,
-                height as i32,
+                self.width as i32,
+                self.height as i32,
             );
+            crate::target::out_of_memory(gl, "storage image", self.width, self.height)?;
             // WRITE_ONLY matches the shader's `writeonly`; the format its `rgba32f`.
             gl.bind_image_texture(
                 binding::IMAGE,
-                Some(texture),
+                Some(self.texture),
                 0,
                 false,
                 0,
                 glow::WRITE_ONLY,
                 glow::RGBA32F,
             );
-            gl.use_program(Some(program));
         }
-        Ok(this)
+        Ok(())
+    }
+
+    /// Windowed: a texture of the new size (storage is immutable, so a new
+    /// texture), re-attached to the blit's framebuffer if there is one.
+    pub fn resize(&mut self, width: u32, height: u32) -> anyhow::Result<()> {
+        let gl = self.gl;
+        self.groups = check_limits(gl, self.workgroup, width, height)?;
+        // SAFETY: objects of the current context; the old texture is no longer bound anywhere after this.
+        let texture = unsafe { gl.create_texture() }
+            .map_err(|e| anyhow!(e))
+            .context("glGenTextures")?;
+        unsafe { gl.delete_texture(self.texture) };
+        self.texture = texture;
+        (self.width, self.height) = (width, height);
+        self.storage()?;
+        if self.read_fbo.is_some() {
+            self.attach()?;
+        }
+        Ok(())
+    }
+
+    /// Windowed: the program in use again (the fragment path may have replaced it).
+    pub fn bind(&self) {
+        // SAFETY: the program is alive on the current context.
+        unsafe { self.gl.use_program(Some(self.program)) }
+    }
+
+    /// Windowed: makes the texture the colour attachment of a read
+    /// framebuffer, for [`Compute::blit_to_window`].
+    pub fn attach(&mut self) -> anyhow::Result<()> {
+        let gl = self.gl;
+        // SAFETY: objects of the current context.
+        unsafe {
+            let fbo = match self.read_fbo {
+                Some(f) => f,
+                None => {
+                    let f = gl
+                        .create_framebuffer()
+                        .map_err(|e| anyhow!(e))
+                        .context("glCreateFramebuffer")?;
+                    self.read_fbo = Some(f);
+                    f
+                }
+            };
+            gl.bind_framebuffer(glow::READ_FRAMEBUFFER, Some(fbo));
+            gl.framebuffer_texture_2d(
+                glow::READ_FRAMEBUFFER,
+                glow::COLOR_ATTACHMENT0,
+                glow::TEXTURE_2D,
+                Some(self.texture),
+                0,
+            );
+            let status = gl.check_framebuffer_status(glow::READ_FRAMEBUFFER);
+            gl.bind_framebuffer(glow::READ_FRAMEBUFFER, None);
+            if status != glow::FRAMEBUFFER_COMPLETE {
+                bail!(
+                    "the RGBA32F {}x{} texture is no complete read framebuffer (status {status:#x})",
+                    self.width,
+                    self.height
+                );
+            }
+        }
+        Ok(())
+    }
+
+    /// Windowed: the last dispatch's image into the window's back buffer.
+    /// The texture's row 0 is the top of the image, the default framebuffer's
+    /// the bottom of the window, so the blit flips (destination y from the top
+    /// down); same size, NEAREST: texel for texel, converted to the window's
+    /// 8-bit format as the fragment path's colour write is.
+    pub fn blit_to_window(&self) {
+        let (w, h) = (self.width as i32, self.height as i32);
+        // SAFETY: objects of the current context; `attach` made the FBO complete.
+        unsafe {
+            let gl = self.gl;
+            // imageStore is incoherent: the blit reads through a framebuffer.
+            gl.memory_barrier(glow::FRAMEBUFFER_BARRIER_BIT);
+            gl.bind_framebuffer(glow::READ_FRAMEBUFFER, self.read_fbo);
+            gl.bind_framebuffer(glow::DRAW_FRAMEBUFFER, None);
+            gl.blit_framebuffer(
+                0,
+                0,
+                w,
+                h,
+                0,
+                h,
+                w,
+                0,
+                glow::COLOR_BUFFER_BIT,
+                glow::NEAREST,
+            );
+            gl.bind_framebuffer(glow::READ_FRAMEBUFFER, None);
+        }
     }
 
     /// One frame's GPU work: the dispatch. The timer brackets exactly this.
@@ -142,6 +254,9 @@ impl Drop for Compute<'_> {
         // SAFETY: objects of this context, which outlives them.
         unsafe {
             self.gl.use_program(None);
+            if let Some(f) = self.read_fbo {
+                self.gl.delete_framebuffer(f);
+            }
             self.gl.delete_program(self.program);
             self.gl.delete_texture(self.texture);
         }

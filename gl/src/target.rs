@@ -38,6 +38,24 @@ pub fn check_size(gl: &glow::Context, width: u32, height: u32) -> anyhow::Result
     Ok(())
 }
 
+/// GL_OUT_OF_MEMORY after allocating an RGBA32F image of `width` x `height`:
+/// the size the user chose is too large for this device (bad input, said so).
+pub fn out_of_memory(
+    gl: &glow::Context,
+    what: &str,
+    width: u32,
+    height: u32,
+) -> anyhow::Result<()> {
+    // SAFETY: a plain query on the current context.
+    if unsafe { gl.get_error() } == glow::OUT_OF_MEMORY {
+        return Err(bad_input(format!(
+            "--size {width}x{height}: this device cannot allocate the {} RGBA32F {what} (GL_OUT_OF_MEMORY); use a smaller --size",
+            twinray_common::limits::gib(width as u64 * height as u64 * 16)
+        )));
+    }
+    Ok(())
+}
+
 impl<'gl> Target<'gl> {
     /// Creates the FBO and leaves it bound for drawing and reading.
     pub fn new(gl: &'gl glow::Context, width: u32, height: u32) -> anyhow::Result<Target<'gl>> {
@@ -68,6 +86,7 @@ impl<'gl> Target<'gl> {
                 width as i32,
                 height as i32,
             );
+            out_of_memory(gl, "render target", width, height)?;
             gl.bind_framebuffer(glow::FRAMEBUFFER, Some(fbo));
             gl.framebuffer_renderbuffer(
                 glow::FRAMEBUFFER,
@@ -76,6 +95,14 @@ impl<'gl> Target<'gl> {
                 Some(colour),
             );
             let status = gl.check_framebuffer_status(glow::FRAMEBUFFER);
+            if status == glow::FRAMEBUFFER_INCOMPLETE_ATTACHMENT {
+                // llvmpipe reports a renderbuffer it could not allocate this way,
+                // without GL_OUT_OF_MEMORY; the size was within the device's limits.
+                return Err(bad_input(format!(
+                    "--size {width}x{height}: this device cannot allocate the {} RGBA32F render target (its framebuffer is incomplete); use a smaller --size",
+                    twinray_common::limits::gib(width as u64 * height as u64 * 16)
+                )));
+            }
             if status != glow::FRAMEBUFFER_COMPLETE {
                 bail!(
                     "the RGBA32F {width}x{height} framebuffer is incomplete (status {status:#x})"

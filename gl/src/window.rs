@@ -16,8 +16,13 @@
 //! down from the top (right for Vulkan, and for GL's bottom-up readback). So
 //! the window's fragment shader redeclares `gl_FragCoord` with
 //! `origin_upper_left`, which makes GL count rows like Vulkan does.
+//!
+//! The compute path (`--path compute`, or `C` at run time) dispatches into its
+//! RGBA32F texture and blits that into the default framebuffer, flipping the
+//! rows for the same reason (gl/src/compute.rs).
 
 use crate::buffers::SceneBuffers;
+use crate::compute::Compute;
 use crate::debug::DebugLog;
 use crate::program::{EmptyVertexArray, Program};
 use crate::target::{self, Target};
@@ -40,8 +45,7 @@ use twinray_common::error::no_device;
 use twinray_common::explain;
 use twinray_common::gpu::{GpuFrame, GpuScene};
 use twinray_common::image_io::FloatImage;
-use twinray_common::interactive::{self, Drawn, Renderer, WindowedRun};
-use twinray_common::shader::{self, Shaders};
+use twinray_common::interactive::{self, Drawn, PathShaders, Renderer, WindowedRun};
 use winit::window::Window;
 
 /// Timer queries in a ring, so that reading one never waits for the GPU: a
@@ -60,10 +64,10 @@ pub struct DeviceInfo {
 pub fn run(args: &RenderArgs, started: Instant) -> Result<(WindowedRun, DeviceInfo, u64)> {
     let scene = args.load_scene()?;
     let variant = interactive::variant_for(args, &scene);
-    let shaders = shader::build(&variant)?;
+    let shaders = interactive::first_shaders(args, &scene)?;
     explain::step(
         "Shaders: GLSL -> naga module -> GLSL 450 core (twinray-common)",
-        || format!("variant {}", variant.label()),
+        || format!("variant {}, {} path", variant.label(), args.path),
     );
 
     let event_loop = interactive::event_loop()?;
@@ -165,17 +169,12 @@ pub fn run(args: &RenderArgs, started: Instant) -> Result<(WindowedRun, DeviceIn
     let gpu = GpuScene::new(&scene, size.width.max(1), size.height.max(1));
     // Declaration order is creation order, so the struct's fields (newest
     // first) and these locals go in reverse on every path.
-    let program = Program::new(
-        gl,
-        &shaders.vertex_glsl,
-        &upper_left_origin(&shaders.fragment_glsl),
-    )?;
+    let drawing = path_program(gl, &shaders, (size.width, size.height))?;
     let buffers = SceneBuffers::new(gl, &gpu)?;
     let vao = EmptyVertexArray::new(gl)?;
     let timers = (0..TIMERS)
         .map(|_| Timer::new(gl, &info.renderer))
         .collect::<Result<Vec<_>>>()?;
-    program.bind(&vao);
     // SAFETY: plain state on the current context: no sRGB encoding on store (see above).
     unsafe {
         gl.disable(glow::FRAMEBUFFER_SRGB);
@@ -187,8 +186,7 @@ pub fn run(args: &RenderArgs, started: Instant) -> Result<(WindowedRun, DeviceIn
         next_timer: 0,
         vao,
         buffers,
-        program,
-        shaders,
+        drawing,
         size: (size.width, size.height),
         log: log.clone(),
         gl,
@@ -197,7 +195,8 @@ pub fn run(args: &RenderArgs, started: Instant) -> Result<(WindowedRun, DeviceIn
         window: &window,
     };
     explain::step("Frame loop starts", || {
-        "per frame: glBufferSubData (camera), glDrawArrays, SwapBuffers: the driver queues, syncs and presents".into()
+        "per frame: glBufferSubData (camera), glDrawArrays (fragment) or glDispatchCompute + glMemoryBarrier\n\
+         + glBlitFramebuffer (compute), SwapBuffers: the driver queues, syncs and presents; C switches the path".into()
     });
     let run = interactive::run(
         "twinray-gl",
@@ -242,14 +241,50 @@ pub fn upper_left_origin(glsl: &str) -> String {
     out
 }
 
+/// The current path's program: the fullscreen pair, or the compute program
+/// with its texture and the framebuffer its blit reads.
+enum PathProgram<'gl> {
+    Fragment(Program<'gl>),
+    Compute(Compute<'gl>),
+}
+
+/// The program for `shaders`' path; the compute path's texture has `size`.
+fn path_program<'gl>(
+    gl: &'gl glow::Context,
+    shaders: &PathShaders,
+    size: (u32, u32),
+) -> Result<PathProgram<'gl>> {
+    Ok(match shaders {
+        PathShaders::Fragment(s) => PathProgram::Fragment(Program::new(
+            gl,
+            &s.vertex_glsl,
+            &upper_left_origin(&s.fragment_glsl),
+        )?),
+        PathShaders::Compute(s) => {
+            let mut c = Compute::new(gl, s, None, size.0.max(1), size.1.max(1))?;
+            c.attach()?;
+            explain::step(
+                "Compute path in the window: program + RGBA32F texture (glBindImageTexture) + read FBO",
+                || {
+                    format!(
+                        "{}x{}, workgroup {}; per frame glDispatchCompute, glMemoryBarrier(FRAMEBUFFER_BARRIER_BIT),\n\
+                         glBlitFramebuffer into the default framebuffer (rows flipped, NEAREST)",
+                        c.width, c.height, s.workgroup
+                    )
+                },
+            );
+            PathProgram::Compute(c)
+        }
+    })
+}
+
 struct GlWindow<'gl> {
     /// Each with "has an unread result".
     timers: Vec<(Timer<'gl>, bool)>,
     next_timer: usize,
     vao: EmptyVertexArray<'gl>,
     buffers: SceneBuffers<'gl>,
-    program: Program<'gl>,
-    shaders: Shaders,
+    drawing: PathProgram<'gl>,
     size: (u32, u32),
     log: DebugLog,
     gl: &'gl glow::Context,
@@ -276,6 +311,10 @@ impl Renderer for GlWindow<'_> {
         self.surface.resize(self.context, w, h);
         // SAFETY: plain state on the current context.
         unsafe { self.gl.viewport(0, 0, width as i32, height as i32) };
+        if let PathProgram::Compute(c) = &mut self.drawing {
+            c.resize(width, height)?;
+        }
+        self.log.check(self.gl, "after a resize");
         Ok(())
     }
 
@@ -292,8 +331,20 @@ impl Renderer for GlWindow<'_> {
             None
         };
         timer.begin();
-        // SAFETY: program, VAO and buffers are bound and alive.
-        unsafe { self.gl.draw_arrays(glow::TRIANGLES, 0, 3) };
+        // Bound every frame: a capture or a path switch may have bound others.
+        match &self.drawing {
+            PathProgram::Fragment(program) => {
+                program.bind(&self.vao);
+                // SAFETY: program, VAO and buffers are bound and alive.
+                unsafe { self.gl.draw_arrays(glow::TRIANGLES, 0, 3) };
+            }
+            PathProgram::Compute(c) => {
+                c.bind();
+                c.barrier_between_frames();
+                c.dispatch();
+                c.blit_to_window();
+            }
+        }
         timer.end();
         *pending = true;
         self.next_timer = (self.next_timer + 1) % TIMERS;
@@ -304,27 +355,38 @@ impl Renderer for GlWindow<'_> {
         Ok(Some(Drawn { gpu_ms }))
     }
 
-    fn load_scene(&mut self, scene: &GpuScene, shaders: &Shaders) -> Result<()> {
+    fn load_scene(&mut self, scene: &GpuScene, shaders: &PathShaders) -> Result<()> {
         let gl = self.gl;
-        self.program = Program::new(
-            gl,
-            &shaders.vertex_glsl,
-            &upper_left_origin(&shaders.fragment_glsl),
-        )?;
+        self.drawing = path_program(gl, shaders, self.size)?;
         self.buffers = SceneBuffers::new(gl, scene)?;
-        self.program.bind(&self.vao);
-        self.shaders = shaders.clone();
-        self.log.check(gl, "after a scene switch");
+        self.log.check(gl, "after a scene or path switch");
         Ok(())
     }
 
-    /// The headless path at the window's size: an RGBA32F FBO and glReadPixels.
-    /// This program counts rows from the top (upper-left origin) and the
-    /// readback returns the bottom row first, hence the flip.
+    /// The headless path at the window's size, with the current path. Fragment:
+    /// an RGBA32F FBO and glReadPixels; this program counts rows from the top
+    /// (upper-left origin) and the readback returns the bottom row first, hence
+    /// the flip. Compute: the window's own texture (the window's size) and
+    /// glGetTexImage, top row first, as headless.
     fn capture(&mut self, frame: &GpuFrame, width: u32, height: u32) -> Result<FloatImage> {
         let gl = self.gl;
         target::check_size(gl, width, height)?;
         self.buffers.update_frame(bytemuck::bytes_of(frame));
+        let program = match &mut self.drawing {
+            PathProgram::Fragment(program) => program,
+            PathProgram::Compute(c) => {
+                if (c.width, c.height) != (width, height) {
+                    c.resize(width, height)?;
+                }
+                c.bind();
+                c.barrier_between_frames();
+                c.dispatch();
+                let pixels = c.read();
+                self.log.check(gl, "after a capture");
+                return Ok(FloatImage::from_rgba(width, height, &pixels));
+            }
+        };
+        program.bind(&self.vao);
         let pixels = {
             let fbo = Target::new(gl, width, height)?;
             // SAFETY: the FBO is bound for drawing; program and buffers are bound.

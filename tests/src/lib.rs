@@ -115,15 +115,22 @@ pub fn fail(program: &Path, args: &[&str], env: &[(&str, &str)]) -> (i32, String
 
 /// A private X server for one windowed test (Debian's `xvfb`; tests/run.sh
 /// installs it). `-displayfd` lets Xvfb pick a free display number itself, so
-/// tests running in parallel never collide. Killed on drop.
+/// tests running in parallel never collide. `-fbdir` keeps the screen in a
+/// file, so a test can read what a window really shows ([`Xvfb::screen`]).
+/// Killed on drop.
 pub struct Xvfb {
     child: std::process::Child,
     pub display: String,
+    fbdir: PathBuf,
 }
 
 impl Xvfb {
     pub fn start() -> Xvfb {
         use std::io::BufRead;
+        static SERVERS: std::sync::atomic::AtomicU32 = std::sync::atomic::AtomicU32::new(0);
+        let k = SERVERS.fetch_add(1, std::sync::atomic::Ordering::SeqCst);
+        let fbdir = std::env::temp_dir().join(format!("twinray-xvfb-{}-{k}", std::process::id()));
+        std::fs::create_dir_all(&fbdir).unwrap();
         let mut child = Command::new("Xvfb")
             .args([
                 "-displayfd",
@@ -133,7 +140,9 @@ impl Xvfb {
                 "640x480x24",
                 "-nolisten",
                 "tcp",
+                "-fbdir",
             ])
+            .arg(&fbdir)
             .stdout(std::process::Stdio::piped())
             .stderr(std::process::Stdio::null())
             .spawn()
@@ -149,7 +158,32 @@ impl Xvfb {
         Xvfb {
             child,
             display: format!(":{n}"),
+            fbdir,
         }
+    }
+
+    /// The screen's pixels in the rectangle at (`x`, `y`) of `width`×`height`,
+    /// as shown now: Xvfb's screen file is an XWD image (a 100-byte header of
+    /// 25 big-endian u32 fields, the colour map, then the rows), which at depth
+    /// 24 holds 32-bit pixels.
+    pub fn screen(&self, x: u32, y: u32, width: u32, height: u32) -> image::RgbImage {
+        let data = std::fs::read(self.fbdir.join("Xvfb_screen0")).expect("Xvfb's screen file");
+        let field = |i: usize| u32::from_be_bytes(data[i * 4..i * 4 + 4].try_into().unwrap());
+        let (header, byte_order, bpp, line, colours) =
+            (field(0), field(7), field(11), field(12), field(19));
+        assert_eq!(bpp, 32, "Xvfb's screen is not 32 bits per pixel");
+        let start = (header + colours * 12) as usize;
+        image::RgbImage::from_fn(width, height, |i, j| {
+            let at = start + ((y + j) * line + (x + i) * 4) as usize;
+            let p = &data[at..at + 4];
+            // 0x00RRGGBB, least significant byte first unless byte_order is 1.
+            let v = if byte_order == 1 {
+                u32::from_be_bytes(p.try_into().unwrap())
+            } else {
+                u32::from_le_bytes(p.try_into().unwrap())
+            };
+            image::Rgb([(v >> 16) as u8, (v >> 8) as u8, v as u8])
+        })
     }
 
     fn command(&self, program: &Path, args: &[&str], env: &[(&str, &str)], dir: &Path) -> Command {
@@ -174,8 +208,14 @@ impl Xvfb {
     }
 
     /// Starts `program` on this display without waiting, its output captured.
-    pub fn spawn(&self, program: &Path, args: &[&str], dir: &Path) -> std::process::Child {
-        self.command(program, args, &[], dir)
+    pub fn spawn(
+        &self,
+        program: &Path,
+        args: &[&str],
+        env: &[(&str, &str)],
+        dir: &Path,
+    ) -> std::process::Child {
+        self.command(program, args, env, dir)
             .stdout(std::process::Stdio::piped())
             .stderr(std::process::Stdio::piped())
             .spawn()
@@ -183,9 +223,13 @@ impl Xvfb {
     }
 
     /// Real X input through XTEST, as a user's mouse and keyboard make it
-    /// (xdotool; tests/run.sh installs it).
+    /// (xdotool; tests/run.sh installs it). A window or title that never comes
+    /// would leave `search --sync` waiting for ever, so 120 s at most
+    /// (coreutils' `timeout`, exit 124).
     pub fn xdotool(&self, args: &[&str]) -> Output {
-        Command::new("xdotool")
+        Command::new("timeout")
+            .arg("120")
+            .arg("xdotool")
             .args(args)
             .env("DISPLAY", &self.display)
             .output()
@@ -199,5 +243,6 @@ impl Drop for Xvfb {
     fn drop(&mut self) {
         let _ = self.child.kill();
         let _ = self.child.wait();
+        let _ = std::fs::remove_dir_all(&self.fbdir);
     }
 }

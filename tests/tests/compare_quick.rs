@@ -86,5 +86,26 @@ fn quick_comparison_writes_every_api_experiment_and_point() {
     ] {
         assert!(out.join(f).exists(), "{f} missing");
     }
+    // Every tracer's dump, and a row for it in the drivers' section.
+    let section = report
+        .split("## What the drivers compiled")
+        .nth(1)
+        .expect("the report has the drivers' section");
+    let rows = section
+        .lines()
+        .filter(|l| l.starts_with("| ") && !l.starts_with("| scene"))
+        .count();
+    assert_eq!(
+        rows,
+        4 * 2 * 2,
+        "scene x accel (4) x path x API rows: {section}"
+    );
+    assert!(!section.contains("failed"), "{section}");
+    for api in ["vulkan", "opengl"] {
+        let dir = out.join(format!("shaders/teapot-bvh-{api}-compute"));
+        for f in ["compute.spv", "compute.glsl", "statistics.json"] {
+            assert!(dir.join(f).exists(), "{} missing", dir.join(f).display());
+        }
+    }
     std::fs::remove_dir_all(out).ok();
 }

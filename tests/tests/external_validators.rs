@@ -99,11 +99,25 @@ fn variants() -> Vec<(String, Variant)> {
         "specialize+bvh".into(),
         chosen(d, Accel::Bvh, false, vec![]),
     ));
-    // Each `--experiment` on its own: several change the source or naga's output.
-    for &e in <Experiment as clap::ValueEnum>::value_variants() {
+    use Experiment::*;
+    for experiments in [
+        vec![
+            NagaZeroInit,
+            NagaLoopBounding,
+            SharedBvhStack,
+            UniformCounts,
+        ],
+        vec![NoLoopBounding, UnpairedBvhStack, StorageCounts],
+        vec![StacklessBvh],
+    ] {
+        let label = experiments
+            .iter()
+            .map(|e| e.name())
+            .collect::<Vec<_>>()
+            .join(",");
         v.push((
-            format!("generic+bvh experiment {}", e.name()),
-            chosen(d, Accel::Bvh, true, vec![e]),
+            format!("generic+bvh experiments {label}"),
+            chosen(d, Accel::Bvh, true, experiments),
         ));
     }
     v

@@ -38,11 +38,6 @@ pub fn run(args: RenderArgs, process_start: Instant) -> Result<()> {
         ));
     }
     if !args.headless {
-        if args.path == RenderPath::Compute {
-            return Err(bad_input(
-                "--path compute runs headless only; add --headless",
-            ));
-        }
         return run_windowed(&args, process_start);
     }
     let scene = args.load_scene()?;
@@ -52,7 +47,7 @@ pub fn run(args: RenderArgs, process_start: Instant) -> Result<()> {
     // Counted only now that every Vulkan object is gone, so teardown mistakes count too.
     report.validation_messages = VALIDATION_MESSAGES.load(Ordering::SeqCst);
     if let Some(path) = &args.out {
-        image.save_png(path)?;
+        image.save_png_for("--out", path)?;
     }
     if args.json {
         report.print_json()?;

@@ -16,17 +16,28 @@
 //!   workgroups; the shader skips invocations past the edges.
 //!
 //! The descriptor set is descriptors.rs's with the compute stage and binding 5.
+//!
+//! In the window ([`WindowCompute`]) the same pipeline and storage image serve
+//! the swapchain: the image is sized to the swapchain and made anew when it
+//! changes size, and each frame *blits* it into the acquired swapchain image
+//! (a copy cannot: RGBA32F and the 8-bit swapchain formats differ in size per
+//! texel, and a blit converts, as the render pass's colour write does). The
+//! shader cannot write the swapchain image itself: its `rgba32f` image format
+//! is not the swapchain's, and few surfaces offer STORAGE usage anyway.
 
 use crate::commands::Commands;
 use crate::descriptors::Descriptors;
 use crate::device::Device;
 use crate::memory::Buffer;
+use crate::scene::scene_buffers;
 use crate::target::{create_image_with_view, read_image, readback_buffer, record_copy_to_host};
 use crate::timestamps::Timestamps;
 use anyhow::{Context, Result};
 use ash::vk;
 use twinray_common::cli::Workgroup;
 use twinray_common::error::bad_input;
+use twinray_common::explain;
+use twinray_common::gpu::GpuScene;
 use twinray_common::image_io::FloatImage;
 use twinray_common::shader::ComputeShader;
 
@@ -166,6 +177,223 @@ impl Compute {
     }
 }
 
+/// The compute path in the window: its scene buffers, descriptor set and
+/// pipeline (all per scene and variant, like `SceneResources` for the fragment
+/// path), and a storage image the size of the swapchain. frames.rs records
+/// [`WindowCompute::record`] into each frame. Fields drop in declaration order:
+/// the pipeline and the set before the image and the buffers they use.
+pub struct WindowCompute {
+    pipeline: ComputePipeline,
+    descriptors: Descriptors,
+    image: StorageImage,
+    pub storage: Vec<(u32, Buffer)>,
+    /// Binding 0, rewritten by each frame's command buffer, as for the fragment path.
+    pub frame: Buffer,
+    pub shader: ComputeShader,
+    groups: (u32, u32),
+    /// The storage image's size, which must be the swapchain's.
+    pub extent: vk::Extent2D,
+}
+
+impl WindowCompute {
+    /// `swapchain_format` is the surface format the blit writes; `extent` the
+    /// swapchain's (or the window's while minimized).
+    pub fn new(
+        device: &Device,
+        scene: &GpuScene,
+        shader: &ComputeShader,
+        swapchain_format: vk::Format,
+        extent: vk::Extent2D,
+    ) -> Result<WindowCompute> {
+        let groups = check_limits(device, shader.workgroup, extent.width, extent.height)?;
+        let (frame, storage) = scene_buffers(device, scene)?;
+        let image = StorageImage::new(device, extent.width, extent.height)?;
+        let descriptors = Descriptors::for_stage(
+            device,
+            &frame,
+            &storage,
+            vk::ShaderStageFlags::COMPUTE,
+            Some(image.view),
+        )?;
+        let pipeline = ComputePipeline::new(device, descriptors.set_layout, &shader.spirv)?;
+        explain::step(
+            "Compute path in the window: VkPipeline (compute) + storage VkImage sized to the swapchain",
+            || {
+                format!(
+                    "{}x{} {IMAGE_FORMAT:?}, usage STORAGE|TRANSFER_SRC, binding 5 of the set; workgroup {}, {}x{} groups
+                     per frame: storage image UNDEFINED->GENERAL, vkCmdDispatch, GENERAL->TRANSFER_SRC_OPTIMAL and the
+                     acquired swapchain image UNDEFINED->TRANSFER_DST_OPTIMAL, vkCmdBlitImage (NEAREST, {IMAGE_FORMAT:?} -> {swapchain_format:?}),
+                     swapchain image TRANSFER_DST_OPTIMAL->PRESENT_SRC_KHR; the submit waits for the image at TRANSFER",
+                    extent.width, extent.height, shader.workgroup, groups.0, groups.1
+                )
+            },
+        );
+        Ok(WindowCompute {
+            pipeline,
+            descriptors,
+            image,
+            storage,
+            frame,
+            shader: shader.clone(),
+            groups,
+            extent,
+        })
+    }
+
+    /// A new storage image for a new swapchain size, and the set pointed at it.
+    /// The caller waits for the GPU first: the old image may still be in use.
+    pub fn resize(&mut self, device: &Device, extent: vk::Extent2D) -> Result<()> {
+        self.groups = check_limits(device, self.shader.workgroup, extent.width, extent.height)?;
+        let image = StorageImage::new(device, extent.width, extent.height)?;
+        self.descriptors.write_image(image.view);
+        self.image = image; // the old one is destroyed here, no longer referenced
+        self.extent = extent;
+        Ok(())
+    }
+
+    /// The frame's GPU work after the uniform write: trace into the storage
+    /// image, then blit it into the acquired swapchain image `target` and hand
+    /// that to presentation. The submit must wait for `target` to be acquired
+    /// at the TRANSFER stage, where the first barrier on it starts.
+    pub fn record(&self, d: &ash::Device, cmd: vk::CommandBuffer, target: vk::Image) {
+        let none = vk::AccessFlags::empty();
+        // Every pixel is written again, so the old contents may go (UNDEFINED).
+        // Waiting for TRANSFER orders this frame's writes after the previous
+        // frame's blit read the image (write after read: no access to flush).
+        let to_general = self.image.barrier(
+            none,
+            vk::AccessFlags::SHADER_WRITE,
+            vk::ImageLayout::UNDEFINED,
+            vk::ImageLayout::GENERAL,
+        );
+        // The blit reads what the dispatch wrote; the swapchain image's old
+        // contents go, and the transition waits for the acquire semaphore,
+        // which the submit waits on at TRANSFER.
+        let to_blit = [
+            self.image.barrier(
+                vk::AccessFlags::SHADER_WRITE,
+                vk::AccessFlags::TRANSFER_READ,
+                vk::ImageLayout::GENERAL,
+                vk::ImageLayout::TRANSFER_SRC_OPTIMAL,
+            ),
+            image_barrier(
+                target,
+                none,
+                vk::AccessFlags::TRANSFER_WRITE,
+                vk::ImageLayout::UNDEFINED,
+                vk::ImageLayout::TRANSFER_DST_OPTIMAL,
+            ),
+        ];
+        // Presentation needs PRESENT_SRC_KHR; the render-finished semaphore,
+        // signalled after every command, makes the blit's writes visible to it.
+        let to_present = image_barrier(
+            target,
+            vk::AccessFlags::TRANSFER_WRITE,
+            none,
+            vk::ImageLayout::TRANSFER_DST_OPTIMAL,
+            vk::ImageLayout::PRESENT_SRC_KHR,
+        );
+        let layers = vk::ImageSubresourceLayers {
+            aspect_mask: vk::ImageAspectFlags::COLOR,
+            mip_level: 0,
+            base_array_layer: 0,
+            layer_count: 1,
+        };
+        let corner = vk::Offset3D {
+            x: self.extent.width as i32,
+            y: self.extent.height as i32,
+            z: 1,
+        };
+        // Same size both sides: texel for texel, converted to the swapchain's format.
+        let region = vk::ImageBlit {
+            src_subresource: layers,
+            src_offsets: [vk::Offset3D::default(), corner],
+            dst_subresource: layers,
+            dst_offsets: [vk::Offset3D::default(), corner],
+        };
+        let flags = vk::DependencyFlags::empty();
+        // SAFETY: every handle is alive; `cmd` is recording; the set matches the layout.
+        unsafe {
+            d.cmd_pipeline_barrier(
+                cmd,
+                vk::PipelineStageFlags::TRANSFER,
+                vk::PipelineStageFlags::COMPUTE_SHADER,
+                flags,
+                &[],
+                &[],
+                &[to_general],
+            );
+            d.cmd_bind_pipeline(cmd, vk::PipelineBindPoint::COMPUTE, self.pipeline.pipeline);
+            d.cmd_bind_descriptor_sets(
+                cmd,
+                vk::PipelineBindPoint::COMPUTE,
+                self.pipeline.layout,
+                0,
+                &[self.descriptors.set],
+                &[],
+            );
+            d.cmd_dispatch(cmd, self.groups.0, self.groups.1, 1);
+            d.cmd_pipeline_barrier(
+                cmd,
+                vk::PipelineStageFlags::COMPUTE_SHADER | vk::PipelineStageFlags::TRANSFER,
+                vk::PipelineStageFlags::TRANSFER,
+                flags,
+                &[],
+                &[],
+                &to_blit,
+            );
+            d.cmd_blit_image(
+                cmd,
+                self.image.image,
+                vk::ImageLayout::TRANSFER_SRC_OPTIMAL,
+                target,
+                vk::ImageLayout::TRANSFER_DST_OPTIMAL,
+                &[region],
+                vk::Filter::NEAREST,
+            );
+            d.cmd_pipeline_barrier(
+                cmd,
+                vk::PipelineStageFlags::TRANSFER,
+                vk::PipelineStageFlags::BOTTOM_OF_PIPE,
+                flags,
+                &[],
+                &[],
+                &[to_present],
+            );
+        }
+    }
+}
+
+/// Why the compute path cannot show its image in this window, if it cannot:
+/// the blit needs TRANSFER_DST on the swapchain images (`transfer_dst`, from
+/// the surface), BLIT_SRC on the storage format and BLIT_DST on the
+/// swapchain's (mandatory for these formats, but a missing one would otherwise
+/// be undefined behaviour rather than a message).
+pub fn window_blocker(
+    instance: &ash::Instance,
+    device: &Device,
+    transfer_dst: bool,
+    swapchain_format: vk::Format,
+) -> Option<String> {
+    let features = |format| {
+        // SAFETY: a plain query on a live physical device.
+        unsafe { instance.get_physical_device_format_properties(device.physical, format) }
+            .optimal_tiling_features
+    };
+    let why = if !transfer_dst {
+        "this surface does not let its images be transfer destinations".to_string()
+    } else if !features(IMAGE_FORMAT).contains(vk::FormatFeatureFlags::BLIT_SRC)
+        || !features(swapchain_format).contains(vk::FormatFeatureFlags::BLIT_DST)
+    {
+        format!("this driver cannot blit {IMAGE_FORMAT:?} into {swapchain_format:?}")
+    } else {
+        return None;
+    };
+    Some(format!(
+        "{why}, which the compute path needs to show its image in a window; use --path fragment, or --headless"
+    ))
+}
+
 /// The workgroup against the device's limits (bad input: the user chose it), and
 /// the dispatch size, which has limits of its own. Returns the group counts.
 fn check_limits(device: &Device, wg: Workgroup, width: u32, height: u32) -> Result<(u32, u32)> {
@@ -296,21 +524,32 @@ impl StorageImage {
         old: vk::ImageLayout,
         new: vk::ImageLayout,
     ) -> vk::ImageMemoryBarrier<'static> {
-        vk::ImageMemoryBarrier::default()
-            .src_access_mask(src)
-            .dst_access_mask(dst)
-            .old_layout(old)
-            .new_layout(new)
-            .src_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
-            .dst_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
-            .image(self.image)
-            .subresource_range(
-                vk::ImageSubresourceRange::default()
-                    .aspect_mask(vk::ImageAspectFlags::COLOR)
-                    .level_count(1)
-                    .layer_count(1),
-            )
+        image_barrier(self.image, src, dst, old, new)
     }
+}
+
+/// A barrier on a whole one-level colour image, from layout `old` to `new`.
+fn image_barrier(
+    image: vk::Image,
+    src: vk::AccessFlags,
+    dst: vk::AccessFlags,
+    old: vk::ImageLayout,
+    new: vk::ImageLayout,
+) -> vk::ImageMemoryBarrier<'static> {
+    vk::ImageMemoryBarrier::default()
+        .src_access_mask(src)
+        .dst_access_mask(dst)
+        .old_layout(old)
+        .new_layout(new)
+        .src_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
+        .dst_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
+        .image(image)
+        .subresource_range(
+            vk::ImageSubresourceRange::default()
+                .aspect_mask(vk::ImageAspectFlags::COLOR)
+                .level_count(1)
+                .layer_count(1),
+        )
 }
 
 impl Drop for StorageImage {

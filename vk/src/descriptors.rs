@@ -78,7 +78,13 @@ impl Descriptors {
             .context("creating the descriptor set layout")?;
         explain::step("VkDescriptorSetLayout", || {
             all.iter()
-                .map(|(b, ty, _)| format!("binding {b}: {ty:?} x1, FRAGMENT stage\n"))
+                .map(|(b, ty, _)| format!("binding {b}: {ty:?} x1, {stage:?} stage\n"))
+                .chain(image.map(|_| {
+                    format!(
+                        "binding {}: STORAGE_IMAGE x1, {stage:?} stage\n",
+                        binding::IMAGE
+                    )
+                }))
                 .collect()
         });
 
@@ -127,7 +133,7 @@ impl Descriptors {
                 }]
             })
             .collect();
-        let mut writes: Vec<_> = all
+        let writes: Vec<_> = all
             .iter()
             .zip(&infos)
             .map(|(&(b, ty, _), info)| {
@@ -138,33 +144,40 @@ impl Descriptors {
                     .buffer_info(info)
             })
             .collect();
-        let image_info = image.map(|view| {
-            [vk::DescriptorImageInfo {
-                sampler: vk::Sampler::null(),
-                image_view: view,
-                image_layout: vk::ImageLayout::GENERAL,
-            }]
-        });
-        if let Some(info) = &image_info {
-            writes.push(
-                vk::WriteDescriptorSet::default()
-                    .dst_set(this.set)
-                    .dst_binding(binding::IMAGE)
-                    .descriptor_type(vk::DescriptorType::STORAGE_IMAGE)
-                    .image_info(info),
-            );
-        }
         unsafe { d.update_descriptor_sets(&writes, &[]) };
+        if let Some(view) = image {
+            this.write_image(view);
+        }
         explain::step(
             "VkDescriptorSet (allocated, then vkUpdateDescriptorSets)",
             || {
                 format!(
                     "{} writes: each binding points at its whole buffer",
-                    writes.len()
+                    writes.len() + usize::from(image.is_some())
                 )
             },
         );
         Ok(this)
+    }
+}
+
+impl Descriptors {
+    /// Points binding 5 at a storage image view (GENERAL layout). The window
+    /// calls it again when its storage image is made anew for a new size; the
+    /// set must not be in use by a pending command buffer then.
+    pub fn write_image(&self, view: vk::ImageView) {
+        let info = [vk::DescriptorImageInfo {
+            sampler: vk::Sampler::null(),
+            image_view: view,
+            image_layout: vk::ImageLayout::GENERAL,
+        }];
+        let write = vk::WriteDescriptorSet::default()
+            .dst_set(self.set)
+            .dst_binding(binding::IMAGE)
+            .descriptor_type(vk::DescriptorType::STORAGE_IMAGE)
+            .image_info(&info);
+        // SAFETY: the set and the view are alive; the callers wait for the GPU first.
+        unsafe { self.device.update_descriptor_sets(&[write], &[]) };
     }
 }
 

@@ -9,7 +9,9 @@
 //!   slot's command buffer; created signalled so the first wait passes;
 //! - an **image-available semaphore** (presentation → GPU): signalled when the
 //!   acquired swapchain image may be written; the submit waits on it at the
-//!   colour-output stage, so the tracer's fragment work can start before;
+//!   stage that first writes the image, so the tracing can start before: the
+//!   colour-output stage on the fragment path, the transfer stage (the blit)
+//!   on the compute path;
 //! - the swapchain's per-image **render-finished semaphore** (GPU → presentation).
 //!
 //! Command buffers are **re-recorded every frame**, not pre-recorded once per
@@ -19,7 +21,14 @@
 //! pre-recorded buffers anyway. Recording a dozen commands costs microseconds
 //! beside a traced frame, and it is what the OpenGL driver does for every frame
 //! too, so the two windowed loops do the same per-frame work.
+//!
+//! The two paths share everything here but the middle of the command buffer
+//! ([`Draw`]): the fragment path runs a render pass into the swapchain image's
+//! framebuffer; the compute path dispatches into its storage image and blits
+//! that into the swapchain image (compute.rs, `WindowCompute::record`), with
+//! the layout transitions a render pass would otherwise make.
 
+use crate::compute::WindowCompute;
 use crate::device::Device;
 use crate::scene::SceneResources;
 use crate::swapchain::Swapchain;
@@ -51,6 +60,42 @@ pub enum FrameResult {
     },
     /// The swapchain no longer matches the window: rebuild it, draw nothing.
     OutOfDate,
+}
+
+/// What a frame draws with: the path and its per-scene objects.
+#[derive(Clone, Copy)]
+pub enum Draw<'a> {
+    Fragment {
+        render_pass: vk::RenderPass,
+        scene: &'a SceneResources,
+    },
+    Compute(&'a WindowCompute),
+}
+
+impl Draw<'_> {
+    /// The `Frame` uniform buffer the tracer reads.
+    fn uniform(self) -> vk::Buffer {
+        match self {
+            Draw::Fragment { scene, .. } => scene.frame.buffer,
+            Draw::Compute(c) => c.frame.buffer,
+        }
+    }
+
+    /// The stage that reads the uniform buffer.
+    fn tracer_stage(self) -> vk::PipelineStageFlags {
+        match self {
+            Draw::Fragment { .. } => vk::PipelineStageFlags::FRAGMENT_SHADER,
+            Draw::Compute(_) => vk::PipelineStageFlags::COMPUTE_SHADER,
+        }
+    }
+
+    /// The stage that first touches the acquired image, where the submit waits for it.
+    fn image_wait_stage(self) -> vk::PipelineStageFlags {
+        match self {
+            Draw::Fragment { .. } => vk::PipelineStageFlags::COLOR_ATTACHMENT_OUTPUT,
+            Draw::Compute(_) => vk::PipelineStageFlags::TRANSFER,
+        }
+    }
 }
 
 pub struct Frames {
@@ -118,8 +163,7 @@ impl Frames {
         device: &Device,
         loader: &khr::swapchain::Device,
         swapchain: &Swapchain,
-        render_pass: vk::RenderPass,
-        scene: &SceneResources,
+        draw: Draw,
         frame: &GpuFrame,
     ) -> Result<FrameResult> {
         let d = &device.device;
@@ -149,10 +193,10 @@ impl Frames {
         // Reset only now: had the acquire failed, a reset fence would never be signalled.
         unsafe { d.reset_fences(&[slot.in_flight]) }.context("resetting a frame fence")?;
 
-        record(d, slot, swapchain, index, render_pass, scene, frame)?;
+        record(d, slot, swapchain, index, draw, frame)?;
 
         let waits = [slot.image_available];
-        let wait_stages = [vk::PipelineStageFlags::COLOR_ATTACHMENT_OUTPUT];
+        let wait_stages = [draw.image_wait_stage()];
         let cmds = [slot.cmd];
         let signals = [swapchain.render_finished[index as usize]];
         let submit = vk::SubmitInfo::default()
@@ -188,12 +232,10 @@ fn record(
     slot: &Slot,
     swapchain: &Swapchain,
     index: u32,
-    render_pass: vk::RenderPass,
-    scene: &SceneResources,
+    draw: Draw,
     frame: &GpuFrame,
 ) -> Result<()> {
     let cmd = slot.cmd;
-    let extent = swapchain.extent;
     unsafe { d.reset_command_buffer(cmd, vk::CommandBufferResetFlags::empty()) }
         .context("resetting a command buffer")?;
     let begin =
@@ -204,15 +246,64 @@ fn record(
         t.record(cmd, 0);
     }
     // One uniform buffer serves both frames in flight, so the write waits for
-    // the previous frame's fragment shaders to finish reading it (write after
-    // read: an execution dependency is enough), and the draw waits for the write.
+    // the previous frame's shaders to finish reading it (write after read: an
+    // execution dependency is enough; both stages, as the previous frame may
+    // have run the other path), and the tracer waits for the write.
+    let uniform = draw.uniform();
     let to_shader = vk::BufferMemoryBarrier::default()
         .src_access_mask(vk::AccessFlags::TRANSFER_WRITE)
         .dst_access_mask(vk::AccessFlags::UNIFORM_READ)
         .src_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
         .dst_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
-        .buffer(scene.frame.buffer)
+        .buffer(uniform)
         .size(vk::WHOLE_SIZE);
+    // SAFETY: every handle is alive; the command buffer is in the recording state.
+    unsafe {
+        let none = vk::DependencyFlags::empty();
+        d.cmd_pipeline_barrier(
+            cmd,
+            vk::PipelineStageFlags::FRAGMENT_SHADER | vk::PipelineStageFlags::COMPUTE_SHADER,
+            vk::PipelineStageFlags::TRANSFER,
+            none,
+            &[],
+            &[],
+            &[],
+        );
+        d.cmd_update_buffer(cmd, uniform, 0, bytemuck::bytes_of(frame));
+        d.cmd_pipeline_barrier(
+            cmd,
+            vk::PipelineStageFlags::TRANSFER,
+            draw.tracer_stage(),
+            none,
+            &[],
+            &[to_shader],
+            &[],
+        );
+    }
+    match draw {
+        Draw::Fragment { render_pass, scene } => {
+            record_render_pass(d, cmd, swapchain, index, render_pass, scene)
+        }
+        Draw::Compute(compute) => compute.record(d, cmd, swapchain.images[index as usize]),
+    }
+    if let Some(t) = &slot.timestamps {
+        t.record(cmd, 1);
+    }
+    unsafe { d.end_command_buffer(cmd) }.context("recording a frame")
+}
+
+/// The fragment path's part of the frame: the fullscreen triangle in the
+/// render pass, whose layout transitions and dependencies take the acquired
+/// image from UNDEFINED to PRESENT_SRC_KHR.
+fn record_render_pass(
+    d: &ash::Device,
+    cmd: vk::CommandBuffer,
+    swapchain: &Swapchain,
+    index: u32,
+    render_pass: vk::RenderPass,
+    scene: &SceneResources,
+) {
+    let extent = swapchain.extent;
     let begin_pass = vk::RenderPassBeginInfo::default()
         .render_pass(render_pass)
         .framebuffer(swapchain.framebuffers[index as usize])
@@ -234,26 +325,6 @@ fn record(
     };
     // SAFETY: every handle is alive; the command buffer is in the recording state.
     unsafe {
-        let none = vk::DependencyFlags::empty();
-        d.cmd_pipeline_barrier(
-            cmd,
-            vk::PipelineStageFlags::FRAGMENT_SHADER,
-            vk::PipelineStageFlags::TRANSFER,
-            none,
-            &[],
-            &[],
-            &[],
-        );
-        d.cmd_update_buffer(cmd, scene.frame.buffer, 0, bytemuck::bytes_of(frame));
-        d.cmd_pipeline_barrier(
-            cmd,
-            vk::PipelineStageFlags::TRANSFER,
-            vk::PipelineStageFlags::FRAGMENT_SHADER,
-            none,
-            &[],
-            &[to_shader],
-            &[],
-        );
         d.cmd_begin_render_pass(cmd, &begin_pass, vk::SubpassContents::INLINE);
         d.cmd_set_viewport(cmd, 0, &[viewport]);
         d.cmd_set_scissor(cmd, 0, &[scissor]);
@@ -273,10 +344,6 @@ fn record(
         d.cmd_draw(cmd, 3, 1, 0, 0);
         d.cmd_end_render_pass(cmd);
     }
-    if let Some(t) = &slot.timestamps {
-        t.record(cmd, 1);
-    }
-    unsafe { d.end_command_buffer(cmd) }.context("recording a frame")
 }
 
 impl Drop for Frames {

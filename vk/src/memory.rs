@@ -40,13 +40,27 @@ pub fn allocate(
     let info = vk::MemoryAllocateInfo::default()
         .allocation_size(needs.size)
         .memory_type_index(index as u32);
-    let memory = unsafe { device.device.allocate_memory(&info, None) }.with_context(|| {
-        format!(
-            "allocating {} KiB of memory for the {what}",
-            needs.size.div_ceil(1024)
-        )
-    })?;
+    let memory = unsafe { device.device.allocate_memory(&info, None) }
+        .map_err(|e| too_large(e, needs.size, what))?;
     Ok((memory, flags))
+}
+
+/// A failed creation or allocation of `bytes` for `what`. Every buffer and image
+/// size follows from --size or the scene, so a device that is out of memory for
+/// one was given a job too large for it: bad input (exit 2), said so.
+pub fn too_large(e: vk::Result, bytes: u64, what: &str) -> anyhow::Error {
+    match e {
+        vk::Result::ERROR_OUT_OF_DEVICE_MEMORY | vk::Result::ERROR_OUT_OF_HOST_MEMORY => {
+            twinray_common::error::bad_input(format!(
+                "this device cannot hold the {what} ({}, {e}): use a smaller --size or fewer primitives",
+                twinray_common::limits::gib(bytes)
+            ))
+        }
+        e => anyhow::Error::new(e).context(format!(
+            "creating or allocating the {what} ({} KiB)",
+            bytes.div_ceil(1024)
+        )),
+    }
 }
 
 /// A buffer and the memory behind it.
@@ -82,8 +96,8 @@ impl Buffer {
             .size(size)
             .usage(usage)
             .sharing_mode(vk::SharingMode::EXCLUSIVE);
-        b.buffer = unsafe { b.device.create_buffer(&info, None) }
-            .with_context(|| format!("creating the {what}"))?;
+        b.buffer =
+            unsafe { b.device.create_buffer(&info, None) }.map_err(|e| too_large(e, size, what))?;
         let needs = unsafe { b.device.get_buffer_memory_requirements(b.buffer) };
         let (memory, flags) = allocate(device, needs, wishes, what)?;
         b.memory = memory;

@@ -17,6 +17,11 @@
 //! - **image count**: one more than the minimum, so acquiring rarely waits for
 //!   the presentation engine to give an image back.
 //! - **extent**: the window's size; 0×0 (minimized) means no swapchain at all.
+//! - **usage**: COLOR_ATTACHMENT for the fragment path's render pass, and
+//!   TRANSFER_DST, where the surface allows it, for the compute path, which
+//!   blits its storage image into the acquired image (compute.rs). Both are
+//!   asked for up front, so a live switch between the paths needs no new
+//!   swapchain.
 //!
 //! When the window changes size the swapchain no longer fits and must be made
 //! again (with the old one passed as `oldSwapchain`), with new views and
@@ -106,11 +111,28 @@ pub fn choose_present_mode(
     Ok(chosen)
 }
 
+/// Whether the surface lets swapchain images be transfer destinations, which
+/// the compute path's blit needs (most drivers do; the spec does not promise it).
+pub fn accepts_transfer_writes(device: &Device, surface: &Surface) -> Result<bool> {
+    // SAFETY: live physical device and surface.
+    let caps = unsafe {
+        surface
+            .loader
+            .get_physical_device_surface_capabilities(device.physical, surface.surface)
+    }
+    .context("reading the surface's capabilities")?;
+    Ok(caps
+        .supported_usage_flags
+        .contains(vk::ImageUsageFlags::TRANSFER_DST))
+}
+
 pub struct Swapchain {
     device: ash::Device,
     loader: khr::swapchain::Device,
     pub swapchain: vk::SwapchainKHR,
     pub extent: vk::Extent2D,
+    /// Owned by the swapchain (destroyed with it); the compute path blits into them.
+    pub images: Vec<vk::Image>,
     views: Vec<vk::ImageView>,
     pub framebuffers: Vec<vk::Framebuffer>,
     /// Per image: signalled by the submit that drew into it, waited on by its present.
@@ -168,6 +190,8 @@ impl Swapchain {
         .into_iter()
         .find(|&a| caps.supported_composite_alpha.contains(a))
         .unwrap_or(vk::CompositeAlphaFlagsKHR::OPAQUE);
+        let usage = vk::ImageUsageFlags::COLOR_ATTACHMENT
+            | (caps.supported_usage_flags & vk::ImageUsageFlags::TRANSFER_DST);
         let info = vk::SwapchainCreateInfoKHR::default()
             .surface(surface.surface)
             .min_image_count(image_count)
@@ -175,7 +199,7 @@ impl Swapchain {
             .image_color_space(format.color_space)
             .image_extent(extent)
             .image_array_layers(1)
-            .image_usage(vk::ImageUsageFlags::COLOR_ATTACHMENT)
+            .image_usage(usage)
             // One queue draws and presents, so no sharing between families.
             .image_sharing_mode(vk::SharingMode::EXCLUSIVE)
             .pre_transform(caps.current_transform)
@@ -189,6 +213,7 @@ impl Swapchain {
             loader: loader.clone(),
             swapchain: vk::SwapchainKHR::null(),
             extent,
+            images: Vec::new(),
             views: Vec::new(),
             framebuffers: Vec::new(),
             render_finished: Vec::new(),
@@ -196,12 +221,13 @@ impl Swapchain {
         // SAFETY: valid create info; the old swapchain (if any) is retired by this call.
         this.swapchain =
             unsafe { loader.create_swapchain(&info, None) }.context("creating the swapchain")?;
-        let images = unsafe { loader.get_swapchain_images(this.swapchain) }
+        this.images = unsafe { loader.get_swapchain_images(this.swapchain) }
             .context("getting the swapchain images")?;
+        let images = this.images.clone();
         explain::step("VkSwapchainKHR", || {
             format!(
                 "{}x{} {:?}, {} images (asked {image_count}: min {} + 1), {present_mode:?}\n\
-                 usage COLOR_ATTACHMENT, EXCLUSIVE, transform {:?}, alpha {alpha:?}, clipped{}",
+                 usage {usage:?}, EXCLUSIVE, transform {:?}, alpha {alpha:?}, clipped{}",
                 extent.width,
                 extent.height,
                 format.format,

@@ -205,8 +205,8 @@ pub fn create_image_with_view(
         .tiling(vk::ImageTiling::OPTIMAL)
         .usage(usage)
         .initial_layout(vk::ImageLayout::UNDEFINED);
-    *image =
-        unsafe { d.create_image(&info, None) }.with_context(|| format!("creating the {what}"))?;
+    *image = unsafe { d.create_image(&info, None) }
+        .map_err(|e| memory::too_large(e, width as u64 * height as u64 * 16, what))?;
     let needs = unsafe { d.get_image_memory_requirements(*image) };
     *memory = memory::allocate(device, needs, &[Flags::DEVICE_LOCAL, Flags::empty()], what)?.0;
     unsafe { d.bind_image_memory(*image, *memory, 0) }

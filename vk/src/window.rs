@@ -4,14 +4,21 @@
 //! (`twinray_common::interactive`, which both apps use, so keys, title and
 //! camera behave identically).
 //!
+//! Either path draws in the window: the fragment path's render pass into the
+//! swapchain's framebuffers, or the compute path's dispatch into a storage
+//! image that each frame blits into the swapchain image (compute.rs,
+//! `WindowCompute`). `C` switches between them by rebuilding the per-scene
+//! bundle for the other path; device, swapchain and frames stay.
+//!
 //! `VkWindow` owns every object. Its fields are declared newest first, so Rust
 //! drops them in the reverse order of creation, which is the order Vulkan
-//! needs: frames, swapchain, scene, render pass, device, surface, instance,
+//! needs: frames, swapchain, the path's per-scene objects, render pass, device, surface, instance,
 //! and the window last of all (the surface refers to it).
 
 use crate::commands::Commands;
+use crate::compute::{self, Compute, WindowCompute};
 use crate::device::Device;
-use crate::frames::{FrameResult, Frames};
+use crate::frames::{Draw, FrameResult, Frames};
 use crate::instance::Instance;
 use crate::pipeline::{Pipeline, RenderPass};
 use crate::scene::SceneResources;
@@ -22,20 +29,29 @@ use anyhow::{Context, Result};
 use ash::{khr, vk};
 use std::time::Instant;
 use twinray_common::cli::RenderArgs;
+use twinray_common::error::no_device;
 use twinray_common::explain;
 use twinray_common::gpu::{GpuFrame, GpuScene};
 use twinray_common::image_io::FloatImage;
-use twinray_common::interactive::{self, Drawn, Renderer, WindowedRun};
-use twinray_common::shader::{self, Shaders};
+use twinray_common::interactive::{self, Drawn, PathShaders, Renderer, WindowedRun};
+use twinray_common::shader::Shaders;
 use winit::window::Window;
+
+/// The current path's per-scene objects, and the shaders they were built
+/// from (a capture builds its headless pipeline from them).
+enum PathResources {
+    Fragment(SceneResources, Shaders),
+    Compute(WindowCompute),
+}
 
 pub struct VkWindow {
     frames: Frames,
     /// `None` while the window has no area (minimized).
     swapchain: Option<Swapchain>,
-    scene: SceneResources,
+    drawing: PathResources,
     render_pass: RenderPass,
-    shaders: Shaders,
+    /// Why the compute path cannot show its image here, if it cannot.
+    compute_blocker: Option<String>,
     loader: khr::swapchain::Device,
     format: vk::SurfaceFormatKHR,
     present_mode: vk::PresentModeKHR,
@@ -52,10 +68,10 @@ pub struct VkWindow {
 pub fn run(args: &RenderArgs, started: Instant) -> Result<(WindowedRun, DeviceInfo)> {
     let scene = args.load_scene()?;
     let variant = interactive::variant_for(args, &scene);
-    let shaders = shader::build(&variant)?;
+    let shaders = interactive::first_shaders(args, &scene)?;
     explain::step(
         "Shaders: GLSL -> naga module -> SPIR-V (twinray-common)",
-        || format!("variant {}", variant.label()),
+        || format!("variant {}, {} path", variant.label(), args.path),
     );
 
     let event_loop = interactive::event_loop()?;
@@ -76,11 +92,15 @@ pub fn run(args: &RenderArgs, started: Instant) -> Result<(WindowedRun, DeviceIn
     let loader = khr::swapchain::Device::new(&instance.instance, &device.device);
     let format = swapchain::choose_format(&device, &surface)?;
     let present_mode = swapchain::choose_present_mode(&device, &surface, args.vsync)?;
+    let compute_blocker = compute::window_blocker(
+        &instance.instance,
+        &device,
+        swapchain::accepts_transfer_writes(&device, &surface)?,
+        format.format,
+    );
     let render_pass = RenderPass::for_swapchain(&device, format.format)?;
     let size = window.inner_size();
     let gpu = GpuScene::new(&scene, size.width.max(1), size.height.max(1));
-    let scene_resources =
-        SceneResources::new(&device, &gpu, &shaders, render_pass.render_pass, None)?;
     let size = (size.width, size.height);
     let chain = Swapchain::new(
         &device,
@@ -92,6 +112,22 @@ pub fn run(args: &RenderArgs, started: Instant) -> Result<(WindowedRun, DeviceIn
         size,
         None,
     )?;
+    let extent = chain.as_ref().map_or(
+        vk::Extent2D {
+            width: size.0.max(1),
+            height: size.1.max(1),
+        },
+        |c| c.extent,
+    );
+    let drawing = path_resources(
+        &device,
+        &gpu,
+        &shaders,
+        render_pass.render_pass,
+        format.format,
+        extent,
+        compute_blocker.as_deref(),
+    )?;
     let frames = Frames::new(&device)?;
     let info = DeviceInfo {
         name: device.name.clone(),
@@ -101,9 +137,9 @@ pub fn run(args: &RenderArgs, started: Instant) -> Result<(WindowedRun, DeviceIn
     let renderer = VkWindow {
         frames,
         swapchain: chain,
-        scene: scene_resources,
+        drawing,
         render_pass,
-        shaders,
+        compute_blocker,
         loader,
         format,
         present_mode,
@@ -115,7 +151,8 @@ pub fn run(args: &RenderArgs, started: Instant) -> Result<(WindowedRun, DeviceIn
         window,
     };
     explain::step("Frame loop starts", || {
-        "per frame: wait fence, acquire image, re-record, submit (wait image-available, signal render-finished), present".into()
+        "per frame: wait fence, acquire image, re-record (fragment: render pass; compute: dispatch + blit),\n\
+         submit (wait image-available, signal render-finished), present; C switches the path".into()
     });
     let run = interactive::run(
         "twinray-vk",
@@ -127,6 +164,32 @@ pub fn run(args: &RenderArgs, started: Instant) -> Result<(WindowedRun, DeviceIn
         started,
     )?;
     Ok((run, info))
+}
+
+/// The per-scene objects of the path `shaders` belongs to: the fragment
+/// path's pipeline for the swapchain's render pass, or the compute path's
+/// pipeline and a storage image of the swapchain's `extent`.
+fn path_resources(
+    device: &Device,
+    scene: &GpuScene,
+    shaders: &PathShaders,
+    render_pass: vk::RenderPass,
+    format: vk::Format,
+    extent: vk::Extent2D,
+    compute_blocker: Option<&str>,
+) -> Result<PathResources> {
+    Ok(match shaders {
+        PathShaders::Fragment(s) => PathResources::Fragment(
+            SceneResources::new(device, scene, s, render_pass, None)?,
+            s.clone(),
+        ),
+        PathShaders::Compute(s) => {
+            if let Some(why) = compute_blocker {
+                return Err(no_device(why));
+            }
+            PathResources::Compute(WindowCompute::new(device, scene, s, format, extent)?)
+        }
+    })
 }
 
 /// What the JSON report says about the device, kept after the device is gone.
@@ -182,10 +245,25 @@ impl Renderer for VkWindow {
         let Some(chain) = &self.swapchain else {
             return Ok(None);
         };
-        let rp = self.render_pass.render_pass;
+        let draw = match &mut self.drawing {
+            PathResources::Fragment(scene, _) => Draw::Fragment {
+                render_pass: self.render_pass.render_pass,
+                scene,
+            },
+            PathResources::Compute(compute) => {
+                // The blit copies texel for texel: the storage image follows the swapchain.
+                if compute.extent != chain.extent {
+                    // SAFETY: the old image may still be in use by a frame.
+                    unsafe { self.device.device.device_wait_idle() }
+                        .context("waiting for the GPU before resizing the storage image")?;
+                    compute.resize(&self.device, chain.extent)?;
+                }
+                Draw::Compute(compute)
+            }
+        };
         match self
             .frames
-            .draw(&self.device, &self.loader, chain, rp, &self.scene, frame)?
+            .draw(&self.device, &self.loader, chain, draw, frame)?
         {
             FrameResult::OutOfDate => {
                 self.stale = true;
@@ -198,25 +276,44 @@ impl Renderer for VkWindow {
         }
     }
 
-    fn load_scene(&mut self, scene: &GpuScene, shaders: &Shaders) -> Result<()> {
+    fn load_scene(&mut self, scene: &GpuScene, shaders: &PathShaders) -> Result<()> {
         // SAFETY: the old scene's buffers and pipeline may still be in use.
         unsafe { self.device.device.device_wait_idle() }
-            .context("waiting for the GPU before a scene switch")?;
-        let rp = self.render_pass.render_pass;
-        self.scene = SceneResources::new(&self.device, scene, shaders, rp, None)?;
-        self.shaders = shaders.clone();
+            .context("waiting for the GPU before a scene or path switch")?;
+        let extent = match (&self.swapchain, &self.drawing) {
+            (Some(c), _) => c.extent,
+            (None, PathResources::Compute(c)) => c.extent,
+            (None, PathResources::Fragment(..)) => vk::Extent2D {
+                width: self.size.0.max(1),
+                height: self.size.1.max(1),
+            },
+        };
+        self.drawing = path_resources(
+            &self.device,
+            scene,
+            shaders,
+            self.render_pass.render_pass,
+            self.format.format,
+            extent,
+            self.compute_blocker.as_deref(),
+        )?;
         Ok(())
     }
 
-    /// The headless path, at the window's size: RGBA32F target, pre-recorded
-    /// commands, readback. The uniform block is written first, so the picture
-    /// is the current view.
+    /// The headless path, at the window's size, with the current path: the
+    /// fragment path's RGBA32F target and render pass, or the compute path's
+    /// storage image and dispatch, each with its pre-recorded commands and
+    /// readback. The uniform block is written first, so the picture is the
+    /// current view.
     fn capture(&mut self, frame: &GpuFrame, width: u32, height: u32) -> Result<FloatImage> {
         let device = &self.device;
         unsafe { device.device.device_wait_idle() }
             .context("waiting for the GPU before a capture")?;
         device.check_size(width, height)?;
-        let uniform = self.scene.frame.buffer;
+        let uniform = match &self.drawing {
+            PathResources::Fragment(s, _) => s.frame.buffer,
+            PathResources::Compute(c) => c.frame.buffer,
+        };
         device.run_once("writing the frame uniform buffer", |cmd| unsafe {
             device
                 .device
@@ -231,19 +328,29 @@ impl Renderer for VkWindow {
             device.device.cmd_pipeline_barrier(
                 cmd,
                 vk::PipelineStageFlags::TRANSFER,
-                vk::PipelineStageFlags::FRAGMENT_SHADER,
+                vk::PipelineStageFlags::FRAGMENT_SHADER | vk::PipelineStageFlags::COMPUTE_SHADER,
                 vk::DependencyFlags::empty(),
                 &[],
                 &[barrier],
                 &[],
             );
         })?;
+        let (scene, shaders) = match &self.drawing {
+            PathResources::Fragment(scene, shaders) => (scene, shaders),
+            PathResources::Compute(c) => {
+                let compute =
+                    Compute::new(device, &c.frame, &c.storage, &c.shader, width, height, None)?;
+                compute.commands.submit()?;
+                compute.commands.wait(false)?;
+                return compute.read_back(device);
+            }
+        };
         let render_pass = RenderPass::offscreen(device)?;
-        let set_layout = self.scene.descriptors.set_layout;
+        let set_layout = scene.descriptors.set_layout;
         let pipeline = Pipeline::new(
             device,
             set_layout,
-            &self.shaders,
+            shaders,
             render_pass.render_pass,
             Some((width, height)),
         )?;
@@ -252,7 +359,7 @@ impl Renderer for VkWindow {
             device,
             render_pass.render_pass,
             &pipeline,
-            &self.scene.descriptors,
+            &scene.descriptors,
             &target,
             None,
         )?;
