@@ -3,8 +3,10 @@
 //! secondary-ray offset, the triangle and sphere tests), measures every image
 //! against the f64 truth (reference.rs `render_truth`, depth 16 for the depth
 //! sweep), marks the Pareto front, then runs the hard cases (scenes/hard/) per
-//! strategy. Writes report.md, accuracy.csv, hard_cases.csv, one SVG per scene
-//! and the images.
+//! strategy (with the local origin's before/after columns), and last compares
+//! both apps and the reference on seeded random scenes (`--random N`). Writes
+//! report.md, accuracy.csv, hard_cases.csv, random.csv, one SVG per scene and
+//! the images.
 
 use crate::apps::{run_json, Api};
 use crate::compare::api_name;
@@ -753,7 +755,9 @@ pub fn run(args: &AccuracyArgs) -> anyhow::Result<()> {
         started.elapsed().as_secs_f64(),
     );
     if !random_rows.is_empty() {
-        md.push_str(&random_markdown(&random_rows, random_size(args.quick)));
+        // Before the closing line that names the files.
+        let at = md.rfind("Every row is in").unwrap_or(md.len());
+        md.insert_str(at, &random_markdown(&random_rows, random_size(args.quick)));
     }
     std::fs::write(args.out.join("report.md"), md).context("writing report.md")?;
     eprintln!(
@@ -1271,7 +1275,7 @@ fn markdown(
     }
     let _ = writeln!(
         s,
-        "Every row is in `accuracy.csv` and `hard_cases.csv`; the images are in `images/`."
+        "Every row is in `accuracy.csv` and `hard_cases.csv` (the random scenes' in `random.csv`); the images are in `images/`."
     );
     s
 }
