@@ -37,7 +37,7 @@ struct Candidate {
     physical: vk::PhysicalDevice,
     properties: vk::PhysicalDeviceProperties,
     name: String,
-    /// The first queue family that can draw (and present, for a window), with
+    /// The first queue family that can draw and dispatch (and present, for a window), with
     /// its timestampValidBits and flags.
     graphics_family: Option<(u32, u32, vk::QueueFlags)>,
 }
@@ -61,9 +61,11 @@ impl Device {
                 let families =
                     unsafe { vk_instance.get_physical_device_queue_family_properties(physical) };
                 let presents = |i: u32| surface.is_none_or(|s| s.supports(physical, i));
+                // Both paths run on this one queue: the fragment path draws, the compute path dispatches.
+                let abilities = vk::QueueFlags::GRAPHICS | vk::QueueFlags::COMPUTE;
                 let graphics_family = (0u32..)
                     .zip(&families)
-                    .find(|&(i, f)| f.queue_flags.contains(vk::QueueFlags::GRAPHICS) && presents(i))
+                    .find(|&(i, f)| f.queue_flags.contains(abilities) && presents(i))
                     .filter(|_| surface.is_none() || has_swapchain(vk_instance, physical))
                     .map(|(i, f)| (i, f.timestamp_valid_bits, f.queue_flags));
                 let name = properties
