@@ -59,8 +59,8 @@ fn relative(path: &Path) -> String {
 
 fn parse(path: &Path) -> (String, syn::File) {
     let text = std::fs::read_to_string(path).unwrap();
-    let file = syn::parse_file(&text)
-        .unwrap_or_else(|e| panic!("{} does not parse: {e}", relative(path)));
+    let file =
+        syn::parse_file(&text).unwrap_or_else(|e| panic!("{} does not parse: {e}", relative(path)));
     (text, file)
 }
 
@@ -589,7 +589,10 @@ fn the_function_measure_counts_lines_and_sees_the_marker() {
     let ast = syn::parse_file(text).unwrap();
     assert_eq!(
         functions(text, &ast),
-        [("A::a".to_string(), 4, 3, true), ("b".to_string(), 9, 1, false)]
+        [
+            ("A::a".to_string(), 4, 3, true),
+            ("b".to_string(), 9, 1, false)
+        ]
     );
 }
 
