@@ -1,4 +1,4 @@
-//! The options both apps accept (DESIGN.md's command-line contract), parsed by
+//! The options both apps accept (docs/architecture.md, the command-line contract), parsed by
 //! one clap struct so that `twinray-vk` and `twinray-gl` can never drift apart.
 
 use crate::error::bad_input;

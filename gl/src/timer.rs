@@ -18,7 +18,7 @@ impl<'gl> Timer<'gl> {
         let query = unsafe { gl.create_query() }.map_err(|e| anyhow!(e).context("glGenQueries"))?;
         // llvmpipe's TIME_ELAPSED does not bracket the work its rasteriser
         // threads do (Mesa 22.3: 1097 s for a first 97 ms frame, then 2-8 ms
-        // for 55-60 ms frames), so DESIGN.md reports wall time there. The
+        // for 55-60 ms frames), so wall time stands in there (docs/architecture.md). The
         // query still runs, so that the loop is the same on every driver;
         // only its result is dropped.
         let reliable = !renderer.contains("llvmpipe");

@@ -1,7 +1,10 @@
-//! docs/vulkan-walkthrough.md stays true to the code: every file it names
-//! exists, every `path::function` it names is still defined there, every
-//! picture it shows exists, and its lines-of-code table is the one this test
-//! counts (`TWINRAY_UPDATE_DOCS=1` rewrites the table instead of failing).
+//! The docs stay true to the code. In every README and document: every file
+//! named exists (in the repository, or as a name the code writes), every
+//! `path::function` is still defined there, every relative link resolves. In
+//! docs/vulkan-walkthrough.md also: its object diagram and its side-by-side
+//! tables name types and calls the two apps really use, every picture exists,
+//! and its lines-of-code table is the one this test counts
+//! (`TWINRAY_UPDATE_DOCS=1` rewrites the table instead of failing).
 
 use std::path::{Path, PathBuf};
 
@@ -16,7 +19,7 @@ fn doc_path() -> PathBuf {
     root().join("docs/vulkan-walkthrough.md")
 }
 
-/// Backticked spans of the document, e.g. `vk/src/device.rs::Device::new`.
+/// Backticked spans of a Markdown text, e.g. `vk/src/device.rs::Device::new`.
 fn code_spans(doc: &str) -> Vec<String> {
     // Only inline spans outside ``` blocks.
     let mut spans = Vec::new();
@@ -35,64 +38,358 @@ fn code_spans(doc: &str) -> Vec<String> {
     spans
 }
 
-/// A span that names a repository file: a relative path with a known extension,
-/// optionally followed by `::Type::function` or `::function`.
+/// Every README and document of the project.
+fn documents() -> Vec<PathBuf> {
+    let mut docs: Vec<PathBuf> = ["README.md", "CONTRIBUTING.md"]
+        .iter()
+        .map(|d| root().join(d))
+        .collect();
+    for dir in [
+        "common",
+        "vk",
+        "gl",
+        "comparison",
+        "tests",
+        "scenes",
+        "shaders",
+    ] {
+        docs.push(root().join(dir).join("README.md"));
+    }
+    if let Ok(entries) = std::fs::read_dir(root().join("docs")) {
+        docs.extend(
+            entries
+                .map(|e| e.unwrap().path())
+                .filter(|p| p.extension().is_some_and(|e| e == "md")),
+        );
+    }
+    docs.retain(|d| d.is_file());
+    docs.sort();
+    docs
+}
+
+/// Every file of the repository (not the build output), relative to the root.
+fn repository_files() -> Vec<String> {
+    fn walk(dir: &Path, out: &mut Vec<PathBuf>) {
+        for entry in std::fs::read_dir(dir).unwrap() {
+            let path = entry.unwrap().path();
+            let name = path.file_name().unwrap().to_string_lossy();
+            if (name.starts_with('.') && name != ".ci") || name == "target" {
+                continue;
+            }
+            if path.is_dir() {
+                walk(&path, out);
+            } else {
+                out.push(path);
+            }
+        }
+    }
+    let mut files = Vec::new();
+    walk(&root(), &mut files);
+    files
+        .iter()
+        .map(|f| f.strip_prefix(root()).unwrap().display().to_string())
+        .collect()
+}
+
+/// A span that names a file: a path without spaces or placeholders whose last
+/// part has an extension, optionally followed by `::Type::function` or `::function`.
 fn file_reference(span: &str) -> Option<(String, Vec<String>)> {
     let (path, rest) = match span.split_once("::") {
         Some((p, r)) => (p, r.split("::").map(str::to_string).collect()),
         None => (span, Vec::new()),
     };
-    let known = [".rs", ".md", ".glsl", ".frag", ".vert", ".sh", ".toml"];
-    (path.contains('/') && !path.contains(' ') && known.iter().any(|e| path.ends_with(e)))
+    let known = [
+        "rs", "md", "glsl", "frag", "vert", "comp", "sh", "toml", "obj", "bpt", "png", "svg",
+        "csv", "json", "lock",
+    ];
+    let placeholder = |c: char| " *<>{}$|=".contains(c);
+    let (_, extension) = path.rsplit_once('.')?;
+    (!path.contains(placeholder) && !path.starts_with('-') && known.contains(&extension))
         .then(|| (path.to_string(), rest))
 }
 
+/// Where a referenced path lies: relative to the root, to the document's
+/// folder, or (a bare file name) anywhere in the repository.
+fn locate(path: &str, doc: &Path, files: &[String]) -> Option<PathBuf> {
+    let candidates = [root().join(path), doc.parent().unwrap().join(path)];
+    if let Some(found) = candidates.into_iter().find(|p| p.is_file()) {
+        return Some(found);
+    }
+    if path.contains('/') {
+        return None;
+    }
+    files
+        .iter()
+        .find(|f| f.rsplit('/').next() == Some(path))
+        .map(|f| root().join(f))
+}
+
+/// File names the apps write (`report.md`, `statistics.json`, ...) are no
+/// repository files; the code holds them as string literals.
+fn written_by_the_code(name: &str, sources: &str) -> bool {
+    let bare = name.rsplit('/').next().unwrap();
+    sources.contains(&format!("\"{bare}\"")) || sources.contains(&format!("\"{bare}"))
+}
+
+fn rust_sources(dir: &Path, text: &mut String) {
+    let Ok(entries) = std::fs::read_dir(dir) else {
+        return;
+    };
+    for entry in entries {
+        let path = entry.unwrap().path();
+        if path.is_dir() {
+            rust_sources(&path, text);
+        } else if path.extension().is_some_and(|e| e == "rs") {
+            *text += &std::fs::read_to_string(&path).unwrap();
+        }
+    }
+}
+
+/// The Rust source under `dirs` (relative to the root), all files together.
+fn sources(dirs: &[&str]) -> String {
+    let mut text = String::new();
+    for dir in dirs {
+        rust_sources(&root().join(dir), &mut text);
+    }
+    text
+}
+
+fn defines_function(text: &str, name: &str) -> bool {
+    [format!("fn {name}("), format!("fn {name}<")]
+        .iter()
+        .any(|pat| text.contains(pat.as_str()))
+}
+
+fn defines_type(text: &str, owner: &str) -> bool {
+    [
+        format!("struct {owner}"),
+        format!("impl {owner}"),
+        format!("for {owner}"),
+        format!("enum {owner}"),
+    ]
+    .iter()
+    .any(|p| text.contains(p.as_str()))
+}
+
 #[test]
-fn every_file_and_function_the_walkthrough_names_exists() {
-    let doc = std::fs::read_to_string(doc_path()).expect("docs/vulkan-walkthrough.md");
-    let mut checked = 0;
+fn every_file_and_function_the_docs_name_exists() {
+    let files = repository_files();
+    let code = sources(&["common", "vk", "gl", "comparison", "tests"]);
     let mut missing = Vec::new();
-    for span in code_spans(&doc) {
-        let Some((path, items)) = file_reference(&span) else {
-            continue;
-        };
-        let file = root().join(&path);
-        let Ok(text) = std::fs::read_to_string(&file) else {
-            missing.push(format!("`{span}`: file {path} does not exist"));
-            continue;
-        };
-        checked += 1;
-        if let Some((function, owners)) = items.split_last() {
-            let defines = |name: &str| {
-                [format!("fn {name}("), format!("fn {name}<")]
-                    .iter()
-                    .any(|pat| text.contains(pat.as_str()))
+    let mut walkthrough_references = 0;
+    for doc in documents() {
+        let text = std::fs::read_to_string(&doc).unwrap();
+        let shown = doc.strip_prefix(root()).unwrap().display().to_string();
+        for span in code_spans(&text) {
+            let Some((path, items)) = file_reference(&span) else {
+                continue;
             };
-            if !defines(function) {
-                missing.push(format!("`{span}`: no fn {function} in {path}"));
+            let Some(file) = locate(&path, &doc, &files) else {
+                if items.is_empty() && written_by_the_code(&path, &code) {
+                    continue;
+                }
+                missing.push(format!(
+                    "{shown}: `{span}`: no file {path} in the repository"
+                ));
+                continue;
+            };
+            if doc == doc_path() {
+                walkthrough_references += 1;
             }
-            for owner in owners {
-                let owned = [
-                    format!("struct {owner}"),
-                    format!("impl {owner}"),
-                    format!("for {owner}"),
-                    format!("enum {owner}"),
-                ];
-                if !owned.iter().any(|p| text.contains(p.as_str())) {
-                    missing.push(format!("`{span}`: no type {owner} in {path}"));
+            let Some((function, owners)) = items.split_last() else {
+                continue;
+            };
+            let text = std::fs::read_to_string(&file).unwrap_or_default();
+            if !defines_function(&text, function) {
+                missing.push(format!("{shown}: `{span}`: no fn {function} in {path}"));
+            }
+            for owner in owners.iter().filter(|o| !defines_type(&text, o)) {
+                missing.push(format!("{shown}: `{span}`: no type {owner} in {path}"));
+            }
+        }
+        // Relative links: [text](path#anchor).
+        for part in text.split("](").skip(1) {
+            let target = part.split(')').next().unwrap();
+            let target = target.split('#').next().unwrap();
+            if target.is_empty() || target.contains("://") || target.starts_with("mailto:") {
+                continue;
+            }
+            if !doc.parent().unwrap().join(target).exists() {
+                missing.push(format!("{shown}: links to {target}, which does not exist"));
+            }
+        }
+    }
+    assert!(
+        missing.is_empty(),
+        "the docs name things that are gone:\n{}",
+        missing.join("\n")
+    );
+    assert!(
+        walkthrough_references >= 40,
+        "only {walkthrough_references} references found in the walkthrough: is the parser still reading it?"
+    );
+}
+
+#[test]
+fn a_file_name_is_recognised_with_or_without_a_folder() {
+    let r = |s: &str| file_reference(s).map(|(p, items)| (p, items.len()));
+    assert_eq!(r("app.rs"), Some(("app.rs".into(), 0)));
+    assert_eq!(
+        r("vk/src/device.rs::Device::new"),
+        Some(("vk/src/device.rs".into(), 2))
+    );
+    assert_eq!(r("FINDINGS.md"), Some(("FINDINGS.md".into(), 0)));
+    assert_eq!(r("--out FILE.png"), None);
+    assert_eq!(r("twinray-vk-<scene>-<n>.png"), None);
+    assert_eq!(r("*.spv"), None);
+    assert_eq!(r("vk::QueueFlags"), None);
+}
+
+/// Identifiers directly followed by `(`: the functions a snippet calls.
+fn called(snippet: &str) -> Vec<String> {
+    let mut names = Vec::new();
+    let mut current = String::new();
+    for c in snippet.chars() {
+        if c.is_alphanumeric() || c == '_' {
+            current.push(c);
+            continue;
+        }
+        let function = current.starts_with(|f: char| f.is_lowercase() || f == '_');
+        if c == '(' && function {
+            names.push(current.clone());
+        }
+        current.clear();
+    }
+    names
+}
+
+fn calls_in(source: &str, name: &str) -> bool {
+    source.contains(&format!("{name}("))
+}
+
+/// The object diagram's Vulkan half names ash types and calls of vk/src, its
+/// OpenGL half glow types and calls of gl/src.
+#[test]
+fn the_object_diagram_names_what_the_code_uses() {
+    let doc = std::fs::read_to_string(doc_path()).unwrap();
+    let start = doc.find("```mermaid\n").expect("a mermaid diagram");
+    let diagram = &doc[start + 3..];
+    let diagram = &diagram[..diagram.find("```").unwrap()];
+    let (vk_src, gl_src) = (sources(&["vk/src"]), sources(&["gl/src"]));
+    let mut side = "";
+    let mut missing = Vec::new();
+    let mut checked = 0;
+    for line in diagram.lines().map(str::trim) {
+        if line.starts_with("subgraph vulkan") {
+            side = "vk";
+            continue;
+        }
+        if line.starts_with("subgraph opengl") {
+            side = "gl";
+            continue;
+        }
+        if line == "end" {
+            side = "";
+            continue;
+        }
+        let source = match side {
+            "vk" => &vk_src,
+            "gl" => &gl_src,
+            _ => continue,
+        };
+        // Type names: ash::X, vk::X, glow::X, as the code writes them.
+        for prefix in ["ash::", "vk::", "glow::"] {
+            for part in line.split(prefix).skip(1) {
+                let name: String = part
+                    .chars()
+                    .take_while(|c| c.is_alphanumeric() || *c == '_')
+                    .collect();
+                let written = format!("{prefix}{name}");
+                let used = source.match_indices(&written).any(|(i, _)| {
+                    !source[i + written.len()..]
+                        .starts_with(|c: char| c.is_alphanumeric() || c == '_')
+                });
+                checked += 1;
+                if !used {
+                    missing.push(format!("{written} is not used in {side}/src"));
+                }
+            }
+        }
+        // Calls: the snake_case word after <br/> in a node, or on an edge.
+        let words = line
+            .split("<br/>")
+            .skip(1)
+            .chain(line.split("-- ").skip(1))
+            .filter_map(|w| {
+                let w: String = w
+                    .chars()
+                    .take_while(|c| c.is_alphanumeric() || *c == '_')
+                    .collect();
+                w.contains('_').then_some(w)
+            });
+        for call in words {
+            checked += 1;
+            if !calls_in(source, &call) {
+                missing.push(format!("{call}(…) is not called in {side}/src"));
+            }
+        }
+    }
+    assert!(
+        missing.is_empty(),
+        "the object diagram names what the code no longer uses:\n{}",
+        missing.join("\n")
+    );
+    assert!(checked >= 50, "only {checked} names read from the diagram");
+}
+
+/// The per-step "Vulkan (ash) | OpenGL (glow)" tables quote calls the two apps
+/// really make.
+#[test]
+fn the_side_by_side_calls_are_in_the_code() {
+    let doc = std::fs::read_to_string(doc_path()).unwrap();
+    let (vk_src, gl_src) = (sources(&["vk/src"]), sources(&["gl/src"]));
+    let mut in_table = false;
+    let mut missing = Vec::new();
+    let (mut tables, mut checked) = (0, 0);
+    for line in doc.lines() {
+        if line.starts_with("| Vulkan (ash) | OpenGL (") {
+            in_table = true;
+            tables += 1;
+            continue;
+        }
+        if !line.starts_with('|') {
+            in_table = false;
+            continue;
+        }
+        if !in_table || line.starts_with("|---") {
+            continue;
+        }
+        // Split on cell borders, not on `\|` inside a closure's code span.
+        let cells: Vec<String> = line
+            .replace("\\|", "¦")
+            .trim()
+            .trim_matches('|')
+            .split('|')
+            .map(str::to_string)
+            .collect();
+        for (cell, (side, source)) in cells.iter().zip([("vk", &vk_src), ("gl", &gl_src)]) {
+            for span in code_spans(cell) {
+                for call in called(&span) {
+                    checked += 1;
+                    if !calls_in(source, &call) {
+                        missing.push(format!("`{span}`: {call} is not called in {side}/src"));
+                    }
                 }
             }
         }
     }
     assert!(
         missing.is_empty(),
-        "the walkthrough names things that are gone:\n{}",
+        "the side-by-side tables quote calls the code does not make:\n{}",
         missing.join("\n")
     );
-    assert!(
-        checked >= 40,
-        "only {checked} references found: is the parser still reading the document?"
-    );
+    assert!(tables >= 15, "only {tables} side-by-side tables found");
+    assert!(checked >= 60, "only {checked} calls read from the tables");
 }
 
 #[test]
