@@ -154,10 +154,17 @@ fn sources(dirs: &[&str]) -> String {
     text
 }
 
-fn defines_function(text: &str, name: &str) -> bool {
-    [format!("fn {name}("), format!("fn {name}<")]
-        .iter()
-        .any(|pat| text.contains(pat.as_str()))
+/// `path::name` names a function, or a type, module or constant of that file.
+fn defines_item(text: &str, name: &str) -> bool {
+    let function = [format!("fn {name}("), format!("fn {name}<")];
+    let other = ["struct", "enum", "trait", "mod", "const", "static", "type"]
+        .map(|kind| format!("{kind} {name}"));
+    let item = |pat: &String| {
+        text.match_indices(pat.as_str()).any(|(i, _)| {
+            !text[i + pat.len()..].starts_with(|c: char| c.is_alphanumeric() || c == '_')
+        })
+    };
+    function.iter().any(|pat| text.contains(pat.as_str())) || other.iter().any(item)
 }
 
 fn defines_type(text: &str, owner: &str) -> bool {
@@ -200,8 +207,8 @@ fn every_file_and_function_the_docs_name_exists() {
                 continue;
             };
             let text = std::fs::read_to_string(&file).unwrap_or_default();
-            if !defines_function(&text, function) {
-                missing.push(format!("{shown}: `{span}`: no fn {function} in {path}"));
+            if !defines_item(&text, function) {
+                missing.push(format!("{shown}: `{span}`: no {function} in {path}"));
             }
             for owner in owners.iter().filter(|o| !defines_type(&text, o)) {
                 missing.push(format!("{shown}: `{span}`: no type {owner} in {path}"));
