@@ -1,6 +1,9 @@
 //! Every kind of bad input gets one sentence naming what is wrong and the exit
 //! code of the contract (2 bad input, 3 no usable driver) — from both apps, and
 //! never a panic.
+//!
+//! Long file: one table of every malformed input, kept in one place so that a
+//! reader sees at a glance which inputs are covered and a new case has one home.
 
 use std::path::Path;
 use twinray_tests::{bin, fail, scratch, App};

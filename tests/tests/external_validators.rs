@@ -127,6 +127,8 @@ fn define_args(defines: &std::collections::BTreeMap<String, String>) -> Vec<Stri
     defines.iter().map(|(k, v)| format!("-D{k}={v}")).collect()
 }
 
+// Long function: it lists every job (variant × stage × output × tool) in one
+// pass, then runs them and checks the counts; the list is its one data structure.
 #[test]
 fn glslang_and_spirv_val_accept_every_variant() {
     for tool in ["glslangValidator", "spirv-val"] {

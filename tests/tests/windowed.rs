@@ -7,6 +7,10 @@
 //! (the title says which path runs), a resize storm with scene and path
 //! switches, every screenshot equal to the headless image of its path, all
 //! under the validation layer's synchronisation validation too.
+//!
+//! Long file: the fragment and compute scenarios share this file's helpers
+//! (reports without messages, screenshots against headless, xdotool retries);
+//! splitting it means moving those into tests/src first.
 
 use std::path::Path;
 use std::process::Output;
