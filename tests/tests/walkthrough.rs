@@ -493,3 +493,42 @@ fn the_lines_of_code_table_matches_the_code() {
         "the walkthrough's lines-of-code table is out of date; run\n  TWINRAY_UPDATE_DOCS=1 cargo test --release -p twinray-tests --test walkthrough\nexpected:\n{expected}"
     );
 }
+
+/// `vk/src/lib.rs` lists the modules in reading order, vk/README.md's table
+/// gives the same order, and the walkthrough's steps meet the files (each
+/// step's first `**Where.**` file) in that order too.
+#[test]
+fn one_reading_order_in_lib_rs_the_vk_readme_and_the_walkthrough() {
+    let read = |p: &str| std::fs::read_to_string(root().join(p)).unwrap();
+    let lib: Vec<String> = read("vk/src/lib.rs")
+        .lines()
+        .filter_map(|l| l.strip_prefix("pub mod ")?.strip_suffix(';'))
+        .map(str::to_string)
+        .collect();
+    let readme: Vec<String> = read("vk/README.md")
+        .lines()
+        .filter_map(|l| l.split("| `src/").nth(1)?.split_once(".rs`"))
+        .map(|(m, _)| m.to_string())
+        .collect();
+    assert_eq!(readme, lib, "vk/README.md's reading order is not lib.rs's");
+    let mut met: Vec<String> = Vec::new();
+    for line in read("docs/vulkan-walkthrough.md").lines() {
+        let Some(rest) = line.strip_prefix("**Where.** `vk/src/") else {
+            continue;
+        };
+        let module = rest.split(".rs").next().unwrap().to_string();
+        if !met.contains(&module) {
+            met.push(module);
+        }
+    }
+    let positions: Vec<Option<usize>> = met
+        .iter()
+        .map(|m| lib.iter().position(|l| l == m))
+        .collect();
+    assert!(
+        met.len() >= 10
+            && positions.iter().all(Option::is_some)
+            && positions.windows(2).all(|w| w[0] < w[1]),
+        "the walkthrough meets vk/src's files as {met:?}, not in lib.rs's order {lib:?}"
+    );
+}
