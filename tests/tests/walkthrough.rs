@@ -274,8 +274,8 @@ fn calls_in(source: &str, name: &str) -> bool {
     source.contains(&format!("{name}("))
 }
 
-/// The object diagram's Vulkan half names ash types and calls of vk/src, its
-/// OpenGL half glow types and calls of gl/src.
+/// The object diagram's Vulkan half names ash types and calls of vk/src, each
+/// type linked to its reference page; its OpenGL half glow types and calls of gl/src.
 #[test]
 fn the_object_diagram_names_what_the_code_uses() {
     let doc = std::fs::read_to_string(doc_path()).unwrap();
@@ -319,6 +319,11 @@ fn the_object_diagram_names_what_the_code_uses() {
                 checked += 1;
                 if !used {
                     missing.push(format!("{written} is not used in {side}/src"));
+                }
+                // Every Vulkan object links to its reference page somewhere on the page.
+                let page = format!("/man/html/Vk{name}.html");
+                if side == "vk" && name != "Entry" && !doc.contains(&page) {
+                    missing.push(format!("no link to the reference page of Vk{name}"));
                 }
             }
         }
