@@ -348,7 +348,7 @@ fn the_object_diagram_names_what_the_code_uses() {
     }
     assert!(
         missing.is_empty(),
-        "the object diagram names what the code no longer uses:\n{}",
+        "the object diagram is out of step with the code or its links:\n{}",
         missing.join("\n")
     );
     assert!(checked >= 50, "only {checked} names read from the diagram");
