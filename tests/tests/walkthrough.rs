@@ -537,3 +537,55 @@ fn one_reading_order_in_lib_rs_the_vk_readme_and_the_walkthrough() {
         "the walkthrough meets vk/src's files as {met:?}, not in lib.rs's order {lib:?}"
     );
 }
+
+/// docs/architecture.md's map of `common` names every module of it: a file
+/// `common/src/a/b.rs` as `b` (a folder's `mod.rs` as the folder's name).
+#[test]
+fn the_module_map_names_every_module_of_common() {
+    let doc = std::fs::read_to_string(root().join("docs/architecture.md")).unwrap();
+    let start = doc
+        .find("## The modules of `common`")
+        .expect("docs/architecture.md has a section on the modules of `common`");
+    let section = &doc[start..];
+    let section = &section[..section[3..].find("\n## ").map_or(section.len(), |e| e + 3)];
+    let mut files = Vec::new();
+    let mut stack = vec![root().join("common/src")];
+    while let Some(dir) = stack.pop() {
+        for entry in std::fs::read_dir(&dir).unwrap() {
+            let path = entry.unwrap().path();
+            if path.is_dir() && !path.ends_with("bin") {
+                stack.push(path);
+            } else if path.extension().is_some_and(|e| e == "rs") {
+                files.push(path);
+            }
+        }
+    }
+    let mut missing = Vec::new();
+    for file in &files {
+        let stem = file.file_stem().unwrap().to_string_lossy();
+        let name = match stem.as_ref() {
+            "lib" => continue,
+            "mod" => file
+                .parent()
+                .unwrap()
+                .file_name()
+                .unwrap()
+                .to_string_lossy(),
+            _ => stem,
+        };
+        let named = [
+            format!("`{name}`"),
+            format!("`{name}/`"),
+            format!("::{name}`"),
+        ];
+        if !named.iter().any(|n| section.contains(n.as_str())) {
+            missing.push(file.strip_prefix(root()).unwrap().display().to_string());
+        }
+    }
+    assert!(files.len() > 10, "only {} files in common/src", files.len());
+    assert!(
+        missing.is_empty(),
+        "docs/architecture.md's map of `common` does not name {}",
+        missing.join(", ")
+    );
+}
