@@ -99,6 +99,18 @@ pub enum Experiment {
     /// Read the primitive and light counts from the Frame uniform instead of
     /// baking them into the shader (what made lavapipe grow per frame).
     UniformCounts,
+    /// Forbid the driver to fuse or reassociate float arithmetic: a
+    /// `NoContraction` decoration on every float operation of the SPIR-V and
+    /// `precise` on every float local of the GLSL.
+    NoContraction,
+    /// SPIR-V only: ask for IEEE behaviour the driver may otherwise relax
+    /// (SPV_KHR_float_controls: denormals preserved, signed zero, Inf and NaN
+    /// preserved), to see whether Vulkan's defaults explain its pixels.
+    FloatControls,
+    /// The SPIR-V (what Vulkan runs) from Khronos' reference compiler,
+    /// glslangValidator (on PATH; Debian's glslang-tools), given the same
+    /// GLSL and defines, instead of from naga.
+    Glslang,
 }
 
 impl Experiment {
@@ -112,6 +124,9 @@ impl Experiment {
             Experiment::StacklessBvh => "stackless-bvh",
             Experiment::UnpairedBvhStack => "unpaired-bvh-stack",
             Experiment::StorageCounts => "storage-counts",
+            Experiment::NoContraction => "no-contraction",
+            Experiment::FloatControls => "float-controls",
+            Experiment::Glslang => "glslang",
         }
     }
 }

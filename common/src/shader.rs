@@ -324,8 +324,13 @@ pub fn build(variant: &Variant) -> anyhow::Result<Shaders> {
     let (fm, fi) = parse(&fragment_source(), ShaderStage::Fragment, variant)?;
     Ok(Shaders {
         variant: variant.clone(),
-        vertex_spirv: to_spirv(&vm, &vi, ShaderStage::Vertex, variant)?,
-        fragment_spirv: to_spirv(&fm, &fi, ShaderStage::Fragment, variant)?,
+        vertex_spirv: spirv_for_vulkan(FULLSCREEN_VERT, (&vm, &vi), ShaderStage::Vertex, variant)?,
+        fragment_spirv: spirv_for_vulkan(
+            &fragment_source(),
+            (&fm, &fi),
+            ShaderStage::Fragment,
+            variant,
+        )?,
         vertex_glsl: to_glsl(&vm, &vi, ShaderStage::Vertex, variant)?,
         fragment_glsl: to_glsl(&fm, &fi, ShaderStage::Fragment, variant)?,
     })
@@ -354,7 +359,7 @@ pub fn build_compute(variant: &Variant, workgroup: Workgroup) -> anyhow::Result<
     Ok(ComputeShader {
         variant: v.clone(),
         workgroup,
-        spirv: to_spirv(&m, &i, ShaderStage::Compute, &v)?,
+        spirv: spirv_for_vulkan(&compute_source(), (&m, &i), ShaderStage::Compute, &v)?,
         glsl: to_glsl(&m, &i, ShaderStage::Compute, &v)?,
     })
 }
@@ -469,11 +474,215 @@ pub fn to_glsl(
     writer
         .write()
         .with_context(|| format!("writing {stage:?} GLSL"))?;
-    Ok(if variant.experiments.contains(&Experiment::NagaZeroInit) {
+    let out = if variant.experiments.contains(&Experiment::NagaZeroInit) {
         out
     } else {
         strip_local_array_zero_init_glsl(&out)
-    })
+    };
+    Ok(
+        if variant.experiments.contains(&Experiment::NoContraction) {
+            precise_float_locals_glsl(&out)
+        } else {
+            out
+        },
+    )
+}
+
+/// The SPIR-V that Vulkan runs: naga's, or with `--experiment glslang` Khronos'
+/// glslangValidator's from the same source and defines; with `--experiment
+/// no-contraction`, decorated so that the driver may not fuse float arithmetic.
+fn spirv_for_vulkan(
+    source: &str,
+    (module, info): (&Module, &ModuleInfo),
+    stage: ShaderStage,
+    variant: &Variant,
+) -> anyhow::Result<Vec<u32>> {
+    let words = if variant.experiments.contains(&Experiment::Glslang) {
+        glslang_spirv(source, stage, variant)?
+    } else {
+        to_spirv(module, info, stage, variant)?
+    };
+    let words = if variant.experiments.contains(&Experiment::NoContraction) {
+        no_contraction_spirv(&words)
+    } else {
+        words
+    };
+    Ok(
+        if variant.experiments.contains(&Experiment::FloatControls) {
+            float_controls_spirv(&words)
+        } else {
+            words
+        },
+    )
+}
+
+/// `--experiment float-controls`: declares SPV_KHR_float_controls' strict
+/// modes for 32-bit floats on every entry point (denormals preserved; signed
+/// zero, Inf and NaN preserved), which forbid the driver's fast-math
+/// shortcuts that assume none of them occur. Vulkan 1.2 accepts them where
+/// the device's float-controls properties say so.
+pub fn float_controls_spirv(words: &[u32]) -> Vec<u32> {
+    const OP_EXTENSION: u32 = 10;
+    const OP_EXT_INST_IMPORT: u32 = 11;
+    const OP_MEMORY_MODEL: u32 = 14;
+    const OP_ENTRY_POINT: u32 = 15;
+    const OP_EXECUTION_MODE: u32 = 16;
+    const OP_CAPABILITY: u32 = 17;
+    const CAPABILITY_DENORM_PRESERVE: u32 = 4464;
+    const CAPABILITY_SIGNED_ZERO_INF_NAN_PRESERVE: u32 = 4466;
+    const MODE_DENORM_PRESERVE: u32 = 4459;
+    const MODE_SIGNED_ZERO_INF_NAN_PRESERVE: u32 = 4461;
+    let instructions: Vec<&[u32]> = spirv_instructions(words).collect();
+    let entry_points: Vec<u32> = instructions
+        .iter()
+        .filter(|inst| inst[0] & 0xffff == OP_ENTRY_POINT && inst.len() >= 3)
+        .map(|inst| inst[2])
+        .collect();
+    let mut name = b"SPV_KHR_float_controls".to_vec();
+    name.resize((name.len() / 4 + 1) * 4, 0);
+    let mut extension = vec![((1 + name.len() as u32 / 4) << 16) | OP_EXTENSION];
+    extension.extend(
+        name.chunks_exact(4)
+            .map(|b| u32::from_le_bytes([b[0], b[1], b[2], b[3]])),
+    );
+    // The module's layout fixes the places: capabilities first, then
+    // extensions, imports, the memory model, entry points, execution modes.
+    let mut out = words[..5.min(words.len())].to_vec();
+    let (mut capabilities_done, mut modes_done) = (false, false);
+    for inst in instructions {
+        let op = inst[0] & 0xffff;
+        if !capabilities_done && op != OP_CAPABILITY {
+            for c in [
+                CAPABILITY_DENORM_PRESERVE,
+                CAPABILITY_SIGNED_ZERO_INF_NAN_PRESERVE,
+            ] {
+                out.extend_from_slice(&[(2 << 16) | OP_CAPABILITY, c]);
+            }
+            out.extend_from_slice(&extension);
+            capabilities_done = true;
+        }
+        let before_modes = [
+            OP_CAPABILITY,
+            OP_EXTENSION,
+            OP_EXT_INST_IMPORT,
+            OP_MEMORY_MODEL,
+            OP_ENTRY_POINT,
+        ];
+        if !modes_done && !before_modes.contains(&op) {
+            for &e in &entry_points {
+                for m in [MODE_DENORM_PRESERVE, MODE_SIGNED_ZERO_INF_NAN_PRESERVE] {
+                    out.extend_from_slice(&[(4 << 16) | OP_EXECUTION_MODE, e, m, 32]);
+                }
+            }
+            modes_done = true;
+        }
+        out.extend_from_slice(inst);
+    }
+    out
+}
+
+/// `--experiment glslang`: compiles `source` with glslangValidator, to measure
+/// naga's SPIR-V against the reference compiler's for the very same GLSL. naga
+/// stays the product's compiler; this is a measurement, run where the tool is
+/// installed.
+fn glslang_spirv(source: &str, stage: ShaderStage, variant: &Variant) -> anyhow::Result<Vec<u32>> {
+    let extension = match stage {
+        ShaderStage::Vertex => "vert",
+        ShaderStage::Fragment => "frag",
+        _ => "comp",
+    };
+    let dir = std::env::temp_dir().join(format!("twinray-glslang-{}", std::process::id()));
+    std::fs::create_dir_all(&dir)
+        .with_context(|| format!("--experiment glslang: creating {}", dir.display()))?;
+    let input = dir.join(format!("trace.{extension}"));
+    let output = dir.join(format!("trace-{extension}.spv"));
+    std::fs::write(&input, source)
+        .with_context(|| format!("--experiment glslang: writing {}", input.display()))?;
+    let mut command = std::process::Command::new("glslangValidator");
+    command.args(["-V", "--target-env", "vulkan1.1"]);
+    command.args(variant.defines.iter().map(|(k, v)| format!("-D{k}={v}")));
+    command.arg("-o").arg(&output).arg(&input);
+    let result = command.output().map_err(|e| {
+        anyhow!("--experiment glslang needs glslangValidator on PATH (Debian: glslang-tools): {e}")
+    })?;
+    if !result.status.success() {
+        anyhow::bail!(
+            "--experiment glslang: glslangValidator rejected the {stage:?} shader:\n{}",
+            String::from_utf8_lossy(&result.stdout)
+        );
+    }
+    let bytes = std::fs::read(&output)
+        .with_context(|| format!("--experiment glslang: reading {}", output.display()))?;
+    let _ = std::fs::remove_dir_all(&dir);
+    if bytes.len() % 4 != 0 {
+        anyhow::bail!("--experiment glslang: {} is not SPIR-V", output.display());
+    }
+    Ok(bytes
+        .chunks_exact(4)
+        .map(|b| u32::from_le_bytes([b[0], b[1], b[2], b[3]]))
+        .collect())
+}
+
+// `--experiment no-contraction`. SPIR-V and GLSL both let a driver contract
+// `a * b + c` into one fused multiply-add (one rounding instead of two) unless
+// told not to; the two APIs' compilers need not contract the same expressions,
+// which is one way the same shader can give different pixels. These passes
+// forbid it everywhere, to measure how much of the Vulkan/OpenGL image
+// difference it explains and what it costs.
+
+/// Adds a `NoContraction` decoration to the result of every float arithmetic
+/// instruction.
+pub fn no_contraction_spirv(words: &[u32]) -> Vec<u32> {
+    const OP_DECORATE: u32 = 71;
+    const DECORATION_NO_CONTRACTION: u32 = 42;
+    // OpFNegate, OpFAdd, OpFSub, OpFMul, OpFDiv, OpFRem, OpFMod,
+    // OpVectorTimesScalar .. OpDot: all have (type, result, operands...).
+    const FLOAT_ARITHMETIC: [u32; 14] = [
+        127, 129, 131, 133, 136, 140, 141, 142, 143, 144, 145, 146, 147, 148,
+    ];
+    // Instructions that may precede the annotations; the decorations go
+    // right after the last of them (annotations come before any type).
+    const PREAMBLE: [u32; 19] = [
+        2, 3, 4, 5, 6, 7, 10, 11, 14, 15, 16, 17, 71, 72, 73, 74, 75, 330, 331,
+    ];
+    let instructions: Vec<&[u32]> = spirv_instructions(words).collect();
+    let decorations: Vec<u32> = instructions
+        .iter()
+        .filter(|inst| FLOAT_ARITHMETIC.contains(&(inst[0] & 0xffff)) && inst.len() >= 3)
+        .flat_map(|inst| [(3 << 16) | OP_DECORATE, inst[2], DECORATION_NO_CONTRACTION])
+        .collect();
+    let mut out = words[..5.min(words.len())].to_vec();
+    let mut inserted = false;
+    for inst in instructions {
+        if !inserted && !PREAMBLE.contains(&(inst[0] & 0xffff)) {
+            out.extend_from_slice(&decorations);
+            inserted = true;
+        }
+        out.extend_from_slice(inst);
+    }
+    out
+}
+
+/// Marks every initialised float local `precise`, GLSL's way to forbid
+/// contraction of the operations that compute it.
+pub fn precise_float_locals_glsl(glsl: &str) -> String {
+    let mut out = String::with_capacity(glsl.len() + glsl.len() / 8);
+    for line in glsl.lines() {
+        let body = line.trim_start();
+        let indent = &line[..line.len() - body.len()];
+        let ty = body.split(' ').next().unwrap_or("");
+        let float_type = matches!(ty, "float" | "vec2" | "vec3" | "vec4")
+            || (ty.starts_with("mat") && ty[3..].chars().all(|c| c.is_ascii_digit() || c == 'x'));
+        if !indent.is_empty() && float_type && body.contains(" = ") {
+            out.push_str(indent);
+            out.push_str("precise ");
+            out.push_str(body);
+        } else {
+            out.push_str(line);
+        }
+        out.push('\n');
+    }
+    out
 }
 
 // naga zero-initialises every function-local variable it writes, in both back

@@ -109,6 +109,9 @@ fn variants() -> Vec<(String, Variant)> {
         ],
         vec![NoLoopBounding, UnpairedBvhStack, StorageCounts],
         vec![StacklessBvh],
+        vec![NoContraction],
+        vec![Glslang],
+        vec![FloatControls],
     ] {
         let label = experiments
             .iter()
