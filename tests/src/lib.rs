@@ -97,7 +97,7 @@ pub fn render(
     let stdout = String::from_utf8_lossy(&o.stdout);
     let report: RunReport = serde_json::from_str(stdout.trim())
         .unwrap_or_else(|e| panic!("{app:?}: stdout is not one JSON report ({e}): {stdout}"));
-    let img = twinray_common::image_io::load_png(out).unwrap();
+    let img = twinray_common::reference::image_io::load_png(out).unwrap();
     (report, img)
 }
 

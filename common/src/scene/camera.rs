@@ -5,7 +5,7 @@
 //! origin: the point subtracted in f64 from every position before the GPU's f32
 //! conversion, so that a scene far from the world origin is traced as if near it.
 
-use crate::scene::{Camera, Scene};
+use crate::scene::{Camera, OriginMode, Scene};
 use glam::DVec3;
 use std::borrow::Cow;
 
@@ -63,39 +63,6 @@ impl RayFrame {
     /// Unit direction through the centre of pixel (x, y).
     pub fn dir(&self, x: f64, y: f64) -> DVec3 {
         (self.top_left + x * self.step_x + y * self.step_y).normalize()
-    }
-}
-
-/// Where the GPU's coordinates are measured from (`--set origin=`, `[render] origin`).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default, serde::Serialize)]
-pub enum OriginMode {
-    /// The camera's look-at point, snapped to a power-of-two grid (`local_origin`).
-    #[default]
-    Local,
-    /// The world origin: every coordinate converted to f32 as written (the
-    /// behaviour before local origins, kept to measure what they gain).
-    World,
-}
-
-impl OriginMode {
-    pub const ALL: [OriginMode; 2] = [OriginMode::Local, OriginMode::World];
-
-    pub fn name(self) -> &'static str {
-        match self {
-            OriginMode::Local => "local",
-            OriginMode::World => "world",
-        }
-    }
-
-    /// Parses `local` or `world`; `what` names the source in the error.
-    pub fn parse(value: &str, what: &str) -> anyhow::Result<OriginMode> {
-        let v = value.trim().to_ascii_lowercase();
-        OriginMode::ALL
-            .into_iter()
-            .find(|m| m.name() == v)
-            .ok_or_else(|| {
-                crate::error::bad_input(format!("{what}: '{value}' is not one of local, world"))
-            })
     }
 }
 
@@ -363,15 +330,15 @@ mod tests {
 
     #[test]
     fn near_scenes_keep_a_zero_origin_and_far_ones_trace_near_zero() {
-        use crate::gpu::GpuScene;
-        for (name, _) in crate::scene::BUILTIN_SCENES {
+        use crate::gpu::upload::GpuScene;
+        for (name, _) in crate::scene::load::BUILTIN_SCENES {
             let s = Scene::load(name, &[]).unwrap();
             assert_eq!(local_origin(&s), DVec3::ZERO, "{name}");
             assert!(matches!(in_local_frame(&s), Cow::Borrowed(_)), "{name}");
         }
-        let dir = std::path::Path::new(crate::hard::SOURCE_DIR);
+        let dir = std::path::Path::new(crate::scene::hard::SOURCE_DIR);
         let mut moved = Vec::new();
-        for case in crate::hard::list(dir).unwrap() {
+        for case in crate::scene::hard::list(dir).unwrap() {
             let s = Scene::load(case.path.to_str().unwrap(), &[]).unwrap();
             let o = local_origin(&s);
             if o == DVec3::ZERO {
@@ -421,7 +388,7 @@ mod tests {
         let mut orbit = Orbit::new(&s.camera);
         orbit.drag(40.0, 25.0, 100);
         orbit.zoom(-5.0);
-        let frame = crate::gpu::GpuFrame::new(&s, &orbit.camera(), 8, 8);
+        let frame = crate::gpu::layout::GpuFrame::new(&s, &orbit.camera(), 8, 8);
         let expect = (orbit.camera().eye - o).as_vec3().to_array();
         assert_eq!(frame.eye, expect);
         // The origin comes from the scene's own camera, never the orbit's: a

@@ -26,7 +26,7 @@ pub const MAX_OFF_SHARE: f64 = 0.002;
 pub const MIN_WITHIN_1: f64 = 0.993;
 
 /// Why two renders of a random scene disagree beyond the thresholds, or `None`.
-pub fn disagreement(m: &crate::metrics::Metrics) -> Option<String> {
+pub fn disagreement(m: &crate::reference::metrics::Metrics) -> Option<String> {
     let mut why = Vec::new();
     if m.above_8 > MAX_OFF_SHARE {
         why.push(format!(
