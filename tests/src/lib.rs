@@ -16,7 +16,7 @@ pub fn bin_dir() -> PathBuf {
     for name in ["twinray-vk", "twinray-gl", "twinray"] {
         assert!(
             dir.join(name).exists(),
-            "{name} is not built in {}: run `cargo build --workspace` with the same profile first (tests/run.sh does)",
+            "{name} is not built in {}: run `cargo build --workspace --features twinray-vk/test-hooks,twinray-gl/test-hooks` with the same profile first (tests/run.sh does)",
             dir.display()
         );
     }

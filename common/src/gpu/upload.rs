@@ -190,3 +190,79 @@ pub fn check_storage_limit(gpu: &GpuScene, limit: u64, limit_name: &str) -> anyh
     }
     Ok(())
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::scene::camera::{local_origin, Orbit, LOCAL_ORIGIN_GRID_VIEWS};
+    use crate::scene::OriginMode;
+    use glam::DVec3;
+    use std::borrow::Cow;
+
+    #[test]
+    fn near_scenes_keep_a_zero_origin_and_far_ones_trace_near_zero() {
+        for (name, _) in crate::scene::load::BUILTIN_SCENES {
+            let s = Scene::load(name, &[]).unwrap();
+            assert_eq!(local_origin(&s), DVec3::ZERO, "{name}");
+            assert!(matches!(in_local_frame(&s), Cow::Borrowed(_)), "{name}");
+        }
+        let dir = std::path::Path::new(crate::scene::hard::SOURCE_DIR);
+        let mut moved = Vec::new();
+        for case in crate::scene::hard::list(dir).unwrap() {
+            let s = Scene::load(case.path.to_str().unwrap(), &[]).unwrap();
+            let o = local_origin(&s);
+            if o == DVec3::ZERO {
+                continue;
+            }
+            moved.push(case.name.clone());
+            // On the grid: a power of two times a whole number per axis.
+            let view = (s.camera.eye - s.camera.look_at).length();
+            let grid = (LOCAL_ORIGIN_GRID_VIEWS * view).log2().ceil().exp2();
+            assert_eq!(o / grid, (o / grid).round(), "{}", case.name);
+            // What the GPU holds lies within a few view distances of zero, and
+            // `origin=world` gives the world coordinates back.
+            let g = GpuScene::new(&s, 8, 8);
+            let far = g
+                .spheres
+                .iter()
+                .map(|x| x.center)
+                .chain(g.triangles.iter().map(|t| t.p0))
+                .chain(std::iter::once(g.frame.eye))
+                .flat_map(|v| v.map(f32::abs))
+                .fold(0.0f32, f32::max);
+            assert!(far < 40.0 * view as f32, "{}: {far}", case.name);
+            let mut world = s.clone();
+            world.origin = OriginMode::World;
+            assert_eq!(local_origin(&world), DVec3::ZERO);
+            assert_eq!(
+                GpuScene::new(&world, 8, 8).frame.eye,
+                s.camera.eye.as_vec3().to_array()
+            );
+        }
+        moved.sort();
+        assert_eq!(
+            moved,
+            ["closed-mesh", "far-1e4", "far-1e5", "far-1e6", "far-1e7"],
+            "the cases README.md names as moved"
+        );
+    }
+
+    #[test]
+    fn the_orbit_never_moves_the_origin() {
+        let s = Scene::load(
+            concat!(env!("CARGO_MANIFEST_DIR"), "/../scenes/hard/far-1e6.toml"),
+            &[],
+        )
+        .unwrap();
+        let o = local_origin(&s);
+        let mut orbit = Orbit::new(&s.camera);
+        orbit.drag(40.0, 25.0, 100);
+        orbit.zoom(-5.0);
+        let frame = GpuFrame::new(&s, &orbit.camera(), 8, 8);
+        let expect = (orbit.camera().eye - o).as_vec3().to_array();
+        assert_eq!(frame.eye, expect);
+        // The origin comes from the scene's own camera, never the orbit's: a
+        // zoom changes the view distance and so the grid, which would move it.
+        assert_eq!(local_origin(&s), o);
+    }
+}

@@ -66,7 +66,7 @@ fn enter_box(min: [f32; 3], max: [f32; 3], o: DVec3, d: DVec3, t_max: f64) -> Op
         // A relative margin on the distances themselves, for the same reason.
         t0 = t0.max(near - 1e-9 * near.abs());
         t1 = t1.min(far + 1e-9 * far.abs());
-        if !(t0 <= t1) {
+        if t0.is_nan() || t1.is_nan() || t0 > t1 {
             return None;
         }
     }
@@ -128,7 +128,7 @@ fn hit_sphere(
             let b = 2.0 * f.dot(d);
             let c = f.dot(f) - r2;
             let disc = b * b - 4.0 * a * c;
-            if !(disc >= 0.0) {
+            if disc.is_nan() || disc < 0.0 {
                 return None;
             }
             let sq = disc.sqrt();
@@ -138,7 +138,7 @@ fn hit_sphere(
             let b = f.dot(d);
             let l = f - b * d;
             let disc = r2 - l.dot(l);
-            if !(disc >= 0.0) {
+            if disc.is_nan() || disc < 0.0 {
                 return None;
             }
             let c = f.dot(f) - r2;
@@ -243,7 +243,7 @@ fn hit_triangle(
             let inv = 1.0 / det;
             let tv = r.o - tri.p[0];
             let u = tv.dot(pv) * inv;
-            if !(u >= 0.0 && u <= 1.0) {
+            if !(0.0..=1.0).contains(&u) {
                 return None;
             }
             let qv = tv.cross(e1);

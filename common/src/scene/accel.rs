@@ -272,7 +272,7 @@ fn sah_split(refs: &[PrimRef], bounds: &Aabb, centroids: &Aabb) -> Option<(usize
     let mut best: Option<(f64, usize, Plane)> = None; // cost, left count, plane
     for axis in 0..3 {
         let (cmin, cmax) = (centroids.min[axis], centroids.max[axis]);
-        if !(cmax > cmin) {
+        if cmax.is_nan() || cmin.is_nan() || cmax <= cmin {
             continue;
         }
         let scale = BINS as f64 / (cmax - cmin);

@@ -116,10 +116,7 @@ pub(super) fn load_bpt(
         .map_err(|e| bad_input(format!("{at}.bpt '{file}' is not a valid patch file: {e}")))?;
     // Counted before tessellating: a large patch count times a fine
     // tessellation must be refused, not allocated.
-    let n = patches
-        .len()
-        .checked_mul(nu as usize * nv as usize * 2)
-        .unwrap_or(usize::MAX);
+    let n = patches.len().saturating_mul(nu as usize * nv as usize * 2);
     limits::check_count(
         &format!(
             "{at}: triangles of '{file}' ({} patches at {t_at} = {nu}x{nv}) with those before it",

@@ -248,6 +248,7 @@ pub fn to_glsl(
 mod tests {
     use super::*;
     use crate::scene::Scene;
+    use crate::shader::post::spirv_for_opengl;
 
     #[test]
     fn spec_constant_table_matches_the_shader() {
@@ -307,5 +308,36 @@ mod tests {
             );
             assert!(c.glsl.contains("imageStore"));
         }
+    }
+
+    #[test]
+    fn spirv_for_opengl_drops_sets_and_flips_origin_only() {
+        let s = build(&Variant::generic(Default::default())).unwrap();
+        let gl = spirv_for_opengl(&s.fragment_spirv);
+        let count = |w: &[u32], op: u32, arg2: u32| {
+            let mut i = 5;
+            let mut n = 0;
+            while i < w.len() {
+                let c = (w[i] >> 16) as usize;
+                if w[i] & 0xffff == op && c >= 3 && w[i + 2] == arg2 {
+                    n += 1;
+                }
+                i += c;
+            }
+            n
+        };
+        assert_eq!(
+            count(&s.fragment_spirv, 71, 34),
+            5,
+            "five resources in set 0"
+        );
+        assert_eq!(count(&gl, 71, 34), 0);
+        assert_eq!(count(&s.fragment_spirv, 16, 7), 1);
+        assert_eq!(count(&gl, 16, 8), 1);
+        assert_eq!(
+            gl.len(),
+            s.fragment_spirv.len() - 5 * 4,
+            "only the five 4-word decorations go"
+        );
     }
 }
