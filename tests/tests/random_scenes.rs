@@ -1,4 +1,4 @@
-//! Differential test on seeded random scenes (common/src/random_scene.rs:
+//! Differential test on seeded random scenes (common/src/scene/random.rs:
 //! spheres, triangles, a mesh, diffuse, mirror and glass with glass inside
 //! glass, 1–4 lights, random cameras): Vulkan, OpenGL and the f64 reference
 //! render each scene with the same numerics, and every pair must agree within
