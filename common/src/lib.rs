@@ -1,19 +1,21 @@
 //! twinray-common: everything both apps share so that they differ only where
-//! Vulkan and OpenGL differ. Its map, lowest layer first (a module imports only
-//! from the layers above it in this list, never from one below):
+//! Vulkan and OpenGL differ. Its map, lowest layer first: a file imports only
+//! from its own row or the rows above it, never from a row below, and no two
+//! files import each other.
 //!
 //! | module | owns |
 //! |---|---|
 //! | `error`, `explain`, `stats` | exit codes and clear errors; `--explain`'s log; frame statistics |
 //! | `gpu::layout` | the `#[repr(C)]` mirror of every shader struct, binding numbers, the flattened BVH |
 //! | `limits` | one limit per user-controlled quantity |
-//! | `scene/` | the scene model; loading (`load`, `format`, `overrides`, `resolve`, `check`, `mesh`, `teapot`); `camera`, `numerics`, `accel` (`--accel`, the BVH builder); `random` and `hard` scenes |
+//! | `reference::image_io`, `reference::metrics` | float images and PNG files; how far one image is from another |
+//! | `scene/` | the scene model; loading (`load`, `format`, `overrides`, `resolve`, `check`, `mesh`, `teapot`); `camera`, `numerics`, `accel` (`--accel` and the BVH builder); the `random` and `hard` scenes |
 //! | `gpu::upload` | a scene as the bytes both apps upload |
-//! | `reference/` | the f64 CPU tracer (`intersect` beside it), `image_io` (float images, PNG files), `metrics` (image differences) |
+//! | `reference/` | the f64 CPU tracer (`mod.rs`: shading and the ray loop; `intersect`: hits and the BVH walk) |
 //! | `cli` | the options both apps take (one clap struct) |
-//! | `shader/` | `variant` (the one decider of a run's shader variant), `build` (naga to SPIR-V and GLSL), `post` (passes over naga's output) |
+//! | `shader/` | `variant` (the one place a run's shader variant is decided), `build` (naga to SPIR-V and GLSL), `post` (passes over naga's output) |
 //! | `report` | the `--json` run report |
-//! | `window/` | the windowed event loop both apps share (cargo feature `window`, which only the apps enable) |
+//! | `window/` | the windowed event loop both apps share; cargo feature `window` (only the apps enable it, so the comparison and the tests build without winit), and `test-hooks` for the end-to-end tests' hooks |
 
 pub mod cli;
 pub mod error;
