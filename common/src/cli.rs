@@ -2,6 +2,7 @@
 //! one clap struct so that `twinray-vk` and `twinray-gl` can never drift apart.
 
 use crate::error::bad_input;
+use crate::scene::accel::Accel;
 use clap::Parser;
 use std::path::PathBuf;
 
@@ -127,23 +128,6 @@ impl Experiment {
             Experiment::NoContraction => "no-contraction",
             Experiment::FloatControls => "float-controls",
             Experiment::Glslang => "glslang",
-        }
-    }
-}
-
-#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
-pub enum Accel {
-    Auto,
-    None,
-    Bvh,
-}
-
-impl Accel {
-    pub fn name(self) -> &'static str {
-        match self {
-            Accel::Auto => "auto",
-            Accel::None => "none",
-            Accel::Bvh => "bvh",
         }
     }
 }
@@ -343,7 +327,7 @@ impl RenderArgs {
     /// Checks every output path (`--out`) before any work: a typo must not cost a render.
     pub fn check_outputs(&self) -> anyhow::Result<()> {
         if let Some(out) = &self.out {
-            crate::image_io::check_output_file("--out", out)?;
+            crate::reference::image_io::check_output_file("--out", out)?;
         }
         Ok(())
     }
