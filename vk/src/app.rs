@@ -158,13 +158,7 @@ fn render_fragment(
 ) -> Result<Rendered> {
     let (width, height) = (args.size.width, args.size.height);
     if let Some(dir) = &args.dump_shaders {
-        dump_shaders(
-            dir,
-            &[
-                ("vertex", &shaders.vertex_spirv, &shaders.vertex_glsl),
-                ("fragment", &shaders.fragment_spirv, &shaders.fragment_glsl),
-            ],
-        )?;
+        dump_shaders(dir, &shaders.stages())?;
     }
     let render_pass = RenderPass::offscreen(device)?;
     let rp = render_pass.render_pass;

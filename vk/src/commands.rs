@@ -204,6 +204,16 @@ pub fn buffer_barrier(
         .size(vk::WHOLE_SIZE)
 }
 
+/// All of a colour image with one mip level and one layer: every image twinray
+/// makes (targets, storage images, swapchain images) and every view of one.
+pub const COLOR_IMAGE: vk::ImageSubresourceRange = vk::ImageSubresourceRange {
+    aspect_mask: vk::ImageAspectFlags::COLOR,
+    base_mip_level: 0,
+    level_count: 1,
+    base_array_layer: 0,
+    layer_count: 1,
+};
+
 /// A barrier on a whole one-level colour image, from layout `old` to `new`.
 pub fn image_barrier(
     image: vk::Image,
@@ -220,12 +230,7 @@ pub fn image_barrier(
         .src_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
         .dst_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
         .image(image)
-        .subresource_range(
-            vk::ImageSubresourceRange::default()
-                .aspect_mask(vk::ImageAspectFlags::COLOR)
-                .level_count(1)
-                .layer_count(1),
-        )
+        .subresource_range(COLOR_IMAGE)
 }
 
 /// Records one vkCmdPipelineBarrier from the `src` stages to the `dst` stages.

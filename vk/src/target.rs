@@ -224,12 +224,7 @@ pub fn create_image_with_view(
         .image(*image)
         .view_type(vk::ImageViewType::TYPE_2D)
         .format(format)
-        .subresource_range(
-            vk::ImageSubresourceRange::default()
-                .aspect_mask(vk::ImageAspectFlags::COLOR)
-                .level_count(1)
-                .layer_count(1),
-        );
+        .subresource_range(crate::commands::COLOR_IMAGE);
     // SAFETY: the image is bound to its memory and has the format, one level and one layer the view
     // describes.
     *view = unsafe { d.create_image_view(&info, None) }
