@@ -105,16 +105,27 @@ fn render(
         idle_wait,
         process_start,
     };
+    let run = HeadlessRun {
+        args,
+        device: &device,
+        gpu_scene: &gpu_scene,
+        frame_loop,
+    };
     let rendered = match args.path {
-        RenderPath::Fragment => render_fragment(args, &device, &gpu_scene, &shaders, &frame_loop)?,
-        RenderPath::Compute => {
-            let shader = shader::build_compute(variant, workgroup)?;
-            render_compute(args, &device, &gpu_scene, &shader, &frame_loop)?
-        }
+        RenderPath::Fragment => render_fragment(&run, &shaders)?,
+        RenderPath::Compute => render_compute(&run, &shader::build_compute(variant, workgroup)?)?,
     };
     let label = variant_label(variant, host_memory, idle_wait);
     report(args, scene, &device, label, workgroup, rendered)
     // Every Vulkan object is dropped here, newest first: ..., device, instance.
+}
+
+/// What both paths render from.
+struct HeadlessRun<'a> {
+    args: &'a RenderArgs,
+    device: &'a Device,
+    gpu_scene: &'a GpuScene,
+    frame_loop: FrameLoop<'a>,
 }
 
 /// The frames and the setup time `frame_loop` measured, and the last frame.
@@ -149,13 +160,13 @@ fn idle_wait() -> Result<bool> {
 /// The fragment path: render pass, scene buffers, descriptor set and pipeline,
 /// the colour target, the recorded commands, the frames, the readback. Its
 /// objects drop at the end, newest first, before the device.
-fn render_fragment(
-    args: &RenderArgs,
-    device: &Device,
-    gpu_scene: &GpuScene,
-    shaders: &Shaders,
-    frame_loop: &FrameLoop,
-) -> Result<Rendered> {
+fn render_fragment(run: &HeadlessRun, shaders: &Shaders) -> Result<Rendered> {
+    let HeadlessRun {
+        args,
+        device,
+        gpu_scene,
+        frame_loop,
+    } = run;
     let (width, height) = (args.size.width, args.size.height);
     if let Some(dir) = &args.dump_shaders {
         dump_shaders(dir, &shaders.stages())?;
@@ -178,13 +189,13 @@ fn render_fragment(
 
 /// The same tracer as a compute shader: compute.rs owns its pipeline and
 /// storage image.
-fn render_compute(
-    args: &RenderArgs,
-    device: &Device,
-    gpu_scene: &GpuScene,
-    shader: &ComputeShader,
-    frame_loop: &FrameLoop,
-) -> Result<Rendered> {
+fn render_compute(run: &HeadlessRun, shader: &ComputeShader) -> Result<Rendered> {
+    let HeadlessRun {
+        args,
+        device,
+        gpu_scene,
+        frame_loop,
+    } = run;
     let (width, height) = (args.size.width, args.size.height);
     if let Some(dir) = &args.dump_shaders {
         dump_shaders(dir, &[("compute", &shader.spirv, &shader.glsl)])?;

@@ -222,15 +222,17 @@ pub fn image_barrier(
     old: vk::ImageLayout,
     new: vk::ImageLayout,
 ) -> vk::ImageMemoryBarrier<'static> {
-    vk::ImageMemoryBarrier::default()
-        .src_access_mask(src)
-        .dst_access_mask(dst)
-        .old_layout(old)
-        .new_layout(new)
-        .src_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
-        .dst_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
-        .image(image)
-        .subresource_range(COLOR_IMAGE)
+    vk::ImageMemoryBarrier {
+        src_access_mask: src,
+        dst_access_mask: dst,
+        old_layout: old,
+        new_layout: new,
+        src_queue_family_index: vk::QUEUE_FAMILY_IGNORED,
+        dst_queue_family_index: vk::QUEUE_FAMILY_IGNORED,
+        image,
+        subresource_range: COLOR_IMAGE,
+        ..Default::default()
+    }
 }
 
 /// Records one vkCmdPipelineBarrier from the `src` stages to the `dst` stages.
