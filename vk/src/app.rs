@@ -128,6 +128,16 @@ struct HeadlessRun<'a> {
     frame_loop: FrameLoop<'a>,
 }
 
+impl HeadlessRun<'_> {
+    /// `--dump-shaders`: the stages this run compiles.
+    fn dump_shaders(&self, stages: &[(&str, &[u32], &str)]) -> Result<()> {
+        match &self.args.dump_shaders {
+            Some(dir) => dump_shaders(dir, stages),
+            None => Ok(()),
+        }
+    }
+}
+
 /// The frames and the setup time `frame_loop` measured, and the last frame.
 type Rendered = (Vec<FrameTime>, f64, FloatImage);
 
@@ -161,19 +171,12 @@ fn idle_wait() -> Result<bool> {
 /// the colour target, the recorded commands, the frames, the readback. Its
 /// objects drop at the end, newest first, before the device.
 fn render_fragment(run: &HeadlessRun, shaders: &Shaders) -> Result<Rendered> {
-    let HeadlessRun {
-        args,
-        device,
-        gpu_scene,
-        frame_loop,
-    } = run;
-    let (width, height) = (args.size.width, args.size.height);
-    if let Some(dir) = &args.dump_shaders {
-        dump_shaders(dir, &shaders.stages())?;
-    }
+    let (device, frame_loop) = (run.device, &run.frame_loop);
+    let (width, height) = (run.args.size.width, run.args.size.height);
+    run.dump_shaders(&shaders.stages())?;
     let render_pass = RenderPass::offscreen(device)?;
     let rp = render_pass.render_pass;
-    let resources = SceneResources::new(device, gpu_scene, shaders, rp, Some((width, height)))?;
+    let resources = SceneResources::new(device, run.gpu_scene, shaders, rp, Some((width, height)))?;
     let (pipeline, descriptors) = (&resources.pipeline, &resources.descriptors);
     let target = Target::new(device, rp, width, height)?;
     let timestamps = frame_loop.timestamps;
@@ -190,28 +193,21 @@ fn render_fragment(run: &HeadlessRun, shaders: &Shaders) -> Result<Rendered> {
 /// The same tracer as a compute shader: compute.rs owns its pipeline and
 /// storage image.
 fn render_compute(run: &HeadlessRun, shader: &ComputeShader) -> Result<Rendered> {
-    let HeadlessRun {
-        args,
-        device,
-        gpu_scene,
-        frame_loop,
-    } = run;
-    let (width, height) = (args.size.width, args.size.height);
-    if let Some(dir) = &args.dump_shaders {
-        dump_shaders(dir, &[("compute", &shader.spirv, &shader.glsl)])?;
-    }
-    let (frame, storage) = crate::scene::scene_buffers(device, gpu_scene)?;
+    let size = &run.args.size;
+    run.dump_shaders(&[("compute", &shader.spirv, &shader.glsl)])?;
+    let (frame, storage) = crate::scene::scene_buffers(run.device, run.gpu_scene)?;
+    let timestamps = run.frame_loop.timestamps;
     let compute = Compute::new(
-        device,
+        run.device,
         &frame,
         &storage,
         shader,
-        width,
-        height,
-        frame_loop.timestamps,
+        size.width,
+        size.height,
+        timestamps,
     )?;
-    let (frames, setup_ms) = frame_loop.run(&compute.commands)?;
-    Ok((frames, setup_ms, compute.read_back(device)?))
+    let (frames, setup_ms) = run.frame_loop.run(&compute.commands)?;
+    Ok((frames, setup_ms, compute.read_back(run.device)?))
 }
 
 /// The variant as the report names it, with the naive choices it was asked for.
