@@ -208,9 +208,10 @@ pub fn create_image_with_view(
         .tiling(vk::ImageTiling::OPTIMAL)
         .usage(usage)
         .initial_layout(vk::ImageLayout::UNDEFINED);
-    // SAFETY: a create on the live device from a local info; the size was checked against the
-    // device's limits (check_size) and the format supports the usage (mandatory for RGBA32F); the
-    // caller's owner destroys the image.
+    // SAFETY: a create on the live device from a local info; the size is within the device's
+    // limits (check_size for --size and captures; in the window the swapchain's extent, which the
+    // surface bounds); RGBA32F supports these usages on every device (the spec makes them
+    // mandatory); the owner whose fields the handles go into destroys the image.
     *image = unsafe { d.create_image(&info, None) }
         .map_err(|e| memory::too_large(e, width as u64 * height as u64 * 16, what))?;
     // SAFETY: a query on the image just made.
