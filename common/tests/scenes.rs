@@ -1,8 +1,8 @@
 //! Scene loading: the built-in scenes have the study's counts, and every kind of
 //! bad scene input is refused with one sentence that names the culprit (exit 2).
 
-use twinray_common::camera::{Frustum, RayFrame};
 use twinray_common::error::exit_code_of;
+use twinray_common::scene::camera::{Frustum, RayFrame};
 use twinray_common::scene::Scene;
 
 fn set(kv: &[(&str, &str)]) -> Vec<(String, String)> {
@@ -220,7 +220,9 @@ fn teapot_tessellation_override_scales_the_triangle_count() {
 fn the_generators_obj_is_the_built_in_teapot() {
     // The scene tessellates teapot.bpt at load; twinray-gen-teapot writes the
     // same tessellation as OBJ with 6 decimals: the same triangles, to rounding.
-    use twinray_common::teapot::{parse_bpt, tessellate, to_obj, HEADER, STUDY_NU, STUDY_NV};
+    use twinray_common::scene::teapot::{
+        parse_bpt, tessellate, to_obj, HEADER, STUDY_NU, STUDY_NV,
+    };
     let bpt = include_str!("../../scenes/teapot.bpt");
     let mesh = tessellate(&parse_bpt(bpt).unwrap(), STUDY_NU, STUDY_NV);
     let dir = std::env::temp_dir().join(format!("twinray-teapot-obj-{}", std::process::id()));

@@ -37,6 +37,9 @@ fn build_apps() -> PathBuf {
     let status = Command::new(&cargo)
         .args(["build", "--quiet", "--profile", &profile])
         .args(["-p", "twinray-vk", "-p", "twinray-gl", "-p", "twinray"])
+        // As tests/run.sh builds them: the windowed tests drive the apps
+        // through their test hooks. The same features make this a no-op there.
+        .args(["--features", "twinray-vk/test-hooks,twinray-gl/test-hooks"])
         .arg("--manifest-path")
         .arg(&manifest)
         .arg("--target-dir")
@@ -136,7 +139,7 @@ pub fn render(
     let stdout = String::from_utf8_lossy(&o.stdout);
     let report: RunReport = serde_json::from_str(stdout.trim())
         .unwrap_or_else(|e| panic!("{app:?}: stdout is not one JSON report ({e}): {stdout}"));
-    let img = twinray_common::image_io::load_png(out).unwrap();
+    let img = twinray_common::reference::image_io::load_png(out).unwrap();
     (report, img)
 }
 

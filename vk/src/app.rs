@@ -22,11 +22,12 @@ use std::time::Instant;
 use twinray_common::cli::{RenderArgs, RenderPath, Workgroup};
 use twinray_common::error::bad_input;
 use twinray_common::explain;
-use twinray_common::gpu::GpuScene;
-use twinray_common::image_io::FloatImage;
+use twinray_common::gpu::upload::GpuScene;
+use twinray_common::reference::image_io::FloatImage;
 use twinray_common::report::{dump_shaders, dump_statistics, DeviceInfo, FrameTime, RunReport};
 use twinray_common::scene::Scene;
-use twinray_common::shader::{self, ComputeShader, Shaders, Variant};
+use twinray_common::shader::build::{build, build_compute, ComputeShader, Shaders};
+use twinray_common::shader::variant::Variant;
 
 pub fn run(args: RenderArgs, process_start: Instant) -> Result<()> {
     if args.explain {
@@ -113,7 +114,7 @@ fn render(
     };
     let rendered = match args.path {
         RenderPath::Fragment => render_fragment(&run, &shaders)?,
-        RenderPath::Compute => render_compute(&run, &shader::build_compute(variant, workgroup)?)?,
+        RenderPath::Compute => render_compute(&run, &build_compute(variant, workgroup)?)?,
     };
     let label = variant_label(variant, host_memory, idle_wait);
     report(args, scene, &device, label, workgroup, rendered)
@@ -144,7 +145,7 @@ type Rendered = (Vec<FrameTime>, f64, FloatImage);
 /// naga's vertex and fragment shaders for the scene's variant; `--dump-shaders`
 /// turns on the driver's statistics before any pipeline is made.
 fn build_shaders(args: &RenderArgs, variant: &Variant) -> Result<Shaders> {
-    let shaders = shader::build(variant)?;
+    let shaders = build(variant)?;
     if args.dump_shaders.is_some() {
         crate::statistics::enable();
     }
