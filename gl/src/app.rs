@@ -73,13 +73,7 @@ pub fn run(args: RenderArgs, started: Instant) -> anyhow::Result<()> {
         RenderPath::Fragment => {
             let shaders = build(&variant)?;
             if let Some(dir) = &args.dump_shaders {
-                dump_shaders(
-                    dir,
-                    &[
-                        ("vertex", &shaders.vertex_spirv, &shaders.vertex_glsl),
-                        ("fragment", &shaders.fragment_spirv, &shaders.fragment_glsl),
-                    ],
-                )?;
+                dump_shaders(dir, &shaders.stages())?;
             }
             explain::step(
                 "Shaders: GLSL -> naga module -> GLSL 450 core (twinray-common)",
