@@ -6,7 +6,7 @@
 //! the app inspects. The logical device is the open connection every later object
 //! is created on; it enables only the queues and features the app asks for, so
 //! the driver sets up nothing else. Work reaches the GPU only through *queues*,
-//! which come in families with different abilities: we need one that can draw.
+//! which come in families with different abilities: we need one that can draw and dispatch.
 
 use crate::instance::Instance;
 use crate::surface::Surface;
