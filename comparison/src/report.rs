@@ -15,6 +15,8 @@ use crate::study::{self, StudyRow};
 use anyhow::Context;
 use std::path::Path;
 
+/// The CPU's model name and thread count, for the machine table and the
+/// CSVs (the drivers' reports do not say what a software rasteriser ran on).
 pub fn cpu_model() -> String {
     std::fs::read_to_string("/proc/cpuinfo")
         .ok()
@@ -35,6 +37,7 @@ pub fn cpu_model() -> String {
         .unwrap_or_else(|| "unknown CPU".into())
 }
 
+/// Writes results.csv, the plots and report.md into `out`.
 pub fn write_all(out: &Path, results: &Results) -> anyhow::Result<()> {
     let cpu = cpu_model();
     std::fs::write(out.join("results.csv"), csv::csv(results.outcomes, &cpu)?)

@@ -25,10 +25,13 @@ pub struct Point {
     pub work: f64,
 }
 
+/// The points of a comparison and how long each may run.
 pub struct Plan {
     pub points: Vec<Point>,
     pub frames: u32,
+    /// Fewer frames for a point predicted to take longer than this per app.
     pub seconds_per_point: f64,
+    /// "quick" or "full".
     pub preset: &'static str,
 }
 

@@ -100,8 +100,8 @@ pub fn mark_pareto(rows: &mut [Row], unsound: &[Numerics]) {
 
 #[cfg(test)]
 mod tests {
-    use super::super::sweeps::{Config, Error};
     use super::*;
+    use crate::accuracy::sweeps::{Config, Error};
     use twinray_common::cli::Size;
 
     #[test]
