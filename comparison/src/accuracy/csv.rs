@@ -147,3 +147,26 @@ fn random_line(r: &RandomRow) -> RandomLine<'_> {
         nonfinite_pixels: m.map(|m| m.nan_pixels),
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The committed results (comparison/results/*/accuracy/) and the tests
+    /// read these columns by name: they must not move or change.
+    #[test]
+    fn the_columns_stay_as_committed_even_without_rows() {
+        assert_eq!(
+            csv(&[]).unwrap(),
+            "scene,width,height,api,max_depth,offset,triangle,sphere,sweeps,default,pareto,point_ms,repeat_ms,status,gpu_min_ms,wall_min_ms,rmse,max_abs,above_1,above_8,flip_mean,nonfinite_pixels\n"
+        );
+        assert_eq!(
+            hard_csv(&[]).unwrap(),
+            "case,tolerance_pct,strategy,api,status,wrong_pct,crack_pixels,time_ms,nonfinite_pixels\n"
+        );
+        assert_eq!(
+            random_csv(&[]).unwrap(),
+            "seed,pair,status,off_8_pct,within_1_pct,max_abs,rmse,nonfinite_pixels\n"
+        );
+    }
+}
