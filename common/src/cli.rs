@@ -2,6 +2,7 @@
 //! one clap struct so that `twinray-vk` and `twinray-gl` can never drift apart.
 
 use crate::error::bad_input;
+use crate::scene::accel::Accel;
 use clap::Parser;
 use std::path::PathBuf;
 
@@ -99,6 +100,18 @@ pub enum Experiment {
     /// Read the primitive and light counts from the Frame uniform instead of
     /// baking them into the shader (what made lavapipe grow per frame).
     UniformCounts,
+    /// Forbid the driver to fuse or reassociate float arithmetic: a
+    /// `NoContraction` decoration on every float operation of the SPIR-V and
+    /// `precise` on every float local of the GLSL.
+    NoContraction,
+    /// SPIR-V only: ask for IEEE behaviour the driver may otherwise relax
+    /// (SPV_KHR_float_controls: denormals preserved, signed zero, Inf and NaN
+    /// preserved), to see whether Vulkan's defaults explain its pixels.
+    FloatControls,
+    /// The SPIR-V (what Vulkan runs) from Khronos' reference compiler,
+    /// glslangValidator (on PATH; Debian's glslang-tools), given the same
+    /// GLSL and defines, instead of from naga.
+    Glslang,
 }
 
 impl Experiment {
@@ -112,23 +125,9 @@ impl Experiment {
             Experiment::StacklessBvh => "stackless-bvh",
             Experiment::UnpairedBvhStack => "unpaired-bvh-stack",
             Experiment::StorageCounts => "storage-counts",
-        }
-    }
-}
-
-#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
-pub enum Accel {
-    Auto,
-    None,
-    Bvh,
-}
-
-impl Accel {
-    pub fn name(self) -> &'static str {
-        match self {
-            Accel::Auto => "auto",
-            Accel::None => "none",
-            Accel::Bvh => "bvh",
+            Experiment::NoContraction => "no-contraction",
+            Experiment::FloatControls => "float-controls",
+            Experiment::Glslang => "glslang",
         }
     }
 }
@@ -328,7 +327,7 @@ impl RenderArgs {
     /// Checks every output path (`--out`) before any work: a typo must not cost a render.
     pub fn check_outputs(&self) -> anyhow::Result<()> {
         if let Some(out) = &self.out {
-            crate::image_io::check_output_file("--out", out)?;
+            crate::reference::image_io::check_output_file("--out", out)?;
         }
         Ok(())
     }

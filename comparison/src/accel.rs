@@ -5,7 +5,8 @@
 use crate::apps::{run_json, Api};
 use crate::runs::{overrides, AccelRun, BvhStats, Plan, ACCEL_CONFIGS};
 use std::sync::atomic::{AtomicBool, Ordering};
-use twinray_common::cli::{Accel, RenderArgs, Size};
+use twinray_common::cli::{RenderArgs, Size};
+use twinray_common::scene::accel::Accel;
 
 /// One scene setting and the ACCEL_CONFIGS it runs in.
 struct Case {
@@ -38,7 +39,7 @@ pub fn acceleration(plan: &Plan, stop: &AtomicBool) -> Vec<AccelRun> {
                 twinray_common::scene::Scene::load(scene, &overrides(&set))
                     .ok()
                     .map(|sc| {
-                        let b = twinray_common::bvh::Bvh::build(&sc);
+                        let b = twinray_common::gpu::layout::Bvh::build(&sc);
                         BvhStats {
                             nodes: b.nodes.len(),
                             bytes: b.bytes(),

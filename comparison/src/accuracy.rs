@@ -21,9 +21,9 @@ use hard::HardRow;
 use random::RandomRow;
 use std::path::{Path, PathBuf};
 use sweeps::Row;
-use twinray_common::camera::OriginMode;
-use twinray_common::hard::HardCase;
-use twinray_common::numerics::Numerics;
+use twinray_common::scene::hard::HardCase;
+use twinray_common::scene::numerics::Numerics;
+use twinray_common::scene::OriginMode;
 
 #[derive(clap::Args, Debug, Clone)]
 pub struct AccuracyArgs {
@@ -46,8 +46,8 @@ pub struct AccuracyArgs {
 }
 
 pub fn run(args: &AccuracyArgs) -> anyhow::Result<()> {
-    twinray_common::image_io::prepare_output_dir("--out", &args.out)?;
-    twinray_common::image_io::prepare_output_dir("--out", &args.out.join("images"))?;
+    twinray_common::reference::image_io::prepare_output_dir("--out", &args.out)?;
+    twinray_common::reference::image_io::prepare_output_dir("--out", &args.out.join("images"))?;
     let frames = if args.quick { 5 } else { 30 };
     let started = std::time::Instant::now();
     let mut rows: Vec<Row> = Vec::new();

@@ -6,9 +6,10 @@ use crate::apps::{run_json, Api};
 use crate::runs::{api_name, overrides, Agreement, Plan, EXPERIMENTS};
 use std::path::Path;
 use std::sync::atomic::{AtomicBool, Ordering};
-use twinray_common::cli::{Accel, RenderArgs, RenderPath, Size, Workgroup};
-use twinray_common::image_io::load_png;
-use twinray_common::metrics::{self, Metrics};
+use twinray_common::cli::{RenderArgs, RenderPath, Size, Workgroup};
+use twinray_common::reference::image_io::load_png;
+use twinray_common::reference::metrics::{self, Metrics};
+use twinray_common::scene::accel::Accel;
 
 /// Renders each built-in scene once with both apps and the reference, keeps the
 /// PNGs under images/, and measures how far apart they are.

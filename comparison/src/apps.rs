@@ -5,9 +5,10 @@ use anyhow::Context;
 use std::path::PathBuf;
 use std::process::Command;
 use std::time::Instant;
-use twinray_common::cli::{Accel, RenderArgs};
+use twinray_common::cli::RenderArgs;
 use twinray_common::error::{bad_input, Failure, FailureKind};
 use twinray_common::report::{DeviceInfo, FrameTime, RunReport};
+use twinray_common::scene::accel::Accel;
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
 pub enum Api {
@@ -213,7 +214,7 @@ fn render_with_progress(
     w: u32,
     h: u32,
     bvh: bool,
-) -> twinray_common::image_io::FloatImage {
+) -> twinray_common::reference::image_io::FloatImage {
     use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
     let rows = AtomicUsize::new(0);
     let finished = AtomicBool::new(false);

@@ -9,7 +9,8 @@ use std::collections::HashMap;
 use std::path::PathBuf;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::Arc;
-use twinray_common::cli::{parse_workgroup, Accel, RenderArgs, RenderPath, Size, Workgroup};
+use twinray_common::cli::{parse_workgroup, RenderArgs, RenderPath, Size, Workgroup};
+use twinray_common::scene::accel::Accel;
 
 #[derive(clap::Args, Debug, Clone)]
 pub struct CompareArgs {
@@ -152,7 +153,7 @@ fn is_software(device: &str) -> bool {
 
 pub fn run(args: &CompareArgs) -> anyhow::Result<()> {
     // Before the device probe and every render: a bad --out must cost nothing.
-    twinray_common::image_io::prepare_output_dir("--out", &args.out)?;
+    twinray_common::reference::image_io::prepare_output_dir("--out", &args.out)?;
     let args = &with_preset(args)?;
     let plan = plan(args)?;
     let stop = Arc::new(AtomicBool::new(false));

@@ -6,7 +6,7 @@
 
 use crate::apps::Api;
 use twinray_common::cli::{RenderPath, Size};
-use twinray_common::metrics::Metrics;
+use twinray_common::reference::metrics::Metrics;
 use twinray_common::report::RunReport;
 
 /// The study's three experiments, in the order every output lists them.

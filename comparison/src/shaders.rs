@@ -11,8 +11,9 @@ use crate::runs::api_name;
 use std::fmt::Write as _;
 use std::path::Path;
 use std::sync::atomic::{AtomicBool, Ordering};
-use twinray_common::cli::{Accel, RenderArgs, RenderPath, Size};
+use twinray_common::cli::{RenderArgs, RenderPath, Size};
 use twinray_common::report::ShaderStats;
+use twinray_common::scene::accel::Accel;
 
 pub struct ShaderRow {
     pub scene: &'static str,

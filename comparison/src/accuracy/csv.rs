@@ -10,7 +10,7 @@ use super::sweeps::Row;
 use crate::csv_out::{self, Num};
 use crate::runs::api_name;
 use serde::Serialize;
-use twinray_common::random_scene;
+use twinray_common::scene::random as random_scene;
 
 #[derive(Serialize, Default)]
 struct ConfigLine<'a> {

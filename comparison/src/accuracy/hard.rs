@@ -6,11 +6,11 @@ use super::sweeps::render_app;
 use crate::apps::Api;
 use crate::runs::api_name;
 use std::path::{Path, PathBuf};
-use twinray_common::camera::OriginMode;
 use twinray_common::cli::Size;
-use twinray_common::hard::{self, HardCase};
-use twinray_common::numerics::{Numerics, Offset, SphereTest, TriangleTest};
 use twinray_common::reference;
+use twinray_common::scene::hard::{self, HardCase};
+use twinray_common::scene::numerics::{Numerics, Offset, SphereTest, TriangleTest};
+use twinray_common::scene::OriginMode;
 use twinray_common::scene::Scene;
 
 /// One hard case under one strategy and API.
@@ -128,7 +128,7 @@ fn run_hard(case: &HardCase, size: Size, out: &Path) -> anyhow::Result<Vec<HardR
     let truth = reference::render_truth(&scene, size.width, size.height);
     truth.save_png(&out.join(format!("images/hard-{}-truth.png", case.name)))?;
     let truth = truth.to_rgb8();
-    let bg = twinray_common::image_io::FloatImage {
+    let bg = twinray_common::reference::image_io::FloatImage {
         width: 1,
         height: 1,
         pixels: vec![scene.background.as_vec3().to_array()],

@@ -4,7 +4,7 @@
 
 use super::sweeps::Row;
 use crate::apps::Api;
-use twinray_common::numerics::Numerics;
+use twinray_common::scene::numerics::Numerics;
 use twinray_common::stats::median;
 
 /// The smallest time tie: below 1% no measurement here is steadier.

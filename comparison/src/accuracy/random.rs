@@ -7,9 +7,9 @@ use crate::runs::api_name;
 use std::fmt::Write as _;
 use std::path::Path;
 use twinray_common::cli::Size;
-use twinray_common::metrics;
-use twinray_common::random_scene;
 use twinray_common::reference;
+use twinray_common::reference::metrics;
+use twinray_common::scene::random as random_scene;
 use twinray_common::scene::Scene;
 
 /// One random scene's three renders compared pairwise.
@@ -113,7 +113,7 @@ pub fn random_markdown(rows: &[RandomRow], size: Size) -> String {
     let seeds = rows.iter().map(|r| r.seed).max().map_or(0, |m| m + 1);
     let _ = writeln!(
         s,
-        "## Random scenes ({seeds} seeds, {size})\n\n`--scene random:SEED` for seeds 0..{seeds} (common/src/random_scene.rs: spheres, triangles, \
+        "## Random scenes ({seeds} seeds, {size})\n\n`--scene random:SEED` for seeds 0..{seeds} (common/src/scene/random.rs: spheres, triangles, \
          a mesh, diffuse, mirror and glass with glass inside glass, 1–4 lights, random cameras), each rendered by both apps and \
          the f64 reference with the scene's own numerics. A pair disagrees when more than {:.2}% of its pixels are off by more \
          than 8/255 or fewer than {:.0}% are within 1/255 (the thresholds tests/tests/random_scenes.rs applies to 20 seeds). \

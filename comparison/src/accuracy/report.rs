@@ -10,10 +10,10 @@ use crate::apps::Api;
 use crate::runs::api_name;
 use std::fmt::Write as _;
 use std::path::Path;
-use twinray_common::camera::OriginMode;
 use twinray_common::cli::Size;
-use twinray_common::hard::{HardCase, WRONG_ABOVE};
-use twinray_common::numerics::Numerics;
+use twinray_common::scene::hard::{HardCase, WRONG_ABOVE};
+use twinray_common::scene::numerics::Numerics;
+use twinray_common::scene::OriginMode;
 use twinray_common::scene::Scene;
 
 fn f3(v: f64) -> String {
@@ -394,7 +394,7 @@ fn origin_table(hard_rows: &[HardRow], cases: &[HardCase]) -> String {
         .iter()
         .filter_map(|c| {
             let scene = Scene::load(&c.path.to_string_lossy(), &[]).ok()?;
-            let o = twinray_common::camera::local_origin(&scene).to_array();
+            let o = twinray_common::scene::camera::local_origin(&scene).to_array();
             (o != [0.0; 3]).then_some((c, o))
         })
         .collect();

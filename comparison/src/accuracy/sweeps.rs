@@ -7,11 +7,12 @@ use crate::apps::{run_json, Api};
 use crate::runs::{api_name, overrides};
 use std::path::Path;
 use twinray_common::cli::{RenderArgs, Size};
-use twinray_common::hard;
-use twinray_common::metrics;
-use twinray_common::numerics::{Numerics, Offset, SphereTest, TriangleTest};
+use twinray_common::limits::MAX_DEPTH;
 use twinray_common::reference;
-use twinray_common::scene::{Scene, MAX_DEPTH_LIMIT};
+use twinray_common::reference::metrics;
+use twinray_common::scene::hard;
+use twinray_common::scene::numerics::{Numerics, Offset, SphereTest, TriangleTest};
+use twinray_common::scene::Scene;
 
 /// One point of a sweep: a maximum depth and a numerical configuration.
 #[derive(Debug, Clone, PartialEq)]
@@ -203,7 +204,7 @@ pub fn render_app(
         ..RenderArgs::headless(scene, size)
     };
     let r = run_json(api, &args)?;
-    let img = twinray_common::image_io::load_png(png)?;
+    let img = twinray_common::reference::image_io::load_png(png)?;
     // The fastest frame, not the median: other work on a shared machine only
     // ever adds time, so the minimum is the steadiest estimate of the cost.
     let wall = r.wall_ms.map(|s| s.min).unwrap_or(f64::NAN);
@@ -213,7 +214,15 @@ pub fn render_app(
 /// The shader a config compiles to on a scene, as its sorted defines.
 pub fn program_of(scene: &str, set: &[String]) -> anyhow::Result<String> {
     let scene = Scene::load(scene, &overrides(set))?;
-    let v = twinray_common::shader::Variant::for_scene(&scene);
+    // The variant the apps would compile for this scene with default options.
+    let args = RenderArgs::headless(
+        &scene.name,
+        Size {
+            width: 1,
+            height: 1,
+        },
+    );
+    let v = twinray_common::shader::variant::Variant::chosen(&scene, &args);
     Ok(v.defines
         .iter()
         .map(|(k, v)| format!("{k}={v}"))
@@ -237,7 +246,7 @@ pub fn run_scene(
         numerics: scene.numerics,
     };
     let mut deep = scene.clone();
-    deep.max_depth = MAX_DEPTH_LIMIT;
+    deep.max_depth = MAX_DEPTH;
     let truth = reference::render_truth(&deep, size.width, size.height);
     truth.save_png(&out.join(format!("images/{scene_name}-truth.png")))?;
     let truth = truth.to_rgb8();
