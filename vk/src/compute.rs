@@ -25,10 +25,11 @@
 //! shader cannot write the swapchain image itself: its `rgba32f` image format
 //! is not the swapchain's, and few surfaces offer STORAGE usage anyway.
 
-use crate::commands::{image_barrier, pipeline_barrier, Commands};
+use crate::commands::Commands;
 use crate::descriptors::Descriptors;
 use crate::device::Device;
 use crate::memory::Buffer;
+use crate::memory::{image_barrier, pipeline_barrier};
 use crate::scene::scene_buffers;
 use crate::target::{create_image_with_view, read_image, readback_buffer, record_copy_to_host};
 use crate::timestamps::Timestamps;

@@ -28,9 +28,9 @@
 //! that into the swapchain image (compute.rs, `WindowCompute::record`), with
 //! the layout transitions a render pass would otherwise make.
 
-use crate::commands::{buffer_barrier, pipeline_barrier};
 use crate::compute::WindowCompute;
 use crate::device::Device;
+use crate::memory::{buffer_barrier, pipeline_barrier};
 use crate::scene::SceneResources;
 use crate::swapchain::Swapchain;
 use crate::timestamps::Timestamps;

@@ -10,7 +10,6 @@
 //! discrete GPU the CPU cannot map. So scene buffers are filled by writing into a
 //! host-visible *staging* buffer and letting the GPU copy it across.
 
-use crate::commands::{buffer_barrier, pipeline_barrier};
 use crate::device::Device;
 use anyhow::{anyhow, Context, Result};
 use ash::vk;
@@ -308,5 +307,86 @@ impl Drop for Buffer {
             self.device.destroy_buffer(self.buffer, None);
             self.device.free_memory(self.memory, None);
         }
+    }
+}
+
+// Barriers: how a write by one stage or the host becomes visible to a later
+// access. They live beside the memory they guard, so that every module that
+// records a command can name its hazard without importing the command buffer.
+
+/// A barrier on the whole of `buffer`: the writes of `src` made available and
+/// visible to the accesses of `dst` (Arseny Kapoulkine's niagara has the same
+/// helper), so that each call site states its hazard and nothing else.
+pub fn buffer_barrier(
+    buffer: vk::Buffer,
+    src: vk::AccessFlags,
+    dst: vk::AccessFlags,
+) -> vk::BufferMemoryBarrier<'static> {
+    vk::BufferMemoryBarrier::default()
+        .src_access_mask(src)
+        .dst_access_mask(dst)
+        .src_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
+        .dst_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
+        .buffer(buffer)
+        .size(vk::WHOLE_SIZE)
+}
+
+/// All of a colour image with one mip level and one layer: every image twinray
+/// makes (targets, storage images, swapchain images) and every view of one.
+pub const COLOR_IMAGE: vk::ImageSubresourceRange = vk::ImageSubresourceRange {
+    aspect_mask: vk::ImageAspectFlags::COLOR,
+    base_mip_level: 0,
+    level_count: 1,
+    base_array_layer: 0,
+    layer_count: 1,
+};
+
+/// A barrier on a whole one-level colour image, from layout `old` to `new`.
+pub fn image_barrier(
+    image: vk::Image,
+    src: vk::AccessFlags,
+    dst: vk::AccessFlags,
+    old: vk::ImageLayout,
+    new: vk::ImageLayout,
+) -> vk::ImageMemoryBarrier<'static> {
+    vk::ImageMemoryBarrier {
+        src_access_mask: src,
+        dst_access_mask: dst,
+        old_layout: old,
+        new_layout: new,
+        src_queue_family_index: vk::QUEUE_FAMILY_IGNORED,
+        dst_queue_family_index: vk::QUEUE_FAMILY_IGNORED,
+        image,
+        subresource_range: COLOR_IMAGE,
+        ..Default::default()
+    }
+}
+
+/// Records one vkCmdPipelineBarrier from the `src` stages to the `dst` stages.
+/// Every barrier in twinray has this shape: no global memory barriers and no
+/// dependency flags, so only what differs is written at the call site.
+///
+/// # Safety
+/// `cmd` was allocated from `d` and is recording, and every buffer and image
+/// the barriers name is alive.
+pub unsafe fn pipeline_barrier(
+    d: &ash::Device,
+    cmd: vk::CommandBuffer,
+    src: vk::PipelineStageFlags,
+    dst: vk::PipelineStageFlags,
+    buffers: &[vk::BufferMemoryBarrier],
+    images: &[vk::ImageMemoryBarrier],
+) {
+    // SAFETY: forwarded from the caller.
+    unsafe {
+        d.cmd_pipeline_barrier(
+            cmd,
+            src,
+            dst,
+            vk::DependencyFlags::empty(),
+            &[],
+            buffers,
+            images,
+        )
     }
 }

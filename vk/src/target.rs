@@ -9,9 +9,9 @@
 //! An OPTIMAL-tiled image cannot be mapped, so after the last frame the GPU
 //! copies it into a host-visible *readback* buffer as plain rows, top row first.
 
-use crate::commands::{buffer_barrier, pipeline_barrier};
 use crate::device::Device;
 use crate::memory::{self, Buffer};
+use crate::memory::{buffer_barrier, pipeline_barrier};
 use crate::pipeline::COLOR_FORMAT;
 use anyhow::{Context, Result};
 use ash::vk;
@@ -225,7 +225,7 @@ pub fn create_image_with_view(
         .image(*image)
         .view_type(vk::ImageViewType::TYPE_2D)
         .format(format)
-        .subresource_range(crate::commands::COLOR_IMAGE);
+        .subresource_range(crate::memory::COLOR_IMAGE);
     // SAFETY: the image is bound to its memory and has the format, one level and one layer the view
     // describes.
     *view = unsafe { d.create_image_view(&info, None) }

@@ -15,11 +15,12 @@
 //! needs: frames, swapchain, the path's per-scene objects, render pass, device, surface, instance,
 //! and the window last of all (the surface refers to it).
 
-use crate::commands::{buffer_barrier, pipeline_barrier, Commands};
+use crate::commands::Commands;
 use crate::compute::{self, Compute, WindowCompute};
 use crate::device::Device;
 use crate::frames::{Draw, FrameResult, Frames};
 use crate::instance::Instance;
+use crate::memory::{buffer_barrier, pipeline_barrier};
 use crate::pipeline::{Pipeline, RenderPass};
 use crate::scene::SceneResources;
 use crate::surface::{self, Surface};
