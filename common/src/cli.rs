@@ -1,11 +1,16 @@
-//! The options both apps accept (DESIGN.md's command-line contract), parsed by
-//! one clap struct so that `twinray-vk` and `twinray-gl` can never drift apart.
+//! The apps' whole configuration surface: the options both apps accept, parsed
+//! by one clap struct so that `twinray-vk` and `twinray-gl` can never drift
+//! apart, and each app's own knobs, which are options too and are also read
+//! from `TWINRAY_*` environment variables (so that a script or the orchestrator
+//! can set them for every run). Everything is parsed once, in `main`.
 
 use crate::error::bad_input;
-use clap::Parser;
+use clap::builder::{PossibleValue, TypedValueParser};
+use clap::parser::ValueSource;
+use clap::{Parser, ValueEnum};
 use std::path::PathBuf;
 
-#[derive(Parser, Debug, Clone)]
+#[derive(Parser, Debug, Clone, PartialEq)]
 pub struct RenderArgs {
     /// Built-in scene (teapot, box, spherelist) or a path to a scene file (.toml).
     #[arg(long, default_value = "box")]
@@ -101,36 +106,11 @@ pub enum Experiment {
     UniformCounts,
 }
 
-impl Experiment {
-    pub fn name(self) -> &'static str {
-        match self {
-            Experiment::NagaZeroInit => "naga-zero-init",
-            Experiment::NagaLoopBounding => "naga-loop-bounding",
-            Experiment::NoLoopBounding => "no-loop-bounding",
-            Experiment::SharedBvhStack => "shared-bvh-stack",
-            Experiment::UniformCounts => "uniform-counts",
-            Experiment::StacklessBvh => "stackless-bvh",
-            Experiment::UnpairedBvhStack => "unpaired-bvh-stack",
-            Experiment::StorageCounts => "storage-counts",
-        }
-    }
-}
-
 #[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
 pub enum Accel {
     Auto,
     None,
     Bvh,
-}
-
-impl Accel {
-    pub fn name(self) -> &'static str {
-        match self {
-            Accel::Auto => "auto",
-            Accel::None => "none",
-            Accel::Bvh => "bvh",
-        }
-    }
 }
 
 /// The tracer's entry point: the two ways one GLSL tracer reaches the GPU.
@@ -155,18 +135,25 @@ pub enum RenderPath {
     Compute,
 }
 
-impl RenderPath {
-    pub fn name(self) -> &'static str {
-        match self {
-            RenderPath::Fragment => "fragment",
-            RenderPath::Compute => "compute",
-        }
+impl std::fmt::Display for RenderPath {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(&self.name())
     }
 }
 
-impl std::fmt::Display for RenderPath {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        f.write_str(self.name())
+/// The name of an enum value as clap parses it (kebab-case unless a variant
+/// says otherwise), so that argv, reports and labels spell every value the one
+/// way the command line accepts it.
+pub trait ValueName {
+    fn name(&self) -> String;
+}
+
+impl<T: ValueEnum> ValueName for T {
+    fn name(&self) -> String {
+        // Only `#[value(skip)]` variants have no possible value, and none is skipped.
+        self.to_possible_value()
+            .map(|v| v.get_name().to_string())
+            .unwrap_or_default()
     }
 }
 
@@ -283,23 +270,6 @@ impl RenderArgs {
         }
     }
 
-    /// Parses argv, mapping clap's usage errors to exit code 2 (clap already
-    /// prints one clear line naming the option).
-    pub fn parse_or_exit() -> Self {
-        match Self::try_parse() {
-            Ok(a) => a,
-            Err(e) => {
-                let code = match e.kind() {
-                    clap::error::ErrorKind::DisplayHelp
-                    | clap::error::ErrorKind::DisplayVersion => 0,
-                    _ => 2,
-                };
-                let _ = e.print();
-                std::process::exit(code);
-            }
-        }
-    }
-
     /// The workgroup of a compute run (`--workgroup` or the default). A
     /// `--workgroup` with the fragment path is a mistake worth saying, not ignoring.
     pub fn compute_workgroup(&self) -> anyhow::Result<Workgroup> {
@@ -341,5 +311,212 @@ impl RenderArgs {
         let mut scene = crate::scene::Scene::load(&self.scene, &self.overrides()?)?;
         scene.set_accel(self.accel);
         Ok(scene)
+    }
+}
+
+/// Parses argv (and the knobs' environment variables), mapping clap's usage
+/// errors to exit code 2 (clap already prints one clear line naming the option).
+pub fn parse_or_exit<T: Parser>() -> T {
+    match T::try_parse() {
+        Ok(a) => a,
+        Err(e) => {
+            let code = if e.use_stderr() { 2 } else { 0 };
+            let _ = e.print();
+            std::process::exit(code);
+        }
+    }
+}
+
+/// `twinray-vk`'s command line: the shared options and the Vulkan knobs.
+#[derive(Parser, Debug, Clone)]
+#[command(
+    name = "twinray-vk",
+    about = "The Whitted ray tracer through Vulkan (ash); twinray-gl is its OpenGL twin"
+)]
+pub struct VulkanCli {
+    #[command(flatten)]
+    pub render: RenderArgs,
+    #[command(flatten)]
+    pub knobs: VulkanKnobs,
+}
+
+/// `twinray-gl`'s command line: the shared options and the OpenGL knob.
+#[derive(Parser, Debug, Clone)]
+#[command(
+    name = "twinray-gl",
+    about = "The Whitted ray tracer through OpenGL (glow + glutin); twinray-vk is its Vulkan twin"
+)]
+pub struct OpenGlCli {
+    #[command(flatten)]
+    pub render: RenderArgs,
+    #[command(flatten)]
+    pub knobs: OpenGlKnobs,
+}
+
+// The knobs are each app's own: the other app never reads them, so a Vulkan
+// knob set for a whole comparison cannot stop the OpenGL runs, as before.
+
+/// Vulkan-only choices, for picking a device and for reproducing the naive
+/// choices the comparison measures.
+#[derive(clap::Args, Debug, Clone, Default, PartialEq)]
+#[command(next_help_heading = "Vulkan knobs (also read from the environment)")]
+pub struct VulkanKnobs {
+    /// The Vulkan device: an index or part of its name [default: the most
+    /// capable kind present: discrete, integrated, virtual, then CPU].
+    #[arg(
+        long = "vk-device",
+        env = "TWINRAY_VK_DEVICE",
+        value_name = "INDEX|NAME",
+        value_parser = named_in_env(clap::builder::StringValueParser::new(), "an index or part of a device name")
+    )]
+    pub device: Option<String>,
+    /// Where the scene's buffers live: device-local memory filled through a
+    /// staging buffer (the careful choice), or host-visible memory the GPU
+    /// reads across the bus (the naive one, to measure what it costs).
+    #[arg(
+        long = "vk-memory",
+        env = "TWINRAY_VK_MEMORY",
+        value_enum,
+        value_parser = named_in_env(clap::builder::EnumValueParser::<SceneMemory>::new(), ""),
+        default_value_t = SceneMemory::Device
+    )]
+    pub memory: SceneMemory,
+    /// Turn the validation layer on without failing on its messages (with a
+    /// note, not an error, where it is not installed); --validate requires it.
+    #[arg(
+        long = "vk-validation",
+        env = "TWINRAY_VK_VALIDATION",
+        value_parser = named_in_env(clap::builder::BoolishValueParser::new(), "1 or 0 (or true/false, yes/no, on/off)")
+    )]
+    pub validation: bool,
+    /// How each headless frame is waited for: its fence, or vkQueueWaitIdle +
+    /// vkDeviceWaitIdle as the 2018 study did.
+    #[arg(
+        long = "vk-wait",
+        env = "TWINRAY_VK_WAIT",
+        value_enum,
+        value_parser = named_in_env(clap::builder::EnumValueParser::<FrameWait>::new(), ""),
+        default_value_t = FrameWait::Fence
+    )]
+    pub wait: FrameWait,
+}
+
+impl VulkanKnobs {
+    /// The device asked for; empty counts as none, so that a script can pass
+    /// an unset variable through.
+    pub fn device(&self) -> Option<&str> {
+        self.device
+            .as_deref()
+            .map(str::trim)
+            .filter(|d| !d.is_empty())
+    }
+}
+
+/// Where the Vulkan app places the scene's buffers (`--vk-memory`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, ValueEnum)]
+pub enum SceneMemory {
+    /// Device-local, filled once through a staging buffer.
+    #[default]
+    Device,
+    /// Host-visible: every GPU access crosses the bus.
+    Host,
+}
+
+/// How the Vulkan app waits for a headless frame (`--vk-wait`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, ValueEnum)]
+pub enum FrameWait {
+    /// The frame's fence: waits for this frame's work only.
+    #[default]
+    Fence,
+    /// vkQueueWaitIdle + vkDeviceWaitIdle, as the 2018 study did.
+    Idle,
+}
+
+/// OpenGL-only choices.
+#[derive(clap::Args, Debug, Clone, Default, PartialEq)]
+#[command(next_help_heading = "OpenGL knobs (also read from the environment)")]
+pub struct OpenGlKnobs {
+    /// The EGL device index, headless [default: hardware devices first, then
+    /// Mesa's software one].
+    #[arg(
+        long = "gl-device",
+        env = "TWINRAY_GL_DEVICE",
+        value_name = "INDEX",
+        value_parser = named_in_env(parse_index, "a device index (0, 1, ...)")
+    )]
+    pub device: Option<usize>,
+}
+
+fn parse_index(s: &str) -> Result<usize, String> {
+    s.trim()
+        .parse()
+        .map_err(|_| format!("'{s}' is not a device index (0, 1, ...)"))
+}
+
+/// Wraps a knob's value parser so that a bad value read from the environment
+/// is named by its variable: clap's own message names only the option, which
+/// the user never typed.
+pub fn named_in_env<P: TypedValueParser>(parser: P, expected: &'static str) -> NamedInEnv<P> {
+    NamedInEnv { parser, expected }
+}
+
+/// See [`named_in_env`]. `expected` says what a valid value is; empty for
+/// enums, whose possible values say it.
+#[derive(Clone)]
+pub struct NamedInEnv<P> {
+    parser: P,
+    expected: &'static str,
+}
+
+impl<P: TypedValueParser> TypedValueParser for NamedInEnv<P> {
+    type Value = P::Value;
+
+    fn parse_ref(
+        &self,
+        cmd: &clap::Command,
+        arg: Option<&clap::Arg>,
+        value: &std::ffi::OsStr,
+    ) -> Result<Self::Value, clap::Error> {
+        self.parser.parse_ref(cmd, arg, value)
+    }
+
+    fn parse_ref_(
+        &self,
+        cmd: &clap::Command,
+        arg: Option<&clap::Arg>,
+        value: &std::ffi::OsStr,
+        source: ValueSource,
+    ) -> Result<Self::Value, clap::Error> {
+        let result = self.parser.parse_ref_(cmd, arg, value, source);
+        let variable = arg.and_then(clap::Arg::get_env);
+        match (result, variable) {
+            (Err(_), Some(variable)) if source == ValueSource::EnvVariable => {
+                let expected = match self.possible_values() {
+                    Some(values) if self.expected.is_empty() => {
+                        let names: Vec<String> =
+                            values.map(|v| format!("'{}'", v.get_name())).collect();
+                        format!("one of {}", names.join(", "))
+                    }
+                    _ => self.expected.to_string(),
+                };
+                let option = arg.map_or(String::new(), |a| {
+                    format!(" (or --{})", a.get_long().unwrap_or_default())
+                });
+                let message = format!(
+                    "{}='{}' is not {expected}{option}\n",
+                    variable.to_string_lossy(),
+                    value.to_string_lossy()
+                );
+                Err(
+                    clap::Error::raw(clap::error::ErrorKind::InvalidValue, message)
+                        .format(&mut cmd.clone()),
+                )
+            }
+            (result, _) => result,
+        }
+    }
+
+    fn possible_values(&self) -> Option<Box<dyn Iterator<Item = PossibleValue> + '_>> {
+        self.parser.possible_values()
     }
 }

@@ -233,21 +233,12 @@ impl WindowedRun {
         device: crate::report::DeviceInfo,
         validation_messages: u64,
     ) -> crate::report::RunReport {
-        crate::report::RunReport {
-            validation_messages,
-            path: self.path,
-            workgroup: (self.path == RenderPath::Compute).then(|| self.workgroup.to_string()),
-            ..crate::report::RunReport::new(
-                api,
-                device,
-                self.scene.stats(),
-                self.variant.label(),
-                self.width,
-                self.height,
-                self.frames,
-                self.setup_ms,
-            )
-        }
+        crate::report::RunReport::builder(api, device, self.scene.stats(), self.variant.label())
+            .size(self.width, self.height)
+            .path(self.path, self.workgroup)
+            .frames(self.frames, self.setup_ms)
+            .validation_messages(validation_messages)
+            .build()
     }
 }
 

@@ -5,7 +5,7 @@
 //! same module — then takes out two costs naga adds on its own (see
 //! `strip_local_array_zero_init` and `spv::Options::force_loop_bounding`).
 
-use crate::cli::{Experiment, RenderArgs, Workgroup};
+use crate::cli::{Experiment, RenderArgs, ValueName, Workgroup};
 use crate::numerics::Numerics;
 use crate::scene::{Features, Scene, MAX_DEPTH_LIMIT};
 use anyhow::{anyhow, Context};

@@ -8,7 +8,7 @@ use std::path::PathBuf;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::Arc;
 use twinray_common::cli::{
-    parse_size, parse_workgroup, Accel, RenderArgs, RenderPath, Size, Workgroup,
+    parse_size, parse_workgroup, Accel, RenderArgs, RenderPath, Size, ValueName, Workgroup,
 };
 use twinray_common::report::RunReport;
 

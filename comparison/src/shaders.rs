@@ -11,7 +11,7 @@ use crate::compare::api_name;
 use std::fmt::Write as _;
 use std::path::Path;
 use std::sync::atomic::{AtomicBool, Ordering};
-use twinray_common::cli::{Accel, RenderArgs, RenderPath, Size};
+use twinray_common::cli::{Accel, RenderArgs, RenderPath, Size, ValueName};
 use twinray_common::report::ShaderStats;
 
 pub struct ShaderRow {

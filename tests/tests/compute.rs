@@ -3,6 +3,7 @@
 //! NaN, zero validation messages / GL debug errors; every measured workgroup
 //! size, and image sizes that are not a multiple of the workgroup, included.
 
+use twinray_common::cli::ValueName;
 use twinray_common::metrics::compare;
 use twinray_tests::{render, scratch, App};
 

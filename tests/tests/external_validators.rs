@@ -11,7 +11,7 @@
 use std::path::{Path, PathBuf};
 use std::process::Command;
 use std::sync::Mutex;
-use twinray_common::cli::{Accel, Experiment, RenderArgs, Size, Workgroup};
+use twinray_common::cli::{Accel, Experiment, RenderArgs, Size, ValueName, Workgroup};
 use twinray_common::numerics::{Numerics, Offset, SphereTest, TriangleTest};
 use twinray_common::scene::{Features, Scene};
 use twinray_common::shader::{self, Variant};

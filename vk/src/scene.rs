@@ -10,6 +10,7 @@ use crate::memory::Buffer;
 use crate::pipeline::Pipeline;
 use anyhow::Result;
 use ash::vk;
+use twinray_common::cli::SceneMemory;
 use twinray_common::gpu::{binding, check_storage_limit, storage_name, GpuScene};
 use twinray_common::shader::Shaders;
 
@@ -53,10 +54,14 @@ impl SceneResources {
 
 /// The `Frame` uniform buffer and the storage buffers, filled with the scene's
 /// bytes: what both the graphics and the compute pipeline read.
+///
+/// Device-local memory, filled once through a staging buffer, is the careful
+/// choice. `--vk-memory host` keeps the scene in host-visible memory instead,
+/// so the comparison can show what a naive placement costs.
 pub fn scene_buffers(device: &Device, scene: &GpuScene) -> Result<(Buffer, Vec<(u32, Buffer)>)> {
     let limit = device.properties.limits.max_storage_buffer_range as u64;
     check_storage_limit(scene, limit, "maxStorageBufferRange")?;
-    let host = host_memory()?;
+    let host = device.scene_memory == SceneMemory::Host;
     let place = |bytes: &[u8], usage: vk::BufferUsageFlags, what: &str| {
         if host {
             Buffer::host_visible_with(device, bytes, usage, what)
@@ -75,17 +80,4 @@ pub fn scene_buffers(device: &Device, scene: &GpuScene) -> Result<(Buffer, Vec<(
         })
         .collect::<Result<Vec<_>>>()?;
     Ok((frame, storage))
-}
-
-/// Device-local memory, filled once through a staging buffer, is the careful
-/// choice. `TWINRAY_VK_MEMORY=host` keeps the scene in host-visible memory
-/// instead, so the comparison can show what a naive placement costs.
-pub fn host_memory() -> Result<bool> {
-    match std::env::var("TWINRAY_VK_MEMORY").as_deref() {
-        Ok("host") => Ok(true),
-        Ok("device") | Err(_) => Ok(false),
-        Ok(other) => Err(twinray_common::error::bad_input(format!(
-            "TWINRAY_VK_MEMORY='{other}' is not 'device' or 'host'"
-        ))),
-    }
 }
