@@ -367,7 +367,7 @@ pub struct VulkanKnobs {
         long = "vk-device",
         env = "TWINRAY_VK_DEVICE",
         value_name = "INDEX|NAME",
-        value_parser = named_in_env(clap::builder::StringValueParser::new(), "an index or part of a device name")
+        value_parser = named_in_env(clap::builder::StringValueParser::new())
     )]
     pub device: Option<String>,
     /// Where the scene's buffers live: device-local memory filled through a
@@ -377,7 +377,7 @@ pub struct VulkanKnobs {
         long = "vk-memory",
         env = "TWINRAY_VK_MEMORY",
         value_enum,
-        value_parser = named_in_env(clap::builder::EnumValueParser::<SceneMemory>::new(), ""),
+        value_parser = named_in_env(clap::builder::EnumValueParser::<SceneMemory>::new()),
         default_value_t = SceneMemory::Device
     )]
     pub memory: SceneMemory,
@@ -386,7 +386,7 @@ pub struct VulkanKnobs {
     #[arg(
         long = "vk-validation",
         env = "TWINRAY_VK_VALIDATION",
-        value_parser = named_in_env(clap::builder::BoolishValueParser::new(), "1 or 0 (or true/false, yes/no, on/off)")
+        value_parser = named_in_env(clap::builder::BoolishValueParser::new())
     )]
     pub validation: bool,
     /// How each headless frame is waited for: its fence, or vkQueueWaitIdle +
@@ -395,7 +395,7 @@ pub struct VulkanKnobs {
         long = "vk-wait",
         env = "TWINRAY_VK_WAIT",
         value_enum,
-        value_parser = named_in_env(clap::builder::EnumValueParser::<FrameWait>::new(), ""),
+        value_parser = named_in_env(clap::builder::EnumValueParser::<FrameWait>::new()),
         default_value_t = FrameWait::Fence
     )]
     pub wait: FrameWait,
@@ -442,7 +442,7 @@ pub struct OpenGlKnobs {
         long = "gl-device",
         env = "TWINRAY_GL_DEVICE",
         value_name = "INDEX",
-        value_parser = named_in_env(parse_index, "a device index (0, 1, ...)")
+        value_parser = named_in_env(parse_index)
     )]
     pub device: Option<usize>,
 }
@@ -450,23 +450,19 @@ pub struct OpenGlKnobs {
 fn parse_index(s: &str) -> Result<usize, String> {
     s.trim()
         .parse()
-        .map_err(|_| format!("'{s}' is not a device index (0, 1, ...)"))
+        .map_err(|_| "not a device index (0, 1, ...)".to_string())
 }
 
 /// Wraps a knob's value parser so that a bad value read from the environment
-/// is named by its variable: clap's own message names only the option, which
-/// the user never typed.
-pub fn named_in_env<P: TypedValueParser>(parser: P, expected: &'static str) -> NamedInEnv<P> {
-    NamedInEnv { parser, expected }
+/// is named by its variable: clap's own message names the option, which the
+/// user never typed.
+pub fn named_in_env<P: TypedValueParser>(parser: P) -> NamedInEnv<P> {
+    NamedInEnv(parser)
 }
 
-/// See [`named_in_env`]. `expected` says what a valid value is; empty for
-/// enums, whose possible values say it.
+/// See [`named_in_env`].
 #[derive(Clone)]
-pub struct NamedInEnv<P> {
-    parser: P,
-    expected: &'static str,
-}
+pub struct NamedInEnv<P>(P);
 
 impl<P: TypedValueParser> TypedValueParser for NamedInEnv<P> {
     type Value = P::Value;
@@ -477,7 +473,7 @@ impl<P: TypedValueParser> TypedValueParser for NamedInEnv<P> {
         arg: Option<&clap::Arg>,
         value: &std::ffi::OsStr,
     ) -> Result<Self::Value, clap::Error> {
-        self.parser.parse_ref(cmd, arg, value)
+        self.0.parse_ref(cmd, arg, value)
     }
 
     fn parse_ref_(
@@ -487,36 +483,20 @@ impl<P: TypedValueParser> TypedValueParser for NamedInEnv<P> {
         value: &std::ffi::OsStr,
         source: ValueSource,
     ) -> Result<Self::Value, clap::Error> {
-        let result = self.parser.parse_ref_(cmd, arg, value, source);
-        let variable = arg.and_then(clap::Arg::get_env);
-        match (result, variable) {
-            (Err(_), Some(variable)) if source == ValueSource::EnvVariable => {
-                let expected = match self.possible_values() {
-                    Some(values) if self.expected.is_empty() => {
-                        let names: Vec<String> =
-                            values.map(|v| format!("'{}'", v.get_name())).collect();
-                        format!("one of {}", names.join(", "))
-                    }
-                    _ => self.expected.to_string(),
-                };
-                let option = arg.map_or(String::new(), |a| {
-                    format!(" (or --{})", a.get_long().unwrap_or_default())
-                });
-                let message = format!(
-                    "{}='{}' is not {expected}{option}\n",
-                    variable.to_string_lossy(),
-                    value.to_string_lossy()
-                );
-                Err(
-                    clap::Error::raw(clap::error::ErrorKind::InvalidValue, message)
-                        .format(&mut cmd.clone()),
-                )
+        use clap::error::{ContextKind, ContextValue};
+        self.0.parse_ref_(cmd, arg, value, source).map_err(|mut e| {
+            let variable = arg.and_then(clap::Arg::get_env);
+            if let (Some(variable), ValueSource::EnvVariable) = (variable, source) {
+                // The clap message stays ("invalid value 'x' for '...'", the
+                // possible values); only the culprit's name changes.
+                let name = ContextValue::String(variable.to_string_lossy().into_owned());
+                e.insert(ContextKind::InvalidArg, name);
             }
-            (result, _) => result,
-        }
+            e
+        })
     }
 
     fn possible_values(&self) -> Option<Box<dyn Iterator<Item = PossibleValue> + '_>> {
-        self.parser.possible_values()
+        self.0.possible_values()
     }
 }

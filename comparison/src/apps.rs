@@ -48,7 +48,7 @@ pub fn parse_bin_dir(s: &str) -> Result<PathBuf, String> {
     if dir.is_dir() {
         Ok(dir)
     } else {
-        Err(format!("'{s}' is not a folder"))
+        Err("not a folder".to_string())
     }
 }
 

@@ -28,7 +28,7 @@ struct Cli {
         global = true,
         env = "TWINRAY_BIN_DIR",
         value_name = "DIR",
-        value_parser = named_in_env(apps::parse_bin_dir, "a folder")
+        value_parser = named_in_env(apps::parse_bin_dir)
     )]
     bin_dir: Option<std::path::PathBuf>,
 }
