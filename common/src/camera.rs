@@ -5,6 +5,7 @@
 //! origin: the point subtracted in f64 from every position before the GPU's f32
 //! conversion, so that a scene far from the world origin is traced as if near it.
 
+use crate::cli::ValueName;
 use crate::scene::{Camera, Scene};
 use glam::DVec3;
 use std::borrow::Cow;
@@ -67,7 +68,8 @@ impl RayFrame {
 }
 
 /// Where the GPU's coordinates are measured from (`--set origin=`, `[render] origin`).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default, serde::Serialize)]
+// ValueEnum for its name only (`ValueName`): `--set` and scene files parse it.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default, serde::Serialize, clap::ValueEnum)]
 pub enum OriginMode {
     /// The camera's look-at point, snapped to a power-of-two grid (`local_origin`).
     #[default]
@@ -79,13 +81,6 @@ pub enum OriginMode {
 
 impl OriginMode {
     pub const ALL: [OriginMode; 2] = [OriginMode::Local, OriginMode::World];
-
-    pub fn name(self) -> &'static str {
-        match self {
-            OriginMode::Local => "local",
-            OriginMode::World => "world",
-        }
-    }
 
     /// Parses `local` or `world`; `what` names the source in the error.
     pub fn parse(value: &str, what: &str) -> anyhow::Result<OriginMode> {

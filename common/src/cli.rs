@@ -500,3 +500,44 @@ impl<P: TypedValueParser> TypedValueParser for NamedInEnv<P> {
         self.0.possible_values()
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::camera::OriginMode;
+    use crate::numerics::{Offset, SphereTest, TriangleTest};
+
+    fn names<T: ValueEnum>() -> Vec<String> {
+        T::value_variants().iter().map(ValueName::name).collect()
+    }
+
+    /// The names are in reports, CSV columns, variant labels and scripts:
+    /// deriving them must keep every spelling.
+    #[test]
+    fn value_names_keep_their_spelling() {
+        assert_eq!(names::<Accel>(), ["auto", "none", "bvh"]);
+        assert_eq!(names::<RenderPath>(), ["fragment", "compute"]);
+        assert_eq!(
+            names::<Experiment>(),
+            [
+                "naga-zero-init",
+                "naga-loop-bounding",
+                "no-loop-bounding",
+                "shared-bvh-stack",
+                "stackless-bvh",
+                "unpaired-bvh-stack",
+                "storage-counts",
+                "uniform-counts"
+            ]
+        );
+        assert_eq!(
+            names::<Offset>(),
+            ["ray", "normal", "normal-scaled", "ulp", "scale-aware"]
+        );
+        assert_eq!(names::<TriangleTest>(), ["moller-trumbore", "watertight"]);
+        assert_eq!(names::<SphereTest>(), ["quadratic", "stable"]);
+        assert_eq!(names::<OriginMode>(), ["local", "world"]);
+        assert_eq!(names::<SceneMemory>(), ["device", "host"]);
+        assert_eq!(names::<FrameWait>(), ["fence", "idle"]);
+    }
+}

@@ -15,7 +15,7 @@ use plotters::prelude::*;
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 use twinray_common::camera::OriginMode;
-use twinray_common::cli::{RenderArgs, Size};
+use twinray_common::cli::{RenderArgs, Size, ValueName};
 use twinray_common::hard::{self, HardCase, WRONG_ABOVE};
 use twinray_common::metrics;
 use twinray_common::numerics::{Numerics, Offset, SphereTest, TriangleTest};
