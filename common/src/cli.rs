@@ -327,31 +327,19 @@ pub fn parse_or_exit<T: Parser>() -> T {
     }
 }
 
-/// `twinray-vk`'s command line: the shared options and the Vulkan knobs.
+/// An app's command line: the shared options and that app's knobs.
 #[derive(Parser, Debug, Clone)]
-#[command(
-    name = "twinray-vk",
-    about = "The Whitted ray tracer through Vulkan (ash); twinray-gl is its OpenGL twin"
-)]
-pub struct VulkanCli {
+pub struct AppCli<K: clap::Args> {
     #[command(flatten)]
     pub render: RenderArgs,
     #[command(flatten)]
-    pub knobs: VulkanKnobs,
+    pub knobs: K,
 }
 
-/// `twinray-gl`'s command line: the shared options and the OpenGL knob.
-#[derive(Parser, Debug, Clone)]
-#[command(
-    name = "twinray-gl",
-    about = "The Whitted ray tracer through OpenGL (glow + glutin); twinray-vk is its Vulkan twin"
-)]
-pub struct OpenGlCli {
-    #[command(flatten)]
-    pub render: RenderArgs,
-    #[command(flatten)]
-    pub knobs: OpenGlKnobs,
-}
+/// `twinray-vk`'s command line.
+pub type VulkanCli = AppCli<VulkanKnobs>;
+/// `twinray-gl`'s command line.
+pub type OpenGlCli = AppCli<OpenGlKnobs>;
 
 // The knobs are each app's own: the other app never reads them, so a Vulkan
 // knob set for a whole comparison cannot stop the OpenGL runs, as before.
