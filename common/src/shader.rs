@@ -14,7 +14,18 @@ use naga::valid::{Capabilities, ModuleInfo, ValidationFlags, Validator};
 use naga::{Module, ShaderStage};
 use std::collections::BTreeMap;
 
-pub const TRACE_GLSL: &str = include_str!("../../shaders/trace.glsl");
+/// The tracer as one source. naga has no `#include`, so this is the one place
+/// that puts the parts of shaders/trace/ together, in the reading order that
+/// trace.glsl's header lists; every variant, both APIs and both paths start
+/// from it.
+pub const TRACE_GLSL: &str = concat!(
+    include_str!("../../shaders/trace/inputs.glsl"),
+    include_str!("../../shaders/trace/intersect.glsl"),
+    include_str!("../../shaders/trace/bvh.glsl"),
+    include_str!("../../shaders/trace/hit.glsl"),
+    include_str!("../../shaders/trace/secondary.glsl"),
+    include_str!("../../shaders/trace.glsl"),
+);
 pub const TRACE_FRAG: &str = include_str!("../../shaders/trace.frag");
 pub const FULLSCREEN_VERT: &str = include_str!("../../shaders/fullscreen.vert");
 pub const TRACE_COMP: &str = include_str!("../../shaders/trace.comp");

@@ -1,0 +1,239 @@
+// trace/bvh.glsl — the closest-hit and any-hit walks of the BVH that
+// common/src/bvh.rs builds; compiled only into the USE_BVH variants.
+
+#ifdef USE_BVH
+const uint SPHERE_BIT = 0x80000000u;
+
+// The traversal stack holds the far children still to visit, each entry
+// uvec2(node, floatBitsToUint(entry t)), two entries to a uvec4: NVIDIA's
+// OpenGL compiler gives every element of a local array a whole 16-byte slot,
+// so two scalar arrays cost it four times the memory of these pairs (on an
+// H100 its teapot BVH tracer went from 259 slots to 21, and from 6.2 to
+// 0.54 ms on the compute path). BVH_STACK is the built tree's depth - 1
+// (common/src/shader.rs): the traversal pushes at most one child per level of
+// the current path, so no push is ever dropped and no slot is wasted.
+//
+// Experiments (--experiment, common/src/cli.rs): BVH_STACK_UNPAIRED keeps
+// one uvec2 per element; BVH_STACK_SHARED (compute only, where it fits)
+// keeps the stack in shared memory, entry-major so that a warp's pushes hit
+// distinct banks; BVH_STACKLESS below has no stack at all.
+#ifndef BVH_STACK
+// Only a source compiled without the build's defines (an external compiler
+// checking trace.glsl on its own) gets here: the apps always size the stack
+// from the tree. A fixed stack cannot know the tree, so it drops what does
+// not fit rather than write past its end.
+#define BVH_STACK 64
+#define BVH_STACK_FIXED 1
+#endif
+#if defined(BVH_STACK_SHARED)
+shared uvec2 bvh_stack[BVH_STACK * WG_X * WG_Y];
+#define BVH_PUSH(i, e) bvh_stack[(i) * uint(WG_X * WG_Y) + gl_LocalInvocationIndex] = (e)
+#define BVH_POP(i) bvh_stack[(i) * uint(WG_X * WG_Y) + gl_LocalInvocationIndex]
+#elif defined(BVH_STACK_UNPAIRED)
+#define BVH_STACK_DECLARE uvec2 stack[BVH_STACK]
+#define BVH_PUSH(i, e) stack[i] = (e)
+#define BVH_POP(i) stack[i]
+#else
+#define BVH_STACK_DECLARE uvec4 stack[(BVH_STACK + 1) / 2]
+#define BVH_PUSH(i, e) if (((i) & 1u) == 0u) { stack[(i) >> 1u].xy = (e); } else { stack[(i) >> 1u].zw = (e); }
+#define BVH_POP(i) (((i) & 1u) == 0u ? stack[(i) >> 1u].xy : stack[(i) >> 1u].zw)
+#endif
+
+// Where the ray enters the box, or -1 if it misses it before t_max. Zero
+// direction components are nudged so 0 * inf never makes a NaN.
+float enter_box(vec3 origin, vec3 inv_dir, uint node, float t_max) {
+    vec3 t0 = (bvh_buf.nodes[node].bmin - origin) * inv_dir;
+    vec3 t1 = (bvh_buf.nodes[node].bmax - origin) * inv_dir;
+    vec3 tn = min(t0, t1);
+    vec3 tf = max(t0, t1);
+    float enter = max(max(tn.x, tn.y), max(tn.z, 0.0));
+    float leave = min(min(tf.x, tf.y), min(tf.z, t_max));
+    return enter <= leave ? enter : -1.0;
+}
+
+vec3 inverse_dir(vec3 dir) {
+    vec3 d = mix(vec3(1.0e-30), abs(dir), greaterThan(abs(dir), vec3(1.0e-30)));
+    return sign(dir + vec3(1.0e-38)) / d;
+}
+
+// Tests a leaf's primitives against the ray, keeping the closest hit in h.
+// True when an any-hit query (shadow rays) may stop.
+bool hit_leaf(inout Hit h, vec3 origin, vec3 dir, TriRay ray, uint first, uint count, bool any_hit) {
+    for (uint k = 0u; k < count; k++) {
+        uint prim = prim_buf.prims[first + k];
+        if ((prim & SPHERE_BIT) != 0u) {
+            uint i = prim & ~SPHERE_BIT;
+            float t = hit_sphere(origin, dir, sphere_buf.spheres[i], 0.0, h.t);
+            if (t > 0.0) {
+                h.t = t;
+                h.kind = 1u;
+                h.index = i;
+            }
+        } else {
+            vec3 r = hit_triangle(ray, triangle_buf.triangles[prim], 0.0, h.t);
+            if (r.x > 0.0) {
+                h.t = r.x;
+                h.kind = 2u;
+                h.index = prim;
+                h.u = r.y;
+                h.v = r.z;
+            }
+        }
+        if (any_hit && h.kind != 0u) {
+            return true;
+        }
+    }
+    return false;
+}
+
+#ifdef BVH_STACKLESS
+// The stackless alternative (Hapala, Davidovic, Wald, Havran 2011): no array
+// at all. From each node's parent link and split axis the traversal knows
+// where to go next: down to the near child (the lower side when the ray runs
+// towards +axis), across to the sibling, or back up. Each box is tested at
+// most once; going up costs a link read instead of a stack pop.
+const uint FROM_PARENT = 0u;
+const uint FROM_SIBLING = 1u;
+const uint FROM_CHILD = 2u;
+
+uint parent_of(uint node) {
+    return link_buf.links[node] & 0x3FFFFFFFu;
+}
+
+uint near_child(uint node, vec3 dir) {
+    uint axis = link_buf.links[node] >> 30u;
+    return dir[axis] >= 0.0 ? node + 1u : bvh_buf.nodes[node].left_or_first;
+}
+
+uint sibling_of(uint node, uint parent) {
+    return node == parent + 1u ? bvh_buf.nodes[parent].left_or_first : parent + 1u;
+}
+
+Hit traverse(vec3 origin, vec3 dir, float t_max, bool any_hit) {
+    Hit h;
+    h.t = t_max;
+    h.kind = 0u;
+    h.index = 0u;
+    h.u = 0.0;
+    h.v = 0.0;
+    vec3 inv_dir = inverse_dir(dir);
+    TriRay ray = tri_ray(origin, dir);
+    if (enter_box(origin, inv_dir, 0u, t_max) < 0.0) {
+        return h;
+    }
+    if (bvh_buf.nodes[0].count > 0u) {
+        hit_leaf(h, origin, dir, ray, bvh_buf.nodes[0].left_or_first, bvh_buf.nodes[0].count, any_hit);
+        return h;
+    }
+    uint node = near_child(0u, dir);
+    uint state = FROM_PARENT;
+    while (true) {
+        if (state == FROM_CHILD) {
+            if (node == 0u) {
+                break;
+            }
+            uint parent = parent_of(node);
+            if (node == near_child(parent, dir)) {
+                node = sibling_of(node, parent);
+                state = FROM_SIBLING;
+            } else {
+                node = parent;
+            }
+            continue;
+        }
+        bool enter = enter_box(origin, inv_dir, node, h.t) >= 0.0;
+        uint count = bvh_buf.nodes[node].count;
+        if (enter && count == 0u) {
+            node = near_child(node, dir);
+            state = FROM_PARENT;
+            continue;
+        }
+        if (enter && hit_leaf(h, origin, dir, ray, bvh_buf.nodes[node].left_or_first, count, any_hit)) {
+            return h;
+        }
+        // Done with this subtree: the far sibling is next after the near
+        // child, the parent after the far one.
+        uint parent = parent_of(node);
+        if (state == FROM_PARENT) {
+            node = sibling_of(node, parent);
+            state = FROM_SIBLING;
+        } else {
+            node = parent;
+            state = FROM_CHILD;
+        }
+    }
+    return h;
+}
+#else
+// Visits the tree near child first and skips subtrees that start beyond the
+// closest hit so far. With `any_hit` (shadow rays) it stops at the first hit
+// before t_max and reports it with kind != 0.
+Hit traverse(vec3 origin, vec3 dir, float t_max, bool any_hit) {
+    Hit h;
+    h.t = t_max;
+    h.kind = 0u;
+    h.index = 0u;
+    h.u = 0.0;
+    h.v = 0.0;
+    vec3 inv_dir = inverse_dir(dir);
+    TriRay ray = tri_ray(origin, dir);
+#ifndef BVH_STACK_SHARED
+    BVH_STACK_DECLARE;
+#endif
+    uint sp = 0u;
+    if (enter_box(origin, inv_dir, 0u, t_max) < 0.0) {
+        return h;
+    }
+    uint node = 0u;
+    while (true) {
+        uint count = bvh_buf.nodes[node].count;
+        uint first = bvh_buf.nodes[node].left_or_first;
+        if (count > 0u) {
+            if (hit_leaf(h, origin, dir, ray, first, count, any_hit)) {
+                return h;
+            }
+        } else {
+            uint left = node + 1u;
+            uint right = first;
+            float tl = enter_box(origin, inv_dir, left, h.t);
+            float tr = enter_box(origin, inv_dir, right, h.t);
+            if (tl >= 0.0 && tr >= 0.0) {
+                bool left_first = tl <= tr;
+                node = left_first ? left : right;
+                // sp < BVH_STACK here: the stack is as deep as the tree.
+#ifdef BVH_STACK_FIXED
+                if (sp < uint(BVH_STACK))
+#endif
+                {
+                    BVH_PUSH(sp, uvec2(left_first ? right : left, floatBitsToUint(left_first ? tr : tl)));
+                    sp += 1u;
+                }
+                continue;
+            }
+            if (tl >= 0.0) {
+                node = left;
+                continue;
+            }
+            if (tr >= 0.0) {
+                node = right;
+                continue;
+            }
+        }
+        // Pop the nearest pending subtree that can still hold a closer hit.
+        bool found = false;
+        while (sp > 0u && !found) {
+            sp -= 1u;
+            uvec2 entry = BVH_POP(sp);
+            if (uintBitsToFloat(entry.y) < h.t) {
+                node = entry.x;
+                found = true;
+            }
+        }
+        if (!found) {
+            break;
+        }
+    }
+    return h;
+}
+#endif
+#endif

@@ -1,0 +1,155 @@
+// trace/inputs.glsl — what the tracer reads: the compile-time switches, the
+// structs that common/src/gpu.rs mirrors (a test checks naga's layout against
+// the Rust one), and every binding. The first part of trace.glsl's tracer.
+
+#ifndef STACK_SIZE
+#define STACK_SIZE 17
+#endif
+
+// The specialization-constant alternative (`--specialize`, common/src/shader.rs):
+// every feature is compiled in and each becomes a constant_id override, which
+// naga's process_overrides fixes per scene before it writes SPIR-V or GLSL.
+// SPEC(x) guards a feature's code with an `if` on its constant; without
+// SPECIALIZE it expands to nothing and the #ifdef alone decides.
+#ifdef SPECIALIZE
+layout(constant_id = 0) const bool SPEC_SPHERES = true;
+layout(constant_id = 1) const bool SPEC_TRIANGLES = true;
+layout(constant_id = 2) const bool SPEC_MIRROR = true;
+layout(constant_id = 3) const bool SPEC_GLASS = true;
+#define HAS_SPHERES 1
+#define HAS_TRIANGLES 1
+#define HAS_MIRROR 1
+#define HAS_GLASS 1
+#define SPEC(feature) if (feature)
+#else
+#define SPEC(feature)
+#endif
+
+struct Material {
+    vec3 ambient;
+    float reflectivity;
+    vec3 diffuse;
+    float transparency;
+    vec3 specular;
+    float shininess;
+    float ior;
+    uint pad0;
+    uint pad1;
+    uint pad2;
+};
+
+struct Sphere {
+    vec3 center;
+    float radius;
+    uint material;
+    uint pad0;
+    uint pad1;
+    uint pad2;
+};
+
+// Vertices and per-vertex normals; the material index rides in p0's spare slot.
+struct Triangle {
+    vec3 p0;
+    uint material;
+    vec3 p1;
+    uint pad0;
+    vec3 p2;
+    uint pad1;
+    vec3 n0;
+    uint pad2;
+    vec3 n1;
+    uint pad3;
+    vec3 n2;
+    uint pad4;
+};
+
+struct Light {
+    vec3 position;
+    float pad0;
+    vec3 color;
+    float pad1;
+};
+
+// The camera is an eye plus the centre of the top-left pixel and per-pixel steps:
+// the y step points down the image, so both APIs produce the same upright image.
+layout(std140, set = 0, binding = 0) uniform Frame {
+    vec3 eye;
+    float min_weight;
+    vec3 top_left;  // relative to the eye (see common/src/camera.rs)
+    float epsilon;
+    vec3 step_x;
+    uint max_depth;
+    vec3 step_y;
+    uint sphere_count;    // read only where SPHERE_COUNT is not given (see below)
+    vec3 background;
+    uint triangle_count;
+    uint light_count;
+    uint width;   // image size in pixels: the compute entry point's bounds check
+    uint height;
+    uint pad;
+} frame;
+
+// The counts as a storage buffer: read at run time, yet no driver inlines
+// them into a new shader the way lavapipe does with uniform values.
+layout(std430, set = 0, binding = 9) readonly buffer Counts {
+    uint spheres;
+    uint triangles;
+    uint lights;
+} count_buf;
+
+// Every variant an app runs bakes the counts in (shader.rs, Variant::chosen)
+// or reads them from Counts; only the scene-independent generic variant of the
+// tests reads them from the uniform.
+#if defined(COUNTS_FROM_STORAGE)
+#define SPHERE_COUNT count_buf.spheres
+#define TRIANGLE_COUNT count_buf.triangles
+#define LIGHT_COUNT count_buf.lights
+#elif !defined(SPHERE_COUNT)
+#define SPHERE_COUNT frame.sphere_count
+#define TRIANGLE_COUNT frame.triangle_count
+#define LIGHT_COUNT frame.light_count
+#endif
+
+layout(std430, set = 0, binding = 1) readonly buffer Spheres {
+    Sphere spheres[];
+} sphere_buf;
+
+layout(std430, set = 0, binding = 2) readonly buffer Triangles {
+    Triangle triangles[];
+} triangle_buf;
+
+layout(std430, set = 0, binding = 3) readonly buffer Materials {
+    Material materials[];
+} material_buf;
+
+layout(std430, set = 0, binding = 4) readonly buffer Lights {
+    Light lights[];
+} light_buf;
+
+// The BVH (common/src/bvh.rs), depth-first: an interior node's left child is the
+// next node and `left_or_first` its right child; a leaf (count > 0) holds
+// prims[left_or_first .. +count], each a triangle index or a sphere index with
+// the top bit set. Bound always; read only by the USE_BVH variant.
+struct BvhNode {
+    vec3 bmin;
+    uint left_or_first;
+    vec3 bmax;
+    uint count;
+};
+
+layout(std430, set = 0, binding = 6) readonly buffer BvhNodes {
+    BvhNode nodes[];
+} bvh_buf;
+
+layout(std430, set = 0, binding = 7) readonly buffer BvhPrims {
+    uint prims[];
+} prim_buf;
+
+// Per node: the parent's index (low 30 bits) and the axis the node's children
+// were split on (top 2 bits). Read only by the BVH_STACKLESS traversal.
+layout(std430, set = 0, binding = 8) readonly buffer BvhLinks {
+    uint links[];
+} link_buf;
+
+const float T_MAX = 1.0e30;
+
