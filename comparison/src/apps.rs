@@ -389,4 +389,47 @@ mod tests {
             );
         }
     }
+
+    #[test]
+    fn each_option_alone_round_trips() {
+        // One option at a time, taken from the parser itself, so that two
+        // options swapped in app_args cannot hide behind each other.
+        use clap::CommandFactory;
+        let sample = |long: &str| match long {
+            "scene" => "spherelist",
+            "size" => "33x17",
+            "frames" => "7",
+            "out" => "a.png",
+            "set" => "max_depth=3",
+            "workgroup" => "8x4",
+            "dump-shaders" => "dump",
+            other => panic!("--{other} needs a sample value in this test"),
+        };
+        for option in RenderArgs::command().get_arguments() {
+            let Some(long) = option.get_long() else {
+                continue;
+            };
+            // app_args always adds --headless, so every run has it.
+            let mut argv = vec!["twinray-vk".to_string(), "--headless".into()];
+            if long != "headless" {
+                argv.push(format!("--{long}"));
+            }
+            if option.get_action().takes_values() {
+                let values = option.get_possible_values();
+                // The last possible value: never the first, which is each enum's default.
+                argv.push(match values.last() {
+                    Some(v) => v.get_name().to_string(),
+                    None => sample(long).to_string(),
+                });
+            }
+            let args = VulkanCli::try_parse_from(&argv)
+                .unwrap_or_else(|e| panic!("{argv:?} does not parse: {e}"))
+                .render;
+            assert_eq!(
+                round_trip(&args),
+                args,
+                "--{long} does not survive app_args"
+            );
+        }
+    }
 }
