@@ -10,12 +10,9 @@ bin=$1
 out=$2
 mkdir -p "$out"
 log="$out/candidates.jsonl"
-run() { # label, app, then the app's options
-    local label=$1 app=$2
-    shift 2
-    echo "{\"label\":\"$label\",\"cmd\":\"twinray-$app $*\"}" >> "$log"
-    timeout 120 "$bin/twinray-$app" --headless --json "$@" >> "$log" 2>> "$out/candidates.log" || echo "{\"failed\":\"twinray-$app $*\"}" >> "$log"
-}
+errors="$out/candidates.log"
+# shellcheck source=comparison/gpu-lib.sh
+source "$(dirname "$0")/gpu-lib.sh"
 for app in vk gl; do
     for path in fragment compute; do
         run dump $app --scene teapot --size 64x64 --accel bvh --path $path --experiment stackless-bvh --dump-shaders "$out/dump-$app-$path-stackless"

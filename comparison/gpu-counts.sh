@@ -10,12 +10,9 @@ bin=$1
 out=$2
 mkdir -p "$out"
 log="$out/counts.jsonl"
-run() { # label, app, then the app's options
-    local label=$1 app=$2
-    shift 2
-    echo "{\"label\":\"$label\",\"cmd\":\"twinray-$app $*\"}" >> "$log"
-    timeout 120 "$bin/twinray-$app" --headless --json "$@" >> "$log" 2>> "$out/counts.log" || echo "{\"failed\":\"twinray-$app $*\"}" >> "$log"
-}
+errors="$out/counts.log"
+# shellcheck source=comparison/gpu-lib.sh
+source "$(dirname "$0")/gpu-lib.sh"
 points=(
     "--scene spherelist --size 300x300 --set extra_spheres=10000 --accel none --frames 10"
     "--scene box --size 1000x1000 --accel none --frames 60"

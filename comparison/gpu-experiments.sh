@@ -11,12 +11,9 @@ out=$2
 shift 2
 mkdir -p "$out"
 log="$out/experiments.jsonl"
-run() { # label, app, then the app's options
-    local label=$1 app=$2
-    shift 2
-    echo "{\"label\":\"$label\",\"cmd\":\"twinray-$app $*\"}" >> "$log"
-    timeout 120 "$bin/twinray-$app" --headless --json "$@" >> "$log" 2>> "$out/experiments.log" || echo "{\"failed\":\"twinray-$app $*\"}" >> "$log"
-}
+errors="$out/experiments.log"
+# shellcheck source=comparison/gpu-lib.sh
+source "$(dirname "$0")/gpu-lib.sh"
 for e in "$@"; do
     for app in vk gl; do
         for path in fragment compute; do

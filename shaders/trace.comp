@@ -7,7 +7,7 @@
 // APIs, and a plain copy/readback of the image gives the upright picture.
 //
 // WG_X x WG_Y is the workgroup size, set per run through naga defines
-// (common/src/shader.rs); the dispatch is ceil(width / WG_X) x ceil(height / WG_Y),
+// (common/src/shader/build.rs); the dispatch is ceil(width / WG_X) x ceil(height / WG_Y),
 // so invocations past the right and bottom edges return at once.
 
 #ifndef WG_X

@@ -20,13 +20,13 @@
 // a uniform made Mesa's lavapipe compile and keep a new copy of the shader at
 // every draw (about 3 MB a frame). The scene's variant knows them anyway.
 //
-// Numerical choices are defines too (common/src/numerics.rs), one of each:
+// Numerical choices are defines too (common/src/scene/numerics.rs), one of each:
 //   OFFSET_RAY | OFFSET_NORMAL | OFFSET_NORMAL_SCALED | OFFSET_ULP | OFFSET_SCALE_AWARE  (secondary-ray origin)
 //   TRIANGLE_MOLLER_TRUMBORE | TRIANGLE_WATERTIGHT                    (ray-triangle test)
 //   SPHERE_QUADRATIC | SPHERE_STABLE                                  (ray-sphere test)
 // With none given, the shader falls back to normal-scaled / Moller-Trumbore / stable.
 //
-// The CPU reference (common/src/reference.rs) follows these files step by step
+// The CPU reference (common/src/reference/) follows these files step by step
 // in f64; change both together.
 
 vec3 trace(vec3 origin, vec3 dir) {

@@ -5,6 +5,8 @@
 //! can set them for every run). Everything is parsed once, in `main`.
 
 use crate::error::bad_input;
+use crate::scene::accel::Accel;
+use crate::value_name::ValueName;
 use clap::builder::{PossibleValue, TypedValueParser};
 use clap::parser::ValueSource;
 use clap::{Parser, ValueEnum};
@@ -104,13 +106,18 @@ pub enum Experiment {
     /// Read the primitive and light counts from the Frame uniform instead of
     /// baking them into the shader (what made lavapipe grow per frame).
     UniformCounts,
-}
-
-#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
-pub enum Accel {
-    Auto,
-    None,
-    Bvh,
+    /// Forbid the driver to fuse or reassociate float arithmetic: a
+    /// `NoContraction` decoration on every float operation of the SPIR-V and
+    /// `precise` on every float local of the GLSL.
+    NoContraction,
+    /// SPIR-V only: ask for IEEE behaviour the driver may otherwise relax
+    /// (SPV_KHR_float_controls: denormals preserved, signed zero, Inf and NaN
+    /// preserved), to see whether Vulkan's defaults explain its pixels.
+    FloatControls,
+    /// The SPIR-V (what Vulkan runs) from Khronos' reference compiler,
+    /// glslangValidator (on PATH; Debian's glslang-tools), given the same
+    /// GLSL and defines, instead of from naga.
+    Glslang,
 }
 
 /// The tracer's entry point: the two ways one GLSL tracer reaches the GPU.
@@ -138,22 +145,6 @@ pub enum RenderPath {
 impl std::fmt::Display for RenderPath {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         f.write_str(&self.name())
-    }
-}
-
-/// The name of an enum value as clap parses it (kebab-case unless a variant
-/// says otherwise), so that argv, reports and labels spell every value the one
-/// way the command line accepts it.
-pub trait ValueName {
-    fn name(&self) -> String;
-}
-
-impl<T: ValueEnum> ValueName for T {
-    fn name(&self) -> String {
-        // Only `#[value(skip)]` variants have no possible value, and none is skipped.
-        self.to_possible_value()
-            .map(|v| v.get_name().to_string())
-            .unwrap_or_default()
     }
 }
 
@@ -298,7 +289,7 @@ impl RenderArgs {
     /// Checks every output path (`--out`) before any work: a typo must not cost a render.
     pub fn check_outputs(&self) -> anyhow::Result<()> {
         if let Some(out) = &self.out {
-            crate::image_io::check_output_file("--out", out)?;
+            crate::reference::image_io::check_output_file("--out", out)?;
         }
         Ok(())
     }
@@ -492,8 +483,8 @@ impl<P: TypedValueParser> TypedValueParser for NamedInEnv<P> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::camera::OriginMode;
-    use crate::numerics::{Offset, SphereTest, TriangleTest};
+    use crate::scene::numerics::{Offset, SphereTest, TriangleTest};
+    use crate::scene::OriginMode;
 
     fn names<T: ValueEnum>() -> Vec<String> {
         T::value_variants().iter().map(ValueName::name).collect()
@@ -515,7 +506,10 @@ mod tests {
                 "stackless-bvh",
                 "unpaired-bvh-stack",
                 "storage-counts",
-                "uniform-counts"
+                "uniform-counts",
+                "no-contraction",
+                "float-controls",
+                "glslang"
             ]
         );
         assert_eq!(

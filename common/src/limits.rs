@@ -6,7 +6,7 @@
 //! are checked by each app against its own device, after these.
 
 use crate::error::bad_input;
-use crate::gpu::{GpuBvhNode, GpuSphere, GpuTriangle};
+use crate::gpu::layout::{GpuBvhNode, GpuSphere, GpuTriangle};
 
 /// Width or height: twice the largest maxImageDimension2D / GL_MAX_TEXTURE_SIZE
 /// any device reports (32768), so no device could render beyond it.

@@ -1,9 +1,10 @@
 //! Proves that naga's layout of every struct in shaders/trace.glsl equals the
-//! Rust mirror in common/src/gpu.rs: member offsets, struct sizes, array strides.
+//! Rust mirror in common/src/gpu/layout.rs: member offsets, struct sizes, array strides.
 
 use std::mem::{offset_of, size_of};
-use twinray_common::gpu::*;
-use twinray_common::shader::{fragment_source, parse, Variant};
+use twinray_common::gpu::layout::*;
+use twinray_common::shader::build::{fragment_source, parse};
+use twinray_common::shader::variant::Variant;
 
 /// (name, offset) of every member, in declaration order.
 fn naga_members(module: &naga::Module, ty: naga::Handle<naga::Type>) -> (Vec<(String, u32)>, u32) {
@@ -175,7 +176,7 @@ fn naga_layout_matches_rust_for_every_shader_struct() {
 fn every_builtin_variant_and_the_generic_one_compile_for_both_apis() {
     let mut variants = vec![Variant::generic(Default::default())];
     // Every numerical choice must compile too.
-    use twinray_common::numerics::{Numerics, Offset, SphereTest, TriangleTest};
+    use twinray_common::scene::numerics::{Numerics, Offset, SphereTest, TriangleTest};
     for offset in Offset::ALL {
         for triangle in TriangleTest::ALL {
             for sphere in SphereTest::ALL {
@@ -190,13 +191,13 @@ fn every_builtin_variant_and_the_generic_one_compile_for_both_apis() {
     let mut bvh = twinray_common::scene::Scene::load("box", &[]).unwrap();
     bvh.bvh = true;
     variants.push(Variant::for_scene(&bvh));
-    for (name, _) in twinray_common::scene::BUILTIN_SCENES {
+    for (name, _) in twinray_common::scene::load::BUILTIN_SCENES {
         let scene = twinray_common::scene::Scene::load(name, &[]).unwrap();
         variants.push(Variant::for_scene(&scene));
     }
     for v in variants {
-        let s =
-            twinray_common::shader::build(&v).unwrap_or_else(|e| panic!("{}: {e:#}", v.label()));
+        let s = twinray_common::shader::build::build(&v)
+            .unwrap_or_else(|e| panic!("{}: {e:#}", v.label()));
         assert_eq!(s.fragment_spirv[0], 0x0723_0203, "SPIR-V magic");
         assert!(
             s.fragment_glsl.starts_with("#version 450 core"),

@@ -1,8 +1,8 @@
 //! Scene loading: the built-in scenes have the study's counts, and every kind of
 //! bad scene input is refused with one sentence that names the culprit (exit 2).
 
-use twinray_common::camera::{Frustum, RayFrame};
 use twinray_common::error::exit_code_of;
+use twinray_common::scene::camera::{Frustum, RayFrame};
 use twinray_common::scene::Scene;
 
 fn set(kv: &[(&str, &str)]) -> Vec<(String, String)> {

@@ -5,9 +5,11 @@
 //! post-passes only ever remove naga's.
 
 use twinray_common::cli::{Experiment, Workgroup};
-use twinray_common::numerics::{Numerics, Offset, SphereTest, TriangleTest};
-use twinray_common::scene::{Scene, BUILTIN_SCENES};
-use twinray_common::shader::{self, Variant};
+use twinray_common::scene::load::BUILTIN_SCENES;
+use twinray_common::scene::numerics::{Numerics, Offset, SphereTest, TriangleTest};
+use twinray_common::scene::Scene;
+use twinray_common::shader::build;
+use twinray_common::shader::variant::Variant;
 
 fn variants() -> Vec<Variant> {
     let mut v = Vec::new();
@@ -76,8 +78,8 @@ fn no_local_array_keeps_an_initialiser() {
     assert!(variants.len() > 20);
     let mut arrays_seen = 0;
     for v in &variants {
-        let s = shader::build(v).unwrap_or_else(|e| panic!("{}: {e:#}", v.label()));
-        let c = shader::build_compute(v, Workgroup::DEFAULT).unwrap();
+        let s = build::build(v).unwrap_or_else(|e| panic!("{}: {e:#}", v.label()));
+        let c = build::build_compute(v, Workgroup::DEFAULT).unwrap();
         for (what, words, glsl) in [
             ("fragment", &s.fragment_spirv, &s.fragment_glsl),
             ("compute", &c.spirv, &c.glsl),
@@ -106,7 +108,7 @@ fn the_experiment_puts_the_initialisers_back() {
     scene.bvh = true;
     let mut v = Variant::for_scene(&scene);
     v.experiments = vec![Experiment::NagaZeroInit];
-    let s = shader::build(&v).unwrap();
+    let s = build::build(&v).unwrap();
     assert!(initialised_local_arrays(&s.fragment_spirv) > 0);
     assert!(!initialised_glsl_arrays(&s.fragment_glsl).is_empty());
 }
@@ -114,9 +116,9 @@ fn the_experiment_puts_the_initialisers_back() {
 #[test]
 fn trace_glsl_initialises_no_array_itself() {
     for (name, src) in [
-        ("trace.glsl", shader::TRACE_GLSL),
-        ("trace.frag", shader::TRACE_FRAG),
-        ("trace.comp", shader::TRACE_COMP),
+        ("trace.glsl", build::TRACE_GLSL),
+        ("trace.frag", build::TRACE_FRAG),
+        ("trace.comp", build::TRACE_COMP),
     ] {
         for (n, line) in src.lines().enumerate() {
             let code = line.split("//").next().unwrap_or("");

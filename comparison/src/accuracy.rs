@@ -14,14 +14,16 @@ use anyhow::Context;
 use plotters::prelude::*;
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
-use twinray_common::camera::OriginMode;
-use twinray_common::cli::{RenderArgs, Size, ValueName};
-use twinray_common::hard::{self, HardCase, WRONG_ABOVE};
-use twinray_common::metrics;
-use twinray_common::numerics::{Numerics, Offset, SphereTest, TriangleTest};
-use twinray_common::random_scene;
+use twinray_common::cli::{RenderArgs, Size};
+use twinray_common::limits::MAX_DEPTH;
 use twinray_common::reference;
-use twinray_common::scene::{Scene, MAX_DEPTH_LIMIT};
+use twinray_common::reference::metrics;
+use twinray_common::scene::hard::{self, HardCase, WRONG_ABOVE};
+use twinray_common::scene::numerics::{Numerics, Offset, SphereTest, TriangleTest};
+use twinray_common::scene::random;
+use twinray_common::scene::OriginMode;
+use twinray_common::scene::Scene;
+use twinray_common::value_name::ValueName;
 
 #[derive(clap::Args, Debug, Clone)]
 pub struct AccuracyArgs {
@@ -77,7 +79,7 @@ fn random_size(quick: bool) -> Size {
 fn run_random(n: u64, size: Size, out: &Path) -> anyhow::Result<Vec<RandomRow>> {
     let mut rows = Vec::new();
     for seed in 0..n {
-        let name = format!("{}{seed}", random_scene::PREFIX);
+        let name = format!("{}{seed}", random::PREFIX);
         let scene = Scene::load(&name, &[])?;
         let reference = reference::render(&scene, size.width, size.height);
         let ref_nan = reference.nonfinite_pixels() as u64;
@@ -116,13 +118,13 @@ fn run_random(n: u64, size: Size, out: &Path) -> anyhow::Result<Vec<RandomRow>> 
         ];
         for (pair, result) in RANDOM_PAIRS.into_iter().zip(results) {
             let bad = match &result {
-                Ok(m) => random_scene::disagreement(m),
+                Ok(m) => random::disagreement(m),
                 Err(e) => Some(e.clone()),
             };
             if let Some(why) = bad {
                 eprintln!(
                     "  random:{seed} {pair}: {why}\n  reproduce: {}",
-                    random_scene::reproduce(seed, size.width, size.height, "")
+                    random::reproduce(seed, size.width, size.height, "")
                 );
             }
             rows.push(RandomRow { seed, pair, result });
@@ -142,7 +144,7 @@ fn random_csv(rows: &[RandomRow]) -> String {
                     "{},{},{},{},{},{},{},{}",
                     r.seed,
                     q(r.pair),
-                    if random_scene::disagreement(m).is_some() {
+                    if random::disagreement(m).is_some() {
                         "disagree"
                     } else {
                         "ok"
@@ -181,13 +183,13 @@ fn random_markdown(rows: &[RandomRow], size: Size) -> String {
     let seeds = rows.iter().map(|r| r.seed).max().map_or(0, |m| m + 1);
     let _ = writeln!(
         s,
-        "## Random scenes ({seeds} seeds, {size})\n\n`--scene random:SEED` for seeds 0..{seeds} (common/src/random_scene.rs: spheres, triangles, \
+        "## Random scenes ({seeds} seeds, {size})\n\n`--scene random:SEED` for seeds 0..{seeds} (common/src/scene/random.rs: spheres, triangles, \
          a mesh, diffuse, mirror and glass with glass inside glass, 1–4 lights, random cameras), each rendered by both apps and \
          the f64 reference with the scene's own numerics. A pair disagrees when more than {:.2}% of its pixels are off by more \
          than 8/255 or fewer than {:.0}% are within 1/255 (the thresholds tests/tests/random_scenes.rs applies to 20 seeds). \
          Distribution over the seeds:\n",
-        100.0 * random_scene::MAX_OFF_SHARE,
-        100.0 * random_scene::MIN_WITHIN_1
+        100.0 * random::MAX_OFF_SHARE,
+        100.0 * random::MIN_WITHIN_1
     );
     let _ = writeln!(
         s,
@@ -211,7 +213,7 @@ fn random_markdown(rows: &[RandomRow], size: Size) -> String {
             .filter(|r| {
                 r.result
                     .as_ref()
-                    .map_or(true, |m| random_scene::disagreement(m).is_some())
+                    .map_or(true, |m| random::disagreement(m).is_some())
             })
             .collect();
         for r in &bad {
@@ -219,10 +221,10 @@ fn random_markdown(rows: &[RandomRow], size: Size) -> String {
                 "- random:{} {pair}: {}. Reproduce: `{}`",
                 r.seed,
                 match &r.result {
-                    Ok(m) => random_scene::disagreement(m).unwrap_or_default(),
+                    Ok(m) => random::disagreement(m).unwrap_or_default(),
                     Err(e) => e.replace('\n', " "),
                 },
-                random_scene::reproduce(r.seed, size.width, size.height, "")
+                random::reproduce(r.seed, size.width, size.height, "")
             ));
         }
         let _ = writeln!(
@@ -439,7 +441,7 @@ fn render_app(
         ..RenderArgs::headless(scene, size)
     };
     let r = run_json(api, &args)?;
-    let img = twinray_common::image_io::load_png(png)?;
+    let img = twinray_common::reference::image_io::load_png(png)?;
     // The fastest frame, not the median: other work on a shared machine only
     // ever adds time, so the minimum is the steadiest estimate of the cost.
     let wall = r.wall_ms.map(|s| s.min).unwrap_or(f64::NAN);
@@ -553,7 +555,15 @@ fn mark_pareto(rows: &mut [Row], unsound: &[Numerics]) {
 /// The shader a config compiles to on a scene, as its sorted defines.
 fn program_of(scene: &str, set: &[String]) -> anyhow::Result<String> {
     let scene = Scene::load(scene, &overrides(set))?;
-    let v = twinray_common::shader::Variant::for_scene(&scene);
+    // The variant the apps would compile for this scene with default options.
+    let args = RenderArgs::headless(
+        &scene.name,
+        Size {
+            width: 1,
+            height: 1,
+        },
+    );
+    let v = twinray_common::shader::variant::Variant::chosen(&scene, &args);
     Ok(v.defines
         .iter()
         .map(|(k, v)| format!("{k}={v}"))
@@ -573,8 +583,8 @@ pub struct HardRow {
 }
 
 pub fn run(args: &AccuracyArgs) -> anyhow::Result<()> {
-    twinray_common::image_io::prepare_output_dir("--out", &args.out)?;
-    twinray_common::image_io::prepare_output_dir("--out", &args.out.join("images"))?;
+    twinray_common::reference::image_io::prepare_output_dir("--out", &args.out)?;
+    twinray_common::reference::image_io::prepare_output_dir("--out", &args.out.join("images"))?;
     let frames = if args.quick { 5 } else { 30 };
     let mut rows: Vec<Row> = Vec::new();
     let started = std::time::Instant::now();
@@ -585,7 +595,7 @@ pub fn run(args: &AccuracyArgs) -> anyhow::Result<()> {
             numerics: scene.numerics,
         };
         let mut deep = scene.clone();
-        deep.max_depth = MAX_DEPTH_LIMIT;
+        deep.max_depth = MAX_DEPTH;
         let truth = reference::render_truth(&deep, size.width, size.height);
         truth.save_png(&args.out.join(format!("images/{scene_name}-truth.png")))?;
         let truth = truth.to_rgb8();
@@ -836,7 +846,7 @@ fn run_hard(case: &HardCase, size: Size, out: &Path) -> anyhow::Result<Vec<HardR
     let truth = reference::render_truth(&scene, size.width, size.height);
     truth.save_png(&out.join(format!("images/hard-{}-truth.png", case.name)))?;
     let truth = truth.to_rgb8();
-    let bg = twinray_common::image_io::FloatImage {
+    let bg = twinray_common::reference::image_io::FloatImage {
         width: 1,
         height: 1,
         pixels: vec![scene.background.as_vec3().to_array()],
@@ -1289,7 +1299,7 @@ fn origin_table(hard_rows: &[HardRow], cases: &[HardCase]) -> String {
         .iter()
         .filter_map(|c| {
             let scene = Scene::load(&c.path.to_string_lossy(), &[]).ok()?;
-            let o = twinray_common::camera::local_origin(&scene).to_array();
+            let o = twinray_common::scene::camera::local_origin(&scene).to_array();
             (o != [0.0; 3]).then_some((c, o))
         })
         .collect();

@@ -6,9 +6,11 @@ use std::path::PathBuf;
 use std::process::Command;
 use std::sync::OnceLock;
 use std::time::Instant;
-use twinray_common::cli::{Accel, RenderArgs, ValueName};
+use twinray_common::cli::RenderArgs;
 use twinray_common::error::{bad_input, Failure, FailureKind};
 use twinray_common::report::{DeviceInfo, FrameTime, RunReport};
+use twinray_common::scene::accel::Accel;
+use twinray_common::value_name::ValueName;
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
 pub enum Api {
@@ -260,7 +262,7 @@ fn render_with_progress(
     w: u32,
     h: u32,
     bvh: bool,
-) -> twinray_common::image_io::FloatImage {
+) -> twinray_common::reference::image_io::FloatImage {
     use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
     let rows = AtomicUsize::new(0);
     let finished = AtomicBool::new(false);
@@ -306,9 +308,8 @@ mod tests {
     use super::app_args;
     use clap::Parser;
     use std::path::PathBuf;
-    use twinray_common::cli::{
-        Accel, Experiment, RenderArgs, RenderPath, Size, VulkanCli, Workgroup,
-    };
+    use twinray_common::cli::{Experiment, RenderArgs, RenderPath, Size, VulkanCli, Workgroup};
+    use twinray_common::scene::accel::Accel;
 
     /// Every option away from its default, so that one the argv builder drops
     /// or misspells parses back different. Written as a struct literal: a new

@@ -7,10 +7,10 @@ use anyhow::Context;
 use std::path::PathBuf;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::Arc;
-use twinray_common::cli::{
-    parse_size, parse_workgroup, Accel, RenderArgs, RenderPath, Size, ValueName, Workgroup,
-};
+use twinray_common::cli::{parse_size, parse_workgroup, RenderArgs, RenderPath, Size, Workgroup};
 use twinray_common::report::RunReport;
+use twinray_common::scene::accel::Accel;
+use twinray_common::value_name::ValueName;
 
 #[derive(clap::Args, Debug, Clone)]
 pub struct CompareArgs {
@@ -177,7 +177,7 @@ fn is_software(device: &str) -> bool {
 
 pub fn run(args: &CompareArgs) -> anyhow::Result<()> {
     // Before the device probe and every render: a bad --out must cost nothing.
-    twinray_common::image_io::prepare_output_dir("--out", &args.out)?;
+    twinray_common::reference::image_io::prepare_output_dir("--out", &args.out)?;
     let mut args = args.clone();
     if !args.quick && !args.full {
         let probe = RenderArgs {
@@ -357,9 +357,9 @@ pub fn run(args: &CompareArgs) -> anyhow::Result<()> {
 pub struct Agreement {
     pub scene: &'static str,
     pub size: Size,
-    pub result: Result<[twinray_common::metrics::Metrics; 3], String>,
+    pub result: Result<[twinray_common::reference::metrics::Metrics; 3], String>,
     /// With the compute path measured: each API's compute image against its fragment image.
-    pub paths: Option<Result<[twinray_common::metrics::Metrics; 2], String>>,
+    pub paths: Option<Result<[twinray_common::reference::metrics::Metrics; 2], String>>,
 }
 
 /// Renders each built-in scene once with both apps and the reference, keeps the
@@ -399,7 +399,7 @@ pub fn agreement(
         } else {
             vec![]
         };
-        let result = (|| -> anyhow::Result<[twinray_common::metrics::Metrics; 3]> {
+        let result = (|| -> anyhow::Result<[twinray_common::reference::metrics::Metrics; 3]> {
             let mut imgs = Vec::new();
             let mut nan = Vec::new();
             for api in [Api::Vulkan, Api::Opengl] {
@@ -414,7 +414,7 @@ pub fn agreement(
                 };
                 let r = run_json(api, &ra)?;
                 nan.push(r.nonfinite_pixels);
-                imgs.push(twinray_common::image_io::load_png(&png)?);
+                imgs.push(twinray_common::reference::image_io::load_png(&png)?);
             }
             let overrides: Vec<(String, String)> = set
                 .iter()
@@ -426,11 +426,11 @@ pub fn agreement(
             let ref_png = dir.join(format!("{scene}-reference.png"));
             reference.save_png(&ref_png)?;
             let reference = reference.to_rgb8();
-            let mut vk_gl = twinray_common::metrics::compare(&imgs[0], &imgs[1])?;
+            let mut vk_gl = twinray_common::reference::metrics::compare(&imgs[0], &imgs[1])?;
             vk_gl.nan_pixels = nan[0] + nan[1];
-            let mut vk_ref = twinray_common::metrics::compare(&imgs[0], &reference)?;
+            let mut vk_ref = twinray_common::reference::metrics::compare(&imgs[0], &reference)?;
             vk_ref.nan_pixels = nan[0];
-            let mut gl_ref = twinray_common::metrics::compare(&imgs[1], &reference)?;
+            let mut gl_ref = twinray_common::reference::metrics::compare(&imgs[1], &reference)?;
             gl_ref.nan_pixels = nan[1];
             Ok([vk_gl, vk_ref, gl_ref])
         })()
@@ -449,7 +449,7 @@ pub fn agreement(
         // through another entry point must give the same image.
         let compute = paths.contains(&RenderPath::Compute) && result.is_ok();
         let paths = compute.then(|| {
-            (|| -> anyhow::Result<[twinray_common::metrics::Metrics; 2]> {
+            (|| -> anyhow::Result<[twinray_common::reference::metrics::Metrics; 2]> {
                 let mut m = Vec::new();
                 for api in [Api::Vulkan, Api::Opengl] {
                     let frag = dir.join(format!("{scene}-{}.png", api_name(api)));
@@ -464,9 +464,9 @@ pub fn agreement(
                         ..RenderArgs::headless(scene, size)
                     };
                     let r = run_json(api, &ra)?;
-                    let mut metrics = twinray_common::metrics::compare(
-                        &twinray_common::image_io::load_png(&png)?,
-                        &twinray_common::image_io::load_png(&frag)?,
+                    let mut metrics = twinray_common::reference::metrics::compare(
+                        &twinray_common::reference::image_io::load_png(&png)?,
+                        &twinray_common::reference::image_io::load_png(&frag)?,
                     )?;
                     metrics.nan_pixels = r.nonfinite_pixels;
                     m.push(metrics);
@@ -635,7 +635,7 @@ pub fn acceleration(plan: &Plan, stop: &AtomicBool) -> Vec<AccelRun> {
                 twinray_common::scene::Scene::load(scene, &overrides)
                     .ok()
                     .map(|sc| {
-                        let b = twinray_common::bvh::Bvh::build(&sc);
+                        let b = twinray_common::gpu::layout::Bvh::build(&sc);
                         (b.nodes.len(), b.bytes(), b.build_ms)
                     })
             });

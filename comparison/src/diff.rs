@@ -1,13 +1,13 @@
 //! `twinray diff A.png B.png`: the image metrics of common::metrics, as a table or JSON.
 
 use std::path::Path;
-use twinray_common::image_io::load_png;
-use twinray_common::metrics::{compare, Metrics};
+use twinray_common::reference::image_io::load_png;
+use twinray_common::reference::metrics::{compare, Metrics};
 
 pub fn run(a: &Path, b: &Path, json: bool, heatmap: Option<&Path>) -> anyhow::Result<()> {
     // Checked first: a bad --heatmap path is said before any image is read.
     if let Some(path) = heatmap {
-        twinray_common::image_io::check_output_file("--heatmap", path)?;
+        twinray_common::reference::image_io::check_output_file("--heatmap", path)?;
     }
     let (ia, ib) = (load_png(a)?, load_png(b)?);
     let m = compare(&ia, &ib).map_err(|e| {
@@ -25,7 +25,7 @@ pub fn run(a: &Path, b: &Path, json: bool, heatmap: Option<&Path>) -> anyhow::Re
                 image::Rgb([grey; 3])
             };
         }
-        twinray_common::image_io::write_png(&out, "--heatmap", path)?;
+        twinray_common::reference::image_io::write_png(&out, "--heatmap", path)?;
     }
     if json {
         println!("{}", serde_json::to_string(&m)?);

@@ -728,10 +728,10 @@ pub fn markdown(
         let _ = writeln!(
             s,
             "\n**Where `--accel auto` switches.** `auto` traces through a BVH from {} primitives on \
-             (`AUTO_BVH_MIN_PRIMITIVES`, common/src/scene.rs), one threshold for both APIs so that both always run the \
+             (`AUTO_BVH_MIN_PRIMITIVES`, common/src/scene/accel.rs), one threshold for both APIs so that both always run the \
              same shader. It was set from the sphere-list crossover rows above, measured on an NVIDIA H200 and on Mesa \
              llvmpipe (comparison/results/). Here:",
-            twinray_common::scene::AUTO_BVH_MIN_PRIMITIVES
+            twinray_common::scene::accel::AUTO_BVH_MIN_PRIMITIVES
         );
         for api in [Api::Vulkan, Api::Opengl] {
             let _ = writeln!(

@@ -11,8 +11,10 @@ use crate::compare::api_name;
 use std::fmt::Write as _;
 use std::path::Path;
 use std::sync::atomic::{AtomicBool, Ordering};
-use twinray_common::cli::{Accel, RenderArgs, RenderPath, Size, ValueName};
+use twinray_common::cli::{RenderArgs, RenderPath, Size};
 use twinray_common::report::ShaderStats;
+use twinray_common::scene::accel::Accel;
+use twinray_common::value_name::ValueName;
 
 pub struct ShaderRow {
     pub scene: &'static str,

@@ -15,10 +15,11 @@ use std::time::Instant;
 use twinray_common::cli::{OpenGlKnobs, RenderArgs, RenderPath};
 use twinray_common::error::bad_input;
 use twinray_common::explain;
-use twinray_common::gpu::{check_storage_limit, GpuScene};
-use twinray_common::image_io::FloatImage;
+use twinray_common::gpu::upload::{check_storage_limit, GpuScene};
+use twinray_common::reference::image_io::FloatImage;
 use twinray_common::report::{dump_shaders, dump_statistics, FrameTime, RunReport};
-use twinray_common::shader::{self, Variant};
+use twinray_common::shader::build::{build, build_compute};
+use twinray_common::shader::variant::Variant;
 
 /// `started` is taken first thing in main, so `setup_ms` includes process,
 /// driver and shader start-up, as in the Vulkan app.
@@ -58,7 +59,7 @@ pub fn run(args: RenderArgs, knobs: &OpenGlKnobs, started: Instant) -> anyhow::R
     let mut shader_stats = Vec::new();
     let (frames, setup_ms, pixels) = match args.path {
         RenderPath::Fragment => {
-            let shaders = shader::build(&variant)?;
+            let shaders = build(&variant)?;
             if let Some(dir) = &args.dump_shaders {
                 dump_shaders(
                     dir,
@@ -73,7 +74,7 @@ pub fn run(args: RenderArgs, knobs: &OpenGlKnobs, started: Instant) -> anyhow::R
                 || format!("variant {}", variant.label()),
             );
             let program = if args.gl_spirv {
-                let fs = shader::spirv_for_opengl(&shaders.fragment_spirv);
+                let fs = twinray_common::shader::post::spirv_for_opengl(&shaders.fragment_spirv);
                 Program::from_spirv(
                     gl,
                     &|name| ctx.proc_address(name),
@@ -99,7 +100,7 @@ pub fn run(args: RenderArgs, knobs: &OpenGlKnobs, started: Instant) -> anyhow::R
         }
         // The same tracer as a compute shader: compute.rs owns its program and texture.
         RenderPath::Compute => {
-            let shader = shader::build_compute(&variant, workgroup)?;
+            let shader = build_compute(&variant, workgroup)?;
             let proc_address = |name: &std::ffi::CStr| ctx.proc_address(name);
             let spirv = args
                 .gl_spirv

@@ -4,7 +4,8 @@
 use anyhow::{anyhow, Context as _};
 use glow::HasContext;
 use twinray_common::explain;
-use twinray_common::gpu::{binding, GpuScene};
+use twinray_common::gpu::layout::binding;
+use twinray_common::gpu::upload::GpuScene;
 
 pub struct SceneBuffers<'gl> {
     gl: &'gl glow::Context,

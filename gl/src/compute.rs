@@ -16,8 +16,9 @@ use anyhow::{anyhow, bail, Context as _};
 use glow::HasContext;
 use twinray_common::cli::Workgroup;
 use twinray_common::error::bad_input;
-use twinray_common::gpu::binding;
-use twinray_common::shader::{spirv_for_opengl, ComputeShader};
+use twinray_common::gpu::layout::binding;
+use twinray_common::shader::build::ComputeShader;
+use twinray_common::shader::post::spirv_for_opengl;
 
 /// The compute program, the storage texture and the dispatch grid.
 pub struct Compute<'gl> {

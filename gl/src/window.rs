@@ -1,7 +1,7 @@
 //! The windowed run, OpenGL's side: a glutin-winit window with an OpenGL 4.5
 //! core context (EGL on X11, GLX as fallback), swap interval 0 (uncapped) or 1
 //! with `--vsync`, and the same program, buffers and draw as headless, driven
-//! by the shared event loop (`twinray_common::interactive`) exactly like the
+//! by the shared event loop (`twinray_common::window`) exactly like the
 //! Vulkan window.
 //!
 //! What Vulkan spells out and OpenGL does not: there is no surface format to
@@ -43,10 +43,12 @@ use std::time::Instant;
 use twinray_common::cli::RenderArgs;
 use twinray_common::error::no_device;
 use twinray_common::explain;
-use twinray_common::gpu::{GpuFrame, GpuScene};
-use twinray_common::image_io::FloatImage;
-use twinray_common::interactive::{self, Drawn, PathShaders, Renderer, WindowedRun};
+use twinray_common::gpu::layout::GpuFrame;
+use twinray_common::gpu::upload::GpuScene;
+use twinray_common::reference::image_io::FloatImage;
 use twinray_common::report::DeviceInfo;
+use twinray_common::shader::variant::Variant;
+use twinray_common::window::{self, Drawn, PathShaders, Renderer, WindowedRun};
 use winit::window::Window;
 
 /// Timer queries in a ring, so that reading one never waits for the GPU: a
@@ -57,15 +59,15 @@ const TIMERS: usize = 3;
 /// description and the number of GL errors seen.
 pub fn run(args: &RenderArgs, started: Instant) -> Result<(WindowedRun, DeviceInfo, u64)> {
     let scene = args.load_scene()?;
-    let variant = interactive::variant_for(args, &scene);
-    let shaders = interactive::first_shaders(args, &scene)?;
+    let variant = Variant::chosen(&scene, args);
+    let shaders = window::first_shaders(args, &scene)?;
     explain::step(
         "Shaders: GLSL -> naga module -> GLSL 450 core (twinray-common)",
         || format!("variant {}, {} path", variant.label(), args.path),
     );
 
-    let event_loop = interactive::event_loop()?;
-    let attributes = interactive::window_attributes(args, &scene.name, "OpenGL");
+    let event_loop = window::event_loop()?;
+    let attributes = window::window_attributes(args, &scene.name, "OpenGL");
     let template = ConfigTemplateBuilder::new()
         .with_api(Api::OPENGL)
         .with_transparency(false);
@@ -185,7 +187,7 @@ pub fn run(args: &RenderArgs, started: Instant) -> Result<(WindowedRun, DeviceIn
         "per frame: glBufferSubData (camera), glDrawArrays (fragment) or glDispatchCompute + glMemoryBarrier\n\
          + glBlitFramebuffer (compute), SwapBuffers: the driver queues, syncs and presents; C switches the path".into()
     });
-    let run = interactive::run(
+    let run = window::session::run(
         "twinray-gl",
         event_loop,
         renderer,

@@ -1,5 +1,5 @@
 // trace/bvh.glsl — the closest-hit and any-hit walks of the BVH that
-// common/src/bvh.rs builds; compiled only into the USE_BVH variants.
+// common/src/scene/accel.rs builds; compiled only into the USE_BVH variants.
 
 #ifdef USE_BVH
 const uint SPHERE_BIT = 0x80000000u;
@@ -10,7 +10,7 @@ const uint SPHERE_BIT = 0x80000000u;
 // so two scalar arrays cost it four times the memory of these pairs (on an
 // H100 its teapot BVH tracer went from 259 slots to 21, and from 6.2 to
 // 0.54 ms on the compute path). BVH_STACK is the built tree's depth - 1
-// (common/src/shader.rs): the traversal pushes at most one child per level of
+// (common/src/shader/variant.rs): the traversal pushes at most one child per level of
 // the current path, so no push is ever dropped and no slot is wasted.
 //
 // Experiments (--experiment, common/src/cli.rs): BVH_STACK_UNPAIRED keeps

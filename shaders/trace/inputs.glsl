@@ -1,12 +1,12 @@
 // trace/inputs.glsl — what the tracer reads: the compile-time switches, the
-// structs that common/src/gpu.rs mirrors (a test checks naga's layout against
+// structs that common/src/gpu/layout.rs mirrors (a test checks naga's layout against
 // the Rust one), and every binding. The first part of trace.glsl's tracer.
 
 #ifndef STACK_SIZE
 #define STACK_SIZE 17
 #endif
 
-// The specialization-constant alternative (`--specialize`, common/src/shader.rs):
+// The specialization-constant alternative (`--specialize`, common/src/shader/variant.rs):
 // every feature is compiled in and each becomes a constant_id override, which
 // naga's process_overrides fixes per scene before it writes SPIR-V or GLSL.
 // SPEC(x) guards a feature's code with an `if` on its constant; without
@@ -75,7 +75,7 @@ struct Light {
 layout(std140, set = 0, binding = 0) uniform Frame {
     vec3 eye;
     float min_weight;
-    vec3 top_left;  // relative to the eye (see common/src/camera.rs)
+    vec3 top_left;  // relative to the eye (see common/src/scene/camera.rs)
     float epsilon;
     vec3 step_x;
     uint max_depth;
@@ -126,7 +126,7 @@ layout(std430, set = 0, binding = 4) readonly buffer Lights {
     Light lights[];
 } light_buf;
 
-// The BVH (common/src/bvh.rs), depth-first: an interior node's left child is the
+// The BVH (common/src/scene/accel.rs), depth-first: an interior node's left child is the
 // next node and `left_or_first` its right child; a leaf (count > 0) holds
 // prims[left_or_first .. +count], each a triangle index or a sphere index with
 // the top bit set. Bound always; read only by the USE_BVH variant.

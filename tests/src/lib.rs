@@ -16,7 +16,7 @@ pub fn bin_dir() -> PathBuf {
     for name in ["twinray-vk", "twinray-gl", "twinray"] {
         assert!(
             dir.join(name).exists(),
-            "{name} is not built in {}: run `cargo build --workspace` with the same profile first (tests/run.sh does)",
+            "{name} is not built in {}: run `cargo build --workspace --features twinray-vk/test-hooks,twinray-gl/test-hooks` with the same profile first (tests/run.sh does)",
             dir.display()
         );
     }
@@ -97,7 +97,7 @@ pub fn render(
     let stdout = String::from_utf8_lossy(&o.stdout);
     let report: RunReport = serde_json::from_str(stdout.trim())
         .unwrap_or_else(|e| panic!("{app:?}: stdout is not one JSON report ({e}): {stdout}"));
-    let img = twinray_common::image_io::load_png(out).unwrap();
+    let img = twinray_common::reference::image_io::load_png(out).unwrap();
     (report, img)
 }
 

@@ -3,7 +3,7 @@
 //! `--generic` and variant vs `--specialize` agree on ≥ 99.99 % of pixels
 //! within 1/255, in both APIs.
 
-use twinray_common::metrics::compare;
+use twinray_common::reference::metrics::compare;
 use twinray_tests::{render, scratch, App};
 
 const SCENES: [(&str, &str, &[&str]); 3] = [
@@ -140,7 +140,7 @@ fn a_bvh_deeper_than_the_small_fixed_stacks_renders_every_primitive() {
         &[],
     );
     assert!(r.status.success(), "{}", String::from_utf8_lossy(&r.stderr));
-    let truth = twinray_common::image_io::load_png(&reference).unwrap();
+    let truth = twinray_common::reference::image_io::load_png(&reference).unwrap();
     for app in App::BOTH {
         for path in ["fragment", "compute"] {
             let (report, img) = render(

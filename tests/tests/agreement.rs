@@ -2,8 +2,8 @@
 //! ≥ 99.9 % of pixels within 1/255, each API vs the reference ≥ 99.5 %, no NaN,
 //! and zero validation messages / GL debug errors in every render.
 
-use twinray_common::metrics::compare;
 use twinray_common::reference;
+use twinray_common::reference::metrics::compare;
 use twinray_common::scene::Scene;
 use twinray_tests::{render, scratch, App};
 

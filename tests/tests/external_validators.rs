@@ -11,10 +11,14 @@
 use std::path::{Path, PathBuf};
 use std::process::Command;
 use std::sync::Mutex;
-use twinray_common::cli::{Accel, Experiment, RenderArgs, Size, ValueName, Workgroup};
-use twinray_common::numerics::{Numerics, Offset, SphereTest, TriangleTest};
+use twinray_common::cli::{Experiment, RenderArgs, Size, Workgroup};
+use twinray_common::scene::accel::Accel;
+use twinray_common::scene::numerics::{Numerics, Offset, SphereTest, TriangleTest};
 use twinray_common::scene::{Features, Scene};
-use twinray_common::shader::{self, Variant};
+use twinray_common::shader::build::{self, build_compute, compute_source, fragment_source};
+use twinray_common::shader::post::spirv_for_opengl;
+use twinray_common::shader::variant::Variant;
+use twinray_common::value_name::ValueName;
 use twinray_tests::scratch;
 
 /// One validator run: the program, its arguments, the file it checks.
@@ -109,6 +113,9 @@ fn variants() -> Vec<(String, Variant)> {
         ],
         vec![NoLoopBounding, UnpairedBvhStack, StorageCounts],
         vec![StacklessBvh],
+        vec![NoContraction],
+        vec![Glslang],
+        vec![FloatControls],
     ] {
         let label = experiments
             .iter()
@@ -139,7 +146,7 @@ fn glslang_and_spirv_val_accept_every_variant() {
     let mut jobs = Vec::new();
     let vert = write(
         &dir.join("fullscreen.vert"),
-        shader::FULLSCREEN_VERT.as_bytes(),
+        build::FULLSCREEN_VERT.as_bytes(),
     );
     jobs.push(Job {
         what: "vertex source".into(),
@@ -162,20 +169,20 @@ fn glslang_and_spirv_val_accept_every_variant() {
         };
         for &stage in stages {
             let (source, defines, spirv, glsl) = if stage == "frag" {
-                let s = shader::build(variant).unwrap_or_else(|e| panic!("{label}: {e:#}"));
+                let s = build::build(variant).unwrap_or_else(|e| panic!("{label}: {e:#}"));
                 fragment_sources += 1;
                 (
-                    shader::fragment_source(),
+                    fragment_source(),
                     variant.defines.clone(),
                     s.fragment_spirv,
                     s.fragment_glsl,
                 )
             } else {
-                let s = shader::build_compute(variant, Workgroup::DEFAULT)
+                let s = build_compute(variant, Workgroup::DEFAULT)
                     .unwrap_or_else(|e| panic!("{label} compute: {e:#}"));
                 compute_sources += 1;
                 // The compute variant adds WG_X, WG_Y (and BVH_STACK_SHARED).
-                (shader::compute_source(), s.variant.defines, s.spirv, s.glsl)
+                (compute_source(), s.variant.defines, s.spirv, s.glsl)
             };
             let what = format!("{label} ({stage})");
             let base = dir.join(format!("v{i}"));
@@ -200,7 +207,7 @@ fn glslang_and_spirv_val_accept_every_variant() {
             });
             let gl = write(
                 &dir.join(format!("v{i}-{stage}.gl.spv")),
-                &words_to_bytes(&shader::spirv_for_opengl(&spirv)),
+                &words_to_bytes(&spirv_for_opengl(&spirv)),
             );
             jobs.push(Job {
                 what: format!("{what}: naga SPIR-V as OpenGL loads it"),

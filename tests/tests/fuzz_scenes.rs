@@ -14,8 +14,9 @@ use arbitrary::Unstructured;
 use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
 use twinray_common::error::exit_code_of;
-use twinray_common::gpu::GpuScene;
-use twinray_common::scene::{Scene, BUILTIN_SCENES};
+use twinray_common::gpu::upload::GpuScene;
+use twinray_common::scene::load::BUILTIN_SCENES;
+use twinray_common::scene::Scene;
 
 /// Values that break parsers and f32 conversions: zero, signed zero, overflow
 /// in f32 and f64, underflow, NaN, the edges of u32, and plain ones.

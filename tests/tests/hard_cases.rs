@@ -6,9 +6,9 @@
 //! GL debug output stay silent.
 
 use std::path::Path;
-use twinray_common::hard::{self, HardCase};
-use twinray_common::image_io::FloatImage;
 use twinray_common::reference;
+use twinray_common::reference::image_io::FloatImage;
+use twinray_common::scene::hard::{self, HardCase};
 use twinray_common::scene::Scene;
 use twinray_tests::{render, scratch, App};
 
@@ -187,7 +187,7 @@ fn numerics_set_keys_work_in_both_apps() {
             "{}",
             report.variant
         );
-        let m = twinray_common::metrics::compare(&img, &reference).unwrap();
+        let m = twinray_common::reference::metrics::compare(&img, &reference).unwrap();
         assert!(
             m.within_1() >= 0.995,
             "{app:?}: {:.3}% within 1/255",

@@ -59,6 +59,6 @@ fn render_through_the_orchestrator_matches_the_app() {
         &[],
     );
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
-    let img = twinray_common::image_io::load_png(&out).unwrap();
+    let img = twinray_common::reference::image_io::load_png(&out).unwrap();
     assert_eq!(img.dimensions(), (48, 32));
 }

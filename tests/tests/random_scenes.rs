@@ -1,8 +1,8 @@
-//! Differential test on seeded random scenes (common/src/random_scene.rs:
+//! Differential test on seeded random scenes (common/src/scene/random.rs:
 //! spheres, triangles, a mesh, diffuse, mirror and glass with glass inside
 //! glass, 1–4 lights, random cameras): Vulkan, OpenGL and the f64 reference
 //! render each scene with the same numerics, and every pair must agree within
-//! `random_scene::MAX_OFF_SHARE` (pixels off by more than 8/255) and
+//! `random::MAX_OFF_SHARE` (pixels off by more than 8/255) and
 //! `MIN_WITHIN_1` (pixels within 1/255). A failing seed prints the commands
 //! that reproduce it. The apps run the generic shader (`--generic`): random
 //! depths and features would otherwise make ~20 variants for the software
@@ -10,9 +10,9 @@
 //! tested on its own (tests/tests/accel.rs); `twinray accuracy --random` runs
 //! each scene's own variant.
 
-use twinray_common::metrics;
-use twinray_common::random_scene;
 use twinray_common::reference;
+use twinray_common::reference::metrics;
+use twinray_common::scene::random;
 use twinray_common::scene::Scene;
 use twinray_tests::{render, scratch, App};
 
@@ -27,7 +27,7 @@ fn vulkan_opengl_and_the_reference_agree_on_random_scenes() {
     let mut failures = Vec::new();
     let mut worst = (0.0f64, String::new());
     for seed in SEEDS {
-        let name = format!("{}{seed}", random_scene::PREFIX);
+        let name = format!("{}{seed}", random::PREFIX);
         let scene = Scene::load(&name, &[]).unwrap();
         let reference = reference::render(&scene, W, H);
         assert_eq!(
@@ -61,10 +61,10 @@ fn vulkan_opengl_and_the_reference_agree_on_random_scenes() {
             if m.above_8 > worst.0 {
                 worst = (m.above_8, format!("{name} {label}"));
             }
-            if let Some(why) = random_scene::disagreement(&m) {
+            if let Some(why) = random::disagreement(&m) {
                 failures.push(format!(
                     "{name} {label}: {why}\n  reproduce: {}",
-                    random_scene::reproduce(seed, W, H, "--generic")
+                    random::reproduce(seed, W, H, "--generic")
                 ));
             }
         }

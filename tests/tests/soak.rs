@@ -2,7 +2,7 @@
 //! Mesa 22.3's lavapipe used to compile and keep a new copy of the tracer at
 //! every draw (about 3 MB a frame: 6 GB over these 2,000 frames) because the
 //! shader's loops were bounded by values from the uniform block; the counts are
-//! compile-time constants now (common/src/shader.rs).
+//! compile-time constants now (common/src/shader/variant.rs).
 //!
 //! The resident set is sampled from /proc while the app runs: after a warm-up
 //! (a fifth of the run, when the shader is compiled and every buffer made) and

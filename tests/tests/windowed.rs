@@ -10,9 +10,10 @@
 
 use std::path::Path;
 use std::process::Output;
-use twinray_common::cli::{RenderPath, ValueName};
-use twinray_common::metrics::compare;
+use twinray_common::cli::RenderPath;
+use twinray_common::reference::metrics::compare;
 use twinray_common::report::RunReport;
+use twinray_common::value_name::ValueName;
 use twinray_tests::{render, scratch, App, Xvfb};
 
 fn stderr(o: &Output) -> String {
@@ -129,7 +130,7 @@ fn every_key_action_works_with_zero_messages() {
             "gl"
         };
         let shot = dir.join(format!("twinray-{tag}-box-1.png"));
-        let img = twinray_common::image_io::load_png(&shot)
+        let img = twinray_common::reference::image_io::load_png(&shot)
             .unwrap_or_else(|e| panic!("{app:?}: P saved nothing: {e}"));
         assert_eq!(img.dimensions(), (96, 72));
     }
@@ -188,7 +189,7 @@ fn after_gesture(
     }
     let o = child.wait_with_output().unwrap();
     assert!(o.status.success(), "{app:?}: {}", stderr(&o));
-    twinray_common::image_io::load_png(&out)
+    twinray_common::reference::image_io::load_png(&out)
         .unwrap_or_else(|e| panic!("{app:?}: no --out at exit: {e}"))
 }
 
@@ -291,7 +292,7 @@ fn windowed_out_equals_the_headless_image() {
         let o = x.run(&app.exe(), &args, &[], &dir);
         assert!(o.status.success(), "{app:?}: {}", stderr(&o));
         let (_, headless) = render(app, "box", "100x80", &[], &dir.join("headless.png"));
-        let windowed = twinray_common::image_io::load_png(&win).unwrap();
+        let windowed = twinray_common::reference::image_io::load_png(&win).unwrap();
         assert!(
             windowed == headless,
             "{app:?}: the windowed --out differs from --headless --out"
@@ -403,7 +404,8 @@ fn tag(app: App) -> &'static str {
 }
 
 fn load(path: &Path) -> image::RgbImage {
-    twinray_common::image_io::load_png(path).unwrap_or_else(|e| panic!("{}: {e}", path.display()))
+    twinray_common::reference::image_io::load_png(path)
+        .unwrap_or_else(|e| panic!("{}: {e}", path.display()))
 }
 
 /// The headless image of `scene` at 64x48 on `path`.

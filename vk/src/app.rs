@@ -22,11 +22,12 @@ use std::time::Instant;
 use twinray_common::cli::{FrameWait, RenderArgs, RenderPath, SceneMemory, VulkanKnobs};
 use twinray_common::error::bad_input;
 use twinray_common::explain;
-use twinray_common::gpu::GpuScene;
-use twinray_common::image_io::FloatImage;
+use twinray_common::gpu::upload::GpuScene;
+use twinray_common::reference::image_io::FloatImage;
 use twinray_common::report::{dump_shaders, dump_statistics, FrameTime, RunReport};
 use twinray_common::scene::Scene;
-use twinray_common::shader::{self, Variant};
+use twinray_common::shader::build::{build, build_compute};
+use twinray_common::shader::variant::Variant;
 
 pub fn run(args: RenderArgs, knobs: &VulkanKnobs, process_start: Instant) -> Result<()> {
     if args.explain {
@@ -87,7 +88,7 @@ fn render(
 ) -> Result<(RunReport, FloatImage)> {
     let (width, height) = (args.size.width, args.size.height);
     let workgroup = args.compute_workgroup()?;
-    let shaders = shader::build(variant)?;
+    let shaders = build(variant)?;
     if args.dump_shaders.is_some() {
         crate::statistics::enable();
     }
@@ -148,7 +149,7 @@ fn render(
         }
         // The same tracer as a compute shader: compute.rs owns its pipeline and storage image.
         RenderPath::Compute => {
-            let shader = shader::build_compute(variant, workgroup)?;
+            let shader = build_compute(variant, workgroup)?;
             if let Some(dir) = &args.dump_shaders {
                 dump_shaders(dir, &[("compute", &shader.spirv, &shader.glsl)])?;
             }

@@ -37,9 +37,9 @@ use ash::vk;
 use twinray_common::cli::Workgroup;
 use twinray_common::error::bad_input;
 use twinray_common::explain;
-use twinray_common::gpu::GpuScene;
-use twinray_common::image_io::FloatImage;
-use twinray_common::shader::ComputeShader;
+use twinray_common::gpu::upload::GpuScene;
+use twinray_common::reference::image_io::FloatImage;
+use twinray_common::shader::build::ComputeShader;
 
 /// The same float format as the fragment path's colour image (pipeline.rs), and
 /// the `rgba32f` of the shader's image declaration. Storage-image support for it

@@ -13,7 +13,7 @@ use crate::memory::Buffer;
 use anyhow::{Context, Result};
 use ash::vk;
 use twinray_common::explain;
-use twinray_common::gpu::binding;
+use twinray_common::gpu::layout::binding;
 
 pub struct Descriptors {
     device: ash::Device,

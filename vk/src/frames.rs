@@ -36,7 +36,7 @@ use crate::timestamps::Timestamps;
 use anyhow::{Context, Result};
 use ash::{khr, vk};
 use twinray_common::explain;
-use twinray_common::gpu::GpuFrame;
+use twinray_common::gpu::layout::GpuFrame;
 
 /// Two: the CPU records one frame while the GPU draws the other. More would
 /// only add latency, since the GPU (the tracer) is the bottleneck.

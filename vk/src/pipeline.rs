@@ -20,7 +20,7 @@ use crate::device::Device;
 use anyhow::{Context, Result};
 use ash::vk;
 use twinray_common::explain;
-use twinray_common::shader::Shaders;
+use twinray_common::shader::build::Shaders;
 
 /// Float output, so the NaN count and the 8-bit rounding happen on the CPU,
 /// identically for both APIs. Every Vulkan device can render to it.

@@ -11,8 +11,9 @@ use crate::pipeline::Pipeline;
 use anyhow::Result;
 use ash::vk;
 use twinray_common::cli::SceneMemory;
-use twinray_common::gpu::{binding, check_storage_limit, storage_name, GpuScene};
-use twinray_common::shader::Shaders;
+use twinray_common::gpu::layout::binding;
+use twinray_common::gpu::upload::{check_storage_limit, storage_name, GpuScene};
+use twinray_common::shader::build::Shaders;
 
 /// Fields in reverse creation order, so that they drop in the order Vulkan needs:
 /// the pipeline and the set before the buffers they use.

@@ -16,7 +16,7 @@ use anyhow::{Context, Result};
 use ash::vk;
 use ash::vk::MemoryPropertyFlags as Flags;
 use twinray_common::explain;
-use twinray_common::image_io::FloatImage;
+use twinray_common::reference::image_io::FloatImage;
 
 pub struct Target {
     device: ash::Device,

@@ -1,7 +1,7 @@
 //! The windowed run: the same setup as headless, in the same order, with a
 //! window, a surface and a swapchain in place of the offscreen image, and the
 //! frame loop of frames.rs driven by the shared event loop
-//! (`twinray_common::interactive`, which both apps use, so keys, title and
+//! (`twinray_common::window`, which both apps use, so keys, title and
 //! camera behave identically).
 //!
 //! Either path draws in the window: the fragment path's render pass into the
@@ -31,11 +31,13 @@ use std::time::Instant;
 use twinray_common::cli::{RenderArgs, VulkanKnobs};
 use twinray_common::error::no_device;
 use twinray_common::explain;
-use twinray_common::gpu::{GpuFrame, GpuScene};
-use twinray_common::image_io::FloatImage;
-use twinray_common::interactive::{self, Drawn, PathShaders, Renderer, WindowedRun};
+use twinray_common::gpu::layout::GpuFrame;
+use twinray_common::gpu::upload::GpuScene;
+use twinray_common::reference::image_io::FloatImage;
 use twinray_common::report::DeviceInfo;
-use twinray_common::shader::Shaders;
+use twinray_common::shader::build::Shaders;
+use twinray_common::shader::variant::Variant;
+use twinray_common::window::{self, Drawn, PathShaders, Renderer, WindowedRun};
 use winit::window::Window;
 
 /// The current path's per-scene objects, and the shaders they were built
@@ -72,20 +74,20 @@ pub fn run(
     started: Instant,
 ) -> Result<(WindowedRun, DeviceInfo)> {
     let scene = args.load_scene()?;
-    let variant = interactive::variant_for(args, &scene);
-    let shaders = interactive::first_shaders(args, &scene)?;
+    let variant = Variant::chosen(&scene, args);
+    let shaders = window::first_shaders(args, &scene)?;
     explain::step(
         "Shaders: GLSL -> naga module -> SPIR-V (twinray-common)",
         || format!("variant {}, {} path", variant.label(), args.path),
     );
 
-    let event_loop = interactive::event_loop()?;
+    let event_loop = window::event_loop()?;
     // winit 0.30 prefers windows made inside `resumed` (for Android's and the
     // web's life cycles). On desktops a window made before the loop starts
     // works the same, and lets setup run top to bottom like the headless path.
     #[allow(deprecated)]
     let window = event_loop
-        .create_window(interactive::window_attributes(args, &scene.name, "Vulkan"))
+        .create_window(window::window_attributes(args, &scene.name, "Vulkan"))
         .context("creating the window")?;
     explain::step("Window (winit)", || {
         let s = window.inner_size();
@@ -159,7 +161,7 @@ pub fn run(
         "per frame: wait fence, acquire image, re-record (fragment: render pass; compute: dispatch + blit),\n\
          submit (wait image-available, signal render-finished), present; C switches the path".into()
     });
-    let run = interactive::run(
+    let run = window::session::run(
         "twinray-vk",
         event_loop,
         renderer,

@@ -11,7 +11,7 @@
 use std::path::PathBuf;
 use std::process::ExitCode;
 
-use twinray_common::teapot::{parse_bpt, tessellate, to_obj, HEADER, STUDY_NU, STUDY_NV};
+use twinray_common::scene::teapot::{parse_bpt, tessellate, to_obj, HEADER, STUDY_NU, STUDY_NV};
 
 const BPT: &str = include_str!("../../../scenes/teapot.bpt");
 

@@ -6,8 +6,8 @@
 //! Scene files set them in `[render]` (`offset`, `triangle`, `sphere`), and both
 //! apps take the same keys through `--set` (e.g. `--set triangle=watertight`).
 
-use crate::cli::ValueName;
 use crate::error::bad_input;
+use crate::value_name::ValueName;
 use serde::Serialize;
 
 /// Where a secondary ray (shadow, mirror, refraction) starts, given the hit

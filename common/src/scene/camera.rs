@@ -5,8 +5,7 @@
 //! origin: the point subtracted in f64 from every position before the GPU's f32
 //! conversion, so that a scene far from the world origin is traced as if near it.
 
-use crate::cli::ValueName;
-use crate::scene::{Camera, Scene};
+use crate::scene::{Camera, OriginMode, Scene};
 use glam::DVec3;
 use std::borrow::Cow;
 
@@ -64,33 +63,6 @@ impl RayFrame {
     /// Unit direction through the centre of pixel (x, y).
     pub fn dir(&self, x: f64, y: f64) -> DVec3 {
         (self.top_left + x * self.step_x + y * self.step_y).normalize()
-    }
-}
-
-/// Where the GPU's coordinates are measured from (`--set origin=`, `[render] origin`).
-// ValueEnum for its name only (`ValueName`): `--set` and scene files parse it.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default, serde::Serialize, clap::ValueEnum)]
-pub enum OriginMode {
-    /// The camera's look-at point, snapped to a power-of-two grid (`local_origin`).
-    #[default]
-    Local,
-    /// The world origin: every coordinate converted to f32 as written (the
-    /// behaviour before local origins, kept to measure what they gain).
-    World,
-}
-
-impl OriginMode {
-    pub const ALL: [OriginMode; 2] = [OriginMode::Local, OriginMode::World];
-
-    /// Parses `local` or `world`; `what` names the source in the error.
-    pub fn parse(value: &str, what: &str) -> anyhow::Result<OriginMode> {
-        let v = value.trim().to_ascii_lowercase();
-        OriginMode::ALL
-            .into_iter()
-            .find(|m| m.name() == v)
-            .ok_or_else(|| {
-                crate::error::bad_input(format!("{what}: '{value}' is not one of local, world"))
-            })
     }
 }
 
@@ -354,74 +326,6 @@ mod tests {
         o.reset();
         assert_eq!(o, Orbit::new(&cam()));
         assert!(close(o.camera().eye, cam().eye));
-    }
-
-    #[test]
-    fn near_scenes_keep_a_zero_origin_and_far_ones_trace_near_zero() {
-        use crate::gpu::GpuScene;
-        for (name, _) in crate::scene::BUILTIN_SCENES {
-            let s = Scene::load(name, &[]).unwrap();
-            assert_eq!(local_origin(&s), DVec3::ZERO, "{name}");
-            assert!(matches!(in_local_frame(&s), Cow::Borrowed(_)), "{name}");
-        }
-        let dir = std::path::Path::new(crate::hard::SOURCE_DIR);
-        let mut moved = Vec::new();
-        for case in crate::hard::list(dir).unwrap() {
-            let s = Scene::load(case.path.to_str().unwrap(), &[]).unwrap();
-            let o = local_origin(&s);
-            if o == DVec3::ZERO {
-                continue;
-            }
-            moved.push(case.name.clone());
-            // On the grid: a power of two times a whole number per axis.
-            let view = (s.camera.eye - s.camera.look_at).length();
-            let grid = (LOCAL_ORIGIN_GRID_VIEWS * view).log2().ceil().exp2();
-            assert_eq!(o / grid, (o / grid).round(), "{}", case.name);
-            // What the GPU holds lies within a few view distances of zero, and
-            // `origin=world` gives the world coordinates back.
-            let g = GpuScene::new(&s, 8, 8);
-            let far = g
-                .spheres
-                .iter()
-                .map(|x| x.center)
-                .chain(g.triangles.iter().map(|t| t.p0))
-                .chain(std::iter::once(g.frame.eye))
-                .flat_map(|v| v.map(f32::abs))
-                .fold(0.0f32, f32::max);
-            assert!(far < 40.0 * view as f32, "{}: {far}", case.name);
-            let mut world = s.clone();
-            world.origin = OriginMode::World;
-            assert_eq!(local_origin(&world), DVec3::ZERO);
-            assert_eq!(
-                GpuScene::new(&world, 8, 8).frame.eye,
-                s.camera.eye.as_vec3().to_array()
-            );
-        }
-        moved.sort();
-        assert_eq!(
-            moved,
-            ["closed-mesh", "far-1e4", "far-1e5", "far-1e6", "far-1e7"],
-            "the cases README.md names as moved"
-        );
-    }
-
-    #[test]
-    fn the_orbit_never_moves_the_origin() {
-        let s = Scene::load(
-            concat!(env!("CARGO_MANIFEST_DIR"), "/../scenes/hard/far-1e6.toml"),
-            &[],
-        )
-        .unwrap();
-        let o = local_origin(&s);
-        let mut orbit = Orbit::new(&s.camera);
-        orbit.drag(40.0, 25.0, 100);
-        orbit.zoom(-5.0);
-        let frame = crate::gpu::GpuFrame::new(&s, &orbit.camera(), 8, 8);
-        let expect = (orbit.camera().eye - o).as_vec3().to_array();
-        assert_eq!(frame.eye, expect);
-        // The origin comes from the scene's own camera, never the orbit's: a
-        // zoom changes the view distance and so the grid, which would move it.
-        assert_eq!(local_origin(&s), o);
     }
 
     fn cam() -> Camera {

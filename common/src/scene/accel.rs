@@ -1,11 +1,53 @@
-//! The bounding volume hierarchy: built on the CPU with binned SAH over spheres
-//! and triangles together, flattened depth-first into the node array the shader
-//! walks (`GpuBvhNode`, mirrored in shaders/trace.glsl and layout-tested), plus
-//! the primitive list its leaves point into.
+//! Acceleration: `--accel` and the scene's choice of a BVH, and the bounding
+//! volume hierarchy itself, built on the CPU with binned SAH over spheres and
+//! triangles together, flattened depth-first into the node array the shader
+//! walks (`gpu::layout::Bvh`, mirrored in shaders/trace.glsl and layout-tested),
+//! plus the primitive list its leaves point into.
 
-use crate::gpu::{GpuBvhNode, LINK_AXIS_SHIFT, LINK_PARENT_MASK, PRIM_SPHERE_BIT};
-use crate::scene::Scene;
+use crate::gpu::layout::{Bvh, GpuBvhNode, LINK_AXIS_SHIFT, LINK_PARENT_MASK, PRIM_SPHERE_BIT};
+use crate::scene::camera::in_local_frame;
+use crate::scene::{BvhCache, Scene};
 use glam::DVec3;
+
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+pub enum Accel {
+    Auto,
+    None,
+    Bvh,
+}
+
+/// `--accel auto` builds a BVH for scenes with at least this many primitives.
+/// Below it the brute-force loop is as fast or faster: see the comparison
+/// report's acceleration section for the measurements behind the number.
+pub const AUTO_BVH_MIN_PRIMITIVES: usize = 64;
+
+impl Scene {
+    /// The scene's BVH where it traces through one (built on first use, then
+    /// kept). Primitives changed after that call would not be seen: scenes are
+    /// not edited once loaded, except for `--accel` and the ray depth.
+    pub fn bvh_tree(&self) -> Option<&Bvh> {
+        self.bvh.then(|| {
+            &**self
+                .bvh_cache
+                .0
+                // Over the primitives as the GPU holds them: relative to the local origin.
+                .get_or_init(|| {
+                    let local = in_local_frame(self);
+                    std::sync::Arc::new(Bvh::build(&local))
+                })
+        })
+    }
+
+    /// Applies `--accel` (none: brute force; bvh: a BVH; auto: a BVH from the threshold on).
+    pub fn set_accel(&mut self, accel: Accel) {
+        self.bvh_cache = BvhCache::default();
+        self.bvh = match accel {
+            Accel::None => false,
+            Accel::Bvh => self.primitive_count() > 0,
+            Accel::Auto => self.primitive_count() >= AUTO_BVH_MIN_PRIMITIVES,
+        };
+    }
+}
 
 /// Primitives per leaf at most; SAH may stop splitting earlier.
 pub const MAX_LEAF: usize = 4;
@@ -43,18 +85,6 @@ struct PrimRef {
     centroid: DVec3,
     /// Index into the shader's primitive list encoding (PRIM_SPHERE_BIT | sphere) or triangle.
     code: u32,
-}
-
-/// The flattened hierarchy, ready to upload.
-#[derive(Debug, Clone, Default)]
-pub struct Bvh {
-    pub nodes: Vec<GpuBvhNode>,
-    /// Leaf contents: a sphere index with `PRIM_SPHERE_BIT` set, or a triangle index.
-    pub prims: Vec<u32>,
-    /// Per node: parent index and split axis (`LINK_*`), for the stackless traversal.
-    pub links: Vec<u32>,
-    pub build_ms: f64,
-    pub depth: u32,
 }
 
 impl Bvh {
@@ -232,7 +262,7 @@ fn sah_split(refs: &[PrimRef], bounds: &Aabb, centroids: &Aabb) -> Option<(usize
     let mut best: Option<(f64, usize, Plane)> = None; // cost, left count, plane
     for axis in 0..3 {
         let (cmin, cmax) = (centroids.min[axis], centroids.max[axis]);
-        if !(cmax > cmin) {
+        if cmax.is_nan() || cmin.is_nan() || cmax <= cmin {
             continue;
         }
         let scale = BINS as f64 / (cmax - cmin);

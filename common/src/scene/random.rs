@@ -26,7 +26,7 @@ pub const MAX_OFF_SHARE: f64 = 0.002;
 pub const MIN_WITHIN_1: f64 = 0.993;
 
 /// Why two renders of a random scene disagree beyond the thresholds, or `None`.
-pub fn disagreement(m: &crate::metrics::Metrics) -> Option<String> {
+pub fn disagreement(m: &crate::reference::metrics::Metrics) -> Option<String> {
     let mut why = Vec::new();
     if m.above_8 > MAX_OFF_SHARE {
         why.push(format!(
@@ -157,15 +157,27 @@ ior = 1.33
 
 const SOLID: [&str; 4] = ["red", "green", "blue", "mirror"];
 
-/// The scene file text of `seed`.
+/// The scene file text of `seed`. Each section draws from one generator in
+/// this order, so a seed always gives the same scene.
 pub fn toml(seed: u64) -> String {
     let mut r = Rng(seed);
     let mut s = String::new();
     let _ = writeln!(
         s,
-        "description = \"random scene {seed} (common/src/random_scene.rs)\"\n"
+        "description = \"random scene {seed} (common/src/scene/random.rs)\"\n"
     );
-    // Camera: orbiting a target near the middle of the objects.
+    camera_and_render(&mut r, &mut s);
+    s.push_str(MATERIALS);
+    lights(&mut r, &mut s);
+    ground(&mut s);
+    spheres(&mut r, &mut s);
+    triangles(&mut r, &mut s);
+    meshes(&mut r, &mut s);
+    s
+}
+
+/// `[camera]`, orbiting a target near the middle of the objects, and `[render]`.
+fn camera_and_render(r: &mut Rng, s: &mut String) {
     let target = [r.range(-0.8, 0.8), r.range(0.2, 1.0), r.range(-0.8, 0.8)];
     let (yaw, pitch) = (r.range(0.0, std::f64::consts::TAU), r.range(0.15, 0.9));
     let dist = r.range(4.5, 8.0);
@@ -188,8 +200,10 @@ pub fn toml(seed: u64) -> String {
         v3([r.range(0.0, 0.3), r.range(0.0, 0.3), r.range(0.05, 0.4)]),
         r.int(3, 8)
     );
-    s.push_str(MATERIALS);
+}
 
+/// One to four lights whose total brightness stays about the same.
+fn lights(r: &mut Rng, s: &mut String) {
     let lights = r.int(1, 4);
     for _ in 0..lights {
         let k = 1.0 / f64::from(lights).sqrt();
@@ -205,8 +219,10 @@ pub fn toml(seed: u64) -> String {
             .map(|x| (x * 1000.0).round() / 1000.0))
         );
     }
+}
 
-    // The ground: two triangles, so every scene has shadows to get right.
+/// The ground: two triangles, so every scene has shadows to get right.
+fn ground(s: &mut String) {
     let g = 6.0;
     let _ = writeln!(
         s,
@@ -216,9 +232,11 @@ pub fn toml(seed: u64) -> String {
         v3([g, 0.0, g]),
         v3([g, 0.0, -g])
     );
+}
 
-    // Spheres, kept apart (and off the ground) so that no two surfaces touch:
-    // touching surfaces are the hard cases' business, not a random test's.
+/// Spheres, kept apart (and off the ground) so that no two surfaces touch:
+/// touching surfaces are the hard cases' business, not a random test's.
+fn spheres(r: &mut Rng, s: &mut String) {
     let mut placed: Vec<([f64; 3], f64)> = Vec::new();
     let mut place = |r: &mut Rng, radius: f64| -> Option<[f64; 3]> {
         for _ in 0..50 {
@@ -242,7 +260,7 @@ pub fn toml(seed: u64) -> String {
     // Glass inside glass: an outer glass sphere holding a smaller one of
     // another index (sometimes with a solid core), not concentric.
     let outer = r.range(0.6, 1.0);
-    if let Some(c) = place(&mut r, outer) {
+    if let Some(c) = place(r, outer) {
         let inner = outer * r.range(0.35, 0.6);
         let shift = (outer - inner) * r.range(0.0, 0.5);
         let ic = [c[0] + shift, c[1], c[2]];
@@ -268,7 +286,7 @@ pub fn toml(seed: u64) -> String {
         } else {
             SOLID[r.int(0, 3) as usize]
         };
-        if let Some(c) = place(&mut r, radius) {
+        if let Some(c) = place(r, radius) {
             let _ = writeln!(
                 s,
                 "\n[[spheres]]\ncenter = {}\nradius = {radius:?}\nmaterial = \"{material}\"",
@@ -276,8 +294,10 @@ pub fn toml(seed: u64) -> String {
             );
         }
     }
+}
 
-    // Free triangles, above the ground; some with vertex normals (smooth shading).
+/// Free triangles, above the ground; some with vertex normals (smooth shading).
+fn triangles(r: &mut Rng, s: &mut String) {
     for _ in 0..r.int(1, 4) {
         let c = [r.range(-3.0, 3.0), r.range(0.6, 2.5), r.range(-3.0, 3.0)];
         let p: Vec<[f64; 3]> = (0..3)
@@ -305,10 +325,12 @@ pub fn toml(seed: u64) -> String {
         }
         let _ = writeln!(s, "material = \"{material}\"");
     }
+}
 
-    // A mesh: the cube on the ground, and in a third of the scenes a coarse
-    // smooth teapot (the built-in patches, 4 x 3 quads each: 768 triangles,
-    // enough for `--accel auto` to build a BVH).
+/// A mesh: the cube on the ground, and in a third of the scenes a coarse
+/// smooth teapot (the built-in patches, 4 x 3 quads each: 768 triangles,
+/// enough for `--accel auto` to build a BVH).
+fn meshes(r: &mut Rng, s: &mut String) {
     let material = SOLID[r.int(0, 3) as usize];
     let size = r.range(0.5, 1.0);
     let _ = writeln!(
@@ -327,7 +349,6 @@ pub fn toml(seed: u64) -> String {
             v3([r.range(-3.0, 3.0), 0.01, r.range(-3.0, 3.0)])
         );
     }
-    s
 }
 
 #[cfg(test)]

@@ -1,246 +1,26 @@
-//! The windowed apps' shared behaviour: the winit event loop, what every key
-//! and mouse gesture does, the window title, the camera, scene, depth and
-//! path (fragment / compute) switches, screenshots and `--frames`. Both apps hand this module a
-//! [`Renderer`] (their API-specific half) and nothing else, so the two windows
-//! cannot behave differently: only the drawing differs.
-//!
-//! Test hooks (not user options; the end-to-end tests use them under Xvfb):
-//! `TWINRAY_TEST_RESIZE=1` makes the app resize its own window on every frame
-//! and minimize/restore it now and then; `TWINRAY_TEST_KEYS=2,p,+,-,r,1` presses
-//! those keys' actions, one per frame.
+//! The event loop of a window: input to actions, redraws, resizes and
+//! minimizes, scene / depth / path switches, screenshots, `--frames` and `--out`.
 
-use crate::camera::Orbit;
 use crate::cli::{RenderArgs, RenderPath, Workgroup};
-use crate::error::{bad_input, no_device};
-use crate::gpu::{GpuFrame, GpuScene};
-use crate::image_io::FloatImage;
+use crate::error::bad_input;
+use crate::gpu::layout::GpuFrame;
+use crate::gpu::upload::GpuScene;
+use crate::limits::MAX_DEPTH;
 use crate::report::FrameTime;
-use crate::scene::{Scene, MAX_DEPTH_LIMIT};
-use crate::shader::{self, ComputeShader, Shaders, Variant};
+use crate::scene::camera::Orbit;
+use crate::scene::Scene;
+use crate::shader::variant::Variant;
+use crate::window::keys::{action_for_key, Action};
+use crate::window::title::{window_title, TitleClock};
+use crate::window::{hooks, PathShaders, Renderer, WindowedRun};
 use anyhow::Context;
 use std::path::PathBuf;
-use std::time::{Duration, Instant};
+use std::time::Instant;
 use winit::application::ApplicationHandler;
 use winit::dpi::{PhysicalPosition, PhysicalSize};
 use winit::event::{ElementState, MouseButton, MouseScrollDelta, WindowEvent};
 use winit::event_loop::{ActiveEventLoop, ControlFlow, EventLoop};
-use winit::keyboard::{Key, NamedKey};
-use winit::window::{Window, WindowAttributes, WindowId};
-
-/// What an API's windowed app must provide. Sizes are physical pixels.
-pub trait Renderer {
-    /// "Vulkan" or "OpenGL", for the title.
-    fn api(&self) -> &'static str;
-    fn window(&self) -> &Window;
-    /// The window's drawable area changed; 0 in either dimension means minimized.
-    fn resize(&mut self, width: u32, height: u32) -> anyhow::Result<()>;
-    /// Draws and presents one frame with this uniform block. `Ok(None)` when no
-    /// frame could be drawn (e.g. a swapchain that must first be rebuilt);
-    /// otherwise the GPU time of the most recent frame whose timing is known.
-    fn draw(&mut self, frame: &GpuFrame) -> anyhow::Result<Option<Drawn>>;
-    /// A new scene, shader variant or path: rebuild buffers, descriptors and
-    /// program (or pipeline) for the path `shaders` belongs to, and draw with
-    /// that path from now on.
-    fn load_scene(&mut self, scene: &GpuScene, shaders: &PathShaders) -> anyhow::Result<()>;
-    /// Renders `frame` at `width`×`height` (the window's size) with the current
-    /// path into the RGBA32F image the headless path uses and reads it back, top
-    /// row first, so that a screenshot is quantised by `image_io` exactly like
-    /// `--headless --out`.
-    fn capture(&mut self, frame: &GpuFrame, width: u32, height: u32) -> anyhow::Result<FloatImage>;
-}
-
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Drawn {
-    pub gpu_ms: Option<f64>,
-}
-
-/// The shaders of the path a window draws with: the fullscreen pair, or the
-/// compute entry point with its workgroup.
-#[derive(Clone)]
-pub enum PathShaders {
-    Fragment(Shaders),
-    Compute(ComputeShader),
-}
-
-impl PathShaders {
-    pub fn build(
-        variant: &Variant,
-        path: RenderPath,
-        workgroup: Workgroup,
-    ) -> anyhow::Result<PathShaders> {
-        Ok(match path {
-            RenderPath::Fragment => PathShaders::Fragment(shader::build(variant)?),
-            RenderPath::Compute => PathShaders::Compute(shader::build_compute(variant, workgroup)?),
-        })
-    }
-
-    pub fn path(&self) -> RenderPath {
-        match self {
-            PathShaders::Fragment(_) => RenderPath::Fragment,
-            PathShaders::Compute(_) => RenderPath::Compute,
-        }
-    }
-}
-
-/// What a key or gesture asks for.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum Action {
-    Quit,
-    Scene(&'static str),
-    ResetCamera,
-    Screenshot,
-    DepthUp,
-    DepthDown,
-    /// Fragment ↔ compute.
-    SwitchPath,
-}
-
-/// The keys of the README's Controls section. `=` counts as `+` (same key
-/// without shift on US layouts), `_` as `-`.
-pub fn action_for_key(key: &Key) -> Option<Action> {
-    match key {
-        Key::Named(NamedKey::Escape) => Some(Action::Quit),
-        Key::Character(c) => action_for_char(c.as_str()),
-        _ => None,
-    }
-}
-
-fn action_for_char(c: &str) -> Option<Action> {
-    Some(match c {
-        "1" => Action::Scene("teapot"),
-        "2" => Action::Scene("box"),
-        "3" => Action::Scene("spherelist"),
-        "r" | "R" => Action::ResetCamera,
-        "p" | "P" => Action::Screenshot,
-        "+" | "=" => Action::DepthUp,
-        "-" | "_" => Action::DepthDown,
-        "c" | "C" => Action::SwitchPath,
-        _ => return None,
-    })
-}
-
-/// The window title, identical in both apps:
-/// `twinray — box — Vulkan compute — 61.3 FPS — 12.41 ms` (`n/a ms` where the
-/// GPU time is unknown, e.g. OpenGL on llvmpipe; `— starting` until the first
-/// figures, and after a switch until new ones).
-pub fn window_title(
-    scene: &str,
-    api: &str,
-    path: RenderPath,
-    fps_gpu: Option<(f64, Option<f64>)>,
-) -> String {
-    let head = format!("twinray — {scene} — {api} {path}");
-    match fps_gpu {
-        None => format!("{head} — starting"),
-        Some((fps, gpu_ms)) => {
-            let gpu = gpu_ms.map_or_else(|| "n/a".to_string(), |ms| format!("{ms:.2}"));
-            format!("{head} — {fps:.1} FPS — {gpu} ms")
-        }
-    }
-}
-
-/// Averages frames over half-second windows for the title.
-#[derive(Debug)]
-pub struct TitleClock {
-    since: Instant,
-    frames: u32,
-    gpu_sum: f64,
-    gpu_n: u32,
-}
-
-impl TitleClock {
-    pub const PERIOD: Duration = Duration::from_millis(500);
-
-    pub fn new(now: Instant) -> TitleClock {
-        TitleClock {
-            since: now,
-            frames: 0,
-            gpu_sum: 0.0,
-            gpu_n: 0,
-        }
-    }
-
-    /// Counts a frame; every `PERIOD` returns (FPS, mean GPU ms) and starts over.
-    pub fn frame(&mut self, now: Instant, gpu_ms: Option<f64>) -> Option<(f64, Option<f64>)> {
-        self.frames += 1;
-        if let Some(g) = gpu_ms {
-            self.gpu_sum += g;
-            self.gpu_n += 1;
-        }
-        let elapsed = now - self.since;
-        if elapsed < Self::PERIOD {
-            return None;
-        }
-        let fps = self.frames as f64 / elapsed.as_secs_f64();
-        let gpu = (self.gpu_n > 0).then(|| self.gpu_sum / self.gpu_n as f64);
-        *self = TitleClock::new(now);
-        Some((fps, gpu))
-    }
-}
-
-/// The event loop, or a clear exit-3 error where there is no display.
-pub fn event_loop() -> anyhow::Result<EventLoop<()>> {
-    EventLoop::new().map_err(|e| {
-        no_device(format!(
-            "cannot open a window ({}): no X display (is DISPLAY set?); run under xvfb-run, or use --headless",
-            crate::error::without_source_location(&e.to_string())
-        ))
-    })
-}
-
-/// The window both apps open: `--size` as the drawable size, a fixed title until
-/// the first FPS figure.
-pub fn window_attributes(args: &RenderArgs, scene: &str, api: &str) -> WindowAttributes {
-    Window::default_attributes()
-        .with_title(window_title(scene, api, args.path, None))
-        .with_inner_size(PhysicalSize::new(args.size.width, args.size.height))
-}
-
-/// The scene and variant a windowed run starts with (the same choice as headless).
-pub fn variant_for(args: &RenderArgs, scene: &Scene) -> Variant {
-    Variant::chosen(scene, args)
-}
-
-/// The shaders a window starts with: `--path`'s, for the scene's variant.
-pub fn first_shaders(args: &RenderArgs, scene: &Scene) -> anyhow::Result<PathShaders> {
-    PathShaders::build(
-        &variant_for(args, scene),
-        args.path,
-        args.compute_workgroup()?,
-    )
-}
-
-/// What the run did, for `--json`.
-pub struct WindowedRun {
-    pub frames: Vec<FrameTime>,
-    pub scene: Scene,
-    pub variant: Variant,
-    /// The path drawing at exit (`C` may have switched it).
-    pub path: RenderPath,
-    pub workgroup: Workgroup,
-    pub width: u32,
-    pub height: u32,
-    /// Milliseconds from `started` to the end of the first frame.
-    pub setup_ms: f64,
-}
-
-impl WindowedRun {
-    /// The `--json` report of a window: the headless shape, with wall time
-    /// frame to frame and no NaN count (nothing is read back).
-    pub fn report(
-        self,
-        api: &str,
-        device: crate::report::DeviceInfo,
-        validation_messages: u64,
-    ) -> crate::report::RunReport {
-        crate::report::RunReport::builder(api, device, self.scene.stats(), self.variant.label())
-            .size(self.width, self.height)
-            .path(self.path, self.workgroup)
-            .frames(self.frames, self.setup_ms)
-            .validation_messages(validation_messages)
-            .build()
-    }
-}
+use winit::window::WindowId;
 
 /// Runs the window until Esc, the close button or `--frames`, then saves `--out`.
 /// The renderer is dropped (every API object destroyed) before this returns.
@@ -276,10 +56,8 @@ pub fn run<R: Renderer>(
         cursor: None,
         screenshots: 0,
         error: None,
-        resize_test: std::env::var("TWINRAY_TEST_RESIZE")
-            .is_ok_and(|v| v == "1")
-            .then(ResizeTest::default),
-        test_keys: test_keys()?,
+        resize_test: hooks::resize_test()?.then(ResizeTest::default),
+        test_keys: hooks::test_keys()?,
     };
     event_loop.set_control_flow(ControlFlow::Poll);
     event_loop
@@ -306,23 +84,6 @@ pub fn run<R: Renderer>(
         height: session.size.height,
         setup_ms: session.setup_ms,
     })
-}
-
-fn test_keys() -> anyhow::Result<Vec<Action>> {
-    let Ok(list) = std::env::var("TWINRAY_TEST_KEYS") else {
-        return Ok(Vec::new());
-    };
-    let mut actions: Vec<Action> = list
-        .split(',')
-        .filter(|k| !k.trim().is_empty())
-        .map(|k| match k.trim() {
-            "esc" => Ok(Action::Quit),
-            c => action_for_char(c)
-                .ok_or_else(|| bad_input(format!("TWINRAY_TEST_KEYS: '{c}' is no key of the app"))),
-        })
-        .collect::<anyhow::Result<_>>()?;
-    actions.reverse(); // popped from the end
-    Ok(actions)
 }
 
 struct Session<R: Renderer> {
@@ -460,7 +221,7 @@ impl<R: Renderer> Session<R> {
                     }
                 };
                 self.orbit = Orbit::new(&scene.camera);
-                self.variant = variant_for(&self.args, &scene);
+                self.variant = Variant::chosen(&scene, &self.args);
                 self.scene = scene;
                 self.rebuild()?;
                 self.restart_title();
@@ -477,14 +238,14 @@ impl<R: Renderer> Session<R> {
             Action::DepthUp | Action::DepthDown => {
                 let d = self.scene.max_depth;
                 let d = if action == Action::DepthUp {
-                    (d + 1).min(MAX_DEPTH_LIMIT)
+                    (d + 1).min(MAX_DEPTH)
                 } else {
                     d.saturating_sub(1).max(1)
                 };
                 self.scene.max_depth = d;
                 // The uniform block carries the depth; only a deeper stack or a
                 // feature the current shader compiled out needs a new variant.
-                let needed = variant_for(&self.args, &self.scene);
+                let needed = Variant::chosen(&self.scene, &self.args);
                 let rebuilt = !self.variant.covers(&needed);
                 if rebuilt {
                     self.variant = needed;
@@ -692,104 +453,6 @@ impl<R: Renderer> ApplicationHandler for Session<R> {
             r.window().request_redraw();
         } else {
             event_loop.set_control_flow(ControlFlow::Wait);
-        }
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn keys_map_to_the_documented_actions() {
-        let ch = |s: &str| action_for_key(&Key::Character(s.into()));
-        assert_eq!(
-            action_for_key(&Key::Named(NamedKey::Escape)),
-            Some(Action::Quit)
-        );
-        assert_eq!(ch("1"), Some(Action::Scene("teapot")));
-        assert_eq!(ch("2"), Some(Action::Scene("box")));
-        assert_eq!(ch("3"), Some(Action::Scene("spherelist")));
-        assert_eq!(ch("R"), Some(Action::ResetCamera));
-        assert_eq!(ch("p"), Some(Action::Screenshot));
-        assert_eq!(ch("+"), Some(Action::DepthUp));
-        assert_eq!(ch("="), Some(Action::DepthUp));
-        assert_eq!(ch("-"), Some(Action::DepthDown));
-        assert_eq!(ch("c"), Some(Action::SwitchPath));
-        assert_eq!(ch("C"), Some(Action::SwitchPath));
-        assert_eq!(ch("x"), None);
-        assert_eq!(action_for_key(&Key::Named(NamedKey::Enter)), None);
-    }
-
-    #[test]
-    fn title_format_is_fixed() {
-        assert_eq!(
-            window_title(
-                "box",
-                "Vulkan",
-                RenderPath::Compute,
-                Some((61.26, Some(12.414)))
-            ),
-            "twinray — box — Vulkan compute — 61.3 FPS — 12.41 ms"
-        );
-        assert_eq!(
-            window_title("teapot", "OpenGL", RenderPath::Fragment, Some((5.0, None))),
-            "twinray — teapot — OpenGL fragment — 5.0 FPS — n/a ms"
-        );
-        assert_eq!(
-            window_title("box", "OpenGL", RenderPath::Compute, None),
-            "twinray — box — OpenGL compute — starting"
-        );
-    }
-
-    #[test]
-    fn title_clock_reports_twice_a_second() {
-        let t0 = Instant::now();
-        let mut c = TitleClock::new(t0);
-        assert_eq!(c.frame(t0 + Duration::from_millis(100), Some(2.0)), None);
-        assert_eq!(c.frame(t0 + Duration::from_millis(200), None), None);
-        let (fps, gpu) = c.frame(t0 + Duration::from_millis(500), Some(4.0)).unwrap();
-        assert!((fps - 6.0).abs() < 1e-9, "3 frames in 0.5 s: {fps}");
-        assert_eq!(gpu, Some(3.0));
-        assert_eq!(
-            c.frame(t0 + Duration::from_millis(600), None),
-            None,
-            "starts over"
-        );
-    }
-
-    #[test]
-    fn depth_changes_rebuild_only_when_the_variant_cannot_cover_them() {
-        let scene = Scene::load("box", &[]).unwrap();
-        let deep = Variant::for_scene(&scene);
-        let mut shallow_scene = scene.clone();
-        shallow_scene.max_depth = 2;
-        let shallow = Variant::for_scene(&shallow_scene);
-        assert!(
-            deep.covers(&shallow),
-            "a deeper stack draws shallower scenes"
-        );
-        assert!(!shallow.covers(&deep), "a stack too small for the depth");
-        shallow_scene.max_depth = 1;
-        let flat = Variant::for_scene(&shallow_scene);
-        assert!(
-            !flat.covers(&shallow),
-            "depth 1 compiles mirror and glass out"
-        );
-        let mut generic = crate::cli::RenderArgs::headless("box", scene_size());
-        generic.generic = true;
-        assert!(Variant::chosen(&scene, &generic).covers(&deep));
-        let teapot = Scene::load("teapot", &[]).unwrap();
-        assert!(
-            !Variant::chosen(&teapot, &generic).covers(&deep),
-            "the counts are baked in: another scene's shader cannot draw this one"
-        );
-    }
-
-    fn scene_size() -> crate::cli::Size {
-        crate::cli::Size {
-            width: 8,
-            height: 8,
         }
     }
 }

@@ -1,149 +1,13 @@
-//! GPU buffer layouts: the one Rust mirror of every struct in shaders/trace.glsl
-//! (`#[repr(C)]` + bytemuck), and the conversion of a `Scene` into the exact bytes
-//! both apps upload, every position relative to the scene's local origin
-//! (`camera::local_origin`). A test checks these layouts against naga's view of the GLSL.
+//! The bytes both apps upload: a `Scene` converted into the layouts of
+//! `gpu::layout`, every position relative to the scene's local origin
+//! (`camera::local_origin`), and the checks of those buffers against a device's limits.
 
-use crate::camera::{in_local_frame, RayFrame};
+use crate::gpu::layout::{
+    binding, Bvh, GpuBvhNode, GpuFrame, GpuLight, GpuMaterial, GpuSphere, GpuTriangle,
+};
+use crate::scene::camera::{in_local_frame, RayFrame};
 use crate::scene::{Camera, Scene};
-use bytemuck::{Pod, Zeroable};
-
-/// Uniform block `Frame` (std140, binding 0).
-#[repr(C)]
-#[derive(Clone, Copy, Debug, Default, Pod, Zeroable, PartialEq)]
-pub struct GpuFrame {
-    pub eye: [f32; 3],
-    pub min_weight: f32,
-    pub top_left: [f32; 3],
-    pub epsilon: f32,
-    pub step_x: [f32; 3],
-    pub max_depth: u32,
-    pub step_y: [f32; 3],
-    pub sphere_count: u32,
-    pub background: [f32; 3],
-    pub triangle_count: u32,
-    pub light_count: u32,
-    /// The image size, for the compute entry point's bounds check (the fragment
-    /// path's viewport does that job there).
-    pub width: u32,
-    pub height: u32,
-    pub pad: u32,
-}
-
-/// `Sphere` (std430 array element, binding 1).
-#[repr(C)]
-#[derive(Clone, Copy, Debug, Default, Pod, Zeroable, PartialEq)]
-pub struct GpuSphere {
-    pub center: [f32; 3],
-    pub radius: f32,
-    pub material: u32,
-    pub pad: [u32; 3],
-}
-
-/// `Triangle` (std430 array element, binding 2): vertices, then per-vertex normals.
-#[repr(C)]
-#[derive(Clone, Copy, Debug, Default, Pod, Zeroable, PartialEq)]
-pub struct GpuTriangle {
-    pub p0: [f32; 3],
-    pub material: u32,
-    pub p1: [f32; 3],
-    pub pad0: u32,
-    pub p2: [f32; 3],
-    pub pad1: u32,
-    pub n0: [f32; 3],
-    pub pad2: u32,
-    pub n1: [f32; 3],
-    pub pad3: u32,
-    pub n2: [f32; 3],
-    pub pad4: u32,
-}
-
-/// `Material` (std430 array element, binding 3).
-#[repr(C)]
-#[derive(Clone, Copy, Debug, Default, Pod, Zeroable, PartialEq)]
-pub struct GpuMaterial {
-    pub ambient: [f32; 3],
-    pub reflectivity: f32,
-    pub diffuse: [f32; 3],
-    pub transparency: f32,
-    pub specular: [f32; 3],
-    pub shininess: f32,
-    pub ior: f32,
-    pub pad: [u32; 3],
-}
-
-/// `Light` (std430 array element, binding 4).
-#[repr(C)]
-#[derive(Clone, Copy, Debug, Default, Pod, Zeroable, PartialEq)]
-pub struct GpuLight {
-    pub position: [f32; 3],
-    pub pad0: f32,
-    pub color: [f32; 3],
-    pub pad1: f32,
-}
-
-/// `BvhNode` (std430 array element, binding 6). Depth-first layout: an interior
-/// node's left child is the next node and `left_or_first` is its right child;
-/// a leaf (`count > 0`) holds `prims[left_or_first .. left_or_first + count]`.
-#[repr(C)]
-#[derive(Clone, Copy, Debug, Default, Pod, Zeroable, PartialEq)]
-pub struct GpuBvhNode {
-    pub min: [f32; 3],
-    pub left_or_first: u32,
-    pub max: [f32; 3],
-    pub count: u32,
-}
-
-impl GpuBvhNode {
-    pub fn leaf((min, max): ([f32; 3], [f32; 3]), first: u32, count: u32) -> GpuBvhNode {
-        GpuBvhNode {
-            min,
-            left_or_first: first,
-            max,
-            count,
-        }
-    }
-
-    pub fn interior((min, max): ([f32; 3], [f32; 3]), right: u32) -> GpuBvhNode {
-        GpuBvhNode {
-            min,
-            left_or_first: right,
-            max,
-            count: 0,
-        }
-    }
-}
-
-/// In the BVH's primitive list (binding 7): set for a sphere index, clear for a triangle index.
-pub const PRIM_SPHERE_BIT: u32 = 1 << 31;
-
-/// Per BVH node (binding 8), for the stackless traversal: the parent's index
-/// in the low bits and, for an interior node, the axis its children were split
-/// on in the top two (the left child holds the lower side).
-pub const LINK_AXIS_SHIFT: u32 = 30;
-pub const LINK_PARENT_MASK: u32 = (1 << LINK_AXIS_SHIFT) - 1;
-
-/// Binding numbers, shared by the shader build (GLSL binding map) and both apps.
-pub mod binding {
-    pub const FRAME: u32 = 0;
-    pub const SPHERES: u32 = 1;
-    pub const TRIANGLES: u32 = 2;
-    pub const MATERIALS: u32 = 3;
-    pub const LIGHTS: u32 = 4;
-    /// The compute path's RGBA32F storage image (the fragment path has a colour attachment instead).
-    pub const IMAGE: u32 = 5;
-    /// 5 is the compute path's output image.
-    pub const BVH_NODES: u32 = 6;
-    pub const BVH_PRIMS: u32 = 7;
-    pub const BVH_LINKS: u32 = 8;
-    /// The sphere, triangle and light counts, where the shader reads them at
-    /// run time (`--experiment storage-counts`) instead of baking them in.
-    pub const COUNTS: u32 = 9;
-    pub const LAST: u32 = COUNTS;
-    /// The storage buffers in binding order.
-    pub const STORAGE: [u32; 8] = [
-        SPHERES, TRIANGLES, MATERIALS, LIGHTS, BVH_NODES, BVH_PRIMS, BVH_LINKS, COUNTS,
-    ];
-}
+use bytemuck::Pod;
 
 /// Everything a frame needs on the GPU, as bytes. Both apps upload exactly these.
 #[derive(Clone, Debug)]
@@ -197,7 +61,7 @@ impl GpuScene {
     /// the same frame.
     pub fn new(world: &Scene, width: u32, height: u32) -> GpuScene {
         let scene = &*in_local_frame(world);
-        let empty = crate::bvh::Bvh::default();
+        let empty = Bvh::default();
         let bvh = world.bvh_tree().unwrap_or(&empty);
         GpuScene {
             frame: GpuFrame::new(world, &world.camera, width, height),
@@ -325,4 +189,80 @@ pub fn check_storage_limit(gpu: &GpuScene, limit: u64, limit_name: &str) -> anyh
         )));
     }
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::scene::camera::{local_origin, Orbit, LOCAL_ORIGIN_GRID_VIEWS};
+    use crate::scene::OriginMode;
+    use glam::DVec3;
+    use std::borrow::Cow;
+
+    #[test]
+    fn near_scenes_keep_a_zero_origin_and_far_ones_trace_near_zero() {
+        for (name, _) in crate::scene::load::BUILTIN_SCENES {
+            let s = Scene::load(name, &[]).unwrap();
+            assert_eq!(local_origin(&s), DVec3::ZERO, "{name}");
+            assert!(matches!(in_local_frame(&s), Cow::Borrowed(_)), "{name}");
+        }
+        let dir = std::path::Path::new(crate::scene::hard::SOURCE_DIR);
+        let mut moved = Vec::new();
+        for case in crate::scene::hard::list(dir).unwrap() {
+            let s = Scene::load(case.path.to_str().unwrap(), &[]).unwrap();
+            let o = local_origin(&s);
+            if o == DVec3::ZERO {
+                continue;
+            }
+            moved.push(case.name.clone());
+            // On the grid: a power of two times a whole number per axis.
+            let view = (s.camera.eye - s.camera.look_at).length();
+            let grid = (LOCAL_ORIGIN_GRID_VIEWS * view).log2().ceil().exp2();
+            assert_eq!(o / grid, (o / grid).round(), "{}", case.name);
+            // What the GPU holds lies within a few view distances of zero, and
+            // `origin=world` gives the world coordinates back.
+            let g = GpuScene::new(&s, 8, 8);
+            let far = g
+                .spheres
+                .iter()
+                .map(|x| x.center)
+                .chain(g.triangles.iter().map(|t| t.p0))
+                .chain(std::iter::once(g.frame.eye))
+                .flat_map(|v| v.map(f32::abs))
+                .fold(0.0f32, f32::max);
+            assert!(far < 40.0 * view as f32, "{}: {far}", case.name);
+            let mut world = s.clone();
+            world.origin = OriginMode::World;
+            assert_eq!(local_origin(&world), DVec3::ZERO);
+            assert_eq!(
+                GpuScene::new(&world, 8, 8).frame.eye,
+                s.camera.eye.as_vec3().to_array()
+            );
+        }
+        moved.sort();
+        assert_eq!(
+            moved,
+            ["closed-mesh", "far-1e4", "far-1e5", "far-1e6", "far-1e7"],
+            "the cases README.md names as moved"
+        );
+    }
+
+    #[test]
+    fn the_orbit_never_moves_the_origin() {
+        let s = Scene::load(
+            concat!(env!("CARGO_MANIFEST_DIR"), "/../scenes/hard/far-1e6.toml"),
+            &[],
+        )
+        .unwrap();
+        let o = local_origin(&s);
+        let mut orbit = Orbit::new(&s.camera);
+        orbit.drag(40.0, 25.0, 100);
+        orbit.zoom(-5.0);
+        let frame = GpuFrame::new(&s, &orbit.camera(), 8, 8);
+        let expect = (orbit.camera().eye - o).as_vec3().to_array();
+        assert_eq!(frame.eye, expect);
+        // The origin comes from the scene's own camera, never the orbit's: a
+        // zoom changes the view distance and so the grid, which would move it.
+        assert_eq!(local_origin(&s), o);
+    }
 }

@@ -1,0 +1,7 @@
+//! The shader: which variant a run compiles (`variant`, the single decider),
+//! the naga build of that variant into SPIR-V and GLSL (`build`), and the
+//! passes over naga's output (`post`).
+
+pub mod build;
+pub mod post;
+pub mod variant;
