@@ -12,7 +12,7 @@ use crate::timer::Timer;
 use anyhow::anyhow;
 use glow::HasContext;
 use std::time::Instant;
-use twinray_common::cli::{OpenGlKnobs, RenderArgs, RenderPath};
+use twinray_common::cli::{Experiment, OpenGlKnobs, RenderArgs, RenderPath};
 use twinray_common::error::bad_input;
 use twinray_common::explain;
 use twinray_common::gpu::upload::{check_storage_limit, GpuScene};
@@ -34,6 +34,11 @@ pub fn run(args: RenderArgs, knobs: &OpenGlKnobs, started: Instant) -> anyhow::R
             ));
         }
         return run_windowed(&args, started);
+    }
+    if args.gl_spirv && args.experiment.contains(&Experiment::Glslang) {
+        return Err(bad_input(
+            "--gl-spirv with --experiment glslang: glslang's SPIR-V is 1.3 for Vulkan 1.1, and OpenGL loads SPIR-V 1.0 only; drop one of them",
+        ));
     }
     let scene = args.load_scene()?;
     let variant = Variant::chosen(&scene, &args);
