@@ -2,7 +2,8 @@
 # needs on Debian/Ubuntu (Vulkan loader + Mesa lavapipe, EGL + Mesa llvmpipe, the
 # Khronos validation layer, a C++ compiler, Xvfb and xdotool for the windowed
 # tests, glslangValidator and spirv-val to check the shader with compilers other
-# than naga) and gives Mesa a writable shader cache.
+# than naga, and the rustfmt and clippy components) and gives Mesa a writable
+# shader cache.
 twinray_packages=(libvulkan1 mesa-vulkan-drivers vulkan-validationlayers libegl1 libegl-mesa0 libgl1-mesa-dri g++ pkg-config xvfb xauth xdotool glslang-tools spirv-tools)
 twinray_missing=()
 for p in "${twinray_packages[@]}"; do
@@ -19,6 +20,16 @@ if ! command -v cargo >/dev/null; then
     [ -f "$HOME/.cargo/env" ] && source "$HOME/.cargo/env"
 fi
 command -v cargo >/dev/null || { echo "twinray: cargo not found; install Rust from https://rustup.rs" >&2; exit 1; }
+# .ci/run's gates need rustfmt and clippy; a minimal rustup profile lacks them.
+if command -v rustup >/dev/null; then
+    twinray_components=$(rustup component list --installed 2>/dev/null || true)
+    for c in rustfmt clippy; do
+        if ! grep -q "^$c" <<<"$twinray_components"; then
+            echo "twinray: installing the Rust component $c" >&2
+            rustup component add "$c" >/dev/null
+        fi
+    done
+fi
 # lavapipe and llvmpipe recompile the shader every frame without a writable cache.
 export MESA_SHADER_CACHE_DIR="${MESA_SHADER_CACHE_DIR:-$PWD/target/mesa-shader-cache}"
 mkdir -p "$MESA_SHADER_CACHE_DIR"

@@ -217,10 +217,17 @@ fn teapot_tessellation_override_scales_the_triangle_count() {
 }
 
 #[test]
-fn the_built_in_teapot_is_the_committed_obj() {
-    // The scene tessellates teapot.bpt at load; teapot.obj is that generator's
-    // output written with 6 decimals: the same triangles, to rounding.
-    let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../scenes");
+fn the_generators_obj_is_the_built_in_teapot() {
+    // The scene tessellates teapot.bpt at load; twinray-gen-teapot writes the
+    // same tessellation as OBJ with 6 decimals: the same triangles, to rounding.
+    use twinray_common::scene::teapot::{
+        parse_bpt, tessellate, to_obj, HEADER, STUDY_NU, STUDY_NV,
+    };
+    let bpt = include_str!("../../scenes/teapot.bpt");
+    let mesh = tessellate(&parse_bpt(bpt).unwrap(), STUDY_NU, STUDY_NV);
+    let dir = std::env::temp_dir().join(format!("twinray-teapot-obj-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    std::fs::write(dir.join("teapot.obj"), to_obj(&mesh, HEADER)).unwrap();
     let from_obj = Scene::from_toml(
         "obj",
         &format!("{}[[meshes]]\nobj = \"teapot.obj\"\nmaterial = \"m\"\n", OK),

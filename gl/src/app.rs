@@ -66,13 +66,7 @@ pub fn run(args: RenderArgs, knobs: &OpenGlKnobs, started: Instant) -> anyhow::R
         RenderPath::Fragment => {
             let shaders = build(&variant)?;
             if let Some(dir) = &args.dump_shaders {
-                dump_shaders(
-                    dir,
-                    &[
-                        ("vertex", &shaders.vertex_spirv, &shaders.vertex_glsl),
-                        ("fragment", &shaders.fragment_spirv, &shaders.fragment_glsl),
-                    ],
-                )?;
+                dump_shaders(dir, &shaders.stages())?;
             }
             explain::step(
                 "Shaders: GLSL -> naga module -> GLSL 450 core (twinray-common)",

@@ -76,8 +76,9 @@ impl<'gl> SceneBuffers<'gl> {
 
 impl Drop for SceneBuffers<'_> {
     fn drop(&mut self) {
-        // SAFETY: these buffers were created on this context, which outlives them.
         for &b in self.buffers.iter().rev() {
+            // SAFETY: the buffer was created on this context, which outlives it;
+            // GL keeps it alive for draws already issued.
             unsafe { self.gl.delete_buffer(b) }
         }
     }

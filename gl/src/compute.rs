@@ -49,26 +49,25 @@ impl<'gl> Compute<'gl> {
         height: u32,
     ) -> anyhow::Result<Compute<'gl>> {
         let groups = check_limits(gl, shader.workgroup, width, height)?;
-        let program = match spirv_proc {
-            Some(proc_address) => link(
+        let compiled = match spirv_proc {
+            Some(proc_address) => crate::program::compile_spirv(
                 gl,
-                crate::program::compile_spirv(
-                    gl,
-                    proc_address,
-                    glow::COMPUTE_SHADER,
-                    &spirv_for_opengl(&shader.spirv),
-                    "compute",
-                )?,
+                proc_address,
+                glow::COMPUTE_SHADER,
+                &spirv_for_opengl(&shader.spirv),
+                "compute",
             )?,
             // SAFETY: the context is current (the caller made it so).
-            None => link(gl, unsafe {
+            None => unsafe {
                 crate::program::compile(gl, glow::COMPUTE_SHADER, &shader.glsl, "compute")
-            }?)?,
+            }?,
         };
+        let program = link(gl, compiled)?;
         // SAFETY: a fresh texture on the current context; sizes were checked.
         let texture = match unsafe { gl.create_texture() } {
             Ok(t) => t,
             Err(e) => {
+                // SAFETY: the program was linked above on this context and nothing uses it yet.
                 unsafe { gl.delete_program(program) };
                 return Err(anyhow!(e).context("glGenTextures"));
             }
@@ -124,10 +123,13 @@ impl<'gl> Compute<'gl> {
     pub fn resize(&mut self, width: u32, height: u32) -> anyhow::Result<()> {
         let gl = self.gl;
         self.groups = check_limits(gl, self.workgroup, width, height)?;
-        // SAFETY: objects of the current context; the old texture is no longer bound anywhere after this.
+        // SAFETY: a new name on the context that is current (the window's).
         let texture = unsafe { gl.create_texture() }
             .map_err(|e| anyhow!(e))
             .context("glGenTextures")?;
+        // SAFETY: the old texture is this context's; GL keeps it alive for
+        // commands already issued, and storage() and attach() below point the
+        // image unit and the framebuffer at the new one.
         unsafe { gl.delete_texture(self.texture) };
         self.texture = texture;
         (self.width, self.height) = (width, height);
@@ -307,9 +309,11 @@ fn check_limits(
     Ok(groups)
 }
 
-/// Links one compiled compute shader into a program; the shader goes either way.
+/// The compute program, linked from one compiled shader, which goes either way.
 fn link(gl: &glow::Context, shader: glow::Shader) -> anyhow::Result<glow::Program> {
-    // SAFETY: objects of the current context; the shader is detached and deleted once linked.
+    // SAFETY: the shader was compiled on the current context (the caller's),
+    // which makes the program too; a program that fails to link is deleted
+    // here, so nothing leaks.
     unsafe {
         let program = match gl.create_program() {
             Ok(p) => p,
@@ -318,15 +322,8 @@ fn link(gl: &glow::Context, shader: glow::Shader) -> anyhow::Result<glow::Progra
                 return Err(anyhow!(e).context("glCreateProgram"));
             }
         };
-        gl.attach_shader(program, shader);
-        gl.link_program(program);
-        gl.detach_shader(program, shader);
-        gl.delete_shader(shader);
-        if !gl.get_program_link_status(program) {
-            let log = gl.get_program_info_log(program);
-            gl.delete_program(program);
-            return Err(anyhow!("linking the compute program failed:\n{log}"));
-        }
+        crate::program::link(gl, program, &[shader], "compute")
+            .inspect_err(|_| gl.delete_program(program))?;
         Ok(program)
     }
 }

@@ -5,6 +5,7 @@
 
 use anyhow::{anyhow, Context as _};
 use glow::HasContext;
+use std::ffi::c_void;
 use twinray_common::explain;
 
 pub struct Program<'gl> {
@@ -21,14 +22,20 @@ struct SeparablePipeline {
     vertex: glow::Program,
 }
 
+type ProgramParameteri = unsafe extern "system" fn(u32, u32, i32);
+type GenProgramPipelines = unsafe extern "system" fn(i32, *mut u32);
+type DeleteProgramPipelines = unsafe extern "system" fn(i32, *const u32);
+type BindProgramPipeline = unsafe extern "system" fn(u32);
+type UseProgramStages = unsafe extern "system" fn(u32, u32, u32);
+
 /// GL 4.1/4.6 entry points glow does not wrap.
 #[derive(Clone, Copy)]
 struct PipelineFns {
-    program_parameteri: unsafe extern "system" fn(u32, u32, i32),
-    gen_program_pipelines: unsafe extern "system" fn(i32, *mut u32),
-    delete_program_pipelines: unsafe extern "system" fn(i32, *const u32),
-    bind_program_pipeline: unsafe extern "system" fn(u32),
-    use_program_stages: unsafe extern "system" fn(u32, u32, u32),
+    program_parameteri: ProgramParameteri,
+    gen_program_pipelines: GenProgramPipelines,
+    delete_program_pipelines: DeleteProgramPipelines,
+    bind_program_pipeline: BindProgramPipeline,
+    use_program_stages: UseProgramStages,
 }
 
 impl PipelineFns {
@@ -36,23 +43,26 @@ impl PipelineFns {
         proc_address: &dyn Fn(&std::ffi::CStr) -> *const std::ffi::c_void,
     ) -> anyhow::Result<PipelineFns> {
         let get = |name: &std::ffi::CStr| entry_point(proc_address, name);
-        // SAFETY: each pointer is the driver's entry point of that name, whose C
-        // signature (GL 4.6 core) the field types spell out.
+        // SAFETY: each pointer is the driver's entry point of that name (non-null,
+        // checked by entry_point), whose C signature in GL 4.6 core is the type
+        // it is transmuted to; function pointers and data pointers have the same
+        // size on every platform GL runs on.
         unsafe {
             Ok(PipelineFns {
-                program_parameteri: std::mem::transmute::<*const std::ffi::c_void, _>(get(
+                program_parameteri: std::mem::transmute::<*const c_void, ProgramParameteri>(get(
                     c"glProgramParameteri",
                 )?),
-                gen_program_pipelines: std::mem::transmute::<*const std::ffi::c_void, _>(get(
-                    c"glGenProgramPipelines",
-                )?),
-                delete_program_pipelines: std::mem::transmute::<*const std::ffi::c_void, _>(get(
-                    c"glDeleteProgramPipelines",
-                )?),
-                bind_program_pipeline: std::mem::transmute::<*const std::ffi::c_void, _>(get(
-                    c"glBindProgramPipeline",
-                )?),
-                use_program_stages: std::mem::transmute::<*const std::ffi::c_void, _>(get(
+                gen_program_pipelines: std::mem::transmute::<*const c_void, GenProgramPipelines>(
+                    get(c"glGenProgramPipelines")?,
+                ),
+                delete_program_pipelines: std::mem::transmute::<
+                    *const c_void,
+                    DeleteProgramPipelines,
+                >(get(c"glDeleteProgramPipelines")?),
+                bind_program_pipeline: std::mem::transmute::<*const c_void, BindProgramPipeline>(
+                    get(c"glBindProgramPipeline")?,
+                ),
+                use_program_stages: std::mem::transmute::<*const c_void, UseProgramStages>(get(
                     c"glUseProgramStages",
                 )?),
             })
@@ -125,23 +135,31 @@ pub(crate) fn compile_spirv(
     }
 }
 
+/// Links compiled `shaders` into `program`, then detaches and deletes them
+/// (the linked program no longer needs them), whether the link worked or not.
+/// Every program here (vertex + fragment, a separable stage, compute) is made
+/// this way; `program` stays the caller's to delete.
+///
 /// # Safety
-/// Needs a current context; `shader` is compiled and is deleted here.
-unsafe fn link_separable(
+/// Needs a current context that owns `program` and `shaders`.
+pub(crate) unsafe fn link(
     gl: &glow::Context,
-    fns: &PipelineFns,
     program: glow::Program,
-    shader: glow::Shader,
+    shaders: &[glow::Shader],
     what: &str,
 ) -> anyhow::Result<()> {
     // SAFETY: forwarded from the caller.
     unsafe {
-        (fns.program_parameteri)(program.0.get(), glow::PROGRAM_SEPARABLE, 1);
-        gl.attach_shader(program, shader);
+        for &s in shaders {
+            gl.attach_shader(program, s);
+        }
         gl.link_program(program);
-        gl.detach_shader(program, shader);
-        gl.delete_shader(shader);
-        if !gl.get_program_link_status(program) {
+        let linked = gl.get_program_link_status(program);
+        for &s in shaders {
+            gl.detach_shader(program, s);
+            gl.delete_shader(s);
+        }
+        if !linked {
             return Err(anyhow!(
                 "linking the {what} program failed:\n{}",
                 gl.get_program_info_log(program)
@@ -239,20 +257,7 @@ impl<'gl> Program<'gl> {
                     return Err(e);
                 }
             };
-            gl.attach_shader(raw, vs);
-            gl.attach_shader(raw, fs);
-            gl.link_program(raw);
-            let linked = gl.get_program_link_status(raw);
-            for s in [fs, vs] {
-                gl.detach_shader(raw, s);
-                gl.delete_shader(s);
-            }
-            if !linked {
-                return Err(anyhow!(
-                    "linking the tracer program failed:\n{}",
-                    gl.get_program_info_log(raw)
-                ));
-            }
+            link(gl, raw, &[vs, fs], "tracer")?;
             explain::step(
                 "glCreateShader x2 + glCompileShader + glCreateProgram + glLinkProgram",
                 || {
@@ -315,9 +320,11 @@ impl<'gl> Program<'gl> {
                 fragment,
                 "fragment",
             )?;
-            link_separable(gl, &fns, raw, fs, "SPIR-V fragment")?;
+            (fns.program_parameteri)(raw.0.get(), glow::PROGRAM_SEPARABLE, 1);
+            link(gl, raw, &[fs], "SPIR-V fragment")?;
             let vs = compile(gl, glow::VERTEX_SHADER, &vertex_glsl, "vertex")?;
-            link_separable(gl, &fns, vertex, vs, "GLSL vertex")?;
+            (fns.program_parameteri)(vertex.0.get(), glow::PROGRAM_SEPARABLE, 1);
+            link(gl, vertex, &[vs], "GLSL vertex")?;
             (fns.use_program_stages)(pipeline, glow::VERTEX_SHADER_BIT, vertex.0.get());
             (fns.use_program_stages)(pipeline, glow::FRAGMENT_SHADER_BIT, raw.0.get());
             Ok(program)

@@ -5,18 +5,60 @@ use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 use twinray_common::report::RunReport;
 
-/// target/<profile>/, found from this test executable (target/<profile>/deps/…).
+/// `target/<profile>/`, found from this test executable (`target/<profile>/deps/…`),
+/// with the three apps built there for this profile. A test must never fail
+/// because nobody built them first (a fresh clone's `cargo test --workspace`),
+/// nor run stale ones after an edit: so the first call in each test process
+/// runs `cargo build` for them, which takes a second when they are up to date.
 pub fn bin_dir() -> PathBuf {
+    static BUILT: std::sync::OnceLock<PathBuf> = std::sync::OnceLock::new();
+    BUILT.get_or_init(build_apps).clone()
+}
+
+/// Builds twinray-vk, twinray-gl and twinray with the profile and target
+/// folder of this test executable. Cargo does not hold its build lock while
+/// tests run, so this nested build cannot wait on the `cargo test` that started it.
+fn build_apps() -> PathBuf {
     let exe = std::env::current_exe().expect("test executable path");
     let dir = exe
         .parent()
         .and_then(Path::parent)
         .expect("target/<profile>")
         .to_path_buf();
+    let profile = match dir.file_name().and_then(|n| n.to_str()) {
+        Some("debug") => "dev".to_string(),
+        Some(name) => name.to_string(),
+        None => panic!("{} is not a target/<profile> folder", dir.display()),
+    };
+    let target_dir = dir.parent().expect("target/");
+    let manifest = Path::new(env!("CARGO_MANIFEST_DIR")).join("../Cargo.toml");
+    // Cargo runs tests with CARGO set to itself; `cargo` is the fallback elsewhere.
+    let cargo = std::env::var_os("CARGO").unwrap_or_else(|| "cargo".into());
+    let status = Command::new(&cargo)
+        .args(["build", "--quiet", "--profile", &profile])
+        .args(["-p", "twinray-vk", "-p", "twinray-gl", "-p", "twinray"])
+        // As tests/run.sh builds them: the windowed tests drive the apps
+        // through their test hooks. The same features make this a no-op there.
+        .args(["--features", "twinray-vk/test-hooks,twinray-gl/test-hooks"])
+        .arg("--manifest-path")
+        .arg(&manifest)
+        .arg("--target-dir")
+        .arg(target_dir)
+        .status()
+        .unwrap_or_else(|e| {
+            panic!(
+                "starting {} to build the apps: {e}",
+                cargo.to_string_lossy()
+            )
+        });
+    assert!(
+        status.success(),
+        "building the apps for the end-to-end tests failed ({status}); the output above says why"
+    );
     for name in ["twinray-vk", "twinray-gl", "twinray"] {
         assert!(
             dir.join(name).exists(),
-            "{name} is not built in {}: run `cargo build --workspace --features twinray-vk/test-hooks,twinray-gl/test-hooks` with the same profile first (tests/run.sh does)",
+            "cargo built the apps but {name} is not in {}",
             dir.display()
         );
     }

@@ -64,7 +64,7 @@ fn specialization_constants_render_what_the_scene_variant_renders() {
     // the BVH.
     for app in App::BOTH {
         for (scene, size, set) in SCENES {
-            let variant: Vec<&str> = set.iter().copied().collect();
+            let variant: Vec<&str> = set.to_vec();
             let spec: Vec<&str> = set.iter().copied().chain(["--specialize"]).collect();
             agree(app, scene, size, &variant, &spec, "specialize");
         }

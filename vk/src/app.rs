@@ -19,14 +19,14 @@ use crate::window;
 use anyhow::{bail, Result};
 use std::sync::atomic::Ordering;
 use std::time::Instant;
-use twinray_common::cli::{FrameWait, RenderArgs, RenderPath, SceneMemory, VulkanKnobs};
+use twinray_common::cli::{FrameWait, RenderArgs, RenderPath, SceneMemory, VulkanKnobs, Workgroup};
 use twinray_common::error::bad_input;
 use twinray_common::explain;
 use twinray_common::gpu::upload::GpuScene;
 use twinray_common::reference::image_io::FloatImage;
 use twinray_common::report::{dump_shaders, dump_statistics, FrameTime, RunReport};
 use twinray_common::scene::Scene;
-use twinray_common::shader::build::{build, build_compute};
+use twinray_common::shader::build::{build, build_compute, ComputeShader, Shaders};
 use twinray_common::shader::variant::Variant;
 
 pub fn run(args: RenderArgs, knobs: &VulkanKnobs, process_start: Instant) -> Result<()> {
@@ -77,8 +77,8 @@ fn run_windowed(args: &RenderArgs, knobs: &VulkanKnobs, process_start: Instant) 
     Ok(())
 }
 
-/// Everything Vulkan, from the instance to the readback. Returns the report
-/// (without the validation count) and the last frame.
+/// Everything Vulkan, from the instance to the readback, one named step per
+/// line. Returns the report (without the validation count) and the last frame.
 fn render(
     args: &RenderArgs,
     knobs: &VulkanKnobs,
@@ -88,6 +88,61 @@ fn render(
 ) -> Result<(RunReport, FloatImage)> {
     let (width, height) = (args.size.width, args.size.height);
     let workgroup = args.compute_workgroup()?;
+    let shaders = build_shaders(args, variant)?;
+    let gpu_scene = GpuScene::new(scene, width, height);
+    let instance = Instance::new(args.validate, knobs.validation, &[])?;
+    let device = Device::new(&instance, None, knobs)?;
+    device.check_size(width, height)?;
+    // --vk-wait idle waits for each frame with vkQueueWaitIdle +
+    // vkDeviceWaitIdle, as the 2018 study did, instead of the frame's fence.
+    let idle_wait = knobs.wait == FrameWait::Idle;
+    let host_memory = device.scene_memory == SceneMemory::Host;
+    let timestamps = Timestamps::new(&device)?;
+    let frame_loop = FrameLoop {
+        timestamps: timestamps.as_ref(),
+        count: args.frame_count(),
+        idle_wait,
+        process_start,
+    };
+    let run = HeadlessRun {
+        args,
+        device: &device,
+        gpu_scene: &gpu_scene,
+        frame_loop,
+    };
+    let rendered = match args.path {
+        RenderPath::Fragment => render_fragment(&run, &shaders)?,
+        RenderPath::Compute => render_compute(&run, &build_compute(variant, workgroup)?)?,
+    };
+    let label = variant_label(variant, host_memory, idle_wait);
+    report(args, scene, &device, label, workgroup, rendered)
+    // Every Vulkan object is dropped here, newest first: ..., device, instance.
+}
+
+/// What both paths render from.
+struct HeadlessRun<'a> {
+    args: &'a RenderArgs,
+    device: &'a Device,
+    gpu_scene: &'a GpuScene,
+    frame_loop: FrameLoop<'a>,
+}
+
+impl HeadlessRun<'_> {
+    /// `--dump-shaders`: the stages this run compiles.
+    fn dump_shaders(&self, stages: &[(&str, &[u32], &str)]) -> Result<()> {
+        match &self.args.dump_shaders {
+            Some(dir) => dump_shaders(dir, stages),
+            None => Ok(()),
+        }
+    }
+}
+
+/// The frames and the setup time `frame_loop` measured, and the last frame.
+type Rendered = (Vec<FrameTime>, f64, FloatImage);
+
+/// naga's vertex and fragment shaders for the scene's variant; `--dump-shaders`
+/// turns on the driver's statistics before any pipeline is made.
+fn build_shaders(args: &RenderArgs, variant: &Variant) -> Result<Shaders> {
     let shaders = build(variant)?;
     if args.dump_shaders.is_some() {
         crate::statistics::enable();
@@ -96,135 +151,134 @@ fn render(
         "Shaders: GLSL -> naga module -> SPIR-V (twinray-common)",
         || format!("variant {}", variant.label()),
     );
-    let gpu_scene = GpuScene::new(scene, width, height);
+    Ok(shaders)
+}
 
-    let instance = Instance::new(args.validate, knobs.validation, &[])?;
-    let device = Device::new(&instance, None, knobs)?;
-    device.check_size(width, height)?;
-    // --vk-wait idle waits for each frame with vkQueueWaitIdle +
-    // vkDeviceWaitIdle, as the 2018 study did, instead of the frame's fence.
-    let idle_wait = knobs.wait == FrameWait::Idle;
-    let timestamps = Timestamps::new(&device)?;
-    let run_frames = |commands: &Commands| {
-        frame_loop(
-            commands,
-            timestamps.as_ref(),
-            args.frame_count(),
-            idle_wait,
-            process_start,
-        )
-    };
-    let (frames, setup_ms, image) = match args.path {
-        RenderPath::Fragment => {
-            if let Some(dir) = &args.dump_shaders {
-                dump_shaders(
-                    dir,
-                    &[
-                        ("vertex", &shaders.vertex_spirv, &shaders.vertex_glsl),
-                        ("fragment", &shaders.fragment_spirv, &shaders.fragment_glsl),
-                    ],
-                )?;
-            }
-            let render_pass = RenderPass::offscreen(&device)?;
-            let rp = render_pass.render_pass;
-            let resources =
-                SceneResources::new(&device, &gpu_scene, &shaders, rp, Some((width, height)))?;
-            let (pipeline, descriptors) = (&resources.pipeline, &resources.descriptors);
-            let target = Target::new(&device, rp, width, height)?;
-            let commands = Commands::record(
-                &device,
-                rp,
-                pipeline,
-                descriptors,
-                &target,
-                timestamps.as_ref(),
-            )?;
-            let (frames, setup_ms) = run_frames(&commands)?;
-            let image = target.read_back(&device)?;
-            explain::step(
-                "Readback: vkCmdCopyImageToBuffer + HOST barrier, then map",
-                || format!("{width}x{height} RGBA32F, top row first"),
-            );
-            (frames, setup_ms, image)
-        }
-        // The same tracer as a compute shader: compute.rs owns its pipeline and storage image.
-        RenderPath::Compute => {
-            let shader = build_compute(variant, workgroup)?;
-            if let Some(dir) = &args.dump_shaders {
-                dump_shaders(dir, &[("compute", &shader.spirv, &shader.glsl)])?;
-            }
-            let (frame, storage) = crate::scene::scene_buffers(&device, &gpu_scene)?;
-            let compute = Compute::new(
-                &device,
-                &frame,
-                &storage,
-                &shader,
-                width,
-                height,
-                timestamps.as_ref(),
-            )?;
-            let (frames, setup_ms) = run_frames(&compute.commands)?;
-            (frames, setup_ms, compute.read_back(&device)?)
-        }
-    };
-    let variant_label = format!(
+/// The fragment path: render pass, scene buffers, descriptor set and pipeline,
+/// the colour target, the recorded commands, the frames, the readback. Its
+/// objects drop at the end, newest first, before the device.
+fn render_fragment(run: &HeadlessRun, shaders: &Shaders) -> Result<Rendered> {
+    let (device, frame_loop) = (run.device, &run.frame_loop);
+    let (width, height) = (run.args.size.width, run.args.size.height);
+    run.dump_shaders(&shaders.stages())?;
+    let render_pass = RenderPass::offscreen(device)?;
+    let rp = render_pass.render_pass;
+    let resources = SceneResources::new(device, run.gpu_scene, shaders, rp, Some((width, height)))?;
+    let (pipeline, descriptors) = (&resources.pipeline, &resources.descriptors);
+    let target = Target::new(device, rp, width, height)?;
+    let timestamps = frame_loop.timestamps;
+    let commands = Commands::record(device, rp, pipeline, descriptors, &target, timestamps)?;
+    let (frames, setup_ms) = frame_loop.run(&commands)?;
+    let image = target.read_back(device)?;
+    explain::step(
+        "Readback: vkCmdCopyImageToBuffer + HOST barrier, then map",
+        || format!("{width}x{height} RGBA32F, top row first"),
+    );
+    Ok((frames, setup_ms, image))
+}
+
+/// The same tracer as a compute shader: compute.rs owns its pipeline and
+/// storage image.
+fn render_compute(run: &HeadlessRun, shader: &ComputeShader) -> Result<Rendered> {
+    let size = &run.args.size;
+    run.dump_shaders(&[("compute", &shader.spirv, &shader.glsl)])?;
+    let (frame, storage) = crate::scene::scene_buffers(run.device, run.gpu_scene)?;
+    let timestamps = run.frame_loop.timestamps;
+    let compute = Compute::new(
+        run.device,
+        &frame,
+        &storage,
+        shader,
+        size.width,
+        size.height,
+        timestamps,
+    )?;
+    let (frames, setup_ms) = run.frame_loop.run(&compute.commands)?;
+    Ok((frames, setup_ms, compute.read_back(run.device)?))
+}
+
+/// The variant as the report names it, with the naive choices it was asked for.
+fn variant_label(variant: &Variant, host_memory: bool, idle_wait: bool) -> String {
+    format!(
         "{}{}{}",
         variant.label(),
-        if device.scene_memory == SceneMemory::Host {
+        if host_memory {
             " (host-visible buffers)"
         } else {
             ""
         },
         if idle_wait { " (idle wait)" } else { "" }
-    );
+    )
+}
+
+/// The run's report (device, variant, size, frames, and what the driver said
+/// of the compiled shaders), with the last frame.
+fn report(
+    args: &RenderArgs,
+    scene: &Scene,
+    device: &Device,
+    variant_label: String,
+    workgroup: Workgroup,
+    (frames, setup_ms, image): Rendered,
+) -> Result<(RunReport, FloatImage)> {
     let shader_stats = crate::statistics::captured();
     if let Some(dir) = &args.dump_shaders {
         dump_statistics(dir, &shader_stats)?;
     }
     let report = RunReport::builder("vulkan", device.info(), scene.stats(), variant_label)
-        .size(width, height)
+        .size(args.size.width, args.size.height)
         .path(args.path, workgroup)
         .frames(frames, setup_ms)
         .nonfinite_pixels(image.nonfinite_pixels())
         .shader_stats(shader_stats)
         .build();
     Ok((report, image))
-    // Every Vulkan object is dropped here, newest first: commands, ..., device, instance.
 }
 
-/// The timed loop: one iteration = submit + wait, as the original study measured.
-/// Returns the frames and `setup_ms` (process start to the first submit).
-fn frame_loop(
-    commands: &Commands,
-    timestamps: Option<&Timestamps>,
+/// The timed loop, the same for both paths: one iteration = submit + wait,
+/// as the original study measured.
+struct FrameLoop<'a> {
+    timestamps: Option<&'a Timestamps>,
     count: u32,
     idle_wait: bool,
+    /// `setup_ms` runs from here to the first submit.
     process_start: Instant,
-) -> Result<(Vec<FrameTime>, f64)> {
-    let mut frames = Vec::new();
-    let mut setup_ms = 0.0;
-    for i in 0..count {
-        let start = Instant::now();
-        if i == 0 {
-            setup_ms = (start - process_start).as_secs_f64() * 1e3;
+}
+
+impl FrameLoop<'_> {
+    /// Runs `commands` `count` times. Returns the frames and `setup_ms`.
+    fn run(&self, commands: &Commands) -> Result<(Vec<FrameTime>, f64)> {
+        let FrameLoop {
+            timestamps,
+            count,
+            idle_wait,
+            process_start,
+        } = *self;
+        let mut frames = Vec::new();
+        let mut setup_ms = 0.0;
+        for i in 0..count {
+            let start = Instant::now();
+            if i == 0 {
+                setup_ms = (start - process_start).as_secs_f64() * 1e3;
+            }
+            commands.submit()?;
+            commands.wait(idle_wait)?;
+            let wall_ms = start.elapsed().as_secs_f64() * 1e3;
+            let gpu_ms = timestamps.map(Timestamps::read_ms).transpose()?;
+            commands.reset_fence()?;
+            frames.push(FrameTime { gpu_ms, wall_ms });
+            if i == 0 {
+                explain::step(
+                    "Frame 1: vkQueueSubmit + vkWaitForFences + vkResetFences",
+                    || {
+                        let gpu = gpu_ms.map_or("no timestamps on this queue".into(), |g| {
+                            format!("GPU {g:.3} ms")
+                        });
+                        format!("wall {wall_ms:.3} ms, {gpu}; later frames resubmit the same command buffer")
+                    },
+                );
+            }
         }
-        commands.submit()?;
-        commands.wait(idle_wait)?;
-        let wall_ms = start.elapsed().as_secs_f64() * 1e3;
-        let gpu_ms = timestamps.map(Timestamps::read_ms).transpose()?;
-        commands.reset_fence()?;
-        frames.push(FrameTime { gpu_ms, wall_ms });
-        if i == 0 {
-            explain::step(
-                "Frame 1: vkQueueSubmit + vkWaitForFences + vkResetFences",
-                || {
-                    let gpu = gpu_ms.map_or("no timestamps on this queue".into(), |g| {
-                        format!("GPU {g:.3} ms")
-                    });
-                    format!("wall {wall_ms:.3} ms, {gpu}; later frames resubmit the same command buffer")
-                },
-            );
-        }
+        Ok((frames, setup_ms))
     }
-    Ok((frames, setup_ms))
 }

@@ -104,15 +104,20 @@ impl Commands {
             fence: vk::Fence::null(),
         };
         let info = vk::CommandPoolCreateInfo::default().queue_family_index(device.queue_family);
+        // SAFETY: `d` is the open device this Commands keeps a clone of; the create info is a local
+        // that outlives the call.
         this.pool =
             unsafe { d.create_command_pool(&info, None) }.context("creating the command pool")?;
         let info = vk::CommandBufferAllocateInfo::default()
             .command_pool(this.pool)
             .level(vk::CommandBufferLevel::PRIMARY)
             .command_buffer_count(1);
+        // SAFETY: the pool was created just above on `d` and is owned by `this`, which frees it on
+        // drop.
         this.cmd = unsafe { d.allocate_command_buffers(&info) }
             .context("allocating the command buffer")?[0];
         // Unsignalled: the first wait is for the first frame.
+        // SAFETY: a plain create on the live device `d`; `this` destroys the fence.
         this.fence = unsafe { d.create_fence(&vk::FenceCreateInfo::default(), None) }
             .context("creating the fence")?;
         explain::step("VkCommandPool + VkCommandBuffer + VkFence", || {
@@ -121,9 +126,12 @@ impl Commands {
                 device.queue_family
             )
         });
+        // SAFETY: the buffer was just allocated, so it is in the initial state and nothing else
+        // records into it; `record` then writes commands into it before it ends.
         unsafe { d.begin_command_buffer(this.cmd, &vk::CommandBufferBeginInfo::default()) }
             .context("recording the frame")?;
         record(d, this.cmd);
+        // SAFETY: the buffer is recording (begun above).
         unsafe { d.end_command_buffer(this.cmd) }.context("recording the frame")?;
         Ok(this)
     }
@@ -132,6 +140,9 @@ impl Commands {
     pub fn submit(&self) -> Result<()> {
         let cmds = [self.cmd];
         let submit = vk::SubmitInfo::default().command_buffers(&cmds);
+        // SAFETY: the buffer is fully recorded and is not pending: every submit is followed by
+        // `wait` and `reset_fence` before the next (app.rs's frame loop), so the fence is
+        // unsignalled here, as vkQueueSubmit requires. Only this thread uses the queue.
         unsafe { self.device.queue_submit(self.queue, &[submit], self.fence) }
             .context("submitting a frame")
     }
@@ -141,16 +152,22 @@ impl Commands {
     /// (vkQueueWaitIdle + vkDeviceWaitIdle), kept to measure whether that costs.
     pub fn wait(&self, idle: bool) -> Result<()> {
         if idle {
+            // SAFETY: a wait on the queue this Commands submits to; only this thread uses it.
             unsafe { self.device.queue_wait_idle(self.queue) }
                 .context("waiting for the queue to idle")?;
+            // SAFETY: a wait on the live device; no other thread submits to it.
             unsafe { self.device.device_wait_idle() }.context("waiting for the device to idle")?;
         }
+        // SAFETY: the fence is alive (owned by self) and was submitted with the frame, so the wait
+        // ends.
         unsafe { self.device.wait_for_fences(&[self.fence], true, u64::MAX) }
             .context("waiting for a frame")
     }
 
     /// A fence stays signalled until reset; the next submit needs it unsignalled.
     pub fn reset_fence(&self) -> Result<()> {
+        // SAFETY: the fence is signalled and its submission has finished (`wait` returned), so no
+        // pending queue operation uses it.
         unsafe { self.device.reset_fences(&[self.fence]) }.context("resetting the fence")
     }
 }
@@ -160,10 +177,89 @@ impl Drop for Commands {
         // This is the last object created, so it is dropped first. When the app
         // unwinds from an error the GPU may still be running a frame: wait for it
         // before anything the frame uses is destroyed.
+        // SAFETY: after the wait no submission uses the fence or the command
+        // buffer; the pool frees the buffer with it; both were made on `device`.
         unsafe {
             let _ = self.device.device_wait_idle();
             self.device.destroy_fence(self.fence, None);
             self.device.destroy_command_pool(self.pool, None);
         }
+    }
+}
+
+/// A barrier on the whole of `buffer`: the writes of `src` made available and
+/// visible to the accesses of `dst` (Arseny Kapoulkine's niagara has the same
+/// helper), so that each call site states its hazard and nothing else.
+pub fn buffer_barrier(
+    buffer: vk::Buffer,
+    src: vk::AccessFlags,
+    dst: vk::AccessFlags,
+) -> vk::BufferMemoryBarrier<'static> {
+    vk::BufferMemoryBarrier::default()
+        .src_access_mask(src)
+        .dst_access_mask(dst)
+        .src_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
+        .dst_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
+        .buffer(buffer)
+        .size(vk::WHOLE_SIZE)
+}
+
+/// All of a colour image with one mip level and one layer: every image twinray
+/// makes (targets, storage images, swapchain images) and every view of one.
+pub const COLOR_IMAGE: vk::ImageSubresourceRange = vk::ImageSubresourceRange {
+    aspect_mask: vk::ImageAspectFlags::COLOR,
+    base_mip_level: 0,
+    level_count: 1,
+    base_array_layer: 0,
+    layer_count: 1,
+};
+
+/// A barrier on a whole one-level colour image, from layout `old` to `new`.
+pub fn image_barrier(
+    image: vk::Image,
+    src: vk::AccessFlags,
+    dst: vk::AccessFlags,
+    old: vk::ImageLayout,
+    new: vk::ImageLayout,
+) -> vk::ImageMemoryBarrier<'static> {
+    vk::ImageMemoryBarrier {
+        src_access_mask: src,
+        dst_access_mask: dst,
+        old_layout: old,
+        new_layout: new,
+        src_queue_family_index: vk::QUEUE_FAMILY_IGNORED,
+        dst_queue_family_index: vk::QUEUE_FAMILY_IGNORED,
+        image,
+        subresource_range: COLOR_IMAGE,
+        ..Default::default()
+    }
+}
+
+/// Records one vkCmdPipelineBarrier from the `src` stages to the `dst` stages.
+/// Every barrier in twinray has this shape: no global memory barriers and no
+/// dependency flags, so only what differs is written at the call site.
+///
+/// # Safety
+/// `cmd` was allocated from `d` and is recording, and every buffer and image
+/// the barriers name is alive.
+pub unsafe fn pipeline_barrier(
+    d: &ash::Device,
+    cmd: vk::CommandBuffer,
+    src: vk::PipelineStageFlags,
+    dst: vk::PipelineStageFlags,
+    buffers: &[vk::BufferMemoryBarrier],
+    images: &[vk::ImageMemoryBarrier],
+) {
+    // SAFETY: forwarded from the caller.
+    unsafe {
+        d.cmd_pipeline_barrier(
+            cmd,
+            src,
+            dst,
+            vk::DependencyFlags::empty(),
+            &[],
+            buffers,
+            images,
+        )
     }
 }

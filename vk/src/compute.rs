@@ -25,7 +25,7 @@
 //! shader cannot write the swapchain image itself: its `rgba32f` image format
 //! is not the swapchain's, and few surfaces offer STORAGE usage anyway.
 
-use crate::commands::Commands;
+use crate::commands::{image_barrier, pipeline_barrier, Commands};
 use crate::descriptors::Descriptors;
 use crate::device::Device;
 use crate::memory::Buffer;
@@ -94,18 +94,10 @@ impl Compute {
                 vk::ImageLayout::GENERAL,
                 vk::ImageLayout::GENERAL,
             );
-            // SAFETY: every handle is alive; the buffer is in the recording state.
-            unsafe {
-                d.cmd_pipeline_barrier(
-                    cmd,
-                    vk::PipelineStageFlags::COMPUTE_SHADER,
-                    vk::PipelineStageFlags::COMPUTE_SHADER,
-                    vk::DependencyFlags::empty(),
-                    &[],
-                    &[],
-                    &[after_last_frame],
-                );
-            }
+            let stages = vk::PipelineStageFlags::COMPUTE_SHADER;
+            // SAFETY: `cmd` is recording (inside record_with); the storage image
+            // is owned by the `Compute` that will own these commands too.
+            unsafe { pipeline_barrier(d, cmd, stages, stages, &[], &[after_last_frame]) };
             if let Some(t) = timestamps {
                 t.record(cmd, 0);
             }
@@ -152,18 +144,17 @@ impl Compute {
                 vk::ImageLayout::GENERAL,
                 vk::ImageLayout::TRANSFER_SRC_OPTIMAL,
             );
-            // SAFETY: handles alive, buffer recording; the image is in GENERAL.
+            // SAFETY: `cmd` is run_once's, recording; `self` owns the image.
             unsafe {
-                device.device.cmd_pipeline_barrier(
+                pipeline_barrier(
+                    &device.device,
                     cmd,
                     vk::PipelineStageFlags::COMPUTE_SHADER,
                     vk::PipelineStageFlags::TRANSFER,
-                    vk::DependencyFlags::empty(),
-                    &[],
                     &[],
                     &[after_dispatch],
-                );
-            }
+                )
+            };
             record_copy_to_host(
                 device,
                 cmd,
@@ -311,15 +302,16 @@ impl WindowCompute {
             dst_subresource: layers,
             dst_offsets: [vk::Offset3D::default(), corner],
         };
-        let flags = vk::DependencyFlags::empty();
-        // SAFETY: every handle is alive; `cmd` is recording; the set matches the layout.
+        // SAFETY: frames.rs records into its slot's command buffer, which is
+        // recording; `self` owns the pipeline, set and storage image and lives
+        // until the GPU is idle (a path switch or resize waits first); `target`
+        // is the swapchain image acquired for this frame, alive with the swapchain.
         unsafe {
-            d.cmd_pipeline_barrier(
+            pipeline_barrier(
+                d,
                 cmd,
                 vk::PipelineStageFlags::TRANSFER,
                 vk::PipelineStageFlags::COMPUTE_SHADER,
-                flags,
-                &[],
                 &[],
                 &[to_general],
             );
@@ -333,12 +325,11 @@ impl WindowCompute {
                 &[],
             );
             d.cmd_dispatch(cmd, self.groups.0, self.groups.1, 1);
-            d.cmd_pipeline_barrier(
+            pipeline_barrier(
+                d,
                 cmd,
                 vk::PipelineStageFlags::COMPUTE_SHADER | vk::PipelineStageFlags::TRANSFER,
                 vk::PipelineStageFlags::TRANSFER,
-                flags,
-                &[],
                 &[],
                 &to_blit,
             );
@@ -351,12 +342,11 @@ impl WindowCompute {
                 &[region],
                 vk::Filter::NEAREST,
             );
-            d.cmd_pipeline_barrier(
+            pipeline_barrier(
+                d,
                 cmd,
                 vk::PipelineStageFlags::TRANSFER,
                 vk::PipelineStageFlags::BOTTOM_OF_PIPE,
-                flags,
-                &[],
                 &[],
                 &[to_present],
             );
@@ -448,6 +438,10 @@ impl ComputePipeline {
             .flags(crate::statistics::pipeline_flags(device))
             .stage(stage)
             .layout(this.layout);
+        // SAFETY: the module and layout are alive until after the call (the module drops at the end
+        // of this function); the SPIR-V was validated by naga and declares the `main` entry point
+        // the stage names; the layout's set layout is the one the shader's bindings were written
+        // for.
         let made = unsafe { d.create_compute_pipelines(vk::PipelineCache::null(), &[info], None) };
         this.pipeline = made
             .map_err(|(_, e)| e)
@@ -501,17 +495,13 @@ impl StorageImage {
             vk::ImageLayout::UNDEFINED,
             vk::ImageLayout::GENERAL,
         );
-        device.run_once("moving the storage image to GENERAL layout", |cmd| unsafe {
-            // SAFETY: the image is alive and the buffer is recording.
-            d.cmd_pipeline_barrier(
-                cmd,
-                vk::PipelineStageFlags::TOP_OF_PIPE,
-                vk::PipelineStageFlags::COMPUTE_SHADER,
-                vk::DependencyFlags::empty(),
-                &[],
-                &[],
-                &[to_general],
-            );
+        let (src, dst) = (
+            vk::PipelineStageFlags::TOP_OF_PIPE,
+            vk::PipelineStageFlags::COMPUTE_SHADER,
+        );
+        device.run_once("moving the storage image to GENERAL layout", |cmd| {
+            // SAFETY: `cmd` is run_once's, recording; `this` owns the image.
+            unsafe { pipeline_barrier(d, cmd, src, dst, &[], &[to_general]) }
         })?;
         Ok(this)
     }
@@ -526,30 +516,6 @@ impl StorageImage {
     ) -> vk::ImageMemoryBarrier<'static> {
         image_barrier(self.image, src, dst, old, new)
     }
-}
-
-/// A barrier on a whole one-level colour image, from layout `old` to `new`.
-fn image_barrier(
-    image: vk::Image,
-    src: vk::AccessFlags,
-    dst: vk::AccessFlags,
-    old: vk::ImageLayout,
-    new: vk::ImageLayout,
-) -> vk::ImageMemoryBarrier<'static> {
-    vk::ImageMemoryBarrier::default()
-        .src_access_mask(src)
-        .dst_access_mask(dst)
-        .old_layout(old)
-        .new_layout(new)
-        .src_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
-        .dst_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
-        .image(image)
-        .subresource_range(
-            vk::ImageSubresourceRange::default()
-                .aspect_mask(vk::ImageAspectFlags::COLOR)
-                .level_count(1)
-                .layer_count(1),
-        )
 }
 
 impl Drop for StorageImage {

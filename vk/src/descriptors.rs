@@ -74,6 +74,8 @@ impl Descriptors {
             );
         }
         let info = vk::DescriptorSetLayoutCreateInfo::default().bindings(&bindings);
+        // SAFETY: `bindings` outlives the call and names each binding once; `this` (which owns the
+        // layout) destroys it on drop.
         this.set_layout = unsafe { d.create_descriptor_set_layout(&info, None) }
             .context("creating the descriptor set layout")?;
         explain::step("VkDescriptorSetLayout", || {
@@ -107,6 +109,8 @@ impl Descriptors {
         let info = vk::DescriptorPoolCreateInfo::default()
             .max_sets(1)
             .pool_sizes(&sizes);
+        // SAFETY: a create on the live device from local sizes; `this` destroys the pool, which
+        // frees its set.
         this.pool = unsafe { d.create_descriptor_pool(&info, None) }
             .context("creating the descriptor pool")?;
         explain::step("VkDescriptorPool", || {
@@ -120,6 +124,8 @@ impl Descriptors {
         let info = vk::DescriptorSetAllocateInfo::default()
             .descriptor_pool(this.pool)
             .set_layouts(&layouts);
+        // SAFETY: the pool and layout were made above on `d`; the pool has room for exactly this
+        // one set.
         this.set = unsafe { d.allocate_descriptor_sets(&info) }
             .context("allocating the descriptor set")?[0];
 
@@ -144,6 +150,10 @@ impl Descriptors {
                     .buffer_info(info)
             })
             .collect();
+        // SAFETY: the set is new, so no command buffer uses it yet; each write's buffer is alive
+        // (the caller owns it and keeps it past this set, see SceneResources) and its range is that
+        // buffer's whole size; binding numbers and types match the layout made from the same `all`
+        // list.
         unsafe { d.update_descriptor_sets(&writes, &[]) };
         if let Some(view) = image {
             this.write_image(view);

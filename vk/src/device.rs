@@ -56,6 +56,8 @@ impl Device {
         knobs: &VulkanKnobs,
     ) -> Result<Device> {
         let vk_instance = &instance.instance;
+        // SAFETY: `instance` is alive for the whole call (borrowed) and is used from this thread
+        // only.
         let physicals = unsafe { vk_instance.enumerate_physical_devices() }
             .context("listing Vulkan devices")?;
         if physicals.is_empty() {
@@ -66,7 +68,10 @@ impl Device {
         let candidates: Vec<Candidate> = physicals
             .into_iter()
             .map(|physical| {
+                // SAFETY: `physical` was just listed by this live instance; physical devices need
+                // no destruction.
                 let properties = unsafe { vk_instance.get_physical_device_properties(physical) };
+                // SAFETY: as above: a query on a listed physical device of the live instance.
                 let families =
                     unsafe { vk_instance.get_physical_device_queue_family_properties(physical) };
                 let presents = |i: u32| surface.is_none_or(|s| s.supports(physical, i));
@@ -155,8 +160,14 @@ queue family {queue_family}: {flags:?}, timestampValidBits {timestamp_valid_bits
         if executable_info {
             info = info.push_next(&mut executable_features);
         }
+        // SAFETY: `chosen.physical` belongs to the live instance; the queue info names a family
+        // that exists (found in its list) with one priority; every extension name is a 'static C
+        // string the device offers (swapchain only with a surface, which has_swapchain checked; the
+        // other only where has_extension found it); the feature struct chained with it outlives the
+        // call. The Device owns the result and destroys it on drop, after everything made on it.
         let device = unsafe { vk_instance.create_device(chosen.physical, &info, None) }
             .with_context(|| format!("opening the Vulkan device '{}'", chosen.name))?;
+        // SAFETY: queue 0 of `queue_family` is the one queue the create info asked for.
         let queue = unsafe { device.get_device_queue(queue_family, 0) };
         explain::step(
             "VkDevice + VkQueue (vkCreateDevice, vkGetDeviceQueue)",
@@ -171,13 +182,14 @@ queue family {queue_family}: {flags:?}, timestampValidBits {timestamp_valid_bits
         );
         let executable_properties = executable_info
             .then(|| khr::pipeline_executable_properties::Device::new(&instance.instance, &device));
+        // SAFETY: a query on the chosen physical device of the live instance.
+        let memory_properties =
+            unsafe { vk_instance.get_physical_device_memory_properties(chosen.physical) };
         Ok(Device {
             executable_properties,
             physical: chosen.physical,
             properties: chosen.properties,
-            memory_properties: unsafe {
-                vk_instance.get_physical_device_memory_properties(chosen.physical)
-            },
+            memory_properties,
             name: chosen.name.clone(),
             driver: driver_description(instance, chosen),
             queue_family,
@@ -235,6 +247,15 @@ queue family {queue_family}: {flags:?}, timestampValidBits {timestamp_valid_bits
         }
     }
 
+    /// Blocks until the GPU has finished everything submitted so far: before
+    /// objects a frame may still use are replaced or destroyed.
+    pub fn wait_idle(&self) -> ash::prelude::VkResult<()> {
+        // SAFETY: the device is alive (self owns it) and twinray submits to its
+        // one queue from this thread only, the external synchronisation that
+        // vkDeviceWaitIdle asks for.
+        unsafe { self.device.device_wait_idle() }
+    }
+
     /// Records commands into a throwaway command buffer, runs them and waits.
     /// For setup and readback copies only; the timed frames use commands.rs.
     pub fn run_once(&self, what: &str, record: impl FnOnce(vk::CommandBuffer)) -> Result<()> {
@@ -242,25 +263,35 @@ queue family {queue_family}: {flags:?}, timestampValidBits {timestamp_valid_bits
         let info = vk::CommandPoolCreateInfo::default()
             .queue_family_index(self.queue_family)
             .flags(vk::CommandPoolCreateFlags::TRANSIENT);
+        // SAFETY: a create on this live device; the pool is destroyed below on every path.
         let pool = unsafe { d.create_command_pool(&info, None) }
             .with_context(|| format!("creating a command pool for {what}"))?;
         let result = (|| -> ash::prelude::VkResult<()> {
             let alloc = vk::CommandBufferAllocateInfo::default()
                 .command_pool(pool)
                 .command_buffer_count(1);
+            // SAFETY: `pool` is alive until the end of run_once and is used by this thread only.
             let cmd = unsafe { d.allocate_command_buffers(&alloc) }?[0];
             let begin = vk::CommandBufferBeginInfo::default()
                 .flags(vk::CommandBufferUsageFlags::ONE_TIME_SUBMIT);
+            // SAFETY: the buffer was just allocated, so it is in the initial state.
             unsafe { d.begin_command_buffer(cmd, &begin) }?;
             record(cmd);
+            // SAFETY: the buffer is recording; `record` only records into it.
             unsafe { d.end_command_buffer(cmd) }?;
             let cmds = [cmd];
             let submit = vk::SubmitInfo::default().command_buffers(&cmds);
+            // SAFETY: the buffer is recorded and submitted once (ONE_TIME_SUBMIT); every object it
+            // names is the caller's, borrowed for the whole of run_once, so alive until the wait
+            // below; only this thread uses the queue.
             unsafe { d.queue_submit(self.queue, &[submit], vk::Fence::null()) }?;
             // Setup only, so waiting for the whole queue is simpler than a fence.
+            // SAFETY: a wait on the queue of this live device.
             unsafe { d.queue_wait_idle(self.queue) }
         })();
         // Destroying the pool frees its command buffer too.
+        // SAFETY: the queue is idle (waited above) or nothing was submitted, so the buffer is not
+        // pending.
         unsafe { d.destroy_command_pool(pool, None) };
         result.with_context(|| format!("running the commands for {what}"))
     }
@@ -335,6 +366,9 @@ fn driver_description(instance: &Instance, c: &Candidate) -> String {
     }
     let mut driver = vk::PhysicalDeviceDriverProperties::default();
     let mut props2 = vk::PhysicalDeviceProperties2::default().push_next(&mut driver);
+    // SAFETY: `c.physical` belongs to the live instance, which (like the device)
+    // is at least Vulkan 1.2, checked above, so vkGetPhysicalDeviceProperties2
+    // and the driver-properties struct exist; `driver` outlives the call.
     unsafe {
         instance
             .instance

@@ -28,6 +28,7 @@
 //! that into the swapchain image (compute.rs, `WindowCompute::record`), with
 //! the layout transitions a render pass would otherwise make.
 
+use crate::commands::{buffer_barrier, pipeline_barrier};
 use crate::compute::WindowCompute;
 use crate::device::Device;
 use crate::scene::SceneResources;
@@ -112,6 +113,8 @@ impl Frames {
         let info = vk::CommandPoolCreateInfo::default()
             .queue_family_index(device.queue_family)
             .flags(vk::CommandPoolCreateFlags::RESET_COMMAND_BUFFER);
+        // SAFETY: a create on the live device; `this` (Frames) destroys the pool on drop, after
+        // waiting for the GPU.
         let pool = unsafe { d.create_command_pool(&info, None) }
             .context("creating the frame command pool")?;
         let mut this = Frames {
@@ -124,16 +127,22 @@ impl Frames {
             .command_pool(pool)
             .level(vk::CommandBufferLevel::PRIMARY)
             .command_buffer_count(FRAMES_IN_FLIGHT as u32);
+        // SAFETY: the pool was made just above and is owned by `this`; only this thread records
+        // from it.
         let cmds = unsafe { d.allocate_command_buffers(&info) }
             .context("allocating the frame command buffers")?;
         for cmd in cmds {
+            // SAFETY: a create on the live device; the slot pushed below owns it, and Frames::drop
+            // destroys it after waiting for the GPU.
             let image_available =
                 unsafe { d.create_semaphore(&vk::SemaphoreCreateInfo::default(), None) }
                     .context("creating an image-available semaphore")?;
             let signalled = vk::FenceCreateInfo::default().flags(vk::FenceCreateFlags::SIGNALED);
+            // SAFETY: as for the semaphore.
             let in_flight = match unsafe { d.create_fence(&signalled, None) } {
                 Ok(f) => f,
                 Err(e) => {
+                    // SAFETY: the semaphore was never used: no slot holds it yet.
                     unsafe { d.destroy_semaphore(image_available, None) };
                     return Err(e).context("creating an in-flight fence");
                 }
@@ -191,6 +200,7 @@ impl Frames {
             Err(e) => return Err(e).context("acquiring a swapchain image"),
         };
         // Reset only now: had the acquire failed, a reset fence would never be signalled.
+        // SAFETY: the fence is signalled (waited above), so no pending submission uses it.
         unsafe { d.reset_fences(&[slot.in_flight]) }.context("resetting a frame fence")?;
 
         record(d, slot, swapchain, index, draw, frame)?;
@@ -204,6 +214,11 @@ impl Frames {
             .wait_dst_stage_mask(&wait_stages)
             .command_buffers(&cmds)
             .signal_semaphores(&signals);
+        // SAFETY: the slot's buffer was recorded just above and its previous submission has
+        // finished (its fence was waited on); the fence was reset above; the wait semaphore has a
+        // signal pending from this frame's acquire; the render-finished semaphore is that image's,
+        // whose last signal the previous present of the image waited on; only this thread uses the
+        // queue.
         unsafe { d.queue_submit(device.queue, &[submit], slot.in_flight) }
             .context("submitting a frame")?;
         slot.submitted = true;
@@ -215,6 +230,9 @@ impl Frames {
             .wait_semaphores(&signals)
             .swapchains(&swapchains)
             .image_indices(&indices);
+        // SAFETY: `index` was acquired from this swapchain above and not yet presented; the submit
+        // just made signals the semaphore the present waits on; the swapchain outlives the call
+        // (borrowed).
         let presented = unsafe { loader.queue_present(device.queue, &present) };
         let suboptimal = suboptimal
             || match presented {
@@ -226,6 +244,13 @@ impl Frames {
     }
 }
 
+// vkCmdUpdateBuffer takes at most 65536 bytes, a multiple of 4: the `Frame`
+// block is written that way every frame (and before a capture in window.rs).
+const _: () = {
+    let size = std::mem::size_of::<GpuFrame>();
+    assert!(size % 4 == 0 && size <= 65536);
+};
+
 /// The frame's commands, recorded afresh (see the module comment).
 fn record(
     d: &ash::Device,
@@ -236,10 +261,13 @@ fn record(
     frame: &GpuFrame,
 ) -> Result<()> {
     let cmd = slot.cmd;
+    // SAFETY: the pool was made with RESET_COMMAND_BUFFER, and the slot's fence has been waited on,
+    // so the buffer is not pending.
     unsafe { d.reset_command_buffer(cmd, vk::CommandBufferResetFlags::empty()) }
         .context("resetting a command buffer")?;
     let begin =
         vk::CommandBufferBeginInfo::default().flags(vk::CommandBufferUsageFlags::ONE_TIME_SUBMIT);
+    // SAFETY: the buffer was reset just above, so it is in the initial state.
     unsafe { d.begin_command_buffer(cmd, &begin) }.context("recording a frame")?;
     if let Some(t) = &slot.timestamps {
         t.record_reset(cmd);
@@ -250,35 +278,21 @@ fn record(
     // execution dependency is enough; both stages, as the previous frame may
     // have run the other path), and the tracer waits for the write.
     let uniform = draw.uniform();
-    let to_shader = vk::BufferMemoryBarrier::default()
-        .src_access_mask(vk::AccessFlags::TRANSFER_WRITE)
-        .dst_access_mask(vk::AccessFlags::UNIFORM_READ)
-        .src_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
-        .dst_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
-        .buffer(uniform)
-        .size(vk::WHOLE_SIZE);
-    // SAFETY: every handle is alive; the command buffer is in the recording state.
+    let shaders = vk::PipelineStageFlags::FRAGMENT_SHADER | vk::PipelineStageFlags::COMPUTE_SHADER;
+    let transfer = vk::PipelineStageFlags::TRANSFER;
+    // Read after write: the tracer reads the block the update wrote.
+    let to_shader = buffer_barrier(
+        uniform,
+        vk::AccessFlags::TRANSFER_WRITE,
+        vk::AccessFlags::UNIFORM_READ,
+    );
+    // SAFETY: `cmd` began recording above; the uniform buffer belongs to the
+    // scene resources in `draw`, which the window keeps until the GPU is idle;
+    // `frame` fits vkCmdUpdateBuffer (asserted at compile time above).
     unsafe {
-        let none = vk::DependencyFlags::empty();
-        d.cmd_pipeline_barrier(
-            cmd,
-            vk::PipelineStageFlags::FRAGMENT_SHADER | vk::PipelineStageFlags::COMPUTE_SHADER,
-            vk::PipelineStageFlags::TRANSFER,
-            none,
-            &[],
-            &[],
-            &[],
-        );
+        pipeline_barrier(d, cmd, shaders, transfer, &[], &[]);
         d.cmd_update_buffer(cmd, uniform, 0, bytemuck::bytes_of(frame));
-        d.cmd_pipeline_barrier(
-            cmd,
-            vk::PipelineStageFlags::TRANSFER,
-            draw.tracer_stage(),
-            none,
-            &[],
-            &[to_shader],
-            &[],
-        );
+        pipeline_barrier(d, cmd, transfer, draw.tracer_stage(), &[to_shader], &[]);
     }
     match draw {
         Draw::Fragment { render_pass, scene } => {
@@ -289,6 +303,8 @@ fn record(
     if let Some(t) = &slot.timestamps {
         t.record(cmd, 1);
     }
+    // SAFETY: the buffer is recording (begun above), and every command above was recorded outside a
+    // render pass or with the pass ended.
     unsafe { d.end_command_buffer(cmd) }.context("recording a frame")
 }
 
@@ -323,7 +339,11 @@ fn record_render_pass(
         offset: vk::Offset2D::default(),
         extent,
     };
-    // SAFETY: every handle is alive; the command buffer is in the recording state.
+    // SAFETY: `cmd` is recording (record() began it); the render pass, the
+    // framebuffer of image `index`, the pipeline and the set belong to the window,
+    // its swapchain and `scene`, which the window replaces only after waiting
+    // for the GPU; viewport and scissor are dynamic states of the windowed
+    // pipeline (made without a fixed size).
     unsafe {
         d.cmd_begin_render_pass(cmd, &begin_pass, vk::SubpassContents::INLINE);
         d.cmd_set_viewport(cmd, 0, &[viewport]);
@@ -348,7 +368,8 @@ fn record_render_pass(
 
 impl Drop for Frames {
     fn drop(&mut self) {
-        // SAFETY: nothing may be destroyed while a frame still uses it. The
+        // SAFETY: after the wait no frame uses the semaphores, fences or command
+        // buffers (the pool frees the buffers); all were made on this device. The
         // timestamp pools drop with the slots, after this.
         unsafe {
             let _ = self.device.device_wait_idle();

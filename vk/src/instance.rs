@@ -41,7 +41,9 @@ impl Instance {
         best_effort: bool,
         window_extensions: &[*const c_char],
     ) -> Result<Instance> {
-        // SAFETY: loads the system's Vulkan loader; nothing else runs meanwhile.
+        // SAFETY: dlopens the system's libvulkan.so.1 (its initialisers are the
+        // loader's own); the Entry keeps it loaded while any of its function
+        // pointers can be called, as the Instance holds the Entry.
         let entry = unsafe { ash::Entry::load() }.map_err(|_| {
             no_device(
                 "no Vulkan loader found (libvulkan.so.1): install libvulkan1 and a Vulkan driver, e.g. mesa-vulkan-drivers",
@@ -54,6 +56,8 @@ impl Instance {
         // The layer checks every call, which costs CPU time on every submit, and a
         // timing run must not pay for it. So it is on only when asked for:
         // --validate (required) or --vk-validation / TWINRAY_VK_VALIDATION=1 (best effort).
+        // SAFETY: a global query through the loader `entry` just opened, which lives in the
+        // returned Instance.
         let layers = unsafe { entry.enumerate_instance_layer_properties() }
             .context("listing Vulkan layers")?;
         let installed = layers
@@ -73,6 +77,7 @@ impl Instance {
 
         // Vulkan 1.2 is asked for only to read VkPhysicalDeviceDriverProperties (the
         // driver's name for the report). A 1.0 loader rejects any higher version.
+        // SAFETY: a global query through the open loader.
         let loader_version = unsafe { entry.try_enumerate_instance_version() }
             .context("asking the loader for its Vulkan version")?
             .unwrap_or(vk::API_VERSION_1_0);
@@ -97,6 +102,10 @@ impl Instance {
                 .enabled_layer_names(&layer_names)
                 .push_next(&mut early_messenger);
         }
+        // SAFETY: every pointer in `info` (application info, the 'static layer and extension names,
+        // the chained messenger info whose callback is a plain function) outlives the call; the
+        // layer is enabled only where it is installed. The Instance returned owns the result and
+        // destroys it on drop, after every device object (app.rs orders the drops).
         let instance = unsafe { entry.create_instance(&info, None) }.map_err(|e| match e {
             vk::Result::ERROR_INCOMPATIBLE_DRIVER => {
                 no_device("the Vulkan loader found no usable driver: install mesa-vulkan-drivers or a GPU driver")
@@ -137,6 +146,8 @@ impl Instance {
         };
         if validation {
             let functions = debug_utils::Instance::new(&this.entry, &this.instance);
+            // SAFETY: the instance was created with VK_EXT_debug_utils enabled (validation is on),
+            // so the functions exist; `this` destroys the messenger before the instance.
             let messenger =
                 unsafe { functions.create_debug_utils_messenger(&messenger_info(), None) }
                     .context("creating the debug messenger")?;

@@ -10,6 +10,7 @@
 //! discrete GPU the CPU cannot map. So scene buffers are filled by writing into a
 //! host-visible *staging* buffer and letting the GPU copy it across.
 
+use crate::commands::{buffer_barrier, pipeline_barrier};
 use crate::device::Device;
 use anyhow::{anyhow, Context, Result};
 use ash::vk;
@@ -40,6 +41,8 @@ pub fn allocate(
     let info = vk::MemoryAllocateInfo::default()
         .allocation_size(needs.size)
         .memory_type_index(index as u32);
+    // SAFETY: `index` is a memory type of this device that `needs` allows, and the size is what the
+    // resource asked for; the caller stores the memory in the object that frees it.
     let memory = unsafe { device.device.allocate_memory(&info, None) }
         .map_err(|e| too_large(e, needs.size, what))?;
     Ok((memory, flags))
@@ -96,14 +99,19 @@ impl Buffer {
             .size(size)
             .usage(usage)
             .sharing_mode(vk::SharingMode::EXCLUSIVE);
+        // SAFETY: a create on the live device from a local info; `b` destroys the buffer on drop,
+        // on success or error.
         b.buffer =
             unsafe { b.device.create_buffer(&info, None) }.map_err(|e| too_large(e, size, what))?;
+        // SAFETY: a query on the buffer just made.
         let needs = unsafe { b.device.get_buffer_memory_requirements(b.buffer) };
         let (memory, flags) = allocate(device, needs, wishes, what)?;
         b.memory = memory;
         b.memory_flags = flags;
         b.needs_flush =
             flags.contains(Flags::HOST_VISIBLE) && !flags.contains(Flags::HOST_COHERENT);
+        // SAFETY: the buffer has no memory yet; the allocation was sized from its requirements and
+        // of a type they allow; offset 0 meets any alignment.
         unsafe { b.device.bind_buffer_memory(b.buffer, b.memory, 0) }
             .with_context(|| format!("binding the {what}"))?;
         Ok(b)
@@ -128,13 +136,88 @@ impl Buffer {
         Ok(buffer)
     }
 
-    /// A device-local buffer holding `bytes`, filled through a staging buffer.
-    pub fn device_local_with(
-        device: &Device,
-        bytes: &[u8],
-        usage: vk::BufferUsageFlags,
-        what: &str,
-    ) -> Result<Buffer> {
+    /// Copies `bytes` into a host-visible buffer.
+    pub fn write(&self, bytes: &[u8]) -> Result<()> {
+        self.check_mappable(bytes.len() as u64)?;
+        let d = &self.device;
+        // SAFETY: the memory is host-visible and not mapped (every map here is
+        // undone before its function returns); only this thread uses it, and no
+        // pending GPU work writes it: a staging or host buffer is written before
+        // any submission that reads it.
+        let ptr =
+            unsafe { d.map_memory(self.memory, 0, vk::WHOLE_SIZE, vk::MemoryMapFlags::empty()) }
+                .context("mapping memory")?;
+        // SAFETY: the mapping covers the whole allocation, at least `size` bytes,
+        // and check_mappable made sure `bytes` is no longer; a fresh mapping
+        // cannot overlap `bytes`.
+        unsafe { std::ptr::copy_nonoverlapping(bytes.as_ptr(), ptr.cast::<u8>(), bytes.len()) };
+        let range = vk::MappedMemoryRange::default()
+            .memory(self.memory)
+            .size(vk::WHOLE_SIZE);
+        let flushed = if self.needs_flush {
+            // SAFETY: the range is the whole of this memory, which is mapped.
+            unsafe { d.flush_mapped_memory_ranges(&[range]) }
+        } else {
+            Ok(())
+        };
+        // SAFETY: mapped above; the copy is done and nothing keeps the pointer.
+        unsafe { d.unmap_memory(self.memory) };
+        flushed.context("flushing mapped memory")
+    }
+
+    /// Copies a host-visible buffer's contents out, as `T`s. (Copied rather than
+    /// cast in place: the mapping is aligned, a `Vec<u8>` copy of it need not be.)
+    pub fn read<T: bytemuck::Pod>(&self) -> Result<Vec<T>> {
+        self.check_mappable(self.size)?;
+        let d = &self.device;
+        // SAFETY: the memory is host-visible and not mapped; the GPU's writes
+        // to it have finished (the caller waited for the copy and its HOST
+        // barrier); only this thread uses it.
+        let ptr =
+            unsafe { d.map_memory(self.memory, 0, vk::WHOLE_SIZE, vk::MemoryMapFlags::empty()) }
+                .context("mapping memory")?;
+        let range = vk::MappedMemoryRange::default()
+            .memory(self.memory)
+            .size(vk::WHOLE_SIZE);
+        let fresh = if self.needs_flush {
+            // SAFETY: the range is the whole of this memory, which is mapped.
+            unsafe { d.invalidate_mapped_memory_ranges(&[range]) }
+        } else {
+            Ok(())
+        };
+        // SAFETY: the mapping covers the whole allocation, at least `size` bytes,
+        // stays mapped until after the copy below, and nothing writes it meanwhile.
+        let bytes = unsafe { std::slice::from_raw_parts(ptr.cast::<u8>(), self.size as usize) };
+        let data = bytemuck::pod_collect_to_vec(bytes);
+        // SAFETY: mapped above; `bytes` is not used after this.
+        unsafe { d.unmap_memory(self.memory) };
+        fresh.context("invalidating mapped memory")?;
+        Ok(data)
+    }
+}
+
+/// Device-local buffers filled through staging buffers, all in one submit: each
+/// [`Uploads::add`] makes a buffer and its filled staging buffer, and
+/// [`Uploads::submit`] records every copy and one barrier for them all, waits
+/// once, and hands the buffers over. Until then they are only reachable here,
+/// so nothing can use or free one before its copy has run.
+pub struct Uploads<'a> {
+    device: &'a Device,
+    /// (staging, destination): the staging buffers live until the copies have run.
+    copies: Vec<(Buffer, Buffer)>,
+}
+
+impl<'a> Uploads<'a> {
+    pub fn new(device: &'a Device) -> Uploads<'a> {
+        Uploads {
+            device,
+            copies: Vec::new(),
+        }
+    }
+
+    /// A device-local buffer that will hold `bytes` once [`Uploads::submit`] has run.
+    pub fn add(&mut self, bytes: &[u8], usage: vk::BufferUsageFlags, what: &str) -> Result<()> {
+        let device = self.device;
         let size = bytes.len() as u64;
         // Coherent memory needs no flush after writing, but any mappable type will do.
         let upload = [
@@ -157,83 +240,64 @@ impl Buffer {
             &[Flags::DEVICE_LOCAL, Flags::empty()],
             what,
         )?;
-        device.run_once(&format!("uploading the {what}"), |cmd| {
-            let region = vk::BufferCopy::default().size(size);
-            // The barrier makes the copied bytes visible to the fragment (or compute) shader of
-            // every later submission: queue order alone does not order memory.
-            let barrier = vk::BufferMemoryBarrier::default()
-                .src_access_mask(vk::AccessFlags::TRANSFER_WRITE)
-                .dst_access_mask(vk::AccessFlags::UNIFORM_READ | vk::AccessFlags::SHADER_READ)
-                .src_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
-                .dst_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
-                .buffer(buffer.buffer)
-                .size(vk::WHOLE_SIZE);
-            unsafe {
-                device
-                    .device
-                    .cmd_copy_buffer(cmd, staging.buffer, buffer.buffer, &[region]);
-                device.device.cmd_pipeline_barrier(
-                    cmd,
-                    vk::PipelineStageFlags::TRANSFER,
-                    vk::PipelineStageFlags::FRAGMENT_SHADER
-                        | vk::PipelineStageFlags::COMPUTE_SHADER,
-                    vk::DependencyFlags::empty(),
-                    &[],
-                    &[barrier],
-                    &[],
-                );
-            }
-        })?;
         explain::step(&format!("VkBuffer + VkDeviceMemory: {what}"), || {
             format!(
                 "{size} bytes, usage {usage:?}, memory {:?}\nfilled from a HOST_VISIBLE staging buffer: vkCmdCopyBuffer, then a TRANSFER -> FRAGMENT_SHADER barrier",
                 buffer.memory_flags
             )
         });
-        Ok(buffer) // `staging` is dropped here: the copy has finished.
+        self.copies.push((staging, buffer));
+        Ok(())
     }
 
-    /// Copies `bytes` into a host-visible buffer.
-    pub fn write(&self, bytes: &[u8]) -> Result<()> {
-        let d = &self.device;
-        let ptr =
-            unsafe { d.map_memory(self.memory, 0, vk::WHOLE_SIZE, vk::MemoryMapFlags::empty()) }
-                .context("mapping memory")?;
-        // SAFETY: the mapping covers the whole buffer, which is bytes.len() long.
-        unsafe { std::ptr::copy_nonoverlapping(bytes.as_ptr(), ptr.cast::<u8>(), bytes.len()) };
-        let range = vk::MappedMemoryRange::default()
-            .memory(self.memory)
-            .size(vk::WHOLE_SIZE);
-        let flushed = if self.needs_flush {
-            unsafe { d.flush_mapped_memory_ranges(&[range]) }
-        } else {
-            Ok(())
-        };
-        unsafe { d.unmap_memory(self.memory) };
-        flushed.context("flushing mapped memory")
+    /// Runs every copy in one command buffer and waits for it; then the staging
+    /// buffers go. Returns the buffers in the order they were added.
+    pub fn submit(self) -> Result<Vec<Buffer>> {
+        let d = &self.device.device;
+        // Read after write: the fragment (or compute) shader of every later
+        // submission reads what the copies wrote; queue order alone does not
+        // order memory.
+        let barriers: Vec<_> = self
+            .copies
+            .iter()
+            .map(|(_, buffer)| {
+                buffer_barrier(
+                    buffer.buffer,
+                    vk::AccessFlags::TRANSFER_WRITE,
+                    vk::AccessFlags::UNIFORM_READ | vk::AccessFlags::SHADER_READ,
+                )
+            })
+            .collect();
+        let shaders =
+            vk::PipelineStageFlags::FRAGMENT_SHADER | vk::PipelineStageFlags::COMPUTE_SHADER;
+        self.device.run_once("uploading the scene", |cmd| {
+            for (staging, buffer) in &self.copies {
+                let region = vk::BufferCopy::default().size(buffer.size);
+                // SAFETY: `cmd` is run_once's, recording; both buffers of each
+                // pair are in `self.copies`, alive until run_once has waited for
+                // the queue, and both are `buffer.size` bytes long.
+                unsafe { d.cmd_copy_buffer(cmd, staging.buffer, buffer.buffer, &[region]) };
+            }
+            let transfer = vk::PipelineStageFlags::TRANSFER;
+            // SAFETY: as for the copies.
+            unsafe { pipeline_barrier(d, cmd, transfer, shaders, &barriers, &[]) };
+        })?;
+        // The staging buffers drop here: run_once waited for the copies.
+        Ok(self.copies.into_iter().map(|(_, buffer)| buffer).collect())
     }
+}
 
-    /// Copies a host-visible buffer's contents out, as `T`s. (Copied rather than
-    /// cast in place: the mapping is aligned, a Vec<u8> copy of it need not be.)
-    pub fn read<T: bytemuck::Pod>(&self) -> Result<Vec<T>> {
-        let d = &self.device;
-        let ptr =
-            unsafe { d.map_memory(self.memory, 0, vk::WHOLE_SIZE, vk::MemoryMapFlags::empty()) }
-                .context("mapping memory")?;
-        let range = vk::MappedMemoryRange::default()
-            .memory(self.memory)
-            .size(vk::WHOLE_SIZE);
-        let fresh = if self.needs_flush {
-            unsafe { d.invalidate_mapped_memory_ranges(&[range]) }
-        } else {
-            Ok(())
-        };
-        // SAFETY: the mapping covers the whole buffer, `size` bytes.
-        let bytes = unsafe { std::slice::from_raw_parts(ptr.cast::<u8>(), self.size as usize) };
-        let data = bytemuck::pod_collect_to_vec(bytes);
-        unsafe { d.unmap_memory(self.memory) };
-        fresh.context("invalidating mapped memory")?;
-        Ok(data)
+impl Buffer {
+    /// What map, write and read assume: host-visible memory holding `bytes`.
+    fn check_mappable(&self, bytes: u64) -> Result<()> {
+        if !self.memory_flags.contains(Flags::HOST_VISIBLE) || bytes > self.size {
+            return Err(anyhow!(
+                "mapping {bytes} bytes of a {}-byte buffer in {:?} memory",
+                self.size,
+                self.memory_flags
+            ));
+        }
+        Ok(())
     }
 }
 

@@ -94,6 +94,9 @@ impl RenderPass {
             .attachments(&attachments)
             .subpasses(&subpasses)
             .dependencies(dependencies);
+        // SAFETY: the attachment, subpass and dependency arrays are locals that outlive the call,
+        // and the subpass's attachment reference names attachment 0, which exists; the RenderPass
+        // returned destroys the pass.
         let render_pass =
             unsafe { d.create_render_pass(&info, None) }.context("creating the render pass")?;
         explain::step("VkRenderPass", || {
@@ -128,12 +131,16 @@ pub(crate) struct Module(ash::Device, pub(crate) vk::ShaderModule);
 
 impl Drop for Module {
     fn drop(&mut self) {
+        // SAFETY: a pipeline keeps its own copy of the code, so the module may go as soon as the
+        // pipelines made from it exist, even while they run.
         unsafe { self.0.destroy_shader_module(self.1, None) };
     }
 }
 
 pub(crate) fn module(d: &ash::Device, spirv: &[u32], stage: &str) -> Result<Module> {
     let info = vk::ShaderModuleCreateInfo::default().code(spirv);
+    // SAFETY: `spirv` is naga's output, validated by naga before it was written, so it is well-
+    // formed SPIR-V words (the slice outlives the call); the Module destroys it.
     let m = unsafe { d.create_shader_module(&info, None) }
         .with_context(|| format!("creating the {stage} shader module"))?;
     Ok(Module(d.clone(), m))
@@ -147,6 +154,8 @@ pub(crate) fn layout(
 ) -> Result<vk::PipelineLayout> {
     let set_layouts = [set_layout];
     let info = vk::PipelineLayoutCreateInfo::default().set_layouts(&set_layouts);
+    // SAFETY: `set_layout` is alive (owned by the caller's Descriptors, which outlive the
+    // pipeline); the caller owns the layout and destroys it with its pipeline.
     unsafe { d.create_pipeline_layout(&info, None) }
         .with_context(|| format!("creating the {what} pipeline layout"))
 }
@@ -245,6 +254,10 @@ impl Pipeline {
             .layout(this.layout)
             .render_pass(render_pass)
             .subpass(0);
+        // SAFETY: every state struct and the shader stages' modules and entry-point names are
+        // locals alive until after the call; the modules hold naga's validated SPIR-V whose
+        // bindings are those of the set layout; `render_pass` is alive (the caller's) and has
+        // subpass 0 with the one colour attachment the blend state describes.
         let pipelines =
             unsafe { d.create_graphics_pipelines(vk::PipelineCache::null(), &[info], None) }
                 .map_err(|(_, e)| e)

@@ -6,7 +6,7 @@
 
 use crate::descriptors::Descriptors;
 use crate::device::Device;
-use crate::memory::Buffer;
+use crate::memory::{Buffer, Uploads};
 use crate::pipeline::Pipeline;
 use anyhow::Result;
 use ash::vk;
@@ -63,22 +63,34 @@ pub fn scene_buffers(device: &Device, scene: &GpuScene) -> Result<(Buffer, Vec<(
     let limit = device.properties.limits.max_storage_buffer_range as u64;
     check_storage_limit(scene, limit, "maxStorageBufferRange")?;
     let host = device.scene_memory == SceneMemory::Host;
-    let place = |bytes: &[u8], usage: vk::BufferUsageFlags, what: &str| {
-        if host {
-            Buffer::host_visible_with(device, bytes, usage, what)
-        } else {
-            Buffer::device_local_with(device, bytes, usage, what)
+    // The uniform block first, then the storage buffers in binding order.
+    let frame = (
+        scene.frame_bytes(),
+        vk::BufferUsageFlags::UNIFORM_BUFFER,
+        "frame uniform buffer".to_string(),
+    );
+    let storage = binding::STORAGE.iter().map(|&b| {
+        (
+            scene.storage_bytes(b),
+            vk::BufferUsageFlags::STORAGE_BUFFER,
+            format!("{} storage buffer", storage_name(b)),
+        )
+    });
+    let contents: Vec<_> = std::iter::once(frame).chain(storage).collect();
+    let buffers = if host {
+        contents
+            .iter()
+            .map(|(bytes, usage, what)| Buffer::host_visible_with(device, bytes, *usage, what))
+            .collect::<Result<Vec<_>>>()?
+    } else {
+        let mut uploads = Uploads::new(device);
+        for (bytes, usage, what) in &contents {
+            uploads.add(bytes, *usage, what)?;
         }
+        uploads.submit()?
     };
-    let uniform = vk::BufferUsageFlags::UNIFORM_BUFFER;
-    let frame = place(scene.frame_bytes(), uniform, "frame uniform buffer")?;
-    let storage = binding::STORAGE
-        .iter()
-        .map(|&b| {
-            let what = format!("{} storage buffer", storage_name(b));
-            let usage = vk::BufferUsageFlags::STORAGE_BUFFER;
-            Ok((b, place(scene.storage_bytes(b), usage, &what)?))
-        })
-        .collect::<Result<Vec<_>>>()?;
+    let mut buffers = buffers.into_iter();
+    let frame = buffers.next().expect("the uniform buffer comes first");
+    let storage = binding::STORAGE.iter().copied().zip(buffers).collect();
     Ok((frame, storage))
 }

@@ -38,7 +38,7 @@ use twinray_common::explain;
 /// The surface's formats, best first for this app: 8-bit UNORM in the standard
 /// colour space (see the module comment for why not sRGB).
 pub fn choose_format(device: &Device, surface: &Surface) -> Result<vk::SurfaceFormatKHR> {
-    // SAFETY: live physical device and surface.
+    // SAFETY: the surface and the physical device are borrowed from their owners, so alive for the query, and come from the same instance.
     let formats = unsafe {
         surface
             .loader
@@ -82,7 +82,7 @@ pub fn choose_present_mode(
     surface: &Surface,
     vsync: bool,
 ) -> Result<vk::PresentModeKHR> {
-    // SAFETY: live physical device and surface.
+    // SAFETY: the surface and the physical device are borrowed from their owners, so alive for the query, and come from the same instance.
     let modes = unsafe {
         surface
             .loader
@@ -114,7 +114,7 @@ pub fn choose_present_mode(
 /// Whether the surface lets swapchain images be transfer destinations, which
 /// the compute path's blit needs (most drivers do; the spec does not promise it).
 pub fn accepts_transfer_writes(device: &Device, surface: &Surface) -> Result<bool> {
-    // SAFETY: live physical device and surface.
+    // SAFETY: the surface and the physical device are borrowed from their owners, so alive for the query, and come from the same instance.
     let caps = unsafe {
         surface
             .loader
@@ -153,7 +153,7 @@ impl Swapchain {
         old: Option<&Swapchain>,
     ) -> Result<Option<Swapchain>> {
         let d = &device.device;
-        // SAFETY: live physical device and surface.
+        // SAFETY: the surface and the physical device are borrowed from their owners, so alive for the query, and come from the same instance.
         let caps = unsafe {
             surface
                 .loader
@@ -218,9 +218,13 @@ impl Swapchain {
             framebuffers: Vec::new(),
             render_finished: Vec::new(),
         };
-        // SAFETY: valid create info; the old swapchain (if any) is retired by this call.
+        // SAFETY: the surface is alive (the window owns it, and it outlives the
+        // swapchain); size, format, present mode, usage and image count were
+        // chosen from what this surface reports; the old swapchain (if any) is
+        // retired by this call and destroyed by its owner after the GPU is idle.
         this.swapchain =
             unsafe { loader.create_swapchain(&info, None) }.context("creating the swapchain")?;
+        // SAFETY: the swapchain was just made; its images are its own and go with it.
         this.images = unsafe { loader.get_swapchain_images(this.swapchain) }
             .context("getting the swapchain images")?;
         let images = this.images.clone();
@@ -247,27 +251,26 @@ impl Swapchain {
                 .image(image)
                 .view_type(vk::ImageViewType::TYPE_2D)
                 .format(format.format)
-                .subresource_range(
-                    vk::ImageSubresourceRange::default()
-                        .aspect_mask(vk::ImageAspectFlags::COLOR)
-                        .level_count(1)
-                        .layer_count(1),
-                );
-            this.views.push(
-                unsafe { d.create_image_view(&info, None) }
-                    .context("creating a swapchain image view")?,
-            );
-            let views = [*this.views.last().expect("just pushed")];
+                .subresource_range(crate::commands::COLOR_IMAGE);
+            // SAFETY: `image` is one of this swapchain's images and `format` its
+            // format; `this` destroys the view before the swapchain.
+            let view = unsafe { d.create_image_view(&info, None) }
+                .context("creating a swapchain image view")?;
+            this.views.push(view);
+            let views = [view];
             let info = vk::FramebufferCreateInfo::default()
                 .render_pass(render_pass)
                 .attachments(&views)
                 .width(extent.width)
                 .height(extent.height)
                 .layers(1);
-            this.framebuffers.push(
-                unsafe { d.create_framebuffer(&info, None) }
-                    .context("creating a swapchain framebuffer")?,
-            );
+            // SAFETY: the view was just made at the swapchain's extent, in the
+            // format the render pass (alive, the window's) was made for; `this`
+            // destroys the framebuffer before the view.
+            let framebuffer = unsafe { d.create_framebuffer(&info, None) }
+                .context("creating a swapchain framebuffer")?;
+            this.framebuffers.push(framebuffer);
+            // SAFETY: a create on the live device; `this` destroys it after the GPU is idle.
             let semaphore =
                 unsafe { d.create_semaphore(&vk::SemaphoreCreateInfo::default(), None) }
                     .context("creating a render-finished semaphore")?;

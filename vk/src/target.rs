@@ -9,6 +9,7 @@
 //! An OPTIMAL-tiled image cannot be mapped, so after the last frame the GPU
 //! copies it into a host-visible *readback* buffer as plain rows, top row first.
 
+use crate::commands::{buffer_barrier, pipeline_barrier};
 use crate::device::Device;
 use crate::memory::{self, Buffer};
 use crate::pipeline::COLOR_FORMAT;
@@ -77,6 +78,8 @@ impl Target {
             .width(width)
             .height(height)
             .layers(1);
+        // SAFETY: the view was just made (owned by `this`) at this size, in the format the render
+        // pass (alive, the caller's) was made for; `this` destroys the framebuffer first.
         this.framebuffer =
             unsafe { d.create_framebuffer(&info, None) }.context("creating the framebuffer")?;
         explain::step("VkFramebuffer", || {
@@ -126,16 +129,17 @@ pub fn record_copy_to_host(
             height,
             depth: 1,
         });
-    let to_host = vk::BufferMemoryBarrier::default()
-        .src_access_mask(vk::AccessFlags::TRANSFER_WRITE)
-        .dst_access_mask(vk::AccessFlags::HOST_READ)
-        .src_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
-        .dst_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
-        .buffer(readback.buffer)
-        .size(vk::WHOLE_SIZE);
-    // SAFETY: the handles are alive and `cmd` is recording.
+    // Read after write: the CPU maps what the copy wrote.
+    let to_host = buffer_barrier(
+        readback.buffer,
+        vk::AccessFlags::TRANSFER_WRITE,
+        vk::AccessFlags::HOST_READ,
+    );
+    let d = &device.device;
+    // SAFETY: `cmd` is run_once's, recording; the caller owns `image` (in
+    // TRANSFER_SRC_OPTIMAL, as the region's layout says) and `readback`, which
+    // holds width x height RGBA32F texels (readback_buffer sized it so).
     unsafe {
-        let d = &device.device;
         d.cmd_copy_image_to_buffer(
             cmd,
             image,
@@ -143,12 +147,11 @@ pub fn record_copy_to_host(
             readback.buffer,
             &[region],
         );
-        d.cmd_pipeline_barrier(
+        pipeline_barrier(
+            d,
             cmd,
             vk::PipelineStageFlags::TRANSFER,
             vk::PipelineStageFlags::HOST,
-            vk::DependencyFlags::empty(),
-            &[],
             &[to_host],
             &[],
         );
@@ -205,22 +208,26 @@ pub fn create_image_with_view(
         .tiling(vk::ImageTiling::OPTIMAL)
         .usage(usage)
         .initial_layout(vk::ImageLayout::UNDEFINED);
+    // SAFETY: a create on the live device from a local info; the size is within the device's
+    // limits (check_size for --size and captures; in the window the swapchain's extent, which the
+    // surface bounds); RGBA32F supports these usages on every device (the spec makes them
+    // mandatory); the owner whose fields the handles go into destroys the image.
     *image = unsafe { d.create_image(&info, None) }
         .map_err(|e| memory::too_large(e, width as u64 * height as u64 * 16, what))?;
+    // SAFETY: a query on the image just made.
     let needs = unsafe { d.get_image_memory_requirements(*image) };
     *memory = memory::allocate(device, needs, &[Flags::DEVICE_LOCAL, Flags::empty()], what)?.0;
+    // SAFETY: the image has no memory yet; the allocation was sized from its requirements and of a
+    // type they allow; offset 0 meets any alignment.
     unsafe { d.bind_image_memory(*image, *memory, 0) }
         .with_context(|| format!("binding the {what}'s memory"))?;
     let info = vk::ImageViewCreateInfo::default()
         .image(*image)
         .view_type(vk::ImageViewType::TYPE_2D)
         .format(format)
-        .subresource_range(
-            vk::ImageSubresourceRange::default()
-                .aspect_mask(vk::ImageAspectFlags::COLOR)
-                .level_count(1)
-                .layer_count(1),
-        );
+        .subresource_range(crate::commands::COLOR_IMAGE);
+    // SAFETY: the image is bound to its memory and has the format, one level and one layer the view
+    // describes.
     *view = unsafe { d.create_image_view(&info, None) }
         .with_context(|| format!("creating the {what} view"))?;
     Ok(needs.size)

@@ -31,6 +31,8 @@ impl Timestamps {
         let info = vk::QueryPoolCreateInfo::default()
             .query_type(vk::QueryType::TIMESTAMP)
             .query_count(2);
+        // SAFETY: a create on the live device; the Timestamps returned owns the pool and destroys
+        // it.
         let pool = unsafe { device.device.create_query_pool(&info, None) }
             .context("creating the timestamp query pool")?;
         explain::step("VkQueryPool (2 TIMESTAMP queries)", || {
@@ -54,6 +56,9 @@ impl Timestamps {
     /// Queries must be reset before each use; this happens on the GPU, every frame,
     /// inside the recorded commands (outside the render pass, where resets must be).
     pub fn record_reset(&self, cmd: vk::CommandBuffer) {
+        // SAFETY: every caller passes the command buffer it is recording, outside
+        // a render pass (Commands::record, compute.rs, frames.rs); the pool is
+        // self's, alive while that buffer can run (its owner waits for the GPU).
         unsafe { self.device.cmd_reset_query_pool(cmd, self.pool, 0, 2) };
     }
 
@@ -65,6 +70,9 @@ impl Timestamps {
         } else {
             vk::PipelineStageFlags::BOTTOM_OF_PIPE
         };
+        assert!(query < 2, "the pool holds two queries");
+        // SAFETY: as for record_reset; the query exists (checked above) and was
+        // reset earlier in the same command buffer.
         unsafe {
             self.device
                 .cmd_write_timestamp(cmd, stage, self.pool, query)
@@ -77,6 +85,9 @@ impl Timestamps {
     pub fn read_ms(&self) -> Result<f64> {
         let mut ticks = [0u64; 2];
         let flags = vk::QueryResultFlags::TYPE_64 | vk::QueryResultFlags::WAIT;
+        // SAFETY: `ticks` holds the two 64-bit results TYPE_64 asks for; every
+        // caller reads after the fence of a submission that wrote both queries,
+        // so WAIT cannot wait for ever.
         unsafe {
             self.device
                 .get_query_pool_results(self.pool, 0, &mut ticks, flags)

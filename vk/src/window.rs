@@ -15,7 +15,7 @@
 //! needs: frames, swapchain, the path's per-scene objects, render pass, device, surface, instance,
 //! and the window last of all (the surface refers to it).
 
-use crate::commands::Commands;
+use crate::commands::{buffer_barrier, pipeline_barrier, Commands};
 use crate::compute::{self, Compute, WindowCompute};
 use crate::device::Device;
 use crate::frames::{Draw, FrameResult, Frames};
@@ -42,6 +42,9 @@ use winit::window::Window;
 
 /// The current path's per-scene objects, and the shaders they were built
 /// from (a capture builds its headless pipeline from them).
+// Both variants are kilobytes in size (the state they own inline) and the window keeps
+// exactly one, so boxing either would only add an indirection.
+#[allow(clippy::large_enum_variant)]
 enum PathResources {
     Fragment(SceneResources, Shaders),
     Compute(WindowCompute),
@@ -202,8 +205,9 @@ fn path_resources(
 impl VkWindow {
     /// Waits for the GPU, then replaces the swapchain (or drops it while minimized).
     fn rebuild_swapchain(&mut self) -> Result<()> {
-        // SAFETY: nothing may be destroyed while a frame still uses it.
-        unsafe { self.device.device.device_wait_idle() }
+        // Nothing may be destroyed while a frame still uses it.
+        self.device
+            .wait_idle()
             .context("waiting for the GPU before a resize")?;
         self.stale = false;
         let old = self.swapchain.take();
@@ -253,8 +257,9 @@ impl Renderer for VkWindow {
             PathResources::Compute(compute) => {
                 // The blit copies texel for texel: the storage image follows the swapchain.
                 if compute.extent != chain.extent {
-                    // SAFETY: the old image may still be in use by a frame.
-                    unsafe { self.device.device.device_wait_idle() }
+                    // The old image may still be in use by a frame.
+                    self.device
+                        .wait_idle()
                         .context("waiting for the GPU before resizing the storage image")?;
                     compute.resize(&self.device, chain.extent)?;
                 }
@@ -277,8 +282,9 @@ impl Renderer for VkWindow {
     }
 
     fn load_scene(&mut self, scene: &GpuScene, shaders: &PathShaders) -> Result<()> {
-        // SAFETY: the old scene's buffers and pipeline may still be in use.
-        unsafe { self.device.device.device_wait_idle() }
+        // The old scene's buffers and pipeline may still be in use.
+        self.device
+            .wait_idle()
             .context("waiting for the GPU before a scene or path switch")?;
         let extent = match (&self.swapchain, &self.drawing) {
             (Some(c), _) => c.extent,
@@ -307,33 +313,32 @@ impl Renderer for VkWindow {
     /// current view.
     fn capture(&mut self, frame: &GpuFrame, width: u32, height: u32) -> Result<FloatImage> {
         let device = &self.device;
-        unsafe { device.device.device_wait_idle() }
+        device
+            .wait_idle()
             .context("waiting for the GPU before a capture")?;
         device.check_size(width, height)?;
         let uniform = match &self.drawing {
             PathResources::Fragment(s, _) => s.frame.buffer,
             PathResources::Compute(c) => c.frame.buffer,
         };
-        device.run_once("writing the frame uniform buffer", |cmd| unsafe {
-            device
-                .device
-                .cmd_update_buffer(cmd, uniform, 0, bytemuck::bytes_of(frame));
-            let barrier = vk::BufferMemoryBarrier::default()
-                .src_access_mask(vk::AccessFlags::TRANSFER_WRITE)
-                .dst_access_mask(vk::AccessFlags::UNIFORM_READ)
-                .src_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
-                .dst_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
-                .buffer(uniform)
-                .size(vk::WHOLE_SIZE);
-            device.device.cmd_pipeline_barrier(
-                cmd,
-                vk::PipelineStageFlags::TRANSFER,
-                vk::PipelineStageFlags::FRAGMENT_SHADER | vk::PipelineStageFlags::COMPUTE_SHADER,
-                vk::DependencyFlags::empty(),
-                &[],
-                &[barrier],
-                &[],
-            );
+        // Read after write: the capture's tracer reads the block the update wrote.
+        let barrier = buffer_barrier(
+            uniform,
+            vk::AccessFlags::TRANSFER_WRITE,
+            vk::AccessFlags::UNIFORM_READ,
+        );
+        let shaders =
+            vk::PipelineStageFlags::FRAGMENT_SHADER | vk::PipelineStageFlags::COMPUTE_SHADER;
+        device.run_once("writing the frame uniform buffer", |cmd| {
+            let d = &device.device;
+            // SAFETY: `cmd` is run_once's, recording; the GPU is idle (waited
+            // above), so no frame reads the uniform buffer, which `self.drawing`
+            // owns; `frame` fits vkCmdUpdateBuffer (asserted in frames.rs).
+            unsafe {
+                d.cmd_update_buffer(cmd, uniform, 0, bytemuck::bytes_of(frame));
+                let transfer = vk::PipelineStageFlags::TRANSFER;
+                pipeline_barrier(d, cmd, transfer, shaders, &[barrier], &[]);
+            }
         })?;
         let (scene, shaders) = match &self.drawing {
             PathResources::Fragment(scene, shaders) => (scene, shaders),
@@ -372,7 +377,6 @@ impl Renderer for VkWindow {
 impl Drop for VkWindow {
     fn drop(&mut self) {
         // Orderly shutdown: let the GPU finish, then the fields drop in order.
-        // SAFETY: plain wait on a live device.
-        let _ = unsafe { self.device.device.device_wait_idle() };
+        let _ = self.device.wait_idle();
     }
 }

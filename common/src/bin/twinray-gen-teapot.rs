@@ -4,9 +4,8 @@
 //! Usage: `twinray-gen-teapot [--nu N --nv M] [--out FILE]`
 //!
 //! Defaults: the study resolution (20 × 15 quads per patch, 19,200 triangles)
-//! written to `scenes/teapot.obj` in the workspace root. With the defaults the
-//! output is byte-identical to the committed file (checked by a unit test in
-//! `twinray_common::teapot`).
+//! written to `teapot.obj` in the current folder. The built-in scenes do not
+//! read it (they tessellate the patches at load); it is for other tools.
 
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -19,7 +18,7 @@ const USAGE: &str = concat!(
     "usage: twinray-gen-teapot [--nu N --nv M] [--out FILE]\n",
     "  --nu N      quads per patch along u (integer 1..=1000, default 20)\n",
     "  --nv M      quads per patch along v (integer 1..=1000, default 15)\n",
-    "  --out FILE  output OBJ path (default: <workspace>/scenes/teapot.obj)",
+    "  --out FILE  output OBJ path (default: teapot.obj in the current folder)",
 );
 
 struct Args {
@@ -75,12 +74,7 @@ fn parse_args(mut it: impl Iterator<Item = String>) -> Result<Parsed, String> {
             _ => return Err(format!("unknown argument {arg:?}.")),
         }
     }
-    let out = out.unwrap_or_else(|| {
-        PathBuf::from(env!("CARGO_MANIFEST_DIR"))
-            .join("..")
-            .join("scenes")
-            .join("teapot.obj")
-    });
+    let out = out.unwrap_or_else(|| PathBuf::from("teapot.obj"));
     Ok(Parsed::Run(Args {
         nu: nu.unwrap_or(STUDY_NU),
         nv: nv.unwrap_or(STUDY_NV),

@@ -95,7 +95,7 @@ fn read_text(what: &str, file: &str, files: &FileSource) -> anyhow::Result<Strin
     }
 }
 
-/// Newell-style Bezier patches, tessellated by the generator that wrote teapot.obj.
+/// Newell-style Bezier patches, tessellated as twinray-gen-teapot does.
 /// `t_at` names the tessellation's source; `room` is how many triangles may still be added.
 pub(super) fn load_bpt(
     at: &str,

@@ -101,6 +101,16 @@ pub struct Shaders {
     pub fragment_glsl: String,
 }
 
+impl Shaders {
+    /// Both stages as `--dump-shaders` writes them: (name, SPIR-V, GLSL).
+    pub fn stages(&self) -> [(&str, &[u32], &str); 2] {
+        [
+            ("vertex", &self.vertex_spirv, &self.vertex_glsl),
+            ("fragment", &self.fragment_spirv, &self.fragment_glsl),
+        ]
+    }
+}
+
 pub fn build(variant: &Variant) -> anyhow::Result<Shaders> {
     let (vm, vi) = parse(FULLSCREEN_VERT, ShaderStage::Vertex, variant)?;
     let (fm, fi) = parse(&fragment_source(), ShaderStage::Fragment, variant)?;

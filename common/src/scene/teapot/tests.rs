@@ -321,16 +321,3 @@ fn obj_format() {
          f 1//1 2//2 3//3\n"
     );
 }
-
-#[test]
-fn committed_obj_matches_generator() {
-    let committed = include_str!("../../../../scenes/teapot.obj").replace("\r\n", "\n");
-    let fresh = to_obj(
-        &tessellate(&parse_bpt(BPT).unwrap(), STUDY_NU, STUDY_NV),
-        HEADER,
-    );
-    assert!(
-        committed == fresh,
-        "scenes/teapot.obj is stale: regenerate with `cargo run -p twinray-common --bin twinray-gen-teapot`"
-    );
-}
