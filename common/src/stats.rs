@@ -32,18 +32,30 @@ pub fn summarize(values: &[f64]) -> Option<Summary> {
     let mut sorted = tail.to_vec();
     sorted.sort_by(|a, b| a.total_cmp(b));
     let n = sorted.len();
-    let median = if n % 2 == 1 {
-        sorted[n / 2]
-    } else {
-        0.5 * (sorted[n / 2 - 1] + sorted[n / 2])
-    };
     Some(Summary {
         mean: sorted.iter().sum::<f64>() / n as f64,
-        median,
+        median: middle(&sorted),
         min: sorted[0],
         max: sorted[n - 1],
         n,
     })
+}
+
+/// The median of `values`: the middle one, or the mean of the middle two.
+pub fn median(values: &[f64]) -> Option<f64> {
+    let mut sorted = values.to_vec();
+    sorted.sort_by(f64::total_cmp);
+    (!sorted.is_empty()).then(|| middle(&sorted))
+}
+
+/// The median of sorted, non-empty `sorted`.
+fn middle(sorted: &[f64]) -> f64 {
+    let n = sorted.len();
+    if n % 2 == 1 {
+        sorted[n / 2]
+    } else {
+        0.5 * (sorted[n / 2 - 1] + sorted[n / 2])
+    }
 }
 
 #[cfg(test)]
@@ -65,5 +77,12 @@ mod tests {
     fn single_frame_and_empty() {
         assert_eq!(summarize(&[2.0]).unwrap().median, 2.0);
         assert!(summarize(&[]).is_none());
+    }
+
+    #[test]
+    fn median_of_odd_and_even_counts_in_any_order() {
+        assert_eq!(median(&[3.0, 1.0, 2.0]), Some(2.0));
+        assert_eq!(median(&[4.0, 1.0, 3.0, 2.0]), Some(2.5));
+        assert_eq!(median(&[]), None);
     }
 }

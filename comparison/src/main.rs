@@ -2,11 +2,15 @@
 //! apps as child processes (one API per process) and reads their JSON, renders
 //! the f64 reference itself, and compares images.
 
+mod accel;
 mod accuracy;
+mod agreement;
 mod apps;
 mod compare;
+mod csv_out;
 mod diff;
 mod report;
+mod runs;
 mod shaders;
 mod study;
 

@@ -7,7 +7,7 @@
 //! software drivers), the table says so.
 
 use crate::apps::{run_json, Api};
-use crate::compare::api_name;
+use crate::runs::api_name;
 use std::fmt::Write as _;
 use std::path::Path;
 use std::sync::atomic::{AtomicBool, Ordering};

@@ -1,0 +1,155 @@
+//! What a comparison runs and what each run gave back: the plan of points,
+//! every API's outcome at a point, the runs of "model only what a scene
+//! needs", the image agreement, and the API names every output prints. The
+//! runner (compare.rs, accel.rs, agreement.rs) fills these in and the report
+//! reads them, so neither imports the other.
+
+use crate::apps::Api;
+use twinray_common::cli::{RenderPath, Size};
+use twinray_common::reference::metrics::Metrics;
+use twinray_common::report::RunReport;
+
+/// The study's three experiments, in the order every output lists them.
+pub const EXPERIMENTS: [&str; 3] = ["teapot", "box", "spherelist"];
+
+/// One point of a sweep: a scene at one size or one extra-sphere count.
+#[derive(Debug, Clone)]
+pub struct Point {
+    pub experiment: &'static str,
+    pub param_name: &'static str,
+    pub param_value: String,
+    pub scene: &'static str,
+    pub size: Size,
+    pub set: Vec<String>,
+    /// Work relative to the sweep's first point (pixels or primitives), to predict frame time.
+    pub work: f64,
+}
+
+/// The points of a comparison and how long each may run.
+pub struct Plan {
+    pub points: Vec<Point>,
+    pub frames: u32,
+    /// Fewer frames for a point predicted to take longer than this per app.
+    pub seconds_per_point: f64,
+    /// "quick" or "full".
+    pub preset: &'static str,
+}
+
+/// One API at one point: its report, or why it failed.
+#[derive(Debug, Clone)]
+pub struct Outcome {
+    pub point: Point,
+    pub api: Api,
+    pub path: RenderPath,
+    pub result: Result<RunReport, String>,
+}
+
+/// The API's name in every CSV, table, plot and file name.
+pub fn api_name(api: Api) -> &'static str {
+    match api {
+        Api::Vulkan => "vulkan",
+        Api::Opengl => "opengl",
+        Api::OpenglSpirv => "opengl-spirv",
+        Api::Reference => "reference",
+    }
+}
+
+/// Image agreement of one scene: both APIs against each other and the f64 reference.
+#[derive(Debug, Clone)]
+pub struct Agreement {
+    pub scene: &'static str,
+    pub size: Size,
+    /// Vulkan vs OpenGL, Vulkan vs reference, OpenGL vs reference.
+    pub result: Result<[Metrics; 3], String>,
+    /// With the compute path measured: each API's compute image against its fragment image.
+    pub paths: Option<Result<[Metrics; 2], String>>,
+}
+
+/// The all-features shader; the scene's own variant (defines); the one
+/// all-features source specialised to the scene through specialization
+/// constants (`--specialize`); the scene's variant with a BVH.
+pub const ACCEL_CONFIGS: [&str; 4] = [
+    "generic, brute force",
+    "variant, brute force",
+    "specialized, brute force",
+    "variant, BVH",
+];
+
+/// One run of "model only what a scene needs": a scene in one configuration.
+#[derive(Debug, Clone)]
+pub struct AccelRun {
+    pub scene: &'static str,
+    pub size: Size,
+    pub set: Vec<String>,
+    /// One of ACCEL_CONFIGS.
+    pub config: &'static str,
+    pub api: Api,
+    pub result: Result<RunReport, String>,
+    /// The BVH, built here as the apps build it (BVH configurations only).
+    pub bvh: Option<BvhStats>,
+}
+
+#[derive(Debug, Clone, Copy)]
+pub struct BvhStats {
+    pub nodes: usize,
+    pub bytes: usize,
+    pub build_ms: f64,
+}
+
+/// A run's `--set KEY=VALUE` list as the (key, value) pairs `Scene::load`
+/// takes: the orchestrator loads the scene a run renders for its reference
+/// image, its BVH figures or its shader's defines.
+pub fn overrides(set: &[String]) -> Vec<(String, String)> {
+    set.iter()
+        .filter_map(|kv| kv.split_once('='))
+        .map(|(k, v)| (k.into(), v.into()))
+        .collect()
+}
+
+/// Everything one `twinray compare` measured: what its report is written from.
+#[derive(Clone, Copy)]
+pub struct Results<'a> {
+    pub plan: &'a Plan,
+    pub outcomes: &'a [Outcome],
+    pub accel: &'a [AccelRun],
+    pub agreement: &'a [Agreement],
+    /// Ctrl-C stopped the run: the report says that only finished points are in.
+    pub interrupted: bool,
+}
+
+/// A successful outcome of `api` on `path` at the box's 8x8 point whose every
+/// frame took `ms`, for the report's tests.
+#[cfg(test)]
+pub fn test_outcome(api: Api, path: RenderPath, ms: f64) -> Outcome {
+    let json = format!(
+        r#"{{"api":"x","device":"d","driver":"v","api_version":"1","os":"o","scene":{{"name":"box","triangles":30,"spheres":2,"lights":1,"materials":3,"max_depth":5}},
+           "variant":"v","width":8,"height":8,{}"frames":[{{"gpu_ms":{ms},"wall_ms":{ms}}}],"gpu_ms":null,"wall_ms":null,
+           "nonfinite_pixels":0,"setup_ms":1.0,"validation_messages":0}}"#,
+        if path == RenderPath::Compute {
+            r#""path":"compute","workgroup":"16x8","#
+        } else {
+            ""
+        }
+    );
+    let mut r: RunReport =
+        serde_json::from_str(&json).expect("a report without `path` still parses");
+    r.summarise();
+    let point = Point {
+        experiment: "box",
+        param_name: "resolution",
+        param_value: "8x8".into(),
+        scene: "box",
+        size: Size {
+            width: 8,
+            height: 8,
+        },
+        set: vec![],
+        work: 1.0,
+    };
+    Outcome {
+        point,
+        api,
+        path,
+        result: Ok(r),
+    }
+}
