@@ -1,12 +1,18 @@
-//! The options both apps accept (docs/architecture.md, the command-line contract), parsed by
-//! one clap struct so that `twinray-vk` and `twinray-gl` can never drift apart.
+//! The apps' whole configuration surface: the options both apps accept, parsed
+//! by one clap struct so that `twinray-vk` and `twinray-gl` can never drift
+//! apart (docs/architecture.md, the command-line contract), and each app's own knobs, which are options too and are also read
+//! from `TWINRAY_*` environment variables (so that a script or the orchestrator
+//! can set them for every run). Everything is parsed once, in `main`.
 
 use crate::error::bad_input;
 use crate::scene::accel::Accel;
-use clap::Parser;
+use crate::value_name::ValueName;
+use clap::builder::{PossibleValue, TypedValueParser};
+use clap::parser::ValueSource;
+use clap::{Parser, ValueEnum};
 use std::path::PathBuf;
 
-#[derive(Parser, Debug, Clone)]
+#[derive(Parser, Debug, Clone, PartialEq)]
 pub struct RenderArgs {
     /// Built-in scene (teapot, box, spherelist) or a path to a scene file (.toml).
     #[arg(long, default_value = "box")]
@@ -114,24 +120,6 @@ pub enum Experiment {
     Glslang,
 }
 
-impl Experiment {
-    pub fn name(self) -> &'static str {
-        match self {
-            Experiment::NagaZeroInit => "naga-zero-init",
-            Experiment::NagaLoopBounding => "naga-loop-bounding",
-            Experiment::NoLoopBounding => "no-loop-bounding",
-            Experiment::SharedBvhStack => "shared-bvh-stack",
-            Experiment::UniformCounts => "uniform-counts",
-            Experiment::StacklessBvh => "stackless-bvh",
-            Experiment::UnpairedBvhStack => "unpaired-bvh-stack",
-            Experiment::StorageCounts => "storage-counts",
-            Experiment::NoContraction => "no-contraction",
-            Experiment::FloatControls => "float-controls",
-            Experiment::Glslang => "glslang",
-        }
-    }
-}
-
 /// The tracer's entry point: the two ways one GLSL tracer reaches the GPU.
 #[derive(
     Debug,
@@ -154,18 +142,9 @@ pub enum RenderPath {
     Compute,
 }
 
-impl RenderPath {
-    pub fn name(self) -> &'static str {
-        match self {
-            RenderPath::Fragment => "fragment",
-            RenderPath::Compute => "compute",
-        }
-    }
-}
-
 impl std::fmt::Display for RenderPath {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        f.write_str(self.name())
+        f.write_str(&self.name())
     }
 }
 
@@ -282,23 +261,6 @@ impl RenderArgs {
         }
     }
 
-    /// Parses argv, mapping clap's usage errors to exit code 2 (clap already
-    /// prints one clear line naming the option).
-    pub fn parse_or_exit() -> Self {
-        match Self::try_parse() {
-            Ok(a) => a,
-            Err(e) => {
-                let code = match e.kind() {
-                    clap::error::ErrorKind::DisplayHelp
-                    | clap::error::ErrorKind::DisplayVersion => 0,
-                    _ => 2,
-                };
-                let _ = e.print();
-                std::process::exit(code);
-            }
-        }
-    }
-
     /// The workgroup of a compute run (`--workgroup` or the default). A
     /// `--workgroup` with the fragment path is a mistake worth saying, not ignoring.
     pub fn compute_workgroup(&self) -> anyhow::Result<Workgroup> {
@@ -340,5 +302,224 @@ impl RenderArgs {
         let mut scene = crate::scene::Scene::load(&self.scene, &self.overrides()?)?;
         scene.set_accel(self.accel);
         Ok(scene)
+    }
+}
+
+/// Parses argv (and the knobs' environment variables), mapping clap's usage
+/// errors to exit code 2 (clap already prints one clear line naming the option).
+pub fn parse_or_exit<T: Parser>() -> T {
+    match T::try_parse() {
+        Ok(a) => a,
+        Err(e) => {
+            let code = if e.use_stderr() { 2 } else { 0 };
+            let _ = e.print();
+            std::process::exit(code);
+        }
+    }
+}
+
+/// An app's command line: the shared options and that app's knobs.
+#[derive(Parser, Debug, Clone)]
+pub struct AppCli<K: clap::Args> {
+    #[command(flatten)]
+    pub render: RenderArgs,
+    #[command(flatten)]
+    pub knobs: K,
+}
+
+/// `twinray-vk`'s command line.
+pub type VulkanCli = AppCli<VulkanKnobs>;
+/// `twinray-gl`'s command line.
+pub type OpenGlCli = AppCli<OpenGlKnobs>;
+
+// The knobs are each app's own: the other app never reads them, so a Vulkan
+// knob set for a whole comparison cannot stop the OpenGL runs, as before.
+
+/// Vulkan-only choices, for picking a device and for reproducing the naive
+/// choices the comparison measures.
+#[derive(clap::Args, Debug, Clone, Default, PartialEq)]
+#[command(next_help_heading = "Vulkan knobs (also read from the environment)")]
+pub struct VulkanKnobs {
+    /// The Vulkan device: an index or part of its name [default: the most
+    /// capable kind present: discrete, integrated, virtual, then CPU].
+    #[arg(
+        long = "vk-device",
+        env = "TWINRAY_VK_DEVICE",
+        value_name = "INDEX|NAME",
+        value_parser = named_in_env(clap::builder::StringValueParser::new())
+    )]
+    pub device: Option<String>,
+    /// Where the scene's buffers live: device-local memory filled through a
+    /// staging buffer (the careful choice), or host-visible memory the GPU
+    /// reads across the bus (the naive one, to measure what it costs).
+    #[arg(
+        long = "vk-memory",
+        env = "TWINRAY_VK_MEMORY",
+        value_enum,
+        value_parser = named_in_env(clap::builder::EnumValueParser::<SceneMemory>::new()),
+        default_value_t = SceneMemory::Device
+    )]
+    pub memory: SceneMemory,
+    /// Turn the validation layer on without failing on its messages (with a
+    /// note, not an error, where it is not installed); --validate requires it.
+    #[arg(
+        long = "vk-validation",
+        env = "TWINRAY_VK_VALIDATION",
+        value_parser = named_in_env(clap::builder::BoolishValueParser::new())
+    )]
+    pub validation: bool,
+    /// How each headless frame is waited for: its fence, or vkQueueWaitIdle +
+    /// vkDeviceWaitIdle as the 2018 study did.
+    #[arg(
+        long = "vk-wait",
+        env = "TWINRAY_VK_WAIT",
+        value_enum,
+        value_parser = named_in_env(clap::builder::EnumValueParser::<FrameWait>::new()),
+        default_value_t = FrameWait::Fence
+    )]
+    pub wait: FrameWait,
+}
+
+impl VulkanKnobs {
+    /// The device asked for; empty counts as none, so that a script can pass
+    /// an unset variable through.
+    pub fn device(&self) -> Option<&str> {
+        self.device
+            .as_deref()
+            .map(str::trim)
+            .filter(|d| !d.is_empty())
+    }
+}
+
+/// Where the Vulkan app places the scene's buffers (`--vk-memory`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, ValueEnum)]
+pub enum SceneMemory {
+    /// Device-local, filled once through a staging buffer.
+    #[default]
+    Device,
+    /// Host-visible: every GPU access crosses the bus.
+    Host,
+}
+
+/// How the Vulkan app waits for a headless frame (`--vk-wait`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, ValueEnum)]
+pub enum FrameWait {
+    /// The frame's fence: waits for this frame's work only.
+    #[default]
+    Fence,
+    /// vkQueueWaitIdle + vkDeviceWaitIdle, as the 2018 study did.
+    Idle,
+}
+
+/// OpenGL-only choices.
+#[derive(clap::Args, Debug, Clone, Default, PartialEq)]
+#[command(next_help_heading = "OpenGL knobs (also read from the environment)")]
+pub struct OpenGlKnobs {
+    /// The EGL device index, headless [default: hardware devices first, then
+    /// Mesa's software one].
+    #[arg(
+        long = "gl-device",
+        env = "TWINRAY_GL_DEVICE",
+        value_name = "INDEX",
+        value_parser = named_in_env(parse_index)
+    )]
+    pub device: Option<usize>,
+}
+
+fn parse_index(s: &str) -> Result<usize, String> {
+    s.trim()
+        .parse()
+        .map_err(|_| "not a device index (0, 1, ...)".to_string())
+}
+
+/// Wraps a knob's value parser so that a bad value read from the environment
+/// is named by its variable: clap's own message names the option, which the
+/// user never typed.
+pub fn named_in_env<P: TypedValueParser>(parser: P) -> NamedInEnv<P> {
+    NamedInEnv(parser)
+}
+
+/// See [`named_in_env`].
+#[derive(Clone)]
+pub struct NamedInEnv<P>(P);
+
+impl<P: TypedValueParser> TypedValueParser for NamedInEnv<P> {
+    type Value = P::Value;
+
+    fn parse_ref(
+        &self,
+        cmd: &clap::Command,
+        arg: Option<&clap::Arg>,
+        value: &std::ffi::OsStr,
+    ) -> Result<Self::Value, clap::Error> {
+        self.0.parse_ref(cmd, arg, value)
+    }
+
+    fn parse_ref_(
+        &self,
+        cmd: &clap::Command,
+        arg: Option<&clap::Arg>,
+        value: &std::ffi::OsStr,
+        source: ValueSource,
+    ) -> Result<Self::Value, clap::Error> {
+        use clap::error::{ContextKind, ContextValue};
+        self.0.parse_ref_(cmd, arg, value, source).map_err(|mut e| {
+            let variable = arg.and_then(clap::Arg::get_env);
+            if let (Some(variable), ValueSource::EnvVariable) = (variable, source) {
+                // The clap message stays ("invalid value 'x' for '...'", the
+                // possible values); only the culprit's name changes.
+                let name = ContextValue::String(variable.to_string_lossy().into_owned());
+                e.insert(ContextKind::InvalidArg, name);
+            }
+            e
+        })
+    }
+
+    fn possible_values(&self) -> Option<Box<dyn Iterator<Item = PossibleValue> + '_>> {
+        self.0.possible_values()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::scene::numerics::{Offset, SphereTest, TriangleTest};
+    use crate::scene::OriginMode;
+
+    fn names<T: ValueEnum>() -> Vec<String> {
+        T::value_variants().iter().map(ValueName::name).collect()
+    }
+
+    /// The names are in reports, CSV columns, variant labels and scripts:
+    /// deriving them must keep every spelling.
+    #[test]
+    fn value_names_keep_their_spelling() {
+        assert_eq!(names::<Accel>(), ["auto", "none", "bvh"]);
+        assert_eq!(names::<RenderPath>(), ["fragment", "compute"]);
+        assert_eq!(
+            names::<Experiment>(),
+            [
+                "naga-zero-init",
+                "naga-loop-bounding",
+                "no-loop-bounding",
+                "shared-bvh-stack",
+                "stackless-bvh",
+                "unpaired-bvh-stack",
+                "storage-counts",
+                "uniform-counts",
+                "no-contraction",
+                "float-controls",
+                "glslang"
+            ]
+        );
+        assert_eq!(
+            names::<Offset>(),
+            ["ray", "normal", "normal-scaled", "ulp", "scale-aware"]
+        );
+        assert_eq!(names::<TriangleTest>(), ["moller-trumbore", "watertight"]);
+        assert_eq!(names::<SphereTest>(), ["quadratic", "stable"]);
+        assert_eq!(names::<OriginMode>(), ["local", "world"]);
+        assert_eq!(names::<SceneMemory>(), ["device", "host"]);
+        assert_eq!(names::<FrameWait>(), ["fence", "idle"]);
     }
 }

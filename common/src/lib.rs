@@ -5,7 +5,7 @@
 //!
 //! | module | owns |
 //! |---|---|
-//! | `error`, `explain`, `stats` | exit codes and clear errors; `--explain`'s log; frame statistics |
+//! | `error`, `explain`, `stats`, `value_name` | exit codes and clear errors; `--explain`'s log; frame statistics; the one spelling of every enum value |
 //! | `gpu::layout` | the `#[repr(C)]` mirror of every shader struct, binding numbers, the flattened BVH |
 //! | `limits` | one limit per user-controlled quantity |
 //! | `reference::image_io`, `reference::metrics` | float images and PNG files; how far one image is from another |
@@ -27,6 +27,7 @@ pub mod report;
 pub mod scene;
 pub mod shader;
 pub mod stats;
+pub mod value_name;
 #[cfg(feature = "window")]
 pub mod window;
 

@@ -1,7 +1,7 @@
 //! The JSON object each app prints with `--json`: the contract between the apps
 //! and the `twinray` orchestrator (which reads it back with the same struct).
 
-use crate::cli::RenderPath;
+use crate::cli::{RenderPath, Workgroup};
 use crate::scene::SceneStats;
 use crate::stats::{summarize, Summary};
 use serde::{Deserialize, Serialize};
@@ -59,7 +59,7 @@ pub struct ShaderStats {
     pub statistics: Vec<(String, String)>,
 }
 
-/// What an app says about its device.
+/// What an app says about its device, kept after the device is gone.
 #[derive(Debug, Clone)]
 pub struct DeviceInfo {
     pub device: String,
@@ -67,42 +67,45 @@ pub struct DeviceInfo {
     pub api_version: String,
 }
 
+/// Assembles a [`RunReport`]: who ran (api, device) and what (scene, variant)
+/// up front, the rest by name; `build` fills the summaries. Every report is
+/// made here, so the apps, the window and the reference cannot disagree on
+/// what a field means.
+#[must_use]
+pub struct RunReportBuilder {
+    report: RunReport,
+}
+
 impl RunReport {
-    /// A fragment-path report with its summaries filled from `frames`; callers
-    /// override the fields that differ (`path`, NaN count, validation count).
-    #[allow(clippy::too_many_arguments)]
-    pub fn new(
+    /// A report of a fragment-path run with no frames yet (see [`RunReportBuilder`]).
+    pub fn builder(
         api: &str,
         info: DeviceInfo,
         scene: SceneStats,
         variant: String,
-        width: u32,
-        height: u32,
-        frames: Vec<FrameTime>,
-        setup_ms: f64,
-    ) -> RunReport {
-        let mut report = RunReport {
-            api: api.to_string(),
-            device: info.device,
-            driver: info.driver,
-            api_version: info.api_version,
-            os: os_description(),
-            scene,
-            variant,
-            width,
-            height,
-            path: Default::default(),
-            workgroup: None,
-            frames,
-            gpu_ms: None,
-            wall_ms: None,
-            nonfinite_pixels: 0,
-            setup_ms,
-            validation_messages: 0,
-            shader_stats: Vec::new(),
-        };
-        report.summarise();
-        report
+    ) -> RunReportBuilder {
+        RunReportBuilder {
+            report: RunReport {
+                api: api.to_string(),
+                device: info.device,
+                driver: info.driver,
+                api_version: info.api_version,
+                os: os_description(),
+                scene,
+                variant,
+                width: 0,
+                height: 0,
+                path: RenderPath::Fragment,
+                workgroup: None,
+                frames: Vec::new(),
+                gpu_ms: None,
+                wall_ms: None,
+                nonfinite_pixels: 0,
+                setup_ms: 0.0,
+                validation_messages: 0,
+                shader_stats: Vec::new(),
+            },
+        }
     }
 
     /// The one JSON line on stdout that `--json` promises.
@@ -119,6 +122,53 @@ impl RunReport {
         self.wall_ms = summarize(&wall);
         let gpu: Option<Vec<f64>> = self.frames.iter().map(|f| f.gpu_ms).collect();
         self.gpu_ms = gpu.and_then(|g| summarize(&g));
+    }
+}
+
+impl RunReportBuilder {
+    /// The image size.
+    pub fn size(mut self, width: u32, height: u32) -> Self {
+        self.report.width = width;
+        self.report.height = height;
+        self
+    }
+
+    /// The entry point that traced; the workgroup is reported for compute only.
+    pub fn path(mut self, path: RenderPath, workgroup: Workgroup) -> Self {
+        self.report.path = path;
+        self.report.workgroup = (path == RenderPath::Compute).then(|| workgroup.to_string());
+        self
+    }
+
+    /// The timed frames and the setup time before the first.
+    pub fn frames(mut self, frames: Vec<FrameTime>, setup_ms: f64) -> Self {
+        self.report.frames = frames;
+        self.report.setup_ms = setup_ms;
+        self
+    }
+
+    /// Pixels of the last frame with a NaN or infinite channel.
+    pub fn nonfinite_pixels(mut self, count: u64) -> Self {
+        self.report.nonfinite_pixels = count;
+        self
+    }
+
+    /// Messages from the validation layer or GL debug output.
+    pub fn validation_messages(mut self, count: u64) -> Self {
+        self.report.validation_messages = count;
+        self
+    }
+
+    /// What the driver reported of the compiled shaders (`--dump-shaders`).
+    pub fn shader_stats(mut self, stats: Vec<ShaderStats>) -> Self {
+        self.report.shader_stats = stats;
+        self
+    }
+
+    /// The report, with its summaries filled from the frames.
+    pub fn build(mut self) -> RunReport {
+        self.report.summarise();
+        self.report
     }
 }
 

@@ -4,11 +4,13 @@
 use anyhow::Context;
 use std::path::PathBuf;
 use std::process::Command;
+use std::sync::OnceLock;
 use std::time::Instant;
 use twinray_common::cli::RenderArgs;
 use twinray_common::error::{bad_input, Failure, FailureKind};
 use twinray_common::report::{DeviceInfo, FrameTime, RunReport};
 use twinray_common::scene::accel::Accel;
+use twinray_common::value_name::ValueName;
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
 pub enum Api {
@@ -30,19 +32,51 @@ impl Api {
     }
 }
 
-/// Where the app binaries live: `TWINRAY_BIN_DIR`, else next to this executable.
+/// `--bin-dir` (`TWINRAY_BIN_DIR`), set once by `main` after parsing: every
+/// run of an app, however deep in a sweep, looks its binary up here.
+static BIN_DIR: OnceLock<PathBuf> = OnceLock::new();
+
+/// Records `--bin-dir`; without it the apps are looked for next to this executable.
+pub fn set_bin_dir(dir: Option<PathBuf>) {
+    if let Some(dir) = dir {
+        let _ = BIN_DIR.set(dir);
+    }
+}
+
+/// `--bin-dir`'s check, at parse time: a folder that does not exist is a typo
+/// worth one sentence before any render, not a failure in the middle of a sweep.
+pub fn parse_bin_dir(s: &str) -> Result<PathBuf, String> {
+    let dir = PathBuf::from(s);
+    if dir.is_dir() {
+        Ok(dir)
+    } else {
+        Err("not a folder".to_string())
+    }
+}
+
+/// Where the app binaries live: `--bin-dir` (`TWINRAY_BIN_DIR`), else next to this executable.
 pub fn app_path(name: &str) -> anyhow::Result<PathBuf> {
-    let dir = match std::env::var_os("TWINRAY_BIN_DIR") {
-        Some(d) => PathBuf::from(d),
-        None => std::env::current_exe()?
-            .parent()
-            .map(PathBuf::from)
-            .unwrap_or_default(),
+    let (dir, chosen) = match BIN_DIR.get() {
+        Some(d) => (d.clone(), true),
+        None => (
+            std::env::current_exe()?
+                .parent()
+                .map(PathBuf::from)
+                .unwrap_or_default(),
+            false,
+        ),
     };
     let path = dir.join(name);
     if !path.exists() {
+        // A folder the user chose that lacks the apps is bad input; a build without them is not.
+        if chosen {
+            return Err(bad_input(format!(
+                "--bin-dir (TWINRAY_BIN_DIR) '{}' holds no {name}; point it at the folder of the release build",
+                dir.display()
+            )));
+        }
         return Err(anyhow::anyhow!(
-            "{name} was not found in '{}'; build the whole workspace (cargo build --release --workspace) or set TWINRAY_BIN_DIR",
+            "{name} was not found in '{}'; build the whole workspace (cargo build --release --workspace) or set --bin-dir (TWINRAY_BIN_DIR)",
             dir.display()
         ));
     }
@@ -51,46 +85,68 @@ pub fn app_path(name: &str) -> anyhow::Result<PathBuf> {
 
 /// The app's command line for `args` (always headless: the orchestrator never opens windows).
 pub fn app_args(args: &RenderArgs) -> Vec<String> {
+    // Destructured field by field, so that an option added to RenderArgs does
+    // not compile until it is passed on here (and `app_args_round_trip` checks it).
+    let RenderArgs {
+        scene,
+        size,
+        headless: _,
+        frames,
+        out,
+        json,
+        set,
+        validate,
+        generic,
+        specialize,
+        accel,
+        gl_spirv,
+        vsync,
+        explain,
+        path,
+        workgroup,
+        experiment,
+        dump_shaders,
+    } = args;
     let mut v = vec![
         "--headless".to_string(),
         "--scene".into(),
-        args.scene.clone(),
+        scene.clone(),
         "--size".into(),
-        args.size.to_string(),
+        size.to_string(),
     ];
-    if let Some(f) = args.frames {
+    if let Some(f) = frames {
         v.extend(["--frames".into(), f.to_string()]);
     }
-    if let Some(o) = &args.out {
+    if let Some(o) = out {
         v.extend(["--out".into(), o.display().to_string()]);
     }
-    for s in &args.set {
+    for s in set {
         v.extend(["--set".into(), s.clone()]);
     }
-    if args.json {
-        v.push("--json".into());
-    }
-    if args.validate {
-        v.push("--validate".into());
-    }
-    if args.generic {
-        v.push("--generic".into());
-    }
-    if args.specialize {
-        v.push("--specialize".into());
-    }
-    if args.gl_spirv {
-        v.push("--gl-spirv".into());
-    }
-    v.extend(["--accel".into(), args.accel.name().into()]);
-    v.extend(["--path".into(), args.path.to_string()]);
-    if let Some(wg) = args.workgroup {
+    let flags = [
+        (json, "--json"),
+        (validate, "--validate"),
+        (generic, "--generic"),
+        (specialize, "--specialize"),
+        (gl_spirv, "--gl-spirv"),
+        (vsync, "--vsync"),
+        (explain, "--explain"),
+    ];
+    v.extend(
+        flags
+            .iter()
+            .filter(|(on, _)| **on)
+            .map(|(_, f)| f.to_string()),
+    );
+    v.extend(["--accel".into(), accel.name()]);
+    v.extend(["--path".into(), path.name()]);
+    if let Some(wg) = workgroup {
         v.extend(["--workgroup".into(), wg.to_string()]);
     }
-    for e in &args.experiment {
-        v.extend(["--experiment".into(), e.name().into()]);
+    for e in experiment {
+        v.extend(["--experiment".into(), e.name()]);
     }
-    if let Some(dir) = &args.dump_shaders {
+    if let Some(dir) = dump_shaders {
         v.extend(["--dump-shaders".into(), dir.display().to_string()]);
     }
     v
@@ -188,20 +244,12 @@ pub fn render_reference(args: &RenderArgs) -> anyhow::Result<()> {
             wall_ms: ms,
         }];
         let setup_ms = (t - start).as_secs_f64() * 1e3;
-        let report = RunReport {
-            nonfinite_pixels: img.nonfinite_pixels(),
-            ..RunReport::new(
-                "reference",
-                info,
-                scene.stats(),
-                "f64".into(),
-                w,
-                h,
-                frames,
-                setup_ms,
-            )
-        };
-        report.print_json()?;
+        RunReport::builder("reference", info, scene.stats(), "f64".into())
+            .size(w, h)
+            .frames(frames, setup_ms)
+            .nonfinite_pixels(img.nonfinite_pixels())
+            .build()
+            .print_json()?;
     }
     Ok(())
 }
@@ -253,4 +301,136 @@ fn render_with_progress(
 
 fn rayon_threads() -> usize {
     rayon::current_num_threads()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::app_args;
+    use clap::Parser;
+    use std::path::PathBuf;
+    use twinray_common::cli::{Experiment, RenderArgs, RenderPath, Size, VulkanCli, Workgroup};
+    use twinray_common::scene::accel::Accel;
+
+    /// Every option away from its default, so that one the argv builder drops
+    /// or misspells parses back different. Written as a struct literal: a new
+    /// option does not compile until it is given a value here too.
+    fn every_option_set() -> RenderArgs {
+        RenderArgs {
+            scene: "spherelist".into(),
+            size: Size {
+                width: 33,
+                height: 17,
+            },
+            // app_args always adds --headless: the orchestrator never opens a window.
+            headless: true,
+            frames: Some(7),
+            out: Some(PathBuf::from("out dir/a.png")),
+            json: true,
+            set: vec!["max_depth=3".into(), "extra_spheres=10".into()],
+            validate: true,
+            generic: false,
+            specialize: true,
+            accel: Accel::Bvh,
+            gl_spirv: true,
+            vsync: true,
+            explain: true,
+            path: RenderPath::Compute,
+            workgroup: Some(Workgroup { x: 8, y: 4 }),
+            experiment: vec![Experiment::NagaZeroInit, Experiment::StacklessBvh],
+            dump_shaders: Some(PathBuf::from("dump")),
+        }
+    }
+
+    fn round_trip(args: &RenderArgs) -> RenderArgs {
+        let argv = std::iter::once("twinray-vk".to_string()).chain(app_args(args));
+        VulkanCli::try_parse_from(argv)
+            .unwrap_or_else(|e| panic!("app_args({args:?}) does not parse: {e}"))
+            .render
+    }
+
+    #[test]
+    fn app_args_round_trip() {
+        let args = every_option_set();
+        assert_eq!(round_trip(&args), args);
+        // --generic conflicts with --specialize, so it gets its own run.
+        let generic = RenderArgs {
+            generic: true,
+            specialize: false,
+            ..every_option_set()
+        };
+        assert_eq!(round_trip(&generic), generic);
+        let plain = RenderArgs::headless(
+            "box",
+            Size {
+                width: 800,
+                height: 600,
+            },
+        );
+        assert_eq!(round_trip(&plain), plain);
+    }
+
+    #[test]
+    fn every_option_is_exercised() {
+        // An option left at its default would pass the round trip even if
+        // app_args dropped it: the two runs above must name every option.
+        use clap::CommandFactory;
+        let generic = RenderArgs {
+            generic: true,
+            ..every_option_set()
+        };
+        let argv = [app_args(&every_option_set()), app_args(&generic)].concat();
+        for option in RenderArgs::command().get_arguments() {
+            let Some(long) = option.get_long() else {
+                continue;
+            };
+            let long = format!("--{long}");
+            assert!(
+                argv.contains(&long),
+                "every_option_set() leaves {long} at its default"
+            );
+        }
+    }
+
+    #[test]
+    fn each_option_alone_round_trips() {
+        // One option at a time, taken from the parser itself, so that two
+        // options swapped in app_args cannot hide behind each other.
+        use clap::CommandFactory;
+        let sample = |long: &str| match long {
+            "scene" => "spherelist",
+            "size" => "33x17",
+            "frames" => "7",
+            "out" => "a.png",
+            "set" => "max_depth=3",
+            "workgroup" => "8x4",
+            "dump-shaders" => "dump",
+            other => panic!("--{other} needs a sample value in this test"),
+        };
+        for option in RenderArgs::command().get_arguments() {
+            let Some(long) = option.get_long() else {
+                continue;
+            };
+            // app_args always adds --headless, so every run has it.
+            let mut argv = vec!["twinray-vk".to_string(), "--headless".into()];
+            if long != "headless" {
+                argv.push(format!("--{long}"));
+            }
+            if option.get_action().takes_values() {
+                let values = option.get_possible_values();
+                // The last possible value: never the first, which is each enum's default.
+                argv.push(match values.last() {
+                    Some(v) => v.get_name().to_string(),
+                    None => sample(long).to_string(),
+                });
+            }
+            let args = VulkanCli::try_parse_from(&argv)
+                .unwrap_or_else(|e| panic!("{argv:?} does not parse: {e}"))
+                .render;
+            assert_eq!(
+                round_trip(&args),
+                args,
+                "--{long} does not survive app_args"
+            );
+        }
+    }
 }

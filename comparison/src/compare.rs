@@ -11,6 +11,7 @@ use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::Arc;
 use twinray_common::cli::{parse_workgroup, RenderArgs, RenderPath, Size, Workgroup};
 use twinray_common::scene::accel::Accel;
+use twinray_common::value_name::ValueName;
 
 #[derive(clap::Args, Debug, Clone)]
 pub struct CompareArgs {

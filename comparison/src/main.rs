@@ -15,7 +15,7 @@ mod shaders;
 mod study;
 
 use clap::{Parser, Subcommand};
-use twinray_common::cli::RenderArgs;
+use twinray_common::cli::{named_in_env, RenderArgs};
 use twinray_common::error::exit_with;
 
 #[derive(Parser)]
@@ -26,6 +26,15 @@ use twinray_common::error::exit_with;
 struct Cli {
     #[command(subcommand)]
     command: Command,
+    /// The folder holding twinray-vk and twinray-gl [default: this executable's folder].
+    #[arg(
+        long,
+        global = true,
+        env = "TWINRAY_BIN_DIR",
+        value_name = "DIR",
+        value_parser = named_in_env(apps::parse_bin_dir)
+    )]
+    bin_dir: Option<std::path::PathBuf>,
 }
 
 #[derive(Subcommand)]
@@ -64,6 +73,7 @@ fn main() {
             std::process::exit(code);
         }
     };
+    apps::set_bin_dir(cli.bin_dir);
     let result = match cli.command {
         Command::Render { api, args } => apps::render(api, &args),
         Command::Diff {

@@ -14,6 +14,7 @@ use std::sync::atomic::{AtomicBool, Ordering};
 use twinray_common::cli::{RenderArgs, RenderPath, Size};
 use twinray_common::report::ShaderStats;
 use twinray_common::scene::accel::Accel;
+use twinray_common::value_name::ValueName;
 
 pub struct ShaderRow {
     pub scene: &'static str,

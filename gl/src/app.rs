@@ -4,7 +4,7 @@
 
 use crate::buffers::SceneBuffers;
 use crate::compute::Compute;
-use crate::context::Gl;
+use crate::context::{self, Gl};
 use crate::debug::DebugLog;
 use crate::program::{self, EmptyVertexArray, Program};
 use crate::target::{self, Target};
@@ -12,18 +12,18 @@ use crate::timer::Timer;
 use anyhow::anyhow;
 use glow::HasContext;
 use std::time::Instant;
-use twinray_common::cli::{Experiment, RenderArgs, RenderPath};
+use twinray_common::cli::{Experiment, OpenGlKnobs, RenderArgs, RenderPath};
 use twinray_common::error::bad_input;
 use twinray_common::explain;
 use twinray_common::gpu::upload::{check_storage_limit, GpuScene};
 use twinray_common::reference::image_io::FloatImage;
-use twinray_common::report::{dump_shaders, dump_statistics, DeviceInfo, FrameTime, RunReport};
+use twinray_common::report::{dump_shaders, dump_statistics, FrameTime, RunReport};
 use twinray_common::shader::build::{build, build_compute};
 use twinray_common::shader::variant::Variant;
 
 /// `started` is taken first thing in main, so `setup_ms` includes process,
 /// driver and shader start-up, as in the Vulkan app.
-pub fn run(args: RenderArgs, started: Instant) -> anyhow::Result<()> {
+pub fn run(args: RenderArgs, knobs: &OpenGlKnobs, started: Instant) -> anyhow::Result<()> {
     if args.explain {
         explain::enable("twinray-gl", "OpenGL");
     }
@@ -46,17 +46,10 @@ pub fn run(args: RenderArgs, started: Instant) -> anyhow::Result<()> {
     let (width, height) = (args.size.width, args.size.height);
     let gpu_scene = GpuScene::new(&scene, width, height);
 
-    let mut ctx = Gl::headless(args.validate)?;
+    let mut ctx = Gl::headless(args.validate, knobs)?;
     let log = DebugLog::install(&mut ctx.gl);
     let gl = &ctx.gl;
-    // SAFETY: plain string queries on the current context.
-    let (renderer, vendor, version) = unsafe {
-        (
-            gl.get_parameter_string(glow::RENDERER),
-            gl.get_parameter_string(glow::VENDOR),
-            gl.get_parameter_string(glow::VERSION),
-        )
-    };
+    let info = context::device_info(gl);
     target::check_size(gl, width, height)?;
     // SAFETY: plain query; 64-bit because the limit may exceed 2 GiB.
     let max_ssbo = unsafe { gl.get_parameter_i64(glow::MAX_SHADER_STORAGE_BLOCK_SIZE) };
@@ -96,7 +89,7 @@ pub fn run(args: RenderArgs, started: Instant) -> anyhow::Result<()> {
             let _buffers = SceneBuffers::new(gl, &gpu_scene)?;
             let target = Target::new(gl, width, height)?;
             let vao = EmptyVertexArray::new(gl)?;
-            let timer = Timer::new(gl, &renderer)?;
+            let timer = Timer::new(gl, &info.device)?;
             program.bind(&vao);
             log.check(gl, "after setup");
             // SAFETY: program, VAO, buffers and FBO are bound and alive.
@@ -122,7 +115,7 @@ pub fn run(args: RenderArgs, started: Instant) -> anyhow::Result<()> {
                 )?);
             }
             let _buffers = SceneBuffers::new(gl, &gpu_scene)?;
-            let timer = Timer::new(gl, &renderer)?;
+            let timer = Timer::new(gl, &info.device)?;
             log.check(gl, "after setup");
             let dispatch = || {
                 compute.barrier_between_frames();
@@ -153,33 +146,19 @@ pub fn run(args: RenderArgs, started: Instant) -> anyhow::Result<()> {
     }
     let errors = log.errors();
     if args.json {
-        let info = DeviceInfo {
-            device: renderer,
-            driver: format!("{vendor} {version}"),
-            api_version: format!("OpenGL {version}"),
-        };
         let label = if args.gl_spirv {
             format!("{} (SPIR-V)", variant.label())
         } else {
             variant.label()
         };
-        let report = RunReport {
-            path: args.path,
-            workgroup: (args.path == RenderPath::Compute).then(|| workgroup.to_string()),
-            nonfinite_pixels: image.nonfinite_pixels(),
-            validation_messages: errors,
-            shader_stats,
-            ..RunReport::new(
-                "opengl",
-                info,
-                scene.stats(),
-                label,
-                width,
-                height,
-                frames,
-                setup_ms,
-            )
-        };
+        let report = RunReport::builder("opengl", info, scene.stats(), label)
+            .size(width, height)
+            .path(args.path, workgroup)
+            .frames(frames, setup_ms)
+            .nonfinite_pixels(image.nonfinite_pixels())
+            .validation_messages(errors)
+            .shader_stats(shader_stats)
+            .build();
         report.print_json()?;
     }
     if args.validate && errors > 0 {
@@ -193,12 +172,7 @@ pub fn run(args: RenderArgs, started: Instant) -> anyhow::Result<()> {
 fn run_windowed(args: &RenderArgs, started: Instant) -> anyhow::Result<()> {
     let (run, info, errors) = crate::window::run(args, started)?;
     if args.json {
-        let device = DeviceInfo {
-            device: info.renderer,
-            driver: format!("{} {}", info.vendor, info.version),
-            api_version: format!("OpenGL {}", info.version),
-        };
-        run.report("opengl", device, errors).print_json()?;
+        run.report("opengl", info, errors).print_json()?;
     }
     if args.validate && errors > 0 {
         return Err(anyhow!("{errors} GL debug errors (see above)"));

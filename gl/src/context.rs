@@ -2,12 +2,15 @@
 //! context, and the glow function table loaded from it. Owns device choice.
 
 use anyhow::Context as _;
+use glow::HasContext;
 use glutin::api::egl::{context::PossiblyCurrentContext, device::Device, display::Display};
 use glutin::config::{Api, ConfigSurfaceTypes, ConfigTemplateBuilder};
 use glutin::context::{ContextApi, ContextAttributesBuilder, GlProfile, Version};
 use glutin::prelude::*;
+use twinray_common::cli::OpenGlKnobs;
 use twinray_common::error::{bad_input, no_device};
 use twinray_common::explain;
+use twinray_common::report::DeviceInfo;
 
 const NO_DEVICE: &str =
     "no EGL device found: install libegl1 and libegl-mesa0 + libgl1-mesa-dri (or a GPU driver)";
@@ -29,9 +32,9 @@ impl Gl {
         self._display.get_proc_address(name)
     }
 
-    /// Creates the context on the preferred device; `debug` asks for a debug
-    /// context so that KHR_debug reports everything the driver checks.
-    pub fn headless(debug: bool) -> anyhow::Result<Gl> {
+    /// Creates the context on the preferred device (or `knobs`'s); `debug` asks
+    /// for a debug context so that KHR_debug reports everything the driver checks.
+    pub fn headless(debug: bool, knobs: &OpenGlKnobs) -> anyhow::Result<Gl> {
         // No libEGL, or one without the device extensions, is a missing driver
         // for the user, not a bug: glutin's error alone would not say what to install.
         let devices: Vec<Device> = Device::query_devices()
@@ -53,10 +56,10 @@ impl Gl {
                     format!("{i}: {}{soft}\n", d.name().unwrap_or("unnamed"))
                 })
                 .collect::<String>()
-                + "hardware devices are tried first; TWINRAY_GL_DEVICE overrides"
+                + "hardware devices are tried first; --gl-device (TWINRAY_GL_DEVICE) overrides"
         });
         let mut failures = Vec::new();
-        for (index, device) in candidates(&devices)? {
+        for (index, device) in candidates(&devices, knobs.device)? {
             match create(index, device, debug) {
                 Ok(gl) => {
                     // A run that fell back to another device must say so: its
@@ -78,16 +81,16 @@ impl Gl {
 
 /// Devices to try in order. Hardware first: the software rasteriser would
 /// silently turn a GPU benchmark into a CPU one.
-fn candidates(devices: &[Device]) -> anyhow::Result<Vec<(usize, &Device)>> {
-    if let Ok(v) = std::env::var("TWINRAY_GL_DEVICE") {
-        let i: usize = v.trim().parse().ok().filter(|&i| i < devices.len()).ok_or_else(|| {
+fn candidates(devices: &[Device], wanted: Option<usize>) -> anyhow::Result<Vec<(usize, &Device)>> {
+    if let Some(i) = wanted {
+        let device = devices.get(i).ok_or_else(|| {
             bad_input(format!(
-                "TWINRAY_GL_DEVICE='{v}' is not a device index; this machine has {} EGL device(s), 0..{}",
+                "--gl-device (TWINRAY_GL_DEVICE) {i} is not a device index; this machine has {} EGL device(s), 0..{}",
                 devices.len(),
                 devices.len() - 1
             ))
         })?;
-        return Ok(vec![(i, &devices[i])]);
+        return Ok(vec![(i, device)]);
     }
     let (soft, hard): (Vec<_>, Vec<_>) = devices
         .iter()
@@ -140,4 +143,22 @@ fn create(index: usize, device: &Device, debug: bool) -> anyhow::Result<Gl> {
         _context: context,
         _display: display,
     })
+}
+
+/// What the `--json` report says about the context's device: the renderer,
+/// the vendor and version strings, as the driver gives them.
+pub fn device_info(gl: &glow::Context) -> DeviceInfo {
+    // SAFETY: plain string queries on the current context.
+    let (renderer, vendor, version) = unsafe {
+        (
+            gl.get_parameter_string(glow::RENDERER),
+            gl.get_parameter_string(glow::VENDOR),
+            gl.get_parameter_string(glow::VERSION),
+        )
+    };
+    DeviceInfo {
+        device: renderer,
+        driver: format!("{vendor} {version}"),
+        api_version: format!("OpenGL {version}"),
+    }
 }

@@ -2,15 +2,15 @@
 //! contract's exit codes; everything else is in the library.
 
 use std::time::Instant;
-use twinray_common::cli::RenderArgs;
+use twinray_common::cli::{parse_or_exit, OpenGlCli};
 use twinray_common::error::exit_with;
 use twinray_gl::run;
 
 fn main() {
     // First thing: setup_ms counts from here.
     let started = Instant::now();
-    let args = RenderArgs::parse_or_exit();
-    if let Err(e) = run(args, started) {
+    let cli: OpenGlCli = parse_or_exit();
+    if let Err(e) = run(cli.render, &cli.knobs, started) {
         exit_with("twinray-gl", e)
     }
 }

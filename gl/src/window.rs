@@ -46,6 +46,7 @@ use twinray_common::explain;
 use twinray_common::gpu::layout::GpuFrame;
 use twinray_common::gpu::upload::GpuScene;
 use twinray_common::reference::image_io::FloatImage;
+use twinray_common::report::DeviceInfo;
 use twinray_common::shader::variant::Variant;
 use twinray_common::window::{self, Drawn, PathShaders, Renderer, WindowedRun};
 use winit::window::Window;
@@ -53,13 +54,6 @@ use winit::window::Window;
 /// Timer queries in a ring, so that reading one never waits for the GPU: a
 /// result is read only once the driver says it is available.
 const TIMERS: usize = 3;
-
-/// What the JSON report says about the device.
-pub struct DeviceInfo {
-    pub renderer: String,
-    pub vendor: String,
-    pub version: String,
-}
 
 /// Opens the window and runs until it is closed. Returns the run, the device
 /// description and the number of GL errors seen.
@@ -153,16 +147,9 @@ pub fn run(args: &RenderArgs, started: Instant) -> Result<(WindowedRun, DeviceIn
     // SAFETY: the context is current on this thread, which glow requires.
     let mut gl =
         unsafe { glow::Context::from_loader_function_cstr(|s| display.get_proc_address(s)) };
-    // SAFETY: plain string queries on the current context.
-    let info = unsafe {
-        DeviceInfo {
-            renderer: gl.get_parameter_string(glow::RENDERER),
-            vendor: gl.get_parameter_string(glow::VENDOR),
-            version: gl.get_parameter_string(glow::VERSION),
-        }
-    };
+    let info = crate::context::device_info(&gl);
     explain::step("glow function table loaded (eglGetProcAddress)", || {
-        format!("{} / {} / {}", info.renderer, info.vendor, info.version)
+        format!("{} / {}", info.device, info.driver)
     });
     let log = DebugLog::install(&mut gl);
     let gl = &gl;
@@ -175,7 +162,7 @@ pub fn run(args: &RenderArgs, started: Instant) -> Result<(WindowedRun, DeviceIn
     let buffers = SceneBuffers::new(gl, &gpu)?;
     let vao = EmptyVertexArray::new(gl)?;
     let timers = (0..TIMERS)
-        .map(|_| Timer::new(gl, &info.renderer))
+        .map(|_| Timer::new(gl, &info.device))
         .collect::<Result<Vec<_>>>()?;
     // SAFETY: plain state on the current context: no sRGB encoding on store (see above).
     unsafe {

@@ -4,6 +4,7 @@
 //! size, and image sizes that are not a multiple of the workgroup, included.
 
 use twinray_common::reference::metrics::compare;
+use twinray_common::value_name::ValueName;
 use twinray_tests::{render, scratch, App};
 
 fn check(scene: &str, size: &str, extra: &[&str]) {

@@ -18,6 +18,7 @@ use twinray_common::scene::{Features, Scene};
 use twinray_common::shader::build::{self, build_compute, compute_source, fragment_source};
 use twinray_common::shader::post::spirv_for_opengl;
 use twinray_common::shader::variant::Variant;
+use twinray_common::value_name::ValueName;
 use twinray_tests::scratch;
 
 /// One validator run: the program, its arguments, the file it checks.

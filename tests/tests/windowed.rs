@@ -17,6 +17,7 @@ use std::process::Output;
 use twinray_common::cli::RenderPath;
 use twinray_common::reference::metrics::compare;
 use twinray_common::report::RunReport;
+use twinray_common::value_name::ValueName;
 use twinray_tests::{render, scratch, App, Xvfb};
 
 fn stderr(o: &Output) -> String {
@@ -414,7 +415,7 @@ fn load(path: &Path) -> image::RgbImage {
 /// The headless image of `scene` at 64x48 on `path`.
 fn headless(app: App, scene: &str, path: RenderPath, dir: &Path) -> image::RgbImage {
     let out = dir.join(format!("headless-{}-{scene}-{path}.png", tag(app)));
-    render(app, scene, "64x48", &["--path", path.name()], &out).1
+    render(app, scene, "64x48", &["--path", &path.name()], &out).1
 }
 
 #[test]

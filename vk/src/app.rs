@@ -19,17 +19,17 @@ use crate::window;
 use anyhow::{bail, Result};
 use std::sync::atomic::Ordering;
 use std::time::Instant;
-use twinray_common::cli::{RenderArgs, RenderPath, Workgroup};
+use twinray_common::cli::{FrameWait, RenderArgs, RenderPath, SceneMemory, VulkanKnobs, Workgroup};
 use twinray_common::error::bad_input;
 use twinray_common::explain;
 use twinray_common::gpu::upload::GpuScene;
 use twinray_common::reference::image_io::FloatImage;
-use twinray_common::report::{dump_shaders, dump_statistics, DeviceInfo, FrameTime, RunReport};
+use twinray_common::report::{dump_shaders, dump_statistics, FrameTime, RunReport};
 use twinray_common::scene::Scene;
 use twinray_common::shader::build::{build, build_compute, ComputeShader, Shaders};
 use twinray_common::shader::variant::Variant;
 
-pub fn run(args: RenderArgs, process_start: Instant) -> Result<()> {
+pub fn run(args: RenderArgs, knobs: &VulkanKnobs, process_start: Instant) -> Result<()> {
     if args.explain {
         explain::enable("twinray-vk", "Vulkan");
     }
@@ -39,11 +39,11 @@ pub fn run(args: RenderArgs, process_start: Instant) -> Result<()> {
         ));
     }
     if !args.headless {
-        return run_windowed(&args, process_start);
+        return run_windowed(&args, knobs, process_start);
     }
     let scene = args.load_scene()?;
     let variant = Variant::chosen(&scene, &args);
-    let (mut report, image) = render(&args, &scene, &variant, process_start)?;
+    let (mut report, image) = render(&args, knobs, &scene, &variant, process_start)?;
 
     // Counted only now that every Vulkan object is gone, so teardown mistakes count too.
     report.validation_messages = VALIDATION_MESSAGES.load(Ordering::SeqCst);
@@ -64,16 +64,11 @@ pub fn run(args: RenderArgs, process_start: Instant) -> Result<()> {
 
 /// The window: `window::run` owns the loop; the report is the same shape as
 /// headless (wall time = frame to frame; no NaN count, nothing is read back).
-fn run_windowed(args: &RenderArgs, process_start: Instant) -> Result<()> {
-    let (run, device) = window::run(args, process_start)?;
+fn run_windowed(args: &RenderArgs, knobs: &VulkanKnobs, process_start: Instant) -> Result<()> {
+    let (run, info) = window::run(args, knobs, process_start)?;
     // Every Vulkan object is gone by now, so teardown mistakes count too.
     let messages = VALIDATION_MESSAGES.load(Ordering::SeqCst);
     if args.json {
-        let info = DeviceInfo {
-            device: device.name,
-            driver: device.driver,
-            api_version: device.api_version,
-        };
         run.report("vulkan", info, messages).print_json()?;
     }
     if args.validate && messages > 0 {
@@ -86,6 +81,7 @@ fn run_windowed(args: &RenderArgs, process_start: Instant) -> Result<()> {
 /// line. Returns the report (without the validation count) and the last frame.
 fn render(
     args: &RenderArgs,
+    knobs: &VulkanKnobs,
     scene: &Scene,
     variant: &Variant,
     process_start: Instant,
@@ -94,11 +90,13 @@ fn render(
     let workgroup = args.compute_workgroup()?;
     let shaders = build_shaders(args, variant)?;
     let gpu_scene = GpuScene::new(scene, width, height);
-    let instance = Instance::new(args.validate, &[])?;
-    let device = Device::new(&instance, None)?;
+    let instance = Instance::new(args.validate, knobs.validation, &[])?;
+    let device = Device::new(&instance, None, knobs)?;
     device.check_size(width, height)?;
-    let idle_wait = idle_wait()?;
-    let host_memory = crate::scene::host_memory()?;
+    // --vk-wait idle waits for each frame with vkQueueWaitIdle +
+    // vkDeviceWaitIdle, as the 2018 study did, instead of the frame's fence.
+    let idle_wait = knobs.wait == FrameWait::Idle;
+    let host_memory = device.scene_memory == SceneMemory::Host;
     let timestamps = Timestamps::new(&device)?;
     let frame_loop = FrameLoop {
         timestamps: timestamps.as_ref(),
@@ -154,18 +152,6 @@ fn build_shaders(args: &RenderArgs, variant: &Variant) -> Result<Shaders> {
         || format!("variant {}", variant.label()),
     );
     Ok(shaders)
-}
-
-/// TWINRAY_VK_WAIT=idle waits for each frame with vkQueueWaitIdle +
-/// vkDeviceWaitIdle, as the 2018 study did, instead of the frame's fence.
-fn idle_wait() -> Result<bool> {
-    match std::env::var("TWINRAY_VK_WAIT").as_deref() {
-        Ok("idle") => Ok(true),
-        Ok("fence") | Err(_) => Ok(false),
-        Ok(other) => Err(bad_input(format!(
-            "TWINRAY_VK_WAIT='{other}' is not 'fence' or 'idle'"
-        ))),
-    }
 }
 
 /// The fragment path: render pass, scene buffers, descriptor set and pipeline,
@@ -235,31 +221,17 @@ fn report(
     workgroup: Workgroup,
     (frames, setup_ms, image): Rendered,
 ) -> Result<(RunReport, FloatImage)> {
-    let info = DeviceInfo {
-        device: device.name.clone(),
-        driver: device.driver.clone(),
-        api_version: device.api_version(),
-    };
     let shader_stats = crate::statistics::captured();
     if let Some(dir) = &args.dump_shaders {
         dump_statistics(dir, &shader_stats)?;
     }
-    let report = RunReport {
-        shader_stats,
-        path: args.path,
-        workgroup: (args.path == RenderPath::Compute).then(|| workgroup.to_string()),
-        nonfinite_pixels: image.nonfinite_pixels(),
-        ..RunReport::new(
-            "vulkan",
-            info,
-            scene.stats(),
-            variant_label,
-            args.size.width,
-            args.size.height,
-            frames,
-            setup_ms,
-        )
-    };
+    let report = RunReport::builder("vulkan", device.info(), scene.stats(), variant_label)
+        .size(args.size.width, args.size.height)
+        .path(args.path, workgroup)
+        .frames(frames, setup_ms)
+        .nonfinite_pixels(image.nonfinite_pixels())
+        .shader_stats(shader_stats)
+        .build();
     Ok((report, image))
 }
 

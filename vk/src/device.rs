@@ -12,8 +12,10 @@ use crate::instance::Instance;
 use crate::surface::Surface;
 use anyhow::{Context, Result};
 use ash::{khr, vk};
+use twinray_common::cli::{SceneMemory, VulkanKnobs};
 use twinray_common::error::{bad_input, no_device};
 use twinray_common::explain;
+use twinray_common::report::DeviceInfo;
 
 pub struct Device {
     pub physical: vk::PhysicalDevice,
@@ -30,6 +32,8 @@ pub struct Device {
     /// VK_KHR_pipeline_executable_properties, where offered: `--dump-shaders`
     /// reads what the driver compiled (statistics.rs).
     pub executable_properties: Option<khr::pipeline_executable_properties::Device>,
+    /// Where the scene's buffers go on this device (`--vk-memory`).
+    pub scene_memory: SceneMemory,
 }
 
 /// One physical device as the chooser sees it.
@@ -44,8 +48,13 @@ struct Candidate {
 
 impl Device {
     /// `surface` is the window's, in windowed mode: the queue must also present
-    /// to it, and the device must offer VK_KHR_swapchain.
-    pub fn new(instance: &Instance, surface: Option<&Surface>) -> Result<Device> {
+    /// to it, and the device must offer VK_KHR_swapchain. `knobs` may name the
+    /// device and say where scene buffers go.
+    pub fn new(
+        instance: &Instance,
+        surface: Option<&Surface>,
+        knobs: &VulkanKnobs,
+    ) -> Result<Device> {
         let vk_instance = &instance.instance;
         // SAFETY: `instance` is alive for the whole call (borrowed) and is used from this thread
         // only.
@@ -86,7 +95,7 @@ impl Device {
                 }
             })
             .collect();
-        let chosen = choose(&candidates)?;
+        let chosen = choose(&candidates, knobs.device())?;
         let (queue_family, timestamp_valid_bits, flags) =
             chosen.graphics_family.expect("choose() checks this");
         explain::step("VkPhysicalDevice chosen", || {
@@ -108,8 +117,8 @@ impl Device {
                     c.name, c.properties.device_type
                 );
             }
-            let why = if std::env::var("TWINRAY_VK_DEVICE").is_ok_and(|v| !v.trim().is_empty()) {
-                "TWINRAY_VK_DEVICE picked it"
+            let why = if knobs.device().is_some() {
+                "--vk-device (TWINRAY_VK_DEVICE) picked it"
             } else {
                 "the most capable kind present (discrete > integrated > virtual > CPU)"
             };
@@ -189,7 +198,17 @@ queue family {queue_family}: {flags:?}, timestampValidBits {timestamp_valid_bits
             timestamp_valid_bits,
             device,
             queue,
+            scene_memory: knobs.memory,
         })
+    }
+
+    /// What the `--json` report says about this device.
+    pub fn info(&self) -> DeviceInfo {
+        DeviceInfo {
+            device: self.name.clone(),
+            driver: self.driver.clone(),
+            api_version: self.api_version(),
+        }
     }
 
     /// "Vulkan 1.3.230": the version the device (not the loader) supports.
@@ -296,14 +315,11 @@ fn has_extension(
     exts.iter().any(|e| e.extension_name_as_c_str() == Ok(name))
 }
 
-/// `TWINRAY_VK_DEVICE` (an index or part of a name) wins; otherwise the kind of
+/// `wanted` (`--vk-device`: an index or part of a name) wins; otherwise the kind of
 /// device most likely to be fast: discrete, integrated, virtual, then CPU.
-fn choose(candidates: &[Candidate]) -> Result<&Candidate> {
-    if let Some(wanted) = std::env::var("TWINRAY_VK_DEVICE")
-        .ok()
-        .filter(|v| !v.trim().is_empty())
-    {
-        let needle = wanted.trim().to_lowercase();
+fn choose<'a>(candidates: &'a [Candidate], wanted: Option<&str>) -> Result<&'a Candidate> {
+    if let Some(wanted) = wanted {
+        let needle = wanted.to_lowercase();
         // A number is an index, never part of a name ("1" is in "LLVM 15.0.6").
         let found = match needle.parse::<usize>() {
             Ok(i) => candidates.get(i),
@@ -318,13 +334,13 @@ fn choose(candidates: &[Candidate]) -> Result<&Candidate> {
             .collect();
         let c = found.ok_or_else(|| {
             bad_input(format!(
-                "TWINRAY_VK_DEVICE='{wanted}' matches no Vulkan device; the devices are {}",
+                "--vk-device (TWINRAY_VK_DEVICE) '{wanted}' matches no Vulkan device; the devices are {}",
                 list.join(", ")
             ))
         })?;
         if c.graphics_family.is_none() {
             return Err(bad_input(format!(
-                "TWINRAY_VK_DEVICE='{wanted}' picks '{}', which cannot draw here (no graphics queue, or none that presents to the window)",
+                "--vk-device (TWINRAY_VK_DEVICE) '{wanted}' picks '{}', which cannot draw here (no graphics queue, or none that presents to the window)",
                 c.name
             )));
         }

@@ -33,9 +33,14 @@ pub struct Instance {
 }
 
 impl Instance {
-    /// `validate` is `--validate`: the layer is then required, not optional.
+    /// `validate` is `--validate`: the layer is then required, not optional;
+    /// `best_effort` is `--vk-validation`: on where installed, a note where not.
     /// `window_extensions` are the surface extensions a window needs (none headless).
-    pub fn new(validate: bool, window_extensions: &[*const c_char]) -> Result<Instance> {
+    pub fn new(
+        validate: bool,
+        best_effort: bool,
+        window_extensions: &[*const c_char],
+    ) -> Result<Instance> {
         // SAFETY: dlopens the system's libvulkan.so.1 (its initialisers are the
         // loader's own); the Entry keeps it loaded while any of its function
         // pointers can be called, as the Instance holds the Entry.
@@ -50,8 +55,7 @@ impl Instance {
 
         // The layer checks every call, which costs CPU time on every submit, and a
         // timing run must not pay for it. So it is on only when asked for:
-        // --validate (required) or TWINRAY_VK_VALIDATION=1 (best effort).
-        let from_env = std::env::var("TWINRAY_VK_VALIDATION").is_ok_and(|v| v == "1");
+        // --validate (required) or --vk-validation / TWINRAY_VK_VALIDATION=1 (best effort).
         // SAFETY: a global query through the loader `entry` just opened, which lives in the
         // returned Instance.
         let layers = unsafe { entry.enumerate_instance_layer_properties() }
@@ -64,12 +68,12 @@ impl Instance {
                 "--validate needs VK_LAYER_KHRONOS_validation, which is not installed: install vulkan-validationlayers",
             ));
         }
-        if from_env && !installed {
+        if best_effort && !installed {
             eprintln!(
-                "twinray-vk: TWINRAY_VK_VALIDATION=1 but the validation layer is not installed; running without it"
+                "twinray-vk: --vk-validation (TWINRAY_VK_VALIDATION) is on but the validation layer is not installed; running without it"
             );
         }
-        let validation = installed && (validate || from_env);
+        let validation = installed && (validate || best_effort);
 
         // Vulkan 1.2 is asked for only to read VkPhysicalDeviceDriverProperties (the
         // driver's name for the report). A 1.0 loader rejects any higher version.

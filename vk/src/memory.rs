@@ -118,7 +118,7 @@ impl Buffer {
 
     /// A buffer in host-visible, coherent memory (system RAM on a discrete GPU),
     /// written directly by the CPU: what a naive app does. The GPU then reads the
-    /// scene across the bus on every access; `TWINRAY_VK_MEMORY=host` selects it
+    /// scene across the bus on every access; `--vk-memory host` (TWINRAY_VK_MEMORY=host) selects it
     /// to measure that cost.
     pub fn host_visible_with(
         device: &Device,

@@ -10,6 +10,7 @@ use crate::memory::{Buffer, Uploads};
 use crate::pipeline::Pipeline;
 use anyhow::Result;
 use ash::vk;
+use twinray_common::cli::SceneMemory;
 use twinray_common::gpu::layout::binding;
 use twinray_common::gpu::upload::{check_storage_limit, storage_name, GpuScene};
 use twinray_common::shader::build::Shaders;
@@ -54,10 +55,14 @@ impl SceneResources {
 
 /// The `Frame` uniform buffer and the storage buffers, filled with the scene's
 /// bytes: what both the graphics and the compute pipeline read.
+///
+/// Device-local memory, filled once through a staging buffer, is the careful
+/// choice. `--vk-memory host` keeps the scene in host-visible memory instead,
+/// so the comparison can show what a naive placement costs.
 pub fn scene_buffers(device: &Device, scene: &GpuScene) -> Result<(Buffer, Vec<(u32, Buffer)>)> {
     let limit = device.properties.limits.max_storage_buffer_range as u64;
     check_storage_limit(scene, limit, "maxStorageBufferRange")?;
-    let host = host_memory()?;
+    let host = device.scene_memory == SceneMemory::Host;
     // The uniform block first, then the storage buffers in binding order.
     let frame = (
         scene.frame_bytes(),
@@ -88,17 +93,4 @@ pub fn scene_buffers(device: &Device, scene: &GpuScene) -> Result<(Buffer, Vec<(
     let frame = buffers.next().expect("the uniform buffer comes first");
     let storage = binding::STORAGE.iter().copied().zip(buffers).collect();
     Ok((frame, storage))
-}
-
-/// Device-local memory, filled once through a staging buffer, is the careful
-/// choice. `TWINRAY_VK_MEMORY=host` keeps the scene in host-visible memory
-/// instead, so the comparison can show what a naive placement costs.
-pub fn host_memory() -> Result<bool> {
-    match std::env::var("TWINRAY_VK_MEMORY").as_deref() {
-        Ok("host") => Ok(true),
-        Ok("device") | Err(_) => Ok(false),
-        Ok(other) => Err(twinray_common::error::bad_input(format!(
-            "TWINRAY_VK_MEMORY='{other}' is not 'device' or 'host'"
-        ))),
-    }
 }

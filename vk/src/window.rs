@@ -29,12 +29,13 @@ use crate::target::Target;
 use anyhow::{Context, Result};
 use ash::{khr, vk};
 use std::time::Instant;
-use twinray_common::cli::RenderArgs;
+use twinray_common::cli::{RenderArgs, VulkanKnobs};
 use twinray_common::error::no_device;
 use twinray_common::explain;
 use twinray_common::gpu::layout::GpuFrame;
 use twinray_common::gpu::upload::GpuScene;
 use twinray_common::reference::image_io::FloatImage;
+use twinray_common::report::DeviceInfo;
 use twinray_common::shader::build::Shaders;
 use twinray_common::shader::variant::Variant;
 use twinray_common::window::{self, Drawn, PathShaders, Renderer, WindowedRun};
@@ -71,7 +72,11 @@ pub struct VkWindow {
 }
 
 /// Opens the window and runs until it is closed; returns what `--json` reports.
-pub fn run(args: &RenderArgs, started: Instant) -> Result<(WindowedRun, DeviceInfo)> {
+pub fn run(
+    args: &RenderArgs,
+    knobs: &VulkanKnobs,
+    started: Instant,
+) -> Result<(WindowedRun, DeviceInfo)> {
     let scene = args.load_scene()?;
     let variant = Variant::chosen(&scene, args);
     let shaders = window::first_shaders(args, &scene)?;
@@ -92,9 +97,13 @@ pub fn run(args: &RenderArgs, started: Instant) -> Result<(WindowedRun, DeviceIn
         let s = window.inner_size();
         format!("{}x{} physical pixels", s.width, s.height)
     });
-    let instance = Instance::new(args.validate, surface::required_extensions(&window)?)?;
+    let instance = Instance::new(
+        args.validate,
+        knobs.validation,
+        surface::required_extensions(&window)?,
+    )?;
     let surface = Surface::new(&instance, &window)?;
-    let device = Device::new(&instance, Some(&surface))?;
+    let device = Device::new(&instance, Some(&surface), knobs)?;
     let loader = khr::swapchain::Device::new(&instance.instance, &device.device);
     let format = swapchain::choose_format(&device, &surface)?;
     let present_mode = swapchain::choose_present_mode(&device, &surface, args.vsync)?;
@@ -135,11 +144,7 @@ pub fn run(args: &RenderArgs, started: Instant) -> Result<(WindowedRun, DeviceIn
         compute_blocker.as_deref(),
     )?;
     let frames = Frames::new(&device)?;
-    let info = DeviceInfo {
-        name: device.name.clone(),
-        driver: device.driver.clone(),
-        api_version: device.api_version(),
-    };
+    let info = device.info();
     let renderer = VkWindow {
         frames,
         swapchain: chain,
@@ -196,13 +201,6 @@ fn path_resources(
             PathResources::Compute(WindowCompute::new(device, scene, s, format, extent)?)
         }
     })
-}
-
-/// What the JSON report says about the device, kept after the device is gone.
-pub struct DeviceInfo {
-    pub name: String,
-    pub driver: String,
-    pub api_version: String,
 }
 
 impl VkWindow {

@@ -16,16 +16,6 @@ pub enum Accel {
     Bvh,
 }
 
-impl Accel {
-    pub fn name(self) -> &'static str {
-        match self {
-            Accel::Auto => "auto",
-            Accel::None => "none",
-            Accel::Bvh => "bvh",
-        }
-    }
-}
-
 /// `--accel auto` builds a BVH for scenes with at least this many primitives.
 /// Below it the brute-force loop is as fast or faster: see the comparison
 /// report's acceleration section for the measurements behind the number.

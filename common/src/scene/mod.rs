@@ -24,6 +24,7 @@ pub mod teapot;
 
 use crate::error::bad_input;
 use crate::gpu::layout::Bvh;
+use crate::value_name::ValueName;
 use glam::DVec3;
 use numerics::Numerics;
 
@@ -137,7 +138,8 @@ pub struct SceneStats {
 }
 
 /// Where the GPU's coordinates are measured from (`--set origin=`, `[render] origin`).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default, serde::Serialize)]
+// ValueEnum for its name only (`ValueName`): `--set` and scene files parse it.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default, serde::Serialize, clap::ValueEnum)]
 pub enum OriginMode {
     /// The camera's look-at point, snapped to a power-of-two grid (`local_origin`).
     #[default]
@@ -149,13 +151,6 @@ pub enum OriginMode {
 
 impl OriginMode {
     pub const ALL: [OriginMode; 2] = [OriginMode::Local, OriginMode::World];
-
-    pub fn name(self) -> &'static str {
-        match self {
-            OriginMode::Local => "local",
-            OriginMode::World => "world",
-        }
-    }
 
     /// Parses `local` or `world`; `what` names the source in the error.
     pub fn parse(value: &str, what: &str) -> anyhow::Result<OriginMode> {

@@ -7,12 +7,14 @@
 //! apps take the same keys through `--set` (e.g. `--set triangle=watertight`).
 
 use crate::error::bad_input;
+use crate::value_name::ValueName;
 use serde::Serialize;
 
 /// Where a secondary ray (shadow, mirror, refraction) starts, given the hit
 /// point `p`, the geometric normal `n` on the side the ray leaves from, and the
 /// new direction `d`.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize)]
+// ValueEnum for its names only (`ValueName`): `--set` and scene files parse them with aliases.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, clap::ValueEnum)]
 pub enum Offset {
     /// `p + epsilon * d`: a fixed distance along the new ray.
     Ray,
@@ -37,7 +39,7 @@ pub enum Offset {
 }
 
 /// The ray-triangle test.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, clap::ValueEnum)]
 pub enum TriangleTest {
     /// Möller & Trumbore 1997: fast, but a ray through a shared edge can miss both triangles.
     MollerTrumbore,
@@ -47,7 +49,7 @@ pub enum TriangleTest {
 }
 
 /// The ray-sphere test.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, clap::ValueEnum)]
 pub enum SphereTest {
     /// `t = (-b ± sqrt(b² - 4ac)) / 2a`: cancels badly for far or small spheres.
     Quadratic,
@@ -87,15 +89,6 @@ impl Offset {
         Offset::Ulp,
         Offset::ScaleAware,
     ];
-    pub fn name(self) -> &'static str {
-        match self {
-            Offset::Ray => "ray",
-            Offset::Normal => "normal",
-            Offset::NormalScaled => "normal-scaled",
-            Offset::Ulp => "ulp",
-            Offset::ScaleAware => "scale-aware",
-        }
-    }
     fn define(self) -> &'static str {
         match self {
             Offset::Ray => "OFFSET_RAY",
@@ -109,12 +102,6 @@ impl Offset {
 
 impl TriangleTest {
     pub const ALL: [TriangleTest; 2] = [TriangleTest::MollerTrumbore, TriangleTest::Watertight];
-    pub fn name(self) -> &'static str {
-        match self {
-            TriangleTest::MollerTrumbore => "moller-trumbore",
-            TriangleTest::Watertight => "watertight",
-        }
-    }
     fn define(self) -> &'static str {
         match self {
             TriangleTest::MollerTrumbore => "TRIANGLE_MOLLER_TRUMBORE",
@@ -125,12 +112,6 @@ impl TriangleTest {
 
 impl SphereTest {
     pub const ALL: [SphereTest; 2] = [SphereTest::Quadratic, SphereTest::Stable];
-    pub fn name(self) -> &'static str {
-        match self {
-            SphereTest::Quadratic => "quadratic",
-            SphereTest::Stable => "stable",
-        }
-    }
     fn define(self) -> &'static str {
         match self {
             SphereTest::Quadratic => "SPHERE_QUADRATIC",
@@ -140,12 +121,7 @@ impl SphereTest {
 }
 
 /// Parses one of `names` (case-insensitive; `_` and `-` alike) or says which are allowed.
-fn pick<T: Copy>(
-    key: &str,
-    value: &str,
-    all: &[T],
-    name: impl Fn(T) -> &'static str,
-) -> anyhow::Result<T> {
+fn pick<T: Copy + ValueName>(key: &str, value: &str, all: &[T]) -> anyhow::Result<T> {
     let v = value.trim().to_ascii_lowercase().replace('_', "-");
     let v = match v.as_str() {
         "mt" | "moller" | "möller-trumbore" => "moller-trumbore".to_string(),
@@ -153,8 +129,8 @@ fn pick<T: Copy>(
         "wachter-binder" => "ulp".into(),
         _ => v,
     };
-    all.iter().copied().find(|t| name(*t) == v).ok_or_else(|| {
-        let names: Vec<&str> = all.iter().map(|t| name(*t)).collect();
+    all.iter().copied().find(|t| t.name() == v).ok_or_else(|| {
+        let names: Vec<String> = all.iter().map(ValueName::name).collect();
         bad_input(format!(
             "{key}: '{value}' is not one of {}",
             names.join(", ")
@@ -170,11 +146,9 @@ impl Numerics {
     /// `what` names the source in the error (e.g. `--set offset`).
     pub fn set(&mut self, key: &str, value: &str, what: &str) -> anyhow::Result<bool> {
         match key {
-            "offset" => self.offset = pick(what, value, &Offset::ALL, Offset::name)?,
-            "triangle" => {
-                self.triangle = pick(what, value, &TriangleTest::ALL, TriangleTest::name)?
-            }
-            "sphere" => self.sphere = pick(what, value, &SphereTest::ALL, SphereTest::name)?,
+            "offset" => self.offset = pick(what, value, &Offset::ALL)?,
+            "triangle" => self.triangle = pick(what, value, &TriangleTest::ALL)?,
+            "sphere" => self.sphere = pick(what, value, &SphereTest::ALL)?,
             _ => return Ok(false),
         }
         Ok(true)

@@ -9,6 +9,7 @@ use crate::cli::{Experiment, RenderArgs};
 use crate::limits::MAX_DEPTH;
 use crate::scene::numerics::Numerics;
 use crate::scene::{Features, Scene};
+use crate::value_name::ValueName;
 use std::collections::BTreeMap;
 
 /// The defines that select a shader variant. Same map → same module → same code

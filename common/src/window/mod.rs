@@ -128,20 +128,11 @@ impl WindowedRun {
     /// The `--json` report of a window: the headless shape, with wall time
     /// frame to frame and no NaN count (nothing is read back).
     pub fn report(self, api: &str, device: DeviceInfo, validation_messages: u64) -> RunReport {
-        RunReport {
-            validation_messages,
-            path: self.path,
-            workgroup: (self.path == RenderPath::Compute).then(|| self.workgroup.to_string()),
-            ..RunReport::new(
-                api,
-                device,
-                self.scene.stats(),
-                self.variant.label(),
-                self.width,
-                self.height,
-                self.frames,
-                self.setup_ms,
-            )
-        }
+        RunReport::builder(api, device, self.scene.stats(), self.variant.label())
+            .size(self.width, self.height)
+            .path(self.path, self.workgroup)
+            .frames(self.frames, self.setup_ms)
+            .validation_messages(validation_messages)
+            .build()
     }
 }

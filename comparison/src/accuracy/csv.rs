@@ -11,6 +11,7 @@ use crate::csv_out::{self, Num};
 use crate::runs::api_name;
 use serde::Serialize;
 use twinray_common::scene::random as random_scene;
+use twinray_common::value_name::ValueName;
 
 #[derive(Serialize, Default)]
 struct ConfigLine<'a> {
@@ -19,9 +20,9 @@ struct ConfigLine<'a> {
     height: u32,
     api: &'a str,
     max_depth: u32,
-    offset: &'a str,
-    triangle: &'a str,
-    sphere: &'a str,
+    offset: String,
+    triangle: String,
+    sphere: String,
     /// The sweeps the row belongs to, joined by `+`.
     sweeps: String,
     default: bool,

@@ -12,6 +12,7 @@ use twinray_common::scene::hard::{self, HardCase};
 use twinray_common::scene::numerics::{Numerics, Offset, SphereTest, TriangleTest};
 use twinray_common::scene::OriginMode;
 use twinray_common::scene::Scene;
+use twinray_common::value_name::ValueName;
 
 /// One hard case under one strategy and API.
 #[derive(Debug, Clone)]

@@ -15,6 +15,7 @@ use twinray_common::scene::hard::{HardCase, WRONG_ABOVE};
 use twinray_common::scene::numerics::Numerics;
 use twinray_common::scene::OriginMode;
 use twinray_common::scene::Scene;
+use twinray_common::value_name::ValueName;
 
 fn f3(v: f64) -> String {
     format!("{v:.3}")
