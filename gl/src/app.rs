@@ -23,6 +23,7 @@ use twinray_common::shader::variant::Variant;
 
 /// `started` is taken first thing in main, so `setup_ms` includes process,
 /// driver and shader start-up, as in the Vulkan app.
+// Long function: the OpenGL twin of vk's headless run, one block per step in the same order as vk/src/app.rs, so the two read side by side.
 pub fn run(args: RenderArgs, knobs: &OpenGlKnobs, started: Instant) -> anyhow::Result<()> {
     if args.explain {
         explain::enable("twinray-gl", "OpenGL");

@@ -57,6 +57,7 @@ const TIMERS: usize = 3;
 
 /// Opens the window and runs until it is closed. Returns the run, the device
 /// description and the number of GL errors seen.
+// Long function: the OpenGL twin of vk's windowed run, kept in the same block order as vk/src/window.rs so the two read side by side.
 pub fn run(args: &RenderArgs, started: Instant) -> Result<(WindowedRun, DeviceInfo, u64)> {
     let scene = args.load_scene()?;
     let variant = Variant::chosen(&scene, args);

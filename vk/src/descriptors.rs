@@ -31,6 +31,7 @@ impl Descriptors {
     /// The same buffers for the shader `stage`, plus, for the compute path, the
     /// storage image view at binding 5 (in GENERAL layout, the one layout in
     /// which shaders may write an image).
+    // Long function: one linear walk through the walkthrough's descriptor step (layout, pool, set, writes), in the order a learner reads it.
     pub fn for_stage(
         device: &Device,
         frame: &Buffer,

@@ -50,6 +50,7 @@ impl Device {
     /// `surface` is the window's, in windowed mode: the queue must also present
     /// to it, and the device must offer VK_KHR_swapchain. `knobs` may name the
     /// device and say where scene buffers go.
+    // Long function: the walkthrough's device step read top to bottom (pick a GPU, a queue family, features, extensions, create); each block is one choice.
     pub fn new(
         instance: &Instance,
         surface: Option<&Surface>,

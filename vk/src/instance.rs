@@ -36,6 +36,7 @@ impl Instance {
     /// `validate` is `--validate`: the layer is then required, not optional;
     /// `best_effort` is `--vk-validation`: on where installed, a note where not.
     /// `window_extensions` are the surface extensions a window needs (none headless).
+    // Long function: the walkthrough's first step in order (layers, extensions, application info, create, debug messenger), one block each.
     pub fn new(
         validate: bool,
         best_effort: bool,

@@ -141,6 +141,7 @@ pub struct Swapchain {
 
 impl Swapchain {
     /// `None` when the window has no area (minimized): there is nothing to show.
+    // Long function: the walkthrough's swapchain step in order (surface formats, present mode, extent, images, views), one block each.
     #[allow(clippy::too_many_arguments)]
     pub fn new(
         device: &Device,
