@@ -141,7 +141,7 @@ pub struct Swapchain {
 
 impl Swapchain {
     /// `None` when the window has no area (minimized): there is nothing to show.
-    // Long function: the walkthrough's swapchain step in order (surface formats, present mode, extent, images, views), one block each.
+    // Long function: the walkthrough's swapchain step in order (the extent, the swapchain, its images and their views), one block each.
     #[allow(clippy::too_many_arguments)]
     pub fn new(
         device: &Device,
