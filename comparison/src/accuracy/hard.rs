@@ -70,7 +70,7 @@ pub struct HardStrategy {
 }
 
 impl HardStrategy {
-    /// `--set` overrides whatever the scene file's [render] section chose.
+    /// `--set` overrides whatever the scene file's `[render]` section chose.
     pub fn set_args(&self) -> Vec<String> {
         let mut v = self.numerics.set_args();
         v.push(format!("origin={}", self.origin.name()));
