@@ -1,15 +1,756 @@
-// trace.glsl — the one Whitted-style tracer shared by every entry point: the
-// ray loop with its Phong shading, shadow, mirror and glass rays.
+// trace.glsl — the one Whitted-style tracer, assembled from shaders/trace/*.glsl (edit those; a test regenerates this file with TWINRAY_UPDATE_DOCS=1).
+// trace/inputs.glsl — what the tracer reads: the compile-time switches, the
+// structs that common/src/gpu/layout.rs mirrors (a test checks naga's layout against
+// the Rust one), and every binding. The first part of trace.glsl's tracer.
+
+#ifndef STACK_SIZE
+#define STACK_SIZE 17
+#endif
+
+// The specialization-constant alternative (`--specialize`, common/src/shader/variant.rs):
+// every feature is compiled in and each becomes a constant_id override, which
+// naga's process_overrides fixes per scene before it writes SPIR-V or GLSL.
+// SPEC(x) guards a feature's code with an `if` on its constant; without
+// SPECIALIZE it expands to nothing and the #ifdef alone decides.
+#ifdef SPECIALIZE
+layout(constant_id = 0) const bool SPEC_SPHERES = true;
+layout(constant_id = 1) const bool SPEC_TRIANGLES = true;
+layout(constant_id = 2) const bool SPEC_MIRROR = true;
+layout(constant_id = 3) const bool SPEC_GLASS = true;
+#define HAS_SPHERES 1
+#define HAS_TRIANGLES 1
+#define HAS_MIRROR 1
+#define HAS_GLASS 1
+#define SPEC(feature) if (feature)
+#else
+#define SPEC(feature)
+#endif
+
+struct Material {
+    vec3 ambient;
+    float reflectivity;
+    vec3 diffuse;
+    float transparency;
+    vec3 specular;
+    float shininess;
+    float ior;
+    uint pad0;
+    uint pad1;
+    uint pad2;
+};
+
+struct Sphere {
+    vec3 center;
+    float radius;
+    uint material;
+    uint pad0;
+    uint pad1;
+    uint pad2;
+};
+
+// Vertices and per-vertex normals; the material index rides in p0's spare slot.
+struct Triangle {
+    vec3 p0;
+    uint material;
+    vec3 p1;
+    uint pad0;
+    vec3 p2;
+    uint pad1;
+    vec3 n0;
+    uint pad2;
+    vec3 n1;
+    uint pad3;
+    vec3 n2;
+    uint pad4;
+};
+
+struct Light {
+    vec3 position;
+    float pad0;
+    vec3 color;
+    float pad1;
+};
+
+// The camera is an eye plus the centre of the top-left pixel and per-pixel steps:
+// the y step points down the image, so both APIs produce the same upright image.
+layout(std140, set = 0, binding = 0) uniform Frame {
+    vec3 eye;
+    float min_weight;
+    vec3 top_left;  // relative to the eye (see common/src/scene/camera.rs)
+    float epsilon;
+    vec3 step_x;
+    uint max_depth;
+    vec3 step_y;
+    uint sphere_count;    // read only where SPHERE_COUNT is not given (see below)
+    vec3 background;
+    uint triangle_count;
+    uint light_count;
+    uint width;   // image size in pixels: the compute entry point's bounds check
+    uint height;
+    uint pad;
+} frame;
+
+// The counts as a storage buffer: read at run time, yet no driver inlines
+// them into a new shader the way lavapipe does with uniform values.
+layout(std430, set = 0, binding = 9) readonly buffer Counts {
+    uint spheres;
+    uint triangles;
+    uint lights;
+} count_buf;
+
+// Every variant an app runs bakes the counts in (shader.rs, Variant::chosen)
+// or reads them from Counts; only the scene-independent generic variant of the
+// tests reads them from the uniform.
+#if defined(COUNTS_FROM_STORAGE)
+#define SPHERE_COUNT count_buf.spheres
+#define TRIANGLE_COUNT count_buf.triangles
+#define LIGHT_COUNT count_buf.lights
+#elif !defined(SPHERE_COUNT)
+#define SPHERE_COUNT frame.sphere_count
+#define TRIANGLE_COUNT frame.triangle_count
+#define LIGHT_COUNT frame.light_count
+#endif
+
+layout(std430, set = 0, binding = 1) readonly buffer Spheres {
+    Sphere spheres[];
+} sphere_buf;
+
+layout(std430, set = 0, binding = 2) readonly buffer Triangles {
+    Triangle triangles[];
+} triangle_buf;
+
+layout(std430, set = 0, binding = 3) readonly buffer Materials {
+    Material materials[];
+} material_buf;
+
+layout(std430, set = 0, binding = 4) readonly buffer Lights {
+    Light lights[];
+} light_buf;
+
+// The BVH (common/src/scene/accel.rs), depth-first: an interior node's left child is the
+// next node and `left_or_first` its right child; a leaf (count > 0) holds
+// prims[left_or_first .. +count], each a triangle index or a sphere index with
+// the top bit set. Bound always; read only by the USE_BVH variant.
+struct BvhNode {
+    vec3 bmin;
+    uint left_or_first;
+    vec3 bmax;
+    uint count;
+};
+
+layout(std430, set = 0, binding = 6) readonly buffer BvhNodes {
+    BvhNode nodes[];
+} bvh_buf;
+
+layout(std430, set = 0, binding = 7) readonly buffer BvhPrims {
+    uint prims[];
+} prim_buf;
+
+// Per node: the parent's index (low 30 bits) and the axis the node's children
+// were split on (top 2 bits). Read only by the BVH_STACKLESS traversal.
+layout(std430, set = 0, binding = 8) readonly buffer BvhLinks {
+    uint links[];
+} link_buf;
+
+const float T_MAX = 1.0e30;
+
+// trace/intersect.glsl — where one ray meets one sphere or one triangle, and
+// the per-primitive steps that the brute-force loops and the BVH leaves share.
+
+// Ray-sphere tests. `dir` is unit length; both return the nearest t in
+// (t_min, t_max) or -1. Conditions are written so that NaN fails them.
+float hit_sphere(vec3 origin, vec3 dir, Sphere s, float t_min, float t_max) {
+    vec3 f = origin - s.center;
+    float r2 = s.radius * s.radius;
+#ifdef SPHERE_QUADRATIC
+    // The textbook quadratic a t^2 + b t + c = 0. b^2 - 4ac cancels when the
+    // sphere is small against its distance, and -b + sqrt(disc) cancels for the
+    // near root.
+    float a = dot(dir, dir);
+    float b = 2.0 * dot(f, dir);
+    float c = dot(f, f) - r2;
+    float disc = b * b - 4.0 * a * c;
+    if (!(disc >= 0.0)) {
+        return -1.0;
+    }
+    float sq = sqrt(disc);
+    float lo = (-b - sq) / (2.0 * a);
+    float hi = (-b + sq) / (2.0 * a);
+#else
+    // Stable form (Haines et al., Ray Tracing Gems ch. 7): the discriminant is
+    // formed from the distance of the centre to the ray, and the two roots as c/q
+    // and q, which avoids cancellation for small or far spheres.
+    float b = dot(f, dir);
+    vec3 l = f - b * dir;
+    float disc = r2 - dot(l, l);
+    if (!(disc >= 0.0)) {
+        return -1.0;
+    }
+    float c = dot(f, f) - r2;
+    float q = -b - (b >= 0.0 ? 1.0 : -1.0) * sqrt(disc);
+    float t0 = c / q;
+    float t1 = q;
+    float lo = min(t0, t1);
+    float hi = max(t0, t1);
+#endif
+    if (lo > t_min && lo < t_max) {
+        return lo;
+    }
+    if (hi > t_min && hi < t_max) {
+        return hi;
+    }
+    return -1.0;
+}
+
+// A ray as the triangle test wants it. The watertight test permutes and shears
+// space once per ray (Woop, Benthin, Wald 2013): kz is the dominant axis of the
+// direction, kx and ky the others (swapped to keep the winding), s the shear.
+struct TriRay {
+    vec3 o;
+    vec3 d;
+    uvec3 k;
+    vec3 s;
+};
+
+TriRay tri_ray(vec3 o, vec3 d) {
+    TriRay r;
+    r.o = o;
+    r.d = d;
+    r.k = uvec3(0u, 1u, 2u);
+    r.s = vec3(0.0);
+#ifdef TRIANGLE_WATERTIGHT
+    vec3 ad = abs(d);
+    uint kz = ad.x > ad.y ? (ad.x > ad.z ? 0u : 2u) : (ad.y > ad.z ? 1u : 2u);
+    uint kx = kz == 2u ? 0u : kz + 1u;
+    uint ky = kx == 2u ? 0u : kx + 1u;
+    if (d[kz] < 0.0) {
+        uint tmp = kx;
+        kx = ky;
+        ky = tmp;
+    }
+    r.k = uvec3(kx, ky, kz);
+    r.s = vec3(d[kx] / d[kz], d[ky] / d[kz], 1.0 / d[kz]);
+#endif
+    return r;
+}
+
+// A triangle whose edges are parallel in f32 has no normal (normalize(0) is
+// undefined), yet rounding can still let a ray through a collinear triangle's
+// line pass either test. Checked only for candidate hits, so it costs little.
+bool is_degenerate(Triangle tri) {
+    vec3 c = cross(tri.p1 - tri.p0, tri.p2 - tri.p0);
+    return c.x == 0.0 && c.y == 0.0 && c.z == 0.0;
+}
+
+// Returns (t, u, v) with u, v the weights of p1 and p2, or t = -1 for a miss.
+// Conditions are written so that NaN fails them: a degenerate triangle is never hit.
+vec3 hit_triangle(TriRay r, Triangle tri, float t_min, float t_max) {
+    vec3 miss = vec3(-1.0, 0.0, 0.0);
+#ifdef TRIANGLE_WATERTIGHT
+    // Vertices relative to the origin, in the sheared frame where the ray is +z.
+    // Each vertex is transformed alone, so two triangles sharing an edge compute
+    // the same 2D edge function with opposite sign: no ray slips between them.
+    vec3 a = tri.p0 - r.o;
+    vec3 b = tri.p1 - r.o;
+    vec3 c = tri.p2 - r.o;
+    float ax = a[r.k.x] - r.s.x * a[r.k.z];
+    float ay = a[r.k.y] - r.s.y * a[r.k.z];
+    float bx = b[r.k.x] - r.s.x * b[r.k.z];
+    float by = b[r.k.y] - r.s.y * b[r.k.z];
+    float cx = c[r.k.x] - r.s.x * c[r.k.z];
+    float cy = c[r.k.y] - r.s.y * c[r.k.z];
+    float eu = cx * by - cy * bx;
+    float ev = ax * cy - ay * cx;
+    float ew = bx * ay - by * ax;
+    // Edges exactly through the ray count for both neighbours (the paper's f64
+    // re-test of zero edge functions is left out: GLSL here has no f64).
+    if ((eu < 0.0 || ev < 0.0 || ew < 0.0) && (eu > 0.0 || ev > 0.0 || ew > 0.0)) {
+        return miss;
+    }
+    float det = eu + ev + ew;
+    if (det == 0.0) {
+        return miss;
+    }
+    float tz = eu * (r.s.z * a[r.k.z]) + ev * (r.s.z * b[r.k.z]) + ew * (r.s.z * c[r.k.z]);
+    float inv = 1.0 / det;
+    float t = tz * inv;
+    if (!(t > t_min && t < t_max) || is_degenerate(tri)) {
+        return miss;
+    }
+    return vec3(t, ev * inv, ew * inv);
+#else
+    // Moller-Trumbore 1997.
+    vec3 e1 = tri.p1 - tri.p0;
+    vec3 e2 = tri.p2 - tri.p0;
+    vec3 pv = cross(r.d, e2);
+    float det = dot(e1, pv);
+    if (det == 0.0) {
+        return miss;
+    }
+    float inv = 1.0 / det;
+    vec3 tv = r.o - tri.p0;
+    float u = dot(tv, pv) * inv;
+    if (!(u >= 0.0 && u <= 1.0)) {
+        return miss;
+    }
+    vec3 qv = cross(tv, e1);
+    float v = dot(r.d, qv) * inv;
+    if (!(v >= 0.0 && u + v <= 1.0)) {
+        return miss;
+    }
+    float t = dot(e2, qv) * inv;
+    if (!(t > t_min && t < t_max) || is_degenerate(tri)) {
+        return miss;
+    }
+    return vec3(t, u, v);
+#endif
+}
+
+struct Hit {
+    float t;
+    uint kind;  // 0 none, 1 sphere, 2 triangle
+    uint index;
+    float u;
+    float v;
+};
+
+// Mesa's software drivers (llvmpipe and lavapipe, 22.3) give each invocation one
+// budget of 65,535 loop iterations for all its loops together and silently leave
+// a loop once it is spent. The brute-force teapot (19,200 triangles, 3 shadow
+// rays) needs 76,800, so the primitive loops visit four primitives per iteration.
+// The order of the tests is unchanged, so the result equals the plain loop's.
+#define PRIMS_PER_ITERATION 4u
+
+void closest_sphere(inout Hit h, vec3 origin, vec3 dir, uint i) {
+    if (i < SPHERE_COUNT) {
+        float t = hit_sphere(origin, dir, sphere_buf.spheres[i], 0.0, h.t);
+        if (t > 0.0) {
+            h.t = t;
+            h.kind = 1u;
+            h.index = i;
+        }
+    }
+}
+
+void closest_triangle(inout Hit h, TriRay ray, uint i) {
+    if (i < TRIANGLE_COUNT) {
+        vec3 r = hit_triangle(ray, triangle_buf.triangles[i], 0.0, h.t);
+        if (r.x > 0.0) {
+            h.t = r.x;
+            h.kind = 2u;
+            h.index = i;
+            h.u = r.y;
+            h.v = r.z;
+        }
+    }
+}
+
+// trace/bvh.glsl — the closest-hit and any-hit walks of the BVH that
+// common/src/scene/accel.rs builds; compiled only into the USE_BVH variants.
+
+#ifdef USE_BVH
+const uint SPHERE_BIT = 0x80000000u;
+
+// The traversal stack holds the far children still to visit, each entry
+// uvec2(node, floatBitsToUint(entry t)), two entries to a uvec4: NVIDIA's
+// OpenGL compiler gives every element of a local array a whole 16-byte slot,
+// so two scalar arrays cost it four times the memory of these pairs (on an
+// H100 its teapot BVH tracer went from 259 slots to 21, and from 6.2 to
+// 0.54 ms on the compute path). BVH_STACK is the built tree's depth - 1
+// (common/src/shader/variant.rs): the traversal pushes at most one child per level of
+// the current path, so no push is ever dropped and no slot is wasted.
 //
-// naga has no #include, so Rust concatenates one source, in one place
-// (TRACE_GLSL in common's shader module): a `#version` line, the parts in
-// reading order, this file, then an entry point (trace.frag or trace.comp):
+// Experiments (--experiment, common/src/cli.rs): BVH_STACK_UNPAIRED keeps
+// one uvec2 per element; BVH_STACK_SHARED (compute only, where it fits)
+// keeps the stack in shared memory, entry-major so that a warp's pushes hit
+// distinct banks; BVH_STACKLESS below has no stack at all.
+#ifndef BVH_STACK
+// Only a source compiled without the build's defines (an external compiler
+// checking trace.glsl on its own) gets here: the apps always size the stack
+// from the tree. A fixed stack cannot know the tree, so it drops what does
+// not fit rather than write past its end.
+#define BVH_STACK 64
+#define BVH_STACK_FIXED 1
+#endif
+#if defined(BVH_STACK_SHARED)
+shared uvec2 bvh_stack[BVH_STACK * WG_X * WG_Y];
+#define BVH_PUSH(i, e) bvh_stack[(i) * uint(WG_X * WG_Y) + gl_LocalInvocationIndex] = (e)
+#define BVH_POP(i) bvh_stack[(i) * uint(WG_X * WG_Y) + gl_LocalInvocationIndex]
+#elif defined(BVH_STACK_UNPAIRED)
+#define BVH_STACK_DECLARE uvec2 stack[BVH_STACK]
+#define BVH_PUSH(i, e) stack[i] = (e)
+#define BVH_POP(i) stack[i]
+#else
+#define BVH_STACK_DECLARE uvec4 stack[(BVH_STACK + 1) / 2]
+#define BVH_PUSH(i, e) if (((i) & 1u) == 0u) { stack[(i) >> 1u].xy = (e); } else { stack[(i) >> 1u].zw = (e); }
+#define BVH_POP(i) (((i) & 1u) == 0u ? stack[(i) >> 1u].xy : stack[(i) >> 1u].zw)
+#endif
+
+// Where the ray enters the box, or -1 if it misses it before t_max. Zero
+// direction components are nudged so 0 * inf never makes a NaN.
+float enter_box(vec3 origin, vec3 inv_dir, uint node, float t_max) {
+    vec3 t0 = (bvh_buf.nodes[node].bmin - origin) * inv_dir;
+    vec3 t1 = (bvh_buf.nodes[node].bmax - origin) * inv_dir;
+    vec3 tn = min(t0, t1);
+    vec3 tf = max(t0, t1);
+    float enter = max(max(tn.x, tn.y), max(tn.z, 0.0));
+    float leave = min(min(tf.x, tf.y), min(tf.z, t_max));
+    return enter <= leave ? enter : -1.0;
+}
+
+vec3 inverse_dir(vec3 dir) {
+    vec3 d = mix(vec3(1.0e-30), abs(dir), greaterThan(abs(dir), vec3(1.0e-30)));
+    return sign(dir + vec3(1.0e-38)) / d;
+}
+
+// Tests a leaf's primitives against the ray, keeping the closest hit in h.
+// True when an any-hit query (shadow rays) may stop.
+bool hit_leaf(inout Hit h, vec3 origin, vec3 dir, TriRay ray, uint first, uint count, bool any_hit) {
+    for (uint k = 0u; k < count; k++) {
+        uint prim = prim_buf.prims[first + k];
+        if ((prim & SPHERE_BIT) != 0u) {
+            uint i = prim & ~SPHERE_BIT;
+            float t = hit_sphere(origin, dir, sphere_buf.spheres[i], 0.0, h.t);
+            if (t > 0.0) {
+                h.t = t;
+                h.kind = 1u;
+                h.index = i;
+            }
+        } else {
+            vec3 r = hit_triangle(ray, triangle_buf.triangles[prim], 0.0, h.t);
+            if (r.x > 0.0) {
+                h.t = r.x;
+                h.kind = 2u;
+                h.index = prim;
+                h.u = r.y;
+                h.v = r.z;
+            }
+        }
+        if (any_hit && h.kind != 0u) {
+            return true;
+        }
+    }
+    return false;
+}
+
+#ifdef BVH_STACKLESS
+// The stackless alternative (Hapala, Davidovic, Wald, Havran 2011): no array
+// at all. From each node's parent link and split axis the traversal knows
+// where to go next: down to the near child (the lower side when the ray runs
+// towards +axis), across to the sibling, or back up. Each box is tested at
+// most once; going up costs a link read instead of a stack pop.
+const uint FROM_PARENT = 0u;
+const uint FROM_SIBLING = 1u;
+const uint FROM_CHILD = 2u;
+
+uint parent_of(uint node) {
+    return link_buf.links[node] & 0x3FFFFFFFu;
+}
+
+uint near_child(uint node, vec3 dir) {
+    uint axis = link_buf.links[node] >> 30u;
+    return dir[axis] >= 0.0 ? node + 1u : bvh_buf.nodes[node].left_or_first;
+}
+
+uint sibling_of(uint node, uint parent) {
+    return node == parent + 1u ? bvh_buf.nodes[parent].left_or_first : parent + 1u;
+}
+
+Hit traverse(vec3 origin, vec3 dir, float t_max, bool any_hit) {
+    Hit h;
+    h.t = t_max;
+    h.kind = 0u;
+    h.index = 0u;
+    h.u = 0.0;
+    h.v = 0.0;
+    vec3 inv_dir = inverse_dir(dir);
+    TriRay ray = tri_ray(origin, dir);
+    if (enter_box(origin, inv_dir, 0u, t_max) < 0.0) {
+        return h;
+    }
+    if (bvh_buf.nodes[0].count > 0u) {
+        hit_leaf(h, origin, dir, ray, bvh_buf.nodes[0].left_or_first, bvh_buf.nodes[0].count, any_hit);
+        return h;
+    }
+    uint node = near_child(0u, dir);
+    uint state = FROM_PARENT;
+    while (true) {
+        if (state == FROM_CHILD) {
+            if (node == 0u) {
+                break;
+            }
+            uint parent = parent_of(node);
+            if (node == near_child(parent, dir)) {
+                node = sibling_of(node, parent);
+                state = FROM_SIBLING;
+            } else {
+                node = parent;
+            }
+            continue;
+        }
+        bool enter = enter_box(origin, inv_dir, node, h.t) >= 0.0;
+        uint count = bvh_buf.nodes[node].count;
+        if (enter && count == 0u) {
+            node = near_child(node, dir);
+            state = FROM_PARENT;
+            continue;
+        }
+        if (enter && hit_leaf(h, origin, dir, ray, bvh_buf.nodes[node].left_or_first, count, any_hit)) {
+            return h;
+        }
+        // Done with this subtree: the far sibling is next after the near
+        // child, the parent after the far one.
+        uint parent = parent_of(node);
+        if (state == FROM_PARENT) {
+            node = sibling_of(node, parent);
+            state = FROM_SIBLING;
+        } else {
+            node = parent;
+            state = FROM_CHILD;
+        }
+    }
+    return h;
+}
+#else
+// Visits the tree near child first and skips subtrees that start beyond the
+// closest hit so far. With `any_hit` (shadow rays) it stops at the first hit
+// before t_max and reports it with kind != 0.
+Hit traverse(vec3 origin, vec3 dir, float t_max, bool any_hit) {
+    Hit h;
+    h.t = t_max;
+    h.kind = 0u;
+    h.index = 0u;
+    h.u = 0.0;
+    h.v = 0.0;
+    vec3 inv_dir = inverse_dir(dir);
+    TriRay ray = tri_ray(origin, dir);
+#ifndef BVH_STACK_SHARED
+    BVH_STACK_DECLARE;
+#endif
+    uint sp = 0u;
+    if (enter_box(origin, inv_dir, 0u, t_max) < 0.0) {
+        return h;
+    }
+    uint node = 0u;
+    while (true) {
+        uint count = bvh_buf.nodes[node].count;
+        uint first = bvh_buf.nodes[node].left_or_first;
+        if (count > 0u) {
+            if (hit_leaf(h, origin, dir, ray, first, count, any_hit)) {
+                return h;
+            }
+        } else {
+            uint left = node + 1u;
+            uint right = first;
+            float tl = enter_box(origin, inv_dir, left, h.t);
+            float tr = enter_box(origin, inv_dir, right, h.t);
+            if (tl >= 0.0 && tr >= 0.0) {
+                bool left_first = tl <= tr;
+                node = left_first ? left : right;
+                // sp < BVH_STACK here: the stack is as deep as the tree.
+#ifdef BVH_STACK_FIXED
+                if (sp < uint(BVH_STACK))
+#endif
+                {
+                    BVH_PUSH(sp, uvec2(left_first ? right : left, floatBitsToUint(left_first ? tr : tl)));
+                    sp += 1u;
+                }
+                continue;
+            }
+            if (tl >= 0.0) {
+                node = left;
+                continue;
+            }
+            if (tr >= 0.0) {
+                node = right;
+                continue;
+            }
+        }
+        // Pop the nearest pending subtree that can still hold a closer hit.
+        bool found = false;
+        while (sp > 0u && !found) {
+            sp -= 1u;
+            uvec2 entry = BVH_POP(sp);
+            if (uintBitsToFloat(entry.y) < h.t) {
+                node = entry.x;
+                found = true;
+            }
+        }
+        if (!found) {
+            break;
+        }
+    }
+    return h;
+}
+#endif
+#endif
+// trace/hit.glsl — the two questions the ray loop asks (the closest hit, and is
+// anything in the way of a light), answered by testing every primitive or,
+// where the variant has one, through the BVH.
+
+Hit closest_hit_brute(vec3 origin, vec3 dir) {
+    Hit h;
+    h.t = T_MAX;
+    h.kind = 0u;
+    h.index = 0u;
+    h.u = 0.0;
+    h.v = 0.0;
+#ifdef HAS_SPHERES
+    SPEC(SPEC_SPHERES) {
+        for (uint i = 0u; i < SPHERE_COUNT; i += PRIMS_PER_ITERATION) {
+            closest_sphere(h, origin, dir, i);
+            closest_sphere(h, origin, dir, i + 1u);
+            closest_sphere(h, origin, dir, i + 2u);
+            closest_sphere(h, origin, dir, i + 3u);
+        }
+    }
+#endif
+#ifdef HAS_TRIANGLES
+    SPEC(SPEC_TRIANGLES) {
+        TriRay ray = tri_ray(origin, dir);
+        for (uint i = 0u; i < TRIANGLE_COUNT; i += PRIMS_PER_ITERATION) {
+            closest_triangle(h, ray, i);
+            closest_triangle(h, ray, i + 1u);
+            closest_triangle(h, ray, i + 2u);
+            closest_triangle(h, ray, i + 3u);
+        }
+    }
+#endif
+    return h;
+}
+
+bool sphere_blocks(vec3 origin, vec3 dir, float dist, uint i) {
+    return i < SPHERE_COUNT && hit_sphere(origin, dir, sphere_buf.spheres[i], 0.0, dist) > 0.0;
+}
+
+bool triangle_blocks(TriRay ray, float dist, uint i) {
+    return i < TRIANGLE_COUNT && hit_triangle(ray, triangle_buf.triangles[i], 0.0, dist).x > 0.0;
+}
+
+// Shadow rays need any hit before the light, not the closest one.
+bool occluded_brute(vec3 origin, vec3 dir, float dist) {
+#ifdef HAS_SPHERES
+    SPEC(SPEC_SPHERES) {
+        for (uint i = 0u; i < SPHERE_COUNT; i += PRIMS_PER_ITERATION) {
+            if (sphere_blocks(origin, dir, dist, i) || sphere_blocks(origin, dir, dist, i + 1u)
+                || sphere_blocks(origin, dir, dist, i + 2u) || sphere_blocks(origin, dir, dist, i + 3u)) {
+                return true;
+            }
+        }
+    }
+#endif
+#ifdef HAS_TRIANGLES
+    SPEC(SPEC_TRIANGLES) {
+        TriRay ray = tri_ray(origin, dir);
+        for (uint i = 0u; i < TRIANGLE_COUNT; i += PRIMS_PER_ITERATION) {
+            if (triangle_blocks(ray, dist, i) || triangle_blocks(ray, dist, i + 1u)
+                || triangle_blocks(ray, dist, i + 2u) || triangle_blocks(ray, dist, i + 3u)) {
+                return true;
+            }
+        }
+    }
+#endif
+    return false;
+}
+
+// The closest hit and the shadow test, through the BVH where the scene's
+// variant uses one, else by testing every primitive.
+Hit closest_hit(vec3 origin, vec3 dir) {
+#ifdef USE_BVH
+    return traverse(origin, dir, T_MAX, false);
+#else
+    return closest_hit_brute(origin, dir);
+#endif
+}
+
+bool occluded(vec3 origin, vec3 dir, float dist) {
+#ifdef USE_BVH
+    return traverse(origin, dir, dist, true).kind != 0u;
+#else
+    return occluded_brute(origin, dir, dist);
+#endif
+}
+
+// trace/secondary.glsl — where a secondary ray starts, and how much of it glass
+// reflects.
+
+// Where a secondary ray starts: p is the hit point, n the geometric normal on
+// the side the new ray leaves from, dir the new ray's direction. The computed p
+// lies off the surface by its rounding error (about an ULP of its largest
+// coordinate), so a start too close re-hits the surface (acne) and one too far
+// misses nearby occluders (detached shadows, light leaks).
+float max_abs(vec3 v) {
+    return max(abs(v.x), max(abs(v.y), abs(v.z)));
+}
+
+#ifdef OFFSET_ULP
+// Wachter & Binder, Ray Tracing Gems ch. 6: move each coordinate by 256 ULPs per
+// unit of normal in integer space; near the origin, where ULPs get tiny, by a
+// fixed 1/65536 instead.
+const float ULP_ORIGIN = 1.0 / 32.0;
+const float ULP_FLOAT_SCALE = 1.0 / 65536.0;
+const float ULP_INT_SCALE = 256.0;
+
+float ulp_offset_1(float p, float n) {
+    int of = int(ULP_INT_SCALE * n);
+    float moved = intBitsToFloat(floatBitsToInt(p) + (p < 0.0 ? -of : of));
+    return abs(p) < ULP_ORIGIN ? p + ULP_FLOAT_SCALE * n : moved;
+}
+#endif
+
+// `scale` is the largest coordinate of the ray origin the hit was found from,
+// and of the vertices for a triangle; only OFFSET_SCALE_AWARE uses it. (Not the
+// sphere's |centre| + radius: the stable test re-tests a radius-1e6 ground from
+// near its surface cleanly, and that scale would lift shadow rays by a unit.) 2^-22 is 2 f32 ULPs at the top of a binade
+// and 4 at its bottom: 2^-23 let acne through in scenes/hard/tiny-1e-4, 2^-21
+// detached the shadows of scenes/hard/far-1e6 (twinray accuracy measures both).
+const float SCALE_AWARE_REL = 1.0 / 4194304.0;
+
+vec3 spawn_point(vec3 p, vec3 n, vec3 dir, float scale) {
+#if defined(OFFSET_RAY)
+    return p + frame.epsilon * dir;
+#elif defined(OFFSET_NORMAL)
+    return p + frame.epsilon * n;
+#elif defined(OFFSET_ULP)
+    return vec3(ulp_offset_1(p.x, n.x), ulp_offset_1(p.y, n.y), ulp_offset_1(p.z, n.z));
+#elif defined(OFFSET_SCALE_AWARE)
+    // The rounding error of p = o + t d is about an ULP of the largest
+    // coordinate of o and p; move a few of those. No absolute floor, so tiny
+    // scenes near the origin keep offsets to scale.
+    return p + n * (SCALE_AWARE_REL * max(scale, max_abs(p)));
+#else
+    // OFFSET_NORMAL_SCALED: epsilon relative to the largest coordinate, at least absolute.
+    // (Its own magnitude, not the parameter: GLSL forbids redeclaring `scale`.)
+    float magnitude = max(1.0, max_abs(p));
+    return p + n * (frame.epsilon * magnitude);
+#endif
+}
+
+const float SHADOW_REACH = 0.9999;
+
+// Unpolarised Fresnel reflectance of a dielectric boundary.
+float fresnel(float cos_i, float cos_t, float eta) {
+    float rs = (eta * cos_i - cos_t) / (eta * cos_i + cos_t);
+    float rp = (cos_i - eta * cos_t) / (cos_i + eta * cos_t);
+    return 0.5 * (rs * rs + rp * rp);
+}
+
+// trace/loop.glsl — the ray loop with its Phong shading, shadow, mirror and
+// glass rays; the last part of the tracer.
+//
+// The tracer is written in parts that follow the walkthrough's vocabulary, in
+// reading order:
 //   trace/inputs.glsl     switches, structs and bindings
 //   trace/intersect.glsl  ray-sphere and ray-triangle tests
 //   trace/bvh.glsl        the BVH traversal
 //   trace/hit.glsl        closest hit and shadow test, brute force or BVH
 //   trace/secondary.glsl  where secondary rays start; Fresnel
-//   trace.glsl            the ray loop
+//   trace/loop.glsl       the ray loop
+// naga has no #include, so shaders/trace.glsl is these parts put together, in
+// one place (TRACE_PARTS in common/src/shader/build.rs): the single tracer that
+// every entry point (trace.frag, trace.comp) and any external compiler takes.
+// A test keeps it equal to the parts; after editing one, regenerate it with
+// TWINRAY_UPDATE_DOCS=1 cargo test --release -p twinray-common --test shader_output
 //
 // Features a scene lacks are compiled out through defines chosen in
 // common's shader module: HAS_SPHERES, HAS_TRIANGLES, HAS_MIRROR, HAS_GLASS,

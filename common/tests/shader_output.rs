@@ -133,3 +133,21 @@ fn trace_glsl_initialises_no_array_itself() {
         }
     }
 }
+
+/// shaders/trace.glsl is the single tracer external compilers take, and the
+/// parts are what people edit: the two must say the same.
+#[test]
+fn trace_glsl_is_its_parts_assembled() {
+    let expected = build::assemble_tracer();
+    if build::TRACE_GLSL == expected {
+        return;
+    }
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../shaders/trace.glsl");
+    if std::env::var("TWINRAY_UPDATE_DOCS").is_ok_and(|v| v == "1") {
+        std::fs::write(&path, &expected).unwrap();
+        return;
+    }
+    panic!(
+        "shaders/trace.glsl differs from shaders/trace/*.glsl put together; run\n  TWINRAY_UPDATE_DOCS=1 cargo test --release -p twinray-common --test shader_output"
+    );
+}

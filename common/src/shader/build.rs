@@ -16,18 +16,47 @@ use naga::back::{glsl, spv};
 use naga::valid::{Capabilities, ModuleInfo, ValidationFlags, Validator};
 use naga::{Module, ShaderStage};
 
-/// The tracer as one source. naga has no `#include`, so this is the one place
-/// that puts the parts of shaders/trace/ together, in the reading order that
-/// trace.glsl's header lists; every variant, both APIs and both paths start
-/// from it.
-pub const TRACE_GLSL: &str = concat!(
-    include_str!("../../../shaders/trace/inputs.glsl"),
-    include_str!("../../../shaders/trace/intersect.glsl"),
-    include_str!("../../../shaders/trace/bvh.glsl"),
-    include_str!("../../../shaders/trace/hit.glsl"),
-    include_str!("../../../shaders/trace/secondary.glsl"),
-    include_str!("../../../shaders/trace.glsl"),
-);
+/// The tracer's parts, in reading order (shaders/trace/loop.glsl lists what
+/// each holds). naga has no `#include`, so [`assemble_tracer`] puts them
+/// together, here and nowhere else.
+pub const TRACE_PARTS: [(&str, &str); 6] = [
+    (
+        "inputs.glsl",
+        include_str!("../../../shaders/trace/inputs.glsl"),
+    ),
+    (
+        "intersect.glsl",
+        include_str!("../../../shaders/trace/intersect.glsl"),
+    ),
+    ("bvh.glsl", include_str!("../../../shaders/trace/bvh.glsl")),
+    ("hit.glsl", include_str!("../../../shaders/trace/hit.glsl")),
+    (
+        "secondary.glsl",
+        include_str!("../../../shaders/trace/secondary.glsl"),
+    ),
+    (
+        "loop.glsl",
+        include_str!("../../../shaders/trace/loop.glsl"),
+    ),
+];
+
+/// The first line of shaders/trace.glsl, which says where it comes from.
+pub const ASSEMBLED_HEADER: &str =
+    "// trace.glsl — the one Whitted-style tracer, assembled from shaders/trace/*.glsl \
+(edit those; a test regenerates this file with TWINRAY_UPDATE_DOCS=1).\n";
+
+/// shaders/trace.glsl as the parts make it: the header line, then each part.
+pub fn assemble_tracer() -> String {
+    let mut s = String::from(ASSEMBLED_HEADER);
+    for (_, part) in TRACE_PARTS {
+        s.push_str(part);
+    }
+    s
+}
+
+/// The single tracer every variant, both APIs and both paths start from, and
+/// the file an external compiler can take as it is (with an entry point).
+pub const TRACE_GLSL: &str = include_str!("../../../shaders/trace.glsl");
 pub const TRACE_FRAG: &str = include_str!("../../../shaders/trace.frag");
 pub const FULLSCREEN_VERT: &str = include_str!("../../../shaders/fullscreen.vert");
 pub const TRACE_COMP: &str = include_str!("../../../shaders/trace.comp");

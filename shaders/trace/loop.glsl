@@ -1,0 +1,184 @@
+// trace/loop.glsl — the ray loop with its Phong shading, shadow, mirror and
+// glass rays; the last part of the tracer.
+//
+// The tracer is written in parts that follow the walkthrough's vocabulary, in
+// reading order:
+//   trace/inputs.glsl     switches, structs and bindings
+//   trace/intersect.glsl  ray-sphere and ray-triangle tests
+//   trace/bvh.glsl        the BVH traversal
+//   trace/hit.glsl        closest hit and shadow test, brute force or BVH
+//   trace/secondary.glsl  where secondary rays start; Fresnel
+//   trace/loop.glsl       the ray loop
+// naga has no #include, so shaders/trace.glsl is these parts put together, in
+// one place (TRACE_PARTS in common/src/shader/build.rs): the single tracer that
+// every entry point (trace.frag, trace.comp) and any external compiler takes.
+// A test keeps it equal to the parts; after editing one, regenerate it with
+// TWINRAY_UPDATE_DOCS=1 cargo test --release -p twinray-common --test shader_output
+//
+// Features a scene lacks are compiled out through defines chosen in
+// common's shader module: HAS_SPHERES, HAS_TRIANGLES, HAS_MIRROR, HAS_GLASS,
+// and STACK_SIZE (the ray stack: max_depth + 1 with glass, else 1).
+//
+// The primitive and light counts are defines too (SPHERE_COUNT, TRIANGLE_COUNT,
+// LIGHT_COUNT): they bound the loops, and a loop bound read from
+// a uniform made Mesa's lavapipe compile and keep a new copy of the shader at
+// every draw (about 3 MB a frame). The scene's variant knows them anyway.
+//
+// Numerical choices are defines too (common/src/scene/numerics.rs), one of each:
+//   OFFSET_RAY | OFFSET_NORMAL | OFFSET_NORMAL_SCALED | OFFSET_ULP | OFFSET_SCALE_AWARE  (secondary-ray origin)
+//   TRIANGLE_MOLLER_TRUMBORE | TRIANGLE_WATERTIGHT                    (ray-triangle test)
+//   SPHERE_QUADRATIC | SPHERE_STABLE                                  (ray-sphere test)
+// With none given, the shader falls back to normal-scaled / Moller-Trumbore / stable.
+//
+// The CPU reference (common/src/reference/) follows these files step by step
+// in f64; change both together.
+
+vec3 trace(vec3 origin, vec3 dir) {
+    vec3 st_origin[STACK_SIZE];
+    vec3 st_dir[STACK_SIZE];
+    float st_weight[STACK_SIZE];
+    uint st_depth[STACK_SIZE];
+#ifdef HAS_GLASS
+    // Glass pushes two rays per hit: the stack's size bounds the depth.
+    uint max_depth = min(frame.max_depth, uint(STACK_SIZE - 1));
+#else
+    // A mirror pushes one ray after popping one: one slot serves any depth.
+    uint max_depth = frame.max_depth;
+#endif
+
+    vec3 color = vec3(0.0);
+    int sp = 0;
+    st_origin[0] = origin;
+    st_dir[0] = dir;
+    st_weight[0] = 1.0;
+    st_depth[0] = 0u;
+    sp = 1;
+
+    while (sp > 0) {
+        sp -= 1;
+        vec3 o = st_origin[sp];
+        vec3 d = st_dir[sp];
+        float w = st_weight[sp];
+        uint depth = st_depth[sp];
+
+        Hit h = closest_hit(o, d);
+        if (h.kind == 0u) {
+            color += w * frame.background;
+            continue;
+        }
+
+        vec3 p = o + h.t * d;
+        vec3 ng;
+        vec3 ns;
+        uint mat_index;
+        float scale = max_abs(o);
+        if (h.kind == 1u) {
+            Sphere s = sphere_buf.spheres[h.index];
+            ng = (p - s.center) / s.radius;
+            ns = ng;
+            mat_index = s.material;
+            // Sphere tests square their inputs (c = f.f - r^2), so a start a few
+            // ULPs inside glass can still re-hit the same sphere: 4x the margin
+            // (scenes/box's glass sphere speckled with 2^-22).
+            scale = 4.0 * max(scale, max_abs(p));
+        } else {
+            Triangle tri = triangle_buf.triangles[h.index];
+            // A triangle test's error grows with its vertices' magnitude (a floor
+            // quad reaching x = 8 seen from a glass sphere at |o| = 1 re-hit itself).
+            scale = max(scale, max(max_abs(tri.p0), max(max_abs(tri.p1), max_abs(tri.p2))));
+            vec3 e1 = tri.p1 - tri.p0;
+            vec3 e2 = tri.p2 - tri.p0;
+#if defined(OFFSET_SCALE_AWARE) || defined(OFFSET_ULP)
+            // These offsets assume p lies within a few ULPs of its coordinates
+            // off the plane. o + t d does not: its error grows with t and with
+            // how thin the triangle is (acne on the teapot's spout and handle).
+            // Rebuilt from the barycentrics, an error in u, v only slides p
+            // along the plane (Wachter & Binder, Ray Tracing Gems ch. 6).
+            p = tri.p0 + h.u * e1 + h.v * e2;
+#endif
+            ng = normalize(cross(e1, e2));
+            ns = normalize((1.0 - h.u - h.v) * tri.n0 + h.u * tri.n1 + h.v * tri.n2);
+            mat_index = tri.material;
+        }
+        // Face both normals towards the incoming ray; `inside` tells glass which way it goes.
+        bool inside = dot(d, ng) > 0.0;
+        if (inside) {
+            ng = -ng;
+        }
+        if (dot(ns, ng) < 0.0) {
+            ns = -ns;
+        }
+        Material m = material_buf.materials[mat_index];
+
+        vec3 local = m.ambient;
+        for (uint li = 0u; li < LIGHT_COUNT; li++) {
+            Light light = light_buf.lights[li];
+            // The offset may depend on the direction (OFFSET_RAY): aim from p first.
+            vec3 p_out = spawn_point(p, ng, normalize(light.position - p), scale);
+            vec3 to_light = light.position - p_out;
+            float dist = length(to_light);
+            vec3 l = to_light / dist;
+            float ndl = dot(ns, l);
+            bool lit = ndl > 0.0 && dot(ng, l) > 0.0;
+            if (lit) {
+                // Stop a hair before the light: a light lying on a surface would
+                // otherwise be hidden by that surface at the whim of rounding.
+                lit = !occluded(p_out, l, dist * SHADOW_REACH);
+            }
+            if (lit) {
+                vec3 r = reflect(-l, ns);
+                float spec = pow(max(dot(r, -d), 0.0), m.shininess);
+                local += light.color * (m.diffuse * ndl + m.specular * spec);
+            }
+        }
+        color += w * local;
+
+#if defined(HAS_MIRROR) || defined(HAS_GLASS)
+        SPEC(SPEC_MIRROR || SPEC_GLASS)
+        if (depth + 1u < max_depth) {
+            float kr = m.reflectivity;
+#ifdef HAS_GLASS
+            float kt = m.transparency;
+            SPEC(SPEC_GLASS)
+            if (kt > 0.0) {
+                float eta = inside ? m.ior : 1.0 / m.ior;
+                float cos_i = -dot(d, ns);
+                float k = 1.0 - eta * eta * (1.0 - cos_i * cos_i);
+                if (k < 0.0) {
+                    kr += kt;  // total internal reflection
+                } else {
+                    float cos_t = sqrt(k);
+                    float f = fresnel(cos_i, cos_t, eta);
+                    kr += kt * f;
+                    float wt = w * kt * (1.0 - f);
+                    if (wt >= frame.min_weight && sp < STACK_SIZE) {
+                        vec3 t_dir = normalize(eta * d + (eta * cos_i - cos_t) * ns);
+                        st_origin[sp] = spawn_point(p, -ng, t_dir, scale);
+                        st_dir[sp] = t_dir;
+                        st_weight[sp] = wt;
+                        st_depth[sp] = depth + 1u;
+                        sp += 1;
+                    }
+                }
+            }
+#endif
+            float wr = w * kr;
+            if (wr >= frame.min_weight && sp < STACK_SIZE) {
+                vec3 r_dir = reflect(d, ns);
+                st_origin[sp] = spawn_point(p, ng, r_dir, scale);
+                st_dir[sp] = r_dir;
+                st_weight[sp] = wr;
+                st_depth[sp] = depth + 1u;
+                sp += 1;
+            }
+        }
+#endif
+    }
+    return color;
+}
+
+vec3 primary_dir(vec2 frag_xy) {
+    // top_left is relative to the eye, so this sum stays small and exact enough
+    // however far the camera is from the origin.
+    return normalize(frame.top_left + (frag_xy.x - 0.5) * frame.step_x + (frag_xy.y - 0.5) * frame.step_y);
+}
