@@ -1,9 +1,11 @@
 //! `twinray compare`: the study's three experiments (teapot and box resolution
 //! sweeps, the sphere-list count sweep) with both apps, each point in fresh
-//! processes with the API order alternating, then results.csv, report.md and plots.
+//! processes with the API order alternating, then results.csv, report.md and
+//! plots, and the why step's experiments at each remaining gap (why.rs).
 
 use crate::apps::{run_json, Api};
 use crate::runs::{api_name, Outcome, Plan, Point};
+use crate::why::WhyPlan;
 use anyhow::Context;
 use std::collections::HashMap;
 use std::path::PathBuf;
@@ -35,7 +37,7 @@ pub struct CompareArgs {
     /// which separates the API from the shader-compiler path.
     #[arg(long)]
     pub gl_spirv: bool,
-    /// Only these experiments (teapot, box, spherelist, accel), comma-separated.
+    /// Only these experiments (teapot, box, spherelist, accel, why), comma-separated.
     #[arg(long, value_delimiter = ',')]
     pub only: Vec<String>,
     /// The tracer's entry points to measure, comma-separated: every point runs
@@ -47,9 +49,10 @@ pub struct CompareArgs {
     pub workgroup: Option<Workgroup>,
 }
 
-/// What `--only` can pick: the three sweeps, and "accel", the runs of "model
-/// only what a scene needs" (variants, specialization constants, BVH).
-pub const ONLY_CHOICES: [&str; 4] = ["teapot", "box", "spherelist", "accel"];
+/// What `--only` can pick: the three sweeps, "accel", the runs of "model
+/// only what a scene needs" (variants, specialization constants, BVH), and
+/// "why", the experiments at each remaining Vulkan/OpenGL gap.
+pub const ONLY_CHOICES: [&str; 5] = ["teapot", "box", "spherelist", "accel", "why"];
 
 /// A preset's sweeps: the study's in full, smaller ones for software drivers.
 struct Preset {
@@ -60,6 +63,7 @@ struct Preset {
     spherelist_side: u32,
     frames: u32,
     seconds_per_point: f64,
+    why: WhyPlan,
 }
 
 impl Preset {
@@ -73,6 +77,14 @@ impl Preset {
                 spherelist_side: 100,
                 frames: 8,
                 seconds_per_point: 8.0,
+                // A brute-force teapot costs seconds a frame on a CPU even at 40².
+                why: WhyPlan {
+                    box_side: 100,
+                    teapot_side: 16,
+                    frames: 4,
+                    seconds_per_point: 4.0,
+                    rounds: 1,
+                },
             }
         } else {
             Preset {
@@ -83,6 +95,13 @@ impl Preset {
                 spherelist_side: 300,
                 frames: 60,
                 seconds_per_point: 30.0,
+                why: WhyPlan {
+                    box_side: 1000,
+                    teapot_side: 1000,
+                    frames: 60,
+                    seconds_per_point: 30.0,
+                    rounds: 2,
+                },
             }
         }
     }
@@ -99,7 +118,8 @@ pub fn plan(args: &CompareArgs) -> anyhow::Result<Plan> {
     for e in &args.only {
         if !ONLY_CHOICES.contains(&e.as_str()) {
             return Err(twinray_common::error::bad_input(format!(
-                "--only '{e}' is not an experiment (teapot, box, spherelist, accel)"
+                "--only '{e}' is not an experiment ({})",
+                ONLY_CHOICES.join(", ")
             )));
         }
     }
@@ -145,7 +165,7 @@ pub fn plan(args: &CompareArgs) -> anyhow::Result<Plan> {
 }
 
 /// Software rasterisers (Mesa's lavapipe/llvmpipe, SwiftShader) get the quick preset.
-fn is_software(device: &str) -> bool {
+pub fn is_software(device: &str) -> bool {
     let d = device.to_lowercase();
     ["llvmpipe", "lavapipe", "softpipe", "swiftshader"]
         .iter()
@@ -172,19 +192,21 @@ pub fn run(args: &CompareArgs) -> anyhow::Result<()> {
     }
     let apis = if args.gl_spirv { 3 } else { 2 };
     let runs = apis * paths.len();
-    let (outcomes, interrupted) = sweep(args, &plan, &paths, &stop);
+    let (outcomes, mut interrupted) = sweep(args, &plan, &paths, &stop);
     let accel = if interrupted || !(args.only.is_empty() || args.only.iter().any(|o| o == "accel"))
     {
         Vec::new()
     } else {
         crate::accel::acceleration(&plan, &stop)
     };
-    let agreement = if interrupted || stop.load(Ordering::SeqCst) {
+    // `--only why` alone runs the why step and nothing else.
+    let only_why = !args.only.is_empty() && args.only.iter().all(|o| o == "why");
+    let agreement = if only_why || interrupted || stop.load(Ordering::SeqCst) {
         Vec::new()
     } else {
         crate::agreement::agreement(&args.out, &plan, &paths, args.workgroup, &stop)
     };
-    let shader_rows = if interrupted || stop.load(Ordering::SeqCst) {
+    let shader_rows = if only_why || interrupted || stop.load(Ordering::SeqCst) {
         Vec::new()
     } else {
         crate::shaders::collect(&args.out, &paths, &stop)
@@ -198,6 +220,12 @@ pub fn run(args: &CompareArgs) -> anyhow::Result<()> {
     };
     crate::report::write_all(&args.out, &results)?;
     crate::shaders::append_to_report(&args.out.join("report.md"), &shader_rows)?;
+    let why_wanted = args.only.is_empty() || args.only.iter().any(|o| o == "why");
+    if why_wanted && !interrupted && !stop.load(Ordering::SeqCst) {
+        let why = crate::why::run(&args.out, &Preset::of(args.quick).why, &paths, &stop);
+        crate::report::why::write(&args.out, &why)?;
+        interrupted = stop.load(Ordering::SeqCst);
+    }
     eprintln!(
         "twinray compare: {} of {} runs done{}; report: {}",
         outcomes.iter().filter(|o| o.result.is_ok()).count(),

@@ -13,6 +13,7 @@ mod report;
 mod runs;
 mod shaders;
 mod study;
+mod why;
 
 use clap::{Parser, Subcommand};
 use twinray_common::cli::{named_in_env, RenderArgs};

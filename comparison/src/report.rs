@@ -9,6 +9,7 @@ mod csv;
 pub mod plots;
 mod summary;
 mod tables;
+pub mod why;
 
 use crate::runs::{Outcome, Results, EXPERIMENTS};
 use crate::study::{self, StudyRow};

@@ -1,13 +1,15 @@
 //! What a comparison runs and what each run gave back: the plan of points,
 //! every API's outcome at a point, the runs of "model only what a scene
-//! needs", the image agreement, and the API names every output prints. The
+//! needs", the image agreement, the gaps and the experiments that explain
+//! them, and the API names every output prints. The
 //! runner (compare.rs, accel.rs, agreement.rs) fills these in and the report
 //! reads them, so neither imports the other.
 
 use crate::apps::Api;
-use twinray_common::cli::{RenderPath, Size};
+use twinray_common::cli::{Experiment, RenderPath, Size};
 use twinray_common::reference::metrics::Metrics;
 use twinray_common::report::RunReport;
+use twinray_common::scene::accel::Accel;
 
 /// The study's three experiments, in the order every output lists them.
 pub const EXPERIMENTS: [&str; 3] = ["teapot", "box", "spherelist"];
@@ -104,6 +106,65 @@ pub fn overrides(set: &[String]) -> Vec<(String, String)> {
         .filter_map(|kv| kv.split_once('='))
         .map(|(k, v)| (k.into(), v.into()))
         .collect()
+}
+
+/// What a gap is a gap in.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum GapMeasure {
+    /// Vulkan's median frame time over OpenGL's.
+    Ratio,
+    /// The share of pixels on which Vulkan's and OpenGL's images agree within 1/255.
+    Agreement,
+}
+
+/// A point where the two APIs differ: one scene, accel and path, at the
+/// preset's size for that scene.
+#[derive(Debug, Clone, Copy)]
+pub struct Gap {
+    pub name: &'static str,
+    pub scene: &'static str,
+    pub accel: Accel,
+    pub path: RenderPath,
+    pub measure: GapMeasure,
+}
+
+/// One candidate cause of a gap: what each API runs instead of its default.
+/// `opengl` names the OpenGL front door: `Api::OpenglSpirv` runs Vulkan's SPIR-V.
+#[derive(Debug, Clone, Copy)]
+pub struct Case {
+    pub gap: &'static Gap,
+    pub vulkan: &'static [Experiment],
+    pub opengl: &'static [Experiment],
+    pub opengl_api: Api,
+}
+
+/// A gap's figure (VK/GL ratio or % of pixels within 1/255) by default and
+/// with the experiment, and the times behind a ratio.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct WhyFigures {
+    pub before: f64,
+    pub after: f64,
+    /// "GPU" or "wall" for a ratio (GPU where all four runs have a timer), "image" for agreement.
+    pub clock: &'static str,
+    /// Median ms: Vulkan and OpenGL by default, then with the experiment (ratios only).
+    pub ms: Option<[f64; 4]>,
+}
+
+/// One case as measured: at which size, and its figures or why there are none
+/// ("not run: ..." or "failed: ...").
+#[derive(Debug, Clone)]
+pub struct WhyRow {
+    pub case: Case,
+    pub size: Size,
+    pub result: Result<WhyFigures, String>,
+}
+
+/// The why step's rows, and whether they came from a software driver (whose
+/// ratios say nothing about GPUs).
+#[derive(Debug, Clone, Default)]
+pub struct Why {
+    pub rows: Vec<WhyRow>,
+    pub software: bool,
 }
 
 /// Everything one `twinray compare` measured: what its report is written from.
