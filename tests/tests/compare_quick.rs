@@ -1,6 +1,7 @@
 //! `twinray compare --quick` end to end on whatever driver is installed: it
 //! finishes, and results.csv holds every API × experiment × point, all ok, with
-//! the report, the plots and the agreement images beside it.
+//! the report, the plots and the agreement images beside it, and the why
+//! step's table and why.csv hold a computed verdict for every gap × experiment.
 
 use std::collections::BTreeSet;
 use twinray_tests::{bin, run, scratch};
@@ -107,5 +108,92 @@ fn quick_comparison_writes_every_api_experiment_and_point() {
             assert!(dir.join(f).exists(), "{} missing", dir.join(f).display());
         }
     }
+    why_table_has_a_verdict_per_gap_and_experiment(&report, &out);
     std::fs::remove_dir_all(out).ok();
+}
+
+fn why_table_has_a_verdict_per_gap_and_experiment(report: &str, out: &std::path::Path) {
+    let section = report
+        .split("## Why the gaps")
+        .nth(1)
+        .expect("the report has the why section");
+    assert!(
+        section.contains("say nothing about GPUs"),
+        "a software driver's why table says what its ratios are worth: {section}"
+    );
+    let table: Vec<&str> = section
+        .lines()
+        .filter(|l| l.starts_with("| ") && !l.starts_with("| gap"))
+        .collect();
+    let csv = std::fs::read_to_string(out.join("why.csv")).unwrap();
+    let mut lines = csv.lines();
+    let header: Vec<&str> = lines.next().unwrap().split(',').collect();
+    assert_eq!(
+        header,
+        [
+            "gap",
+            "scene",
+            "accel",
+            "path",
+            "size",
+            "measure",
+            "experiment",
+            "clock",
+            "default_value",
+            "experiment_value",
+            "share_closed",
+            "vulkan_ms_default",
+            "opengl_ms_default",
+            "vulkan_ms_experiment",
+            "opengl_ms_experiment",
+            "verdict",
+            "status"
+        ]
+    );
+    let rows: Vec<Vec<&str>> = lines.map(|l| l.split(',').collect()).collect();
+    assert_eq!(rows.len(), table.len(), "one CSV row per table row");
+    let col = |name: &str| header.iter().position(|h| *h == name).unwrap();
+    let verdicts = [
+        "no gap to explain",
+        "closes the gap",
+        "no effect",
+        "explains ",
+        "widens the gap by ",
+        "reverses the gap",
+    ];
+    let mut experiments = String::new();
+    for (row, line) in rows.iter().zip(&table) {
+        assert_eq!(row.len(), header.len(), "{row:?}");
+        let status = row[col("status")];
+        let experiment = row[col("experiment")];
+        experiments.push_str(experiment);
+        if status.starts_with("not run: glslangValidator not on PATH") {
+            assert!(experiment.contains("glslang"), "{row:?}");
+            continue;
+        }
+        assert_eq!(status, "ok", "{row:?}");
+        let verdict = row[col("verdict")];
+        assert!(verdicts.iter().any(|v| verdict.starts_with(v)), "{verdict}");
+        assert!(line.ends_with(&format!("| {verdict} |")), "{line}");
+        let value = |c: &str| row[col(c)].parse::<f64>().unwrap();
+        let (before, after) = (value("default_value"), value("experiment_value"));
+        if row[col("clock")] == "image" {
+            assert!((0.0..=100.0).contains(&before) && (0.0..=100.0).contains(&after));
+        } else {
+            // The ratio is the times behind it.
+            let ratio = value("vulkan_ms_default") / value("opengl_ms_default");
+            assert!((ratio / before - 1.0).abs() < 1e-9, "{row:?}");
+        }
+    }
+    for e in [
+        "glslang",
+        "no-loop-bounding",
+        "opengl-spirv",
+        "stackless-bvh",
+        "unpaired-bvh-stack",
+        "no-contraction",
+        "float-controls",
+    ] {
+        assert!(experiments.contains(e), "no why row for {e}");
+    }
 }
