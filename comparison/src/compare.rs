@@ -83,7 +83,7 @@ impl Preset {
                     teapot_side: 16,
                     frames: 4,
                     seconds_per_point: 4.0,
-                    rounds: 1,
+                    rounds: 2,
                 },
             }
         } else {

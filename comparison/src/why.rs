@@ -86,6 +86,7 @@ pub const CASES: &[Case] = &[
     gl_spirv(&TEAPOT_FRAGMENT),
     both(&TEAPOT_BVH_COMPUTE, &[Experiment::StacklessBvh]),
     both(&TEAPOT_BVH_COMPUTE, &[Experiment::UnpairedBvhStack]),
+    both(&TEAPOT_BVH_COMPUTE, &[Experiment::OneQuery]),
     both(&BOX_IMAGES, &[Experiment::NoContraction]),
     vulkan(&BOX_IMAGES, &[Experiment::NoContraction]),
     vulkan(&BOX_IMAGES, &[Experiment::FloatControls]),
@@ -180,7 +181,8 @@ pub fn run(out: &Path, plan: &WhyPlan, paths: &[RenderPath], stop: &AtomicBool) 
             .filter(|c| std::ptr::eq(c.gap, gap))
             .copied()
             .collect();
-        let mut order: Vec<Run> = Vec::new();
+        // Every case is read against the defaults, whether a case runs them or not.
+        let mut order: Vec<Run> = vec![(Api::Vulkan, &[]), (Api::Opengl, &[])];
         for run in cases.iter().flat_map(runs_of) {
             if !order.contains(&run) {
                 order.push(run);
@@ -193,7 +195,13 @@ pub fn run(out: &Path, plan: &WhyPlan, paths: &[RenderPath], stop: &AtomicBool) 
         for case in cases {
             let result = figures(gap, &case, &measured, &dir);
             if let Err(e) = &result {
-                eprintln!("  {} / {}: {e}", gap.name, run_label(runs_of(&case)[0]));
+                let [vk, gl] = runs_of(&case);
+                eprintln!(
+                    "  {} / {} + {}: {e}",
+                    gap.name,
+                    run_label(vk),
+                    run_label(gl)
+                );
             }
             why.rows.push(WhyRow { case, size, result });
         }

@@ -89,8 +89,12 @@ pub fn agreement_verdict(before: f64, after: f64) -> Verdict {
     }
 }
 
-/// The share of the gap closed, as a number (above 1 past closing; negative when it widened).
+/// The share of the gap closed, as a number (above 1 past closing; negative
+/// when it widened); none where there is no gap to share.
 fn closed_share(measure: GapMeasure, before: f64, after: f64) -> Option<f64> {
+    if verdict(measure, before, after) == Verdict::NoGap {
+        return None;
+    }
     let (g0, g1) = match measure {
         GapMeasure::Ratio => (before - 1.0, after - 1.0),
         GapMeasure::Agreement => (100.0 - before, 100.0 - after),
@@ -302,5 +306,6 @@ mod tests {
         let s = closed_share(GapMeasure::Ratio, 1.2, 0.9).unwrap();
         assert!((s - 1.5).abs() < 1e-12);
         assert_eq!(closed_share(GapMeasure::Agreement, 100.0, 100.0), None);
+        assert_eq!(closed_share(GapMeasure::Ratio, 1.002, 0.97), None, "no gap");
     }
 }
