@@ -193,7 +193,7 @@ pub fn markdown(why: &Why) -> String {
     let mut s = String::new();
     let _ = writeln!(
         s,
-        "## Why the gaps\n\nAt each gap point the default and each experiment that isolates one candidate cause, \
+        "\n## Why the gaps\n\nAt each gap point the default and each experiment that isolates one candidate cause, \
          in fresh processes with the order alternating (`why.csv` has the times). Verdicts follow from the figures: \
          a VK/GL ratio within {:.0} % of 1 is no gap (by default) or a closed gap (with the experiment); an experiment \
          that moves the ratio, or the disagreeing pixels, by less than {:.0} % of itself has no effect; otherwise it \
