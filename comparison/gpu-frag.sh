@@ -23,10 +23,9 @@ points=(
     "--scene box --size 1000x1000 --accel none --frames 60"
     "--scene teapot --size 1000x1000 --accel bvh --frames 60"
 )
-for round in 1 2; do
-    if [ $round = 1 ]; then apps=(vk gl); else apps=(gl vk); fi
+for order in "vk gl" "gl vk"; do
     for c in "${points[@]}"; do
-        for app in "${apps[@]}"; do
+        for app in $order; do
             # shellcheck disable=SC2086
             run default $app $c --path fragment
             for e in quad load-clear rgba8; do
