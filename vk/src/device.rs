@@ -25,6 +25,9 @@ pub struct Device {
     /// "driverName driverInfo" where Vulkan 1.2 can tell us, else the raw driverVersion.
     pub driver: String,
     pub queue_family: u32,
+    /// What the queue family can do: without GRAPHICS (`--experiment
+    /// compute-queue`) no barrier may name a graphics stage.
+    pub queue_flags: vk::QueueFlags,
     /// The queue family's timestampValidBits: 0 means no timestamps on this queue.
     pub timestamp_valid_bits: u32,
     pub device: ash::Device,
@@ -218,6 +221,7 @@ queue family {queue_family}: {flags:?}, timestampValidBits {timestamp_valid_bits
             name: chosen.name.clone(),
             driver: driver_description(instance, chosen),
             queue_family,
+            queue_flags: flags,
             timestamp_valid_bits,
             device,
             queue,
