@@ -5,6 +5,8 @@
 #   - quad: the fullscreen pass as two triangles instead of one oversized one;
 #   - load-clear: the colour target cleared at the start of the pass;
 #   - rgba8: an RGBA8 UNORM target instead of RGBA32F;
+#   - dynamic-viewport (Vulkan): viewport and scissor set while recording, as
+#     OpenGL has them, instead of fixed in the pipeline;
 #   - compute-queue (Vulkan, compute path): a queue family without GRAPHICS.
 # Two rounds in alternating API order, 60 frames a run; about 2 minutes on an
 # H100 (box brute force ~8 ms a frame, teapot BVH ~7 ms).
@@ -35,6 +37,8 @@ for order in "vk gl" "gl vk"; do
             # shellcheck disable=SC2086
             run default $app $c --path compute
             if [ $app = vk ]; then
+                # shellcheck disable=SC2086
+                run dynamic-viewport $app $c --path fragment --experiment dynamic-viewport
                 # shellcheck disable=SC2086
                 run compute-queue $app $c --path compute --experiment compute-queue
             fi

@@ -130,6 +130,10 @@ pub enum Experiment {
     /// Vulkan, compute path: dispatch on a queue family with COMPUTE but not
     /// GRAPHICS (refused where the device has none, and by OpenGL).
     ComputeQueue,
+    /// Vulkan, fragment path: the viewport and scissor as dynamic state set
+    /// in the command buffer (as OpenGL always has them) instead of baked
+    /// into the pipeline.
+    DynamicViewport,
 }
 
 /// The tracer's entry point: the two ways one GLSL tracer reaches the GPU.
@@ -525,7 +529,8 @@ mod tests {
                 "quad",
                 "load-clear",
                 "rgba8",
-                "compute-queue"
+                "compute-queue",
+                "dynamic-viewport"
             ]
         );
         assert_eq!(

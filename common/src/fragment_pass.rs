@@ -1,7 +1,8 @@
 //! The fullscreen pass as the fragment-path experiments shape it (`quad`,
-//! `load-clear`, `rgba8`) and the runs that refuse an experiment of the pass
-//! or of the queue (`compute-queue`): one place, so that Vulkan and OpenGL
-//! draw, clear and read back alike and say the same sentence when they refuse.
+//! `load-clear`, `rgba8`, Vulkan's `dynamic-viewport`) and the runs that
+//! refuse an experiment of the pass or of the queue (`compute-queue`): one
+//! place, so that Vulkan and OpenGL draw, clear and read back alike and say
+//! the same sentence when they refuse.
 
 use crate::cli::{Experiment, RenderArgs, RenderPath};
 use crate::error::bad_input;
@@ -21,6 +22,9 @@ pub struct FragmentPass {
     pub clear: bool,
     /// An RGBA8 UNORM target (the GPU rounds to 8 bits) instead of RGBA32F.
     pub rgba8: bool,
+    /// Vulkan: the viewport and scissor set while recording instead of fixed
+    /// in the pipeline (OpenGL has no other kind).
+    pub dynamic_viewport: bool,
 }
 
 impl FragmentPass {
@@ -29,6 +33,7 @@ impl FragmentPass {
             quad: experiments.contains(&Experiment::Quad),
             clear: experiments.contains(&Experiment::LoadClear),
             rgba8: experiments.contains(&Experiment::Rgba8),
+            dynamic_viewport: experiments.contains(&Experiment::DynamicViewport),
         }
     }
 
@@ -62,18 +67,31 @@ impl FragmentPass {
 
 /// Refuses, in one sentence (exit 2), an experiment this run cannot honour:
 /// the pass's experiments need the headless fragment path, `compute-queue` the
-/// headless compute path in Vulkan (`vulkan` false: OpenGL, which has no queues).
+/// headless compute path; `dynamic-viewport` and `compute-queue` are Vulkan's
+/// alone (`vulkan` false: OpenGL, which has neither queues nor a viewport
+/// fixed in advance).
 pub fn check_experiments(args: &RenderArgs, vulkan: bool) -> anyhow::Result<()> {
     for e in &args.experiment {
         let name = e.name();
-        let path = match e {
-            Experiment::Quad | Experiment::LoadClear | Experiment::Rgba8 => RenderPath::Fragment,
-            Experiment::ComputeQueue if !vulkan => return Err(bad_input(
-                "--experiment compute-queue is Vulkan only: OpenGL has no queues to choose from",
-            )),
-            Experiment::ComputeQueue => RenderPath::Compute,
+        let (path, not_in_opengl) = match e {
+            Experiment::Quad | Experiment::LoadClear | Experiment::Rgba8 => {
+                (RenderPath::Fragment, None)
+            }
+            Experiment::DynamicViewport => (
+                RenderPath::Fragment,
+                Some("OpenGL's viewport is always state set before the draw"),
+            ),
+            Experiment::ComputeQueue => (
+                RenderPath::Compute,
+                Some("OpenGL has no queues to choose from"),
+            ),
             _ => continue,
         };
+        if let (false, Some(why)) = (vulkan, not_in_opengl) {
+            return Err(bad_input(format!(
+                "--experiment {name} is Vulkan only: {why}"
+            )));
+        }
         if args.path != path {
             return Err(bad_input(format!(
                 "--experiment {name} applies to --path {path} only"

@@ -1,5 +1,6 @@
 //! The fragment-path experiments are measurement-only: on lavapipe and
-//! llvmpipe, `quad` and `load-clear` render the default image bit for bit and
+//! llvmpipe, `quad`, `load-clear` and (Vulkan) `dynamic-viewport` render the
+//! default image bit for bit and
 //! `rgba8` within 1/255 (the GPU rounds to 8 bits instead of the CPU), with the
 //! Khronos validation layer / GL debug context silent and the experiment named
 //! in the report's variant. Every run that cannot honour one of them (the
@@ -15,7 +16,11 @@ fn same_image(scene: &str, size: &str, extra: &[&str]) {
     let dir = scratch(&format!("fragment-experiments-{scene}"));
     for app in App::BOTH {
         let (base_report, base) = render(app, scene, size, extra, &dir.join("default.png"));
-        for experiment in ["quad", "load-clear", "rgba8"] {
+        let vulkan_only: &[&str] = match app {
+            App::Vulkan => &["dynamic-viewport"],
+            App::OpenGl => &[],
+        };
+        for &experiment in ["quad", "load-clear", "rgba8"].iter().chain(vulkan_only) {
             let mut args = extra.to_vec();
             args.extend(["--experiment", experiment]);
             let (report, img) = render(app, scene, size, &args, &dir.join("experiment.png"));
@@ -88,6 +93,11 @@ fn runs_that_cannot_honour_an_experiment_refuse_it() {
         App::Vulkan,
         &with(&["--path", "compute", "--experiment", "compute-queue"]),
         "has no compute-only queue family (one with COMPUTE but not GRAPHICS)",
+    );
+    refused(
+        App::OpenGl,
+        &with(&["--experiment", "dynamic-viewport"]),
+        "--experiment dynamic-viewport is Vulkan only: OpenGL's viewport is always state set before the draw",
     );
     refused(
         App::Vulkan,

@@ -169,7 +169,9 @@ fn render_fragment(run: &HeadlessRun, shaders: &Shaders) -> Result<Rendered> {
     let pass = FragmentPass::of(&run.args.experiment);
     let render_pass = RenderPass::offscreen(device, &pass)?;
     let rp = render_pass.render_pass;
-    let resources = SceneResources::new(device, run.gpu_scene, shaders, rp, Some((width, height)))?;
+    // None: a pipeline whose viewport and scissor are set while recording.
+    let fixed_size = (!pass.dynamic_viewport).then_some((width, height));
+    let resources = SceneResources::new(device, run.gpu_scene, shaders, rp, fixed_size)?;
     let (pipeline, descriptors) = (&resources.pipeline, &resources.descriptors);
     let target = Target::new(device, rp, width, height, &pass)?;
     let timestamps = frame_loop.timestamps;

@@ -42,6 +42,11 @@ impl Commands {
     ) -> Result<Commands> {
         // Read only by a pass whose load op is CLEAR (`--experiment load-clear`).
         let clear = [vk::ClearValue::default()];
+        let extent = vk::Extent2D {
+            width: target.width,
+            height: target.height,
+        };
+        let (viewport, scissor) = crate::pipeline::whole(extent);
         let this = Commands::record_with(device, |d, cmd| {
             if let Some(t) = timestamps {
                 t.record_reset(cmd);
@@ -50,17 +55,16 @@ impl Commands {
             let begin = vk::RenderPassBeginInfo::default()
                 .render_pass(render_pass)
                 .framebuffer(target.framebuffer)
-                .render_area(vk::Rect2D {
-                    offset: vk::Offset2D::default(),
-                    extent: vk::Extent2D {
-                        width: target.width,
-                        height: target.height,
-                    },
-                })
+                .render_area(scissor)
                 .clear_values(if pass.clear { &clear } else { &[] });
             // SAFETY: every handle is alive and `cmd` is recording.
             unsafe {
                 d.cmd_begin_render_pass(cmd, &begin, vk::SubpassContents::INLINE);
+                // `--experiment dynamic-viewport`: the pipeline left them dynamic.
+                if pass.dynamic_viewport {
+                    d.cmd_set_viewport(cmd, 0, &[viewport]);
+                    d.cmd_set_scissor(cmd, 0, &[scissor]);
+                }
                 d.cmd_bind_pipeline(cmd, vk::PipelineBindPoint::GRAPHICS, pipeline.pipeline);
                 d.cmd_bind_descriptor_sets(
                     cmd,

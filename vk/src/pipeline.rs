@@ -227,18 +227,8 @@ impl Pipeline {
         // A normal viewport (positive height): Vulkan's row 0 is the top, and the
         // shader builds rays with +y down, so rows go to the PNG unflipped.
         let (width, height) = fixed_size.unwrap_or((1, 1));
-        let viewports = [vk::Viewport {
-            x: 0.0,
-            y: 0.0,
-            width: width as f32,
-            height: height as f32,
-            min_depth: 0.0,
-            max_depth: 1.0,
-        }];
-        let scissors = [vk::Rect2D {
-            offset: vk::Offset2D::default(),
-            extent: vk::Extent2D { width, height },
-        }];
+        let (viewport, scissor) = whole(vk::Extent2D { width, height });
+        let (viewports, scissors) = ([viewport], [scissor]);
         let viewport = vk::PipelineViewportStateCreateInfo::default()
             .viewports(&viewports)
             .scissors(&scissors);
@@ -299,6 +289,23 @@ impl Pipeline {
         );
         Ok(this) // the shader modules are dropped here: the pipeline has its own copy.
     }
+}
+
+/// The viewport and scissor that cover the whole `extent`.
+pub fn whole(extent: vk::Extent2D) -> (vk::Viewport, vk::Rect2D) {
+    let viewport = vk::Viewport {
+        x: 0.0,
+        y: 0.0,
+        width: extent.width as f32,
+        height: extent.height as f32,
+        min_depth: 0.0,
+        max_depth: 1.0,
+    };
+    let scissor = vk::Rect2D {
+        offset: vk::Offset2D::default(),
+        extent,
+    };
+    (viewport, scissor)
 }
 
 impl Drop for Pipeline {
