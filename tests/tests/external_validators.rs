@@ -12,6 +12,7 @@ use std::path::{Path, PathBuf};
 use std::process::Command;
 use std::sync::Mutex;
 use twinray_common::cli::{Experiment, RenderArgs, Size, Workgroup};
+use twinray_common::fragment_pass::QUAD_DEFINE;
 use twinray_common::scene::accel::Accel;
 use twinray_common::scene::numerics::{Numerics, Offset, SphereTest, TriangleTest};
 use twinray_common::scene::{Features, Scene};
@@ -155,6 +156,23 @@ fn glslang_and_spirv_val_accept_every_variant() {
         program: "glslangValidator",
         args: vec!["-V".into(), "--target-env".into(), "vulkan1.0".into()],
         file: vert,
+    });
+    // `--experiment quad`'s two triangles (naga's output of them goes through
+    // the validation layer in tests/tests/fragment_experiments.rs).
+    let quad = write(
+        &dir.join("fullscreen-quad.vert"),
+        build::FULLSCREEN_VERT.as_bytes(),
+    );
+    jobs.push(Job {
+        what: "vertex source, quad".into(),
+        program: "glslangValidator",
+        args: vec![
+            "-V".into(),
+            "--target-env".into(),
+            "vulkan1.0".into(),
+            format!("-D{QUAD_DEFINE}=1"),
+        ],
+        file: quad,
     });
     let list = variants();
     let mut fragment_sources = 0;
