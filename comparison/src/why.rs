@@ -11,6 +11,7 @@ use std::ffi::OsStr;
 use std::path::Path;
 use std::sync::atomic::{AtomicBool, Ordering};
 use twinray_common::cli::{Experiment, RenderArgs, RenderPath, Size};
+use twinray_common::error::{Failure, FailureKind};
 use twinray_common::reference::image_io::load_png;
 use twinray_common::reference::metrics;
 use twinray_common::report::RunReport;
@@ -22,6 +23,13 @@ const BOX_FRAGMENT: Gap = Gap {
     scene: "box",
     accel: Accel::None,
     path: RenderPath::Fragment,
+    measure: GapMeasure::Ratio,
+};
+const BOX_COMPUTE: Gap = Gap {
+    name: "box brute compute",
+    scene: "box",
+    accel: Accel::None,
+    path: RenderPath::Compute,
     measure: GapMeasure::Ratio,
 };
 const TEAPOT_FRAGMENT: Gap = Gap {
@@ -81,6 +89,11 @@ pub const CASES: &[Case] = &[
     vulkan(&BOX_FRAGMENT, &[Experiment::Glslang]),
     vulkan(&BOX_FRAGMENT, &[Experiment::NoLoopBounding]),
     gl_spirv(&BOX_FRAGMENT),
+    both(&BOX_FRAGMENT, &[Experiment::Quad]),
+    both(&BOX_FRAGMENT, &[Experiment::LoadClear]),
+    both(&BOX_FRAGMENT, &[Experiment::Rgba8]),
+    vulkan(&BOX_FRAGMENT, &[Experiment::DynamicViewport]),
+    vulkan(&BOX_COMPUTE, &[Experiment::ComputeQueue]),
     vulkan(&TEAPOT_FRAGMENT, &[Experiment::Glslang]),
     vulkan(&TEAPOT_FRAGMENT, &[Experiment::NoLoopBounding]),
     gl_spirv(&TEAPOT_FRAGMENT),
@@ -275,13 +288,24 @@ fn measure(
                         experiment: run.1.to_vec(),
                         ..base.clone()
                     };
-                    run_json(run.0, &args).map_err(|e| format!("failed: {e:#}"))
+                    run_json(run.0, &args).map_err(|e| refused_or_failed(run, &e))
                 }
             };
             measured.entry(label).or_default().push(result);
         }
     }
     measured
+}
+
+/// Why a run gave no report: an experiment the app refuses on this device
+/// (its one sentence, exit 2) was not run; anything else failed.
+fn refused_or_failed(run: Run, e: &anyhow::Error) -> String {
+    match e.downcast_ref::<Failure>() {
+        Some(f) if f.kind == FailureKind::BadInput && !run.1.is_empty() => {
+            format!("not run: {}", f.message)
+        }
+        _ => format!("failed: {e:#}"),
+    }
 }
 
 /// The median over rounds of each round's median: GPU ms with `gpu`, else wall ms.

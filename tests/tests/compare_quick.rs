@@ -167,8 +167,13 @@ fn why_table_has_a_verdict_per_gap_and_experiment(report: &str, out: &std::path:
         let status = row[col("status")];
         let experiment = row[col("experiment")];
         experiments.push_str(experiment);
-        if status.starts_with("not run: glslangValidator not on PATH") {
-            assert!(experiment.contains("glslang"), "{row:?}");
+        // glslangValidator missing, or an experiment this device refuses
+        // (lavapipe has no compute-only queue): the row says so.
+        if status.starts_with("not run: ") {
+            assert!(
+                experiment.contains("glslang") || experiment.contains("compute-queue"),
+                "{row:?}"
+            );
             continue;
         }
         assert_eq!(status, "ok", "{row:?}");
@@ -194,6 +199,11 @@ fn why_table_has_a_verdict_per_gap_and_experiment(report: &str, out: &std::path:
         "one-query",
         "no-contraction",
         "float-controls",
+        "quad",
+        "load-clear",
+        "rgba8",
+        "dynamic-viewport",
+        "compute-queue",
     ] {
         assert!(experiments.contains(e), "no why row for {e}");
     }
