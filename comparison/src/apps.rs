@@ -172,6 +172,15 @@ pub fn render(api: Api, args: &RenderArgs) -> anyhow::Result<()> {
     }
 }
 
+/// Software rasterisers (Mesa's lavapipe/llvmpipe, SwiftShader): they get the
+/// quick preset, and their ratios say nothing about GPUs.
+pub fn is_software(device: &str) -> bool {
+    let d = device.to_lowercase();
+    ["llvmpipe", "lavapipe", "softpipe", "swiftshader"]
+        .iter()
+        .any(|s| d.contains(s))
+}
+
 /// Runs an app with `--json` and returns its report; a failure carries the app's own message and exit code.
 pub fn run_json(api: Api, args: &RenderArgs) -> anyhow::Result<RunReport> {
     let bin = api.binary().expect("an app");

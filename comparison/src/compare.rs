@@ -3,7 +3,7 @@
 //! processes with the API order alternating, then results.csv, report.md and
 //! plots, and the why step's experiments at each remaining gap (why.rs).
 
-use crate::apps::{run_json, Api};
+use crate::apps::{is_software, run_json, Api};
 use crate::runs::{api_name, Outcome, Plan, Point};
 use crate::why::WhyPlan;
 use anyhow::Context;
@@ -162,14 +162,6 @@ pub fn plan(args: &CompareArgs) -> anyhow::Result<Plan> {
         seconds_per_point: args.seconds_per_point.unwrap_or(preset.seconds_per_point),
         preset: preset.name,
     })
-}
-
-/// Software rasterisers (Mesa's lavapipe/llvmpipe, SwiftShader) get the quick preset.
-pub fn is_software(device: &str) -> bool {
-    let d = device.to_lowercase();
-    ["llvmpipe", "lavapipe", "softpipe", "swiftshader"]
-        .iter()
-        .any(|s| d.contains(s))
 }
 
 pub fn run(args: &CompareArgs) -> anyhow::Result<()> {
