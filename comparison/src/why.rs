@@ -54,34 +54,34 @@ const BOX_IMAGES: Gap = Gap {
     measure: GapMeasure::Agreement,
 };
 
-/// Vulkan alone runs the experiment; OpenGL as shipped.
-const fn vulkan(gap: &'static Gap, e: &'static [Experiment]) -> Case {
+/// What each API runs at `gap` instead of its default.
+const fn case(
+    gap: &'static Gap,
+    vulkan: &'static [Experiment],
+    opengl: &'static [Experiment],
+    opengl_api: Api,
+) -> Case {
     Case {
         gap,
-        vulkan: e,
-        opengl: &[],
-        opengl_api: Api::Opengl,
+        vulkan,
+        opengl,
+        opengl_api,
     }
+}
+
+/// Vulkan alone runs the experiment; OpenGL as shipped.
+const fn vulkan(gap: &'static Gap, e: &'static [Experiment]) -> Case {
+    case(gap, e, &[], Api::Opengl)
 }
 
 /// Both APIs run the experiment.
 const fn both(gap: &'static Gap, e: &'static [Experiment]) -> Case {
-    Case {
-        gap,
-        vulkan: e,
-        opengl: e,
-        opengl_api: Api::Opengl,
-    }
+    case(gap, e, e, Api::Opengl)
 }
 
 /// OpenGL runs naga's SPIR-V (`--gl-spirv`), the very binary Vulkan runs.
 const fn gl_spirv(gap: &'static Gap) -> Case {
-    Case {
-        gap,
-        vulkan: &[],
-        opengl: &[],
-        opengl_api: Api::OpenglSpirv,
-    }
+    case(gap, &[], &[], Api::OpenglSpirv)
 }
 
 /// Every gap × experiment the step measures, in the report's order.
