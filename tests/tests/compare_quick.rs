@@ -151,7 +151,15 @@ fn why_table_has_a_verdict_per_gap_and_experiment(report: &str, out: &std::path:
             "status"
         ]
     );
-    let rows: Vec<Vec<&str>> = lines.map(|l| l.split(',').collect()).collect();
+    // Status is the last column and the only one that may hold a comma (an
+    // app's sentence naming a device), so the split stops before it.
+    let rows: Vec<Vec<&str>> = lines
+        .map(|l| {
+            l.splitn(header.len(), ',')
+                .map(|f| f.trim_matches('"'))
+                .collect()
+        })
+        .collect();
     assert_eq!(rows.len(), table.len(), "one CSV row per table row");
     let col = |name: &str| header.iter().position(|h| *h == name).unwrap();
     let verdicts = [
