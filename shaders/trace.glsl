@@ -274,7 +274,11 @@ vec3 hit_triangle(TriRay r, Triangle tri, float t_min, float t_max) {
     float tz = eu * (r.s.z * a[r.k.z]) + ev * (r.s.z * b[r.k.z]) + ew * (r.s.z * c[r.k.z]);
     float inv = 1.0 / det;
     float t = tz * inv;
-    if (!(t > t_min && t < t_max) || is_degenerate(tri)) {
+    // Two ifs, not `||`: naga would test for degeneracy on every call.
+    if (!(t > t_min && t < t_max)) {
+        return miss;
+    }
+    if (is_degenerate(tri)) {
         return miss;
     }
     return vec3(t, ev * inv, ew * inv);
@@ -299,7 +303,11 @@ vec3 hit_triangle(TriRay r, Triangle tri, float t_min, float t_max) {
         return miss;
     }
     float t = dot(e2, qv) * inv;
-    if (!(t > t_min && t < t_max) || is_degenerate(tri)) {
+    // Two ifs, not `||`: naga would test for degeneracy on every call.
+    if (!(t > t_min && t < t_max)) {
+        return miss;
+    }
+    if (is_degenerate(tri)) {
         return miss;
     }
     return vec3(t, u, v);
@@ -495,8 +503,11 @@ Hit traverse(vec3 origin, vec3 dir, float t_max, bool any_hit) {
             state = FROM_PARENT;
             continue;
         }
-        if (enter && hit_leaf(h, origin, dir, ray, bvh_buf.nodes[node].left_or_first, count, any_hit)) {
-            return h;
+        // Nested, not `&&`: naga would test the leaf of every box, entered or not.
+        if (enter) {
+            if (hit_leaf(h, origin, dir, ray, bvh_buf.nodes[node].left_or_first, count, any_hit)) {
+                return h;
+            }
         }
         // Done with this subtree: the far sibling is next after the near
         // child, the parent after the far one.
@@ -619,12 +630,21 @@ Hit closest_hit_brute(vec3 origin, vec3 dir) {
     return h;
 }
 
+// naga's GLSL front end does not short-circuit && and ||: whatever stands
+// right of them is evaluated every time (gfx-rs/wgpu#4394). A guard against
+// reading past the end of a buffer, or against a costly call, must be an `if`.
 bool sphere_blocks(vec3 origin, vec3 dir, float dist, uint i) {
-    return i < SPHERE_COUNT && hit_sphere(origin, dir, sphere_buf.spheres[i], 0.0, dist) > 0.0;
+    if (i >= SPHERE_COUNT) {
+        return false;
+    }
+    return hit_sphere(origin, dir, sphere_buf.spheres[i], 0.0, dist) > 0.0;
 }
 
 bool triangle_blocks(TriRay ray, float dist, uint i) {
-    return i < TRIANGLE_COUNT && hit_triangle(ray, triangle_buf.triangles[i], 0.0, dist).x > 0.0;
+    if (i >= TRIANGLE_COUNT) {
+        return false;
+    }
+    return hit_triangle(ray, triangle_buf.triangles[i], 0.0, dist).x > 0.0;
 }
 
 // Shadow rays need any hit before the light, not the closest one.
@@ -632,8 +652,16 @@ bool occluded_brute(vec3 origin, vec3 dir, float dist) {
 #ifdef HAS_SPHERES
     SPEC(SPEC_SPHERES) {
         for (uint i = 0u; i < SPHERE_COUNT; i += PRIMS_PER_ITERATION) {
-            if (sphere_blocks(origin, dir, dist, i) || sphere_blocks(origin, dir, dist, i + 1u)
-                || sphere_blocks(origin, dir, dist, i + 2u) || sphere_blocks(origin, dir, dist, i + 3u)) {
+            if (sphere_blocks(origin, dir, dist, i)) {
+                return true;
+            }
+            if (sphere_blocks(origin, dir, dist, i + 1u)) {
+                return true;
+            }
+            if (sphere_blocks(origin, dir, dist, i + 2u)) {
+                return true;
+            }
+            if (sphere_blocks(origin, dir, dist, i + 3u)) {
                 return true;
             }
         }
@@ -643,8 +671,16 @@ bool occluded_brute(vec3 origin, vec3 dir, float dist) {
     SPEC(SPEC_TRIANGLES) {
         TriRay ray = tri_ray(origin, dir);
         for (uint i = 0u; i < TRIANGLE_COUNT; i += PRIMS_PER_ITERATION) {
-            if (triangle_blocks(ray, dist, i) || triangle_blocks(ray, dist, i + 1u)
-                || triangle_blocks(ray, dist, i + 2u) || triangle_blocks(ray, dist, i + 3u)) {
+            if (triangle_blocks(ray, dist, i)) {
+                return true;
+            }
+            if (triangle_blocks(ray, dist, i + 1u)) {
+                return true;
+            }
+            if (triangle_blocks(ray, dist, i + 2u)) {
+                return true;
+            }
+            if (triangle_blocks(ray, dist, i + 3u)) {
                 return true;
             }
         }

@@ -33,12 +33,21 @@ Hit closest_hit_brute(vec3 origin, vec3 dir) {
     return h;
 }
 
+// naga's GLSL front end does not short-circuit && and ||: whatever stands
+// right of them is evaluated every time (gfx-rs/wgpu#4394). A guard against
+// reading past the end of a buffer, or against a costly call, must be an `if`.
 bool sphere_blocks(vec3 origin, vec3 dir, float dist, uint i) {
-    return i < SPHERE_COUNT && hit_sphere(origin, dir, sphere_buf.spheres[i], 0.0, dist) > 0.0;
+    if (i >= SPHERE_COUNT) {
+        return false;
+    }
+    return hit_sphere(origin, dir, sphere_buf.spheres[i], 0.0, dist) > 0.0;
 }
 
 bool triangle_blocks(TriRay ray, float dist, uint i) {
-    return i < TRIANGLE_COUNT && hit_triangle(ray, triangle_buf.triangles[i], 0.0, dist).x > 0.0;
+    if (i >= TRIANGLE_COUNT) {
+        return false;
+    }
+    return hit_triangle(ray, triangle_buf.triangles[i], 0.0, dist).x > 0.0;
 }
 
 // Shadow rays need any hit before the light, not the closest one.
@@ -46,8 +55,16 @@ bool occluded_brute(vec3 origin, vec3 dir, float dist) {
 #ifdef HAS_SPHERES
     SPEC(SPEC_SPHERES) {
         for (uint i = 0u; i < SPHERE_COUNT; i += PRIMS_PER_ITERATION) {
-            if (sphere_blocks(origin, dir, dist, i) || sphere_blocks(origin, dir, dist, i + 1u)
-                || sphere_blocks(origin, dir, dist, i + 2u) || sphere_blocks(origin, dir, dist, i + 3u)) {
+            if (sphere_blocks(origin, dir, dist, i)) {
+                return true;
+            }
+            if (sphere_blocks(origin, dir, dist, i + 1u)) {
+                return true;
+            }
+            if (sphere_blocks(origin, dir, dist, i + 2u)) {
+                return true;
+            }
+            if (sphere_blocks(origin, dir, dist, i + 3u)) {
                 return true;
             }
         }
@@ -57,8 +74,16 @@ bool occluded_brute(vec3 origin, vec3 dir, float dist) {
     SPEC(SPEC_TRIANGLES) {
         TriRay ray = tri_ray(origin, dir);
         for (uint i = 0u; i < TRIANGLE_COUNT; i += PRIMS_PER_ITERATION) {
-            if (triangle_blocks(ray, dist, i) || triangle_blocks(ray, dist, i + 1u)
-                || triangle_blocks(ray, dist, i + 2u) || triangle_blocks(ray, dist, i + 3u)) {
+            if (triangle_blocks(ray, dist, i)) {
+                return true;
+            }
+            if (triangle_blocks(ray, dist, i + 1u)) {
+                return true;
+            }
+            if (triangle_blocks(ray, dist, i + 2u)) {
+                return true;
+            }
+            if (triangle_blocks(ray, dist, i + 3u)) {
                 return true;
             }
         }

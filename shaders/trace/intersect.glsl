@@ -118,7 +118,11 @@ vec3 hit_triangle(TriRay r, Triangle tri, float t_min, float t_max) {
     float tz = eu * (r.s.z * a[r.k.z]) + ev * (r.s.z * b[r.k.z]) + ew * (r.s.z * c[r.k.z]);
     float inv = 1.0 / det;
     float t = tz * inv;
-    if (!(t > t_min && t < t_max) || is_degenerate(tri)) {
+    // Two ifs, not `||`: naga would test for degeneracy on every call.
+    if (!(t > t_min && t < t_max)) {
+        return miss;
+    }
+    if (is_degenerate(tri)) {
         return miss;
     }
     return vec3(t, ev * inv, ew * inv);
@@ -143,7 +147,11 @@ vec3 hit_triangle(TriRay r, Triangle tri, float t_min, float t_max) {
         return miss;
     }
     float t = dot(e2, qv) * inv;
-    if (!(t > t_min && t < t_max) || is_degenerate(tri)) {
+    // Two ifs, not `||`: naga would test for degeneracy on every call.
+    if (!(t > t_min && t < t_max)) {
+        return miss;
+    }
+    if (is_degenerate(tri)) {
         return miss;
     }
     return vec3(t, u, v);
