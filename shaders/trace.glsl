@@ -154,6 +154,26 @@ layout(std430, set = 0, binding = 8) readonly buffer BvhLinks {
 
 const float T_MAX = 1.0e30;
 
+#ifdef COUNT_RAYS
+// The counting variant (COUNT_RAYS: one untimed frame, never the timed shader)
+// counts each pixel's rays by kind in `rays_traced` and stores them in the
+// pixel's own slot; the apps add the slots up. A slot per pixel needs no
+// atomics, which naga's GLSL front end does not parse.
+struct RayCount {
+    uint primary;
+    uint shadow;
+    uint mirror;           // reflected from a surface that is not glass
+    uint glass_reflected;
+    uint glass_refracted;
+};
+
+layout(std430, set = 0, binding = 10) buffer RayCounts {
+    RayCount pixels[];
+} ray_count_buf;
+
+RayCount rays_traced;
+#endif
+
 // trace/intersect.glsl — where one ray meets one sphere or one triangle, and
 // the per-primitive steps that the brute-force loops and the BVH leaves share.
 
@@ -664,6 +684,9 @@ Hit closest_hit(vec3 origin, vec3 dir) {
 }
 
 bool occluded(vec3 origin, vec3 dir, float dist) {
+#ifdef COUNT_RAYS
+    rays_traced.shadow += 1u;
+#endif
 #ifdef USE_BVH
     return traverse(origin, dir, dist, true).kind != 0u;
 #else
@@ -895,6 +918,9 @@ vec3 trace(vec3 origin, vec3 dir) {
                         st_weight[sp] = wt;
                         st_depth[sp] = depth + 1u;
                         sp += 1;
+#ifdef COUNT_RAYS
+                        rays_traced.glass_refracted += 1u;
+#endif
                     }
                 }
             }
@@ -907,6 +933,13 @@ vec3 trace(vec3 origin, vec3 dir) {
                 st_weight[sp] = wr;
                 st_depth[sp] = depth + 1u;
                 sp += 1;
+#ifdef COUNT_RAYS
+                if (m.transparency > 0.0) {
+                    rays_traced.glass_reflected += 1u;
+                } else {
+                    rays_traced.mirror += 1u;
+                }
+#endif
             }
         }
 #endif

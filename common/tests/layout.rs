@@ -156,6 +156,29 @@ fn naga_layout_matches_rust_for_every_shader_struct() {
     let (_, stride) = prims.expect("BVH primitives are a runtime array");
     assert_eq!(stride, 4, "BVH primitive stride");
 
+    // Declared by the counting variant only.
+    let (counting, _) = parse(
+        &fragment_source(),
+        naga::ShaderStage::Fragment,
+        &Variant::generic(Default::default()).counting(),
+    )
+    .unwrap();
+    let (_, count) = block(&counting, binding::RAY_COUNTS);
+    let (ty, stride) = count.expect("ray counts are a runtime array");
+    assert_eq!(stride as usize, size_of::<GpuRayCount>(), "RayCount stride");
+    check(
+        "RayCount",
+        naga_members(&counting, ty),
+        rust_offsets!(GpuRayCount {
+            primary,
+            shadow,
+            mirror,
+            glass_reflected,
+            glass_refracted
+        }),
+        size_of::<GpuRayCount>(),
+    );
+
     let (_, light) = block(&module, binding::LIGHTS);
     let (ty, stride) = light.expect("lights is a runtime array");
     assert_eq!(stride as usize, size_of::<GpuLight>(), "Light stride");

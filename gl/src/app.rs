@@ -7,6 +7,7 @@ use crate::compute::Compute;
 use crate::context::{self, Gl};
 use crate::debug::DebugLog;
 use crate::program::{self, EmptyVertexArray, Program};
+use crate::rays::CountingFrame;
 use crate::target::{self, Target};
 use crate::timer::Timer;
 use anyhow::anyhow;
@@ -140,6 +141,19 @@ pub fn run(args: RenderArgs, knobs: &OpenGlKnobs, started: Instant) -> anyhow::R
     explain::step("Readback", || {
         format!("{width}x{height} RGBA32F, top row first")
     });
+    let rays = if args.count_rays {
+        let counting = CountingFrame {
+            scene: &gpu_scene,
+            variant: &variant,
+            path: args.path,
+            workgroup,
+            width,
+            height,
+        };
+        Some(counting.count(gl)?)
+    } else {
+        None
+    };
     log.check(gl, "after the frame loop");
 
     if let Some(out) = &args.out {
@@ -152,7 +166,7 @@ pub fn run(args: RenderArgs, knobs: &OpenGlKnobs, started: Instant) -> anyhow::R
         } else {
             variant.label()
         };
-        let report = RunReport::builder("opengl", info, scene.stats(), label)
+        let mut report = RunReport::builder("opengl", info, scene.stats(), label)
             .size(width, height)
             .path(args.path, workgroup)
             .frames(frames, setup_ms)
@@ -160,6 +174,9 @@ pub fn run(args: RenderArgs, knobs: &OpenGlKnobs, started: Instant) -> anyhow::R
             .validation_messages(errors)
             .shader_stats(shader_stats)
             .build();
+        if let Some(kinds) = rays {
+            report.add_rays(kinds);
+        }
         report.print_json()?;
     }
     if args.validate && errors > 0 {

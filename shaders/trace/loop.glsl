@@ -158,6 +158,9 @@ vec3 trace(vec3 origin, vec3 dir) {
                         st_weight[sp] = wt;
                         st_depth[sp] = depth + 1u;
                         sp += 1;
+#ifdef COUNT_RAYS
+                        rays_traced.glass_refracted += 1u;
+#endif
                     }
                 }
             }
@@ -170,6 +173,13 @@ vec3 trace(vec3 origin, vec3 dir) {
                 st_weight[sp] = wr;
                 st_depth[sp] = depth + 1u;
                 sp += 1;
+#ifdef COUNT_RAYS
+                if (m.transparency > 0.0) {
+                    rays_traced.glass_reflected += 1u;
+                } else {
+                    rays_traced.mirror += 1u;
+                }
+#endif
             }
         }
 #endif

@@ -12,6 +12,7 @@ use crate::compute::Compute;
 use crate::device::Device;
 use crate::instance::{Instance, VALIDATION_MESSAGES};
 use crate::pipeline::RenderPass;
+use crate::rays::CountingFrame;
 use crate::scene::SceneResources;
 use crate::target::Target;
 use crate::timestamps::Timestamps;
@@ -91,7 +92,7 @@ fn render(
     let shaders = build_shaders(args, variant)?;
     let gpu_scene = GpuScene::new(scene, width, height);
     let instance = Instance::new(args.validate, knobs.validation, &[])?;
-    let device = Device::new(&instance, None, knobs)?;
+    let device = Device::new(&instance, None, knobs, args.count_rays)?;
     device.check_size(width, height)?;
     // --vk-wait idle waits for each frame with vkQueueWaitIdle +
     // vkDeviceWaitIdle, as the 2018 study did, instead of the frame's fence.
@@ -115,7 +116,20 @@ fn render(
         RenderPath::Compute => render_compute(&run, &build_compute(variant, workgroup)?)?,
     };
     let label = variant_label(variant, host_memory, idle_wait);
-    report(args, scene, &device, label, workgroup, rendered)
+    let (mut report, image) = report(args, scene, &device, label, workgroup, rendered)?;
+    if args.count_rays {
+        let counting = CountingFrame {
+            device: &device,
+            scene: &gpu_scene,
+            variant,
+            path: args.path,
+            workgroup,
+            width,
+            height,
+        };
+        report.add_rays(counting.count()?);
+    }
+    Ok((report, image))
     // Every Vulkan object is dropped here, newest first: ..., device, instance.
 }
 

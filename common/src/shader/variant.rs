@@ -112,6 +112,15 @@ impl Variant {
         v
     }
 
+    /// This variant with the ray counters compiled in (COUNT_RAYS): the shader
+    /// of the one untimed frame that counts rays. Every other define is the
+    /// timed variant's, so both trace the same rays.
+    pub fn counting(&self) -> Variant {
+        let mut v = self.clone();
+        v.defines.insert("COUNT_RAYS".into(), "1".into());
+        v
+    }
+
     /// The variant the apps render: `--generic`, `--specialize` or the scene's
     /// own; each traces through the BVH when the scene has one. The one place
     /// both apps (and the windowed ones) choose what to compile.
