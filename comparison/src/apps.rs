@@ -332,6 +332,7 @@ mod tests {
             frames: Some(7),
             out: Some(PathBuf::from("out dir/a.png")),
             json: true,
+            count_rays: true,
             set: vec!["max_depth=3".into(), "extra_spheres=10".into()],
             validate: true,
             generic: false,

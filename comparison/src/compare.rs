@@ -308,6 +308,8 @@ fn sweep(
                 frames: Some(frames),
                 out: None,
                 json: true,
+                // One untimed frame more per point, for the Grays/s column and plot.
+                count_rays: true,
                 set: point.set.clone(),
                 // The study's tracer tests every primitive: so do the sweeps.
                 accel: Accel::None,
