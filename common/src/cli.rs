@@ -118,6 +118,10 @@ pub enum Experiment {
     /// (SPV_KHR_float_controls: denormals preserved, signed zero, Inf and NaN
     /// preserved), to see whether Vulkan's defaults explain its pixels.
     FloatControls,
+    /// BVH variants: one traversal call for every ray of the loop (closest
+    /// and shadow queries take turns), so that a compiler that inlines the
+    /// traversal keeps one copy instead of two.
+    OneQuery,
     /// The SPIR-V (what Vulkan runs) from Khronos' reference compiler,
     /// glslangValidator (on PATH; Debian's glslang-tools), given the same
     /// GLSL and defines, instead of from naga.
@@ -514,6 +518,7 @@ mod tests {
                 "uniform-counts",
                 "no-contraction",
                 "float-controls",
+                "one-query",
                 "glslang"
             ]
         );

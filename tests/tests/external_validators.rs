@@ -116,6 +116,7 @@ fn variants() -> Vec<(String, Variant)> {
         vec![NoContraction],
         vec![Glslang],
         vec![FloatControls],
+        vec![OneQuery],
     ] {
         let label = experiments
             .iter()

@@ -138,6 +138,9 @@ impl Variant {
         v.experiments.sort();
         v.experiments.dedup();
         if v.defines.contains_key("USE_BVH") {
+            if v.experiments.contains(&Experiment::OneQuery) {
+                v.defines.insert("BVH_ONE_QUERY".into(), "1".into());
+            }
             if v.experiments.contains(&Experiment::StacklessBvh) {
                 v.defines.insert("BVH_STACKLESS".into(), "1".into());
             }
