@@ -922,6 +922,12 @@ vec3 trace(vec3 origin, vec3 dir) {
             w = st_weight[sp];
             depth = st_depth[sp];
         }
+#ifdef COUNT_RAYS
+        // This loop's shadow queries bypass occluded(), which counts the others.
+        if (pending) {
+            rays_traced.shadow += 1u;
+        }
+#endif
         Hit h = traverse(q_origin, q_dir, q_t, pending);
         if (pending) {
             if (h.kind == 0u) {
@@ -971,10 +977,15 @@ vec3 trace(vec3 origin, vec3 dir) {
             vec3 l;
             float dist;
             float ndl;
-            // Stop a hair before the light: a light lying on a surface would
-            // otherwise be hidden by that surface at the whim of rounding.
-            if (shadow_ray(light, s, p_out, l, dist, ndl) && !occluded(p_out, l, dist * SHADOW_REACH)) {
-                local += light_color(light, m, s.ns, l, ndl, d);
+            // Nested, not `&&`: naga's GLSL front end evaluates a call on the
+            // right of `&&` even when the left is false, which traced a shadow
+            // ray towards every light behind the surface (the ray count showed it).
+            if (shadow_ray(light, s, p_out, l, dist, ndl)) {
+                // Stop a hair before the light: a light lying on a surface would
+                // otherwise be hidden by that surface at the whim of rounding.
+                if (!occluded(p_out, l, dist * SHADOW_REACH)) {
+                    local += light_color(light, m, s.ns, l, ndl, d);
+                }
             }
         }
 #endif
