@@ -54,6 +54,22 @@ impl RayKinds {
     }
 }
 
+/// One line for `--explain`: the total, then each kind.
+impl std::fmt::Display for RayKinds {
+    fn fmt(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
+        write!(
+            f,
+            "{} rays: {} primary, {} shadow, {} mirror, {} glass reflected, {} glass refracted",
+            self.total(),
+            self.primary,
+            self.shadow,
+            self.mirror,
+            self.glass_reflected,
+            self.glass_refracted
+        )
+    }
+}
+
 impl std::ops::Add for RayKinds {
     type Output = RayKinds;
     fn add(self, o: RayKinds) -> RayKinds {

@@ -7,7 +7,7 @@ use crate::compute::Compute;
 use crate::context::{self, Gl};
 use crate::debug::DebugLog;
 use crate::program::{self, EmptyVertexArray, Program};
-use crate::rays::CountingFrame;
+use crate::rays::count_rays;
 use crate::target::{self, Target};
 use crate::timer::Timer;
 use anyhow::anyhow;
@@ -20,7 +20,7 @@ use twinray_common::gpu::upload::{check_storage_limit, GpuScene};
 use twinray_common::reference::image_io::FloatImage;
 use twinray_common::report::{dump_shaders, dump_statistics, FrameTime, RunReport};
 use twinray_common::shader::build::{build, build_compute};
-use twinray_common::shader::variant::Variant;
+use twinray_common::shader::variant::{CountingRun, Variant};
 
 /// `started` is taken first thing in main, so `setup_ms` includes process,
 /// driver and shader start-up, as in the Vulkan app.
@@ -142,7 +142,7 @@ pub fn run(args: RenderArgs, knobs: &OpenGlKnobs, started: Instant) -> anyhow::R
         format!("{width}x{height} RGBA32F, top row first")
     });
     let rays = if args.count_rays {
-        let counting = CountingFrame {
+        let counting = CountingRun {
             scene: &gpu_scene,
             variant: &variant,
             path: args.path,
@@ -150,7 +150,7 @@ pub fn run(args: RenderArgs, knobs: &OpenGlKnobs, started: Instant) -> anyhow::R
             width,
             height,
         };
-        Some(counting.count(gl)?)
+        Some(count_rays(gl, &counting)?)
     } else {
         None
     };

@@ -10,66 +10,45 @@ use crate::program::{EmptyVertexArray, Program};
 use crate::target::Target;
 use anyhow::{anyhow, Context as _};
 use glow::HasContext;
-use twinray_common::cli::{RenderPath, Workgroup};
+use twinray_common::cli::RenderPath;
 use twinray_common::explain;
 use twinray_common::gpu::layout::{binding, GpuRayCount};
-use twinray_common::gpu::upload::GpuScene;
 use twinray_common::limits::pixel_count;
 use twinray_common::rays::RayKinds;
 use twinray_common::shader::build::{build, build_compute};
-use twinray_common::shader::variant::Variant;
+use twinray_common::shader::variant::CountingRun;
 
-/// What the counting frame renders: the scene at the run's size, on its path.
-pub struct CountingFrame<'a> {
-    pub scene: &'a GpuScene,
-    pub variant: &'a Variant,
-    pub path: RenderPath,
-    pub workgroup: Workgroup,
-    pub width: u32,
-    pub height: u32,
-}
-
-impl CountingFrame<'_> {
-    /// Renders the counting frame and returns its rays by kind. Always naga's
-    /// GLSL (also under `--gl-spirv`): the rays do not depend on how the
-    /// driver was handed the shader.
-    pub fn count(&self, gl: &glow::Context) -> anyhow::Result<RayKinds> {
-        let (width, height) = (self.width, self.height);
-        let counting = self.variant.counting();
-        // Declared first, so deleted last: after the programs that use them.
-        let _scene = SceneBuffers::new(gl, self.scene)?;
-        let counts = CountBuffer::new(gl, pixel_count(width, height))?;
-        match self.path {
-            RenderPath::Fragment => {
-                let shaders = build(&counting)?;
-                let program = Program::new(gl, &shaders.vertex_glsl, &shaders.fragment_glsl)?;
-                let _target = Target::new(gl, width, height)?;
-                let vao = EmptyVertexArray::new(gl)?;
-                program.bind(&vao);
-                // SAFETY: program, VAO, buffers and FBO are bound and alive.
-                unsafe { gl.draw_arrays(glow::TRIANGLES, 0, 3) };
-            }
-            RenderPath::Compute => {
-                let shader = build_compute(&counting, self.workgroup)?;
-                let compute = Compute::new(gl, &shader, None, width, height)?;
-                compute.dispatch();
-            }
+/// Renders the counting frame of `run` and returns its rays by kind. Always
+/// naga's GLSL (also under `--gl-spirv`): the rays do not depend on how the
+/// driver was handed the shader.
+pub fn count_rays(gl: &glow::Context, run: &CountingRun) -> anyhow::Result<RayKinds> {
+    let (width, height) = (run.width, run.height);
+    let counting = run.variant.counting();
+    // Declared first, so deleted last: after the programs that use them.
+    let _scene = SceneBuffers::new(gl, run.scene)?;
+    let counts = CountBuffer::new(gl, pixel_count(width, height))?;
+    match run.path {
+        RenderPath::Fragment => {
+            let shaders = build(&counting)?;
+            let program = Program::new(gl, &shaders.vertex_glsl, &shaders.fragment_glsl)?;
+            let _target = Target::new(gl, width, height)?;
+            let vao = EmptyVertexArray::new(gl)?;
+            program.bind(&vao);
+            // SAFETY: program, VAO, buffers and FBO are bound and alive.
+            unsafe { gl.draw_arrays(glow::TRIANGLES, 0, 3) };
         }
-        let kinds = RayKinds::from_pixels(&counts.read());
-        explain::step(
-            "Ray count: one untimed frame of the COUNT_RAYS variant",
-            || {
-                format!(
-                    "{} rays: {} primary, {} shadow, {} secondary",
-                    kinds.total(),
-                    kinds.primary,
-                    kinds.shadow,
-                    kinds.secondary()
-                )
-            },
-        );
-        Ok(kinds)
+        RenderPath::Compute => {
+            let shader = build_compute(&counting, run.workgroup)?;
+            let compute = Compute::new(gl, &shader, None, width, height)?;
+            compute.dispatch();
+        }
     }
+    let kinds = RayKinds::from_pixels(&counts.read());
+    explain::step(
+        "Ray count: one untimed frame of the COUNT_RAYS variant",
+        || kinds.to_string(),
+    );
+    Ok(kinds)
 }
 
 /// The per-pixel count slots, zeroed and bound at binding 10; deleted on drop.

@@ -5,11 +5,13 @@
 //! 0.1 % of the frame's rays for the kinds that f32 can change (a handful of
 //! rays inside the glass sphere go another way in f32). Also: the report
 //! gives a positive Grays/s and names its clock, and the check itself
-//! rejects a count that is off by one.
+//! rejects a count that is off by one. In the window, `--count-rays` counts
+//! the view at the start and after each switch, and the window still draws
+//! the headless image of its view.
 
 use twinray_common::rays::RayCounts;
 use twinray_common::scene::Scene;
-use twinray_tests::{run, App};
+use twinray_tests::{render, run, scratch, App, Xvfb};
 
 /// How closely the GPU's counts must follow the reference's.
 #[derive(Clone, Copy, Debug)]
@@ -133,4 +135,47 @@ fn an_off_by_one_count_is_rejected() {
     glass.secondary += 1;
     glass.total += 1;
     assert!(agrees(Agreement::Exact, &glass, &reference).is_err());
+}
+
+#[test]
+fn the_window_counts_rays_and_still_draws_its_view() {
+    let x = Xvfb::start();
+    let dir = scratch("rays-window");
+    let out = dir.join("window.png");
+    for app in App::BOTH {
+        // To compute, to spherelist, back to box, back to fragment: each a recount.
+        let args = [
+            "--scene",
+            "box",
+            "--size",
+            "96x72",
+            "--frames",
+            "12",
+            "--count-rays",
+            "--explain",
+            "--validate",
+            "--json",
+            "--out",
+            out.to_str().unwrap(),
+        ];
+        let o = x.run(&app.exe(), &args, &[("TWINRAY_TEST_KEYS", "c,3,2,c")], &dir);
+        let stderr = String::from_utf8_lossy(&o.stderr);
+        assert!(o.status.success(), "{app:?}: {stderr}");
+        let report: twinray_common::report::RunReport = serde_json::from_slice(&o.stdout).unwrap();
+        assert_eq!(report.validation_messages, 0, "{app:?}: {stderr}");
+        let counts = stderr.matches("Ray count:").count();
+        // The first key acts on the first frame, before the opening count:
+        // that count is already the switched view's.
+        assert!(
+            counts >= 4,
+            "{app:?}: {counts} counting frames, not one per view (4 switches)"
+        );
+        let (_, headless) = render(app, "box", "96x72", &[], &dir.join("headless.png"));
+        let window = twinray_common::reference::image_io::load_png(&out).unwrap();
+        assert!(
+            window == headless,
+            "{app:?}: after counting, the window's view differs from the headless image"
+        );
+    }
+    std::fs::remove_dir_all(dir).ok();
 }

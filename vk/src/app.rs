@@ -12,7 +12,7 @@ use crate::compute::Compute;
 use crate::device::Device;
 use crate::instance::{Instance, VALIDATION_MESSAGES};
 use crate::pipeline::RenderPass;
-use crate::rays::CountingFrame;
+use crate::rays::count_rays;
 use crate::scene::SceneResources;
 use crate::target::Target;
 use crate::timestamps::Timestamps;
@@ -28,7 +28,7 @@ use twinray_common::reference::image_io::FloatImage;
 use twinray_common::report::{dump_shaders, dump_statistics, FrameTime, RunReport};
 use twinray_common::scene::Scene;
 use twinray_common::shader::build::{build, build_compute, ComputeShader, Shaders};
-use twinray_common::shader::variant::Variant;
+use twinray_common::shader::variant::{CountingRun, Variant};
 
 pub fn run(args: RenderArgs, knobs: &VulkanKnobs, process_start: Instant) -> Result<()> {
     if args.explain {
@@ -118,8 +118,7 @@ fn render(
     let label = variant_label(variant, host_memory, idle_wait);
     let (mut report, image) = report(args, scene, &device, label, workgroup, rendered)?;
     if args.count_rays {
-        let counting = CountingFrame {
-            device: &device,
+        let counting = CountingRun {
             scene: &gpu_scene,
             variant,
             path: args.path,
@@ -127,7 +126,7 @@ fn render(
             width,
             height,
         };
-        report.add_rays(counting.count()?);
+        report.add_rays(count_rays(&device, &counting)?);
     }
     Ok((report, image))
     // Every Vulkan object is dropped here, newest first: ..., device, instance.

@@ -14,114 +14,86 @@ use crate::scene::scene_buffers;
 use crate::target::Target;
 use anyhow::Result;
 use ash::vk;
-use twinray_common::cli::{RenderPath, Workgroup};
+use twinray_common::cli::RenderPath;
 use twinray_common::error::no_device;
 use twinray_common::explain;
 use twinray_common::gpu::layout::{binding, GpuRayCount};
-use twinray_common::gpu::upload::GpuScene;
 use twinray_common::limits::pixel_count;
 use twinray_common::rays::RayKinds;
 use twinray_common::shader::build::{build, build_compute};
-use twinray_common::shader::variant::Variant;
+use twinray_common::shader::variant::CountingRun;
 
-/// What the counting frame renders: the scene at the run's size, on its path.
-pub struct CountingFrame<'a> {
-    pub device: &'a Device,
-    pub scene: &'a GpuScene,
-    pub variant: &'a Variant,
-    pub path: RenderPath,
-    pub workgroup: Workgroup,
-    pub width: u32,
-    pub height: u32,
-}
-
-impl CountingFrame<'_> {
-    /// Renders the counting frame and returns its rays by kind.
-    pub fn count(&self) -> Result<RayKinds> {
-        let CountingFrame {
-            device,
-            width,
-            height,
-            ..
-        } = *self;
-        let counting = self.variant.counting();
-        // Declared first, so dropped last: after the pipelines that use them.
-        let (frame, mut storage) = scene_buffers(device, self.scene)?;
-        let bytes = pixel_count(width, height) * size_of::<GpuRayCount>();
-        let counts = Buffer::host_visible_with(
-            device,
-            &vec![0u8; bytes],
-            vk::BufferUsageFlags::STORAGE_BUFFER,
-            "ray count buffer",
-        )?;
-        let counts_handle = counts.buffer;
-        storage.push((binding::RAY_COUNTS, counts));
-        match self.path {
-            RenderPath::Fragment => {
-                if !device.fragment_stores {
-                    return Err(no_device(format!(
+/// Renders the counting frame of `run` and returns its rays by kind.
+pub fn count_rays(device: &Device, run: &CountingRun) -> Result<RayKinds> {
+    let (width, height) = (run.width, run.height);
+    let counting = run.variant.counting();
+    // Declared first, so dropped last: after the pipelines that use them.
+    let (frame, mut storage) = scene_buffers(device, run.scene)?;
+    let bytes = pixel_count(width, height) * size_of::<GpuRayCount>();
+    let counts = Buffer::host_visible_with(
+        device,
+        &vec![0u8; bytes],
+        vk::BufferUsageFlags::STORAGE_BUFFER,
+        "ray count buffer",
+    )?;
+    let counts_handle = counts.buffer;
+    storage.push((binding::RAY_COUNTS, counts));
+    match run.path {
+        RenderPath::Fragment => {
+            if !device.fragment_stores {
+                return Err(no_device(format!(
                         "--count-rays on the fragment path needs fragmentStoresAndAtomics, which '{}' does not offer; count with --path compute",
                         device.name
                     )));
-                }
-                let shaders = build(&counting)?;
-                let render_pass = RenderPass::offscreen(device)?;
-                let rp = render_pass.render_pass;
-                let descriptors = Descriptors::new(device, &frame, &storage)?;
-                let size = Some((width, height));
-                let pipeline = Pipeline::new(device, descriptors.set_layout, &shaders, rp, size)?;
-                let target = Target::new(device, rp, width, height)?;
-                let commands =
-                    Commands::record(device, rp, &pipeline, &descriptors, &target, None)?;
-                commands.submit()?;
-                commands.wait(false)?;
             }
-            RenderPath::Compute => {
-                let shader = build_compute(&counting, self.workgroup)?;
-                let compute = Compute::new(device, &frame, &storage, &shader, width, height, None)?;
-                compute.commands.submit()?;
-                compute.commands.wait(false)?;
-            }
+            let shaders = build(&counting)?;
+            let render_pass = RenderPass::offscreen(device)?;
+            let rp = render_pass.render_pass;
+            let descriptors = Descriptors::new(device, &frame, &storage)?;
+            let size = Some((width, height));
+            let pipeline = Pipeline::new(device, descriptors.set_layout, &shaders, rp, size)?;
+            let target = Target::new(device, rp, width, height)?;
+            let commands = Commands::record(device, rp, &pipeline, &descriptors, &target, None)?;
+            commands.submit()?;
+            commands.wait(false)?;
         }
-        // Read after write: the CPU maps what the shader wrote. A barrier in a
-        // later submission still orders the frame's writes, submitted before it.
-        device.run_once("making the ray counts visible to the CPU", |cmd| {
-            let to_host = buffer_barrier(
-                counts_handle,
-                vk::AccessFlags::SHADER_WRITE,
-                vk::AccessFlags::HOST_READ,
-            );
-            let shaders =
-                vk::PipelineStageFlags::FRAGMENT_SHADER | vk::PipelineStageFlags::COMPUTE_SHADER;
-            // SAFETY: `cmd` is recording (inside run_once); the buffer is
-            // alive in `storage` until the end of this function.
-            unsafe {
-                pipeline_barrier(
-                    &device.device,
-                    cmd,
-                    shaders,
-                    vk::PipelineStageFlags::HOST,
-                    &[to_host],
-                    &[],
-                )
-            };
-        })?;
-        let (_, counts) = storage
-            .last()
-            .expect("the ray count buffer was pushed last");
-        let kinds = RayKinds::from_pixels(&counts.read::<GpuRayCount>()?);
-        explain::step(
-            "Ray count: one untimed frame of the COUNT_RAYS variant",
-            || {
-                format!(
-                    "{} rays: {} primary, {} shadow, {} secondary",
-                    kinds.total(),
-                    kinds.primary,
-                    kinds.shadow,
-                    kinds.secondary()
-                )
-            },
-        );
-        Ok(kinds)
+        RenderPath::Compute => {
+            let shader = build_compute(&counting, run.workgroup)?;
+            let compute = Compute::new(device, &frame, &storage, &shader, width, height, None)?;
+            compute.commands.submit()?;
+            compute.commands.wait(false)?;
+        }
     }
+    // Read after write: the CPU maps what the shader wrote. A barrier in a
+    // later submission still orders the frame's writes, submitted before it.
+    device.run_once("making the ray counts visible to the CPU", |cmd| {
+        let to_host = buffer_barrier(
+            counts_handle,
+            vk::AccessFlags::SHADER_WRITE,
+            vk::AccessFlags::HOST_READ,
+        );
+        let shaders =
+            vk::PipelineStageFlags::FRAGMENT_SHADER | vk::PipelineStageFlags::COMPUTE_SHADER;
+        // SAFETY: `cmd` is recording (inside run_once); the buffer is
+        // alive in `storage` until the end of this function.
+        unsafe {
+            pipeline_barrier(
+                &device.device,
+                cmd,
+                shaders,
+                vk::PipelineStageFlags::HOST,
+                &[to_host],
+                &[],
+            )
+        };
+    })?;
+    let (_, counts) = storage
+        .last()
+        .expect("the ray count buffer was pushed last");
+    let kinds = RayKinds::from_pixels(&counts.read::<GpuRayCount>()?);
+    explain::step(
+        "Ray count: one untimed frame of the COUNT_RAYS variant",
+        || kinds.to_string(),
+    );
+    Ok(kinds)
 }
