@@ -156,7 +156,25 @@ fn naga_layout_matches_rust_for_every_shader_struct() {
     let (_, stride) = prims.expect("BVH primitives are a runtime array");
     assert_eq!(stride, 4, "BVH primitive stride");
 
-    // Declared by the counting variant only.
+    let (_, light) = block(&module, binding::LIGHTS);
+    let (ty, stride) = light.expect("lights is a runtime array");
+    assert_eq!(stride as usize, size_of::<GpuLight>(), "Light stride");
+    check(
+        "Light",
+        naga_members(&module, ty),
+        rust_offsets!(GpuLight {
+            position,
+            pad0,
+            color,
+            pad1
+        }),
+        size_of::<GpuLight>(),
+    );
+}
+
+/// The counting variant's per-pixel slots (`--count-rays`), which only it declares.
+#[test]
+fn naga_layout_matches_rust_for_the_ray_counts() {
     let (counting, _) = parse(
         &fragment_source(),
         naga::ShaderStage::Fragment,
@@ -177,21 +195,6 @@ fn naga_layout_matches_rust_for_every_shader_struct() {
             glass_refracted
         }),
         size_of::<GpuRayCount>(),
-    );
-
-    let (_, light) = block(&module, binding::LIGHTS);
-    let (ty, stride) = light.expect("lights is a runtime array");
-    assert_eq!(stride as usize, size_of::<GpuLight>(), "Light stride");
-    check(
-        "Light",
-        naga_members(&module, ty),
-        rust_offsets!(GpuLight {
-            position,
-            pad0,
-            color,
-            pad1
-        }),
-        size_of::<GpuLight>(),
     );
 }
 
