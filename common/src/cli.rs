@@ -118,14 +118,30 @@ pub enum Experiment {
     /// (SPV_KHR_float_controls: denormals preserved, signed zero, Inf and NaN
     /// preserved), to see whether Vulkan's defaults explain its pixels.
     FloatControls,
-    /// BVH variants: one traversal call for every ray of the loop (closest
-    /// and shadow queries take turns), so that a compiler that inlines the
-    /// traversal keeps one copy instead of two.
+    /// One call site for the closest hit and the shadow rays of each hit
+    /// (they take turns in a small loop), so that a compiler that inlines the
+    /// traversal keeps one copy of it instead of two.
     OneQuery,
     /// The SPIR-V (what Vulkan runs) from Khronos' reference compiler,
     /// glslangValidator (on PATH; Debian's glslang-tools), given the same
     /// GLSL and defines, instead of from naga.
     Glslang,
+    /// Fragment path: the fullscreen pass as two triangles (6 vertices)
+    /// instead of one oversized triangle.
+    Quad,
+    /// Fragment path: clear the colour target at the start of the pass
+    /// (Vulkan: load op CLEAR instead of DONT_CARE; OpenGL: glClear before the draw).
+    LoadClear,
+    /// Fragment path: an RGBA8 UNORM render target instead of RGBA32F (the
+    /// GPU rounds to 8 bits; the PNG stays within 1/255).
+    Rgba8,
+    /// Vulkan, compute path: dispatch on a queue family with COMPUTE but not
+    /// GRAPHICS (refused where the device has none, and by OpenGL).
+    ComputeQueue,
+    /// Vulkan, fragment path: the viewport and scissor as dynamic state set
+    /// in the command buffer (as OpenGL always has them) instead of baked
+    /// into the pipeline.
+    DynamicViewport,
 }
 
 /// The tracer's entry point: the two ways one GLSL tracer reaches the GPU.
@@ -519,7 +535,12 @@ mod tests {
                 "no-contraction",
                 "float-controls",
                 "one-query",
-                "glslang"
+                "glslang",
+                "quad",
+                "load-clear",
+                "rgba8",
+                "compute-queue",
+                "dynamic-viewport"
             ]
         );
         assert_eq!(

@@ -12,7 +12,7 @@
 //! | `scene/` | the scene model; loading (`load`, `format`, `overrides`, `resolve`, `check`, `mesh`, `teapot`); `camera`, `numerics`, `accel` (`--accel` and the BVH builder); the `random` and `hard` scenes |
 //! | `gpu::upload` | a scene as the bytes both apps upload |
 //! | `reference/` | the f64 CPU tracer (`mod.rs`: shading and the ray loop; `intersect`: hits and the BVH walk) |
-//! | `cli` | the options both apps take (one clap struct) |
+//! | `cli`, `fragment_pass` | the options both apps take (one clap struct); what the fragment path's experiments change outside the shader (vertices, clear, target format), and which runs refuse an experiment |
 //! | `shader/` | `variant` (the one place a run's shader variant is decided), `build` (naga to SPIR-V and GLSL), `post` (passes over naga's output) |
 //! | `report` | the `--json` run report |
 //! | `window/` | the windowed event loop both apps share; cargo feature `window` (only the apps enable it, so the comparison and the tests build without winit), and `test-hooks` for the end-to-end tests' hooks |
@@ -20,6 +20,7 @@
 pub mod cli;
 pub mod error;
 pub mod explain;
+pub mod fragment_pass;
 pub mod gpu;
 pub mod limits;
 pub mod rays;

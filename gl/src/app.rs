@@ -16,6 +16,7 @@ use std::time::Instant;
 use twinray_common::cli::{Experiment, OpenGlKnobs, RenderArgs, RenderPath};
 use twinray_common::error::bad_input;
 use twinray_common::explain;
+use twinray_common::fragment_pass::{check_experiments, FragmentPass};
 use twinray_common::gpu::upload::{check_storage_limit, GpuScene};
 use twinray_common::reference::image_io::FloatImage;
 use twinray_common::report::{dump_shaders, dump_statistics, FrameTime, RunReport};
@@ -29,6 +30,7 @@ pub fn run(args: RenderArgs, knobs: &OpenGlKnobs, started: Instant) -> anyhow::R
     if args.explain {
         explain::enable("twinray-gl", "OpenGL");
     }
+    check_experiments(&args, false)?;
     if !args.headless {
         if args.gl_spirv {
             return Err(bad_input(
@@ -89,13 +91,19 @@ pub fn run(args: RenderArgs, knobs: &OpenGlKnobs, started: Instant) -> anyhow::R
                 shader_stats.push(program::dump_binary(gl, program.raw(), dir, "gl-program")?);
             }
             let _buffers = SceneBuffers::new(gl, &gpu_scene)?;
-            let target = Target::new(gl, width, height)?;
+            let pass = FragmentPass::of(&args.experiment);
+            let target = Target::new(gl, width, height, &pass)?;
             let vao = EmptyVertexArray::new(gl)?;
             let timer = Timer::new(gl, &info.device)?;
             program.bind(&vao);
             log.check(gl, "after setup");
             // SAFETY: program, VAO, buffers and FBO are bound and alive.
-            let draw = || unsafe { gl.draw_arrays(glow::TRIANGLES, 0, 3) };
+            let draw = || unsafe {
+                if pass.clear {
+                    gl.clear(glow::COLOR_BUFFER_BIT);
+                }
+                gl.draw_arrays(glow::TRIANGLES, 0, pass.vertices() as i32);
+            };
             let (frames, setup_ms) = frame_loop(gl, &timer, args.frame_count(), started, &draw);
             (frames, setup_ms, target.read())
         }

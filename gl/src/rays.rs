@@ -12,6 +12,7 @@ use anyhow::{anyhow, Context as _};
 use glow::HasContext;
 use twinray_common::cli::RenderPath;
 use twinray_common::explain;
+use twinray_common::fragment_pass::FragmentPass;
 use twinray_common::gpu::layout::{binding, GpuRayCount};
 use twinray_common::limits::pixel_count;
 use twinray_common::rays::RayKinds;
@@ -31,11 +32,13 @@ pub fn count_rays(gl: &glow::Context, run: &CountingRun) -> anyhow::Result<RayKi
         RenderPath::Fragment => {
             let shaders = build(&counting)?;
             let program = Program::new(gl, &shaders.vertex_glsl, &shaders.fragment_glsl)?;
-            let _target = Target::new(gl, width, height)?;
+            // The run's own fragment pass (`--experiment quad` draws two triangles).
+            let pass = FragmentPass::of(&run.variant.experiments);
+            let _target = Target::new(gl, width, height, &pass)?;
             let vao = EmptyVertexArray::new(gl)?;
             program.bind(&vao);
             // SAFETY: program, VAO, buffers and FBO are bound and alive.
-            unsafe { gl.draw_arrays(glow::TRIANGLES, 0, 3) };
+            unsafe { gl.draw_arrays(glow::TRIANGLES, 0, pass.vertices() as i32) };
         }
         RenderPath::Compute => {
             let shader = build_compute(&counting, run.workgroup)?;

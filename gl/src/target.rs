@@ -1,11 +1,12 @@
 //! The offscreen render target: an FBO with one RGBA32F colour renderbuffer
-//! (float, so the PNG is quantised exactly as for Vulkan and the reference),
-//! the device's size limits, and the readback.
+//! (float, so the PNG is quantised exactly as for Vulkan and the reference;
+//! RGBA8 with `--experiment rgba8`), the device's size limits, and the readback.
 
 use anyhow::{anyhow, bail, Context as _};
 use glow::HasContext;
 use twinray_common::error::bad_input;
 use twinray_common::explain;
+use twinray_common::fragment_pass::FragmentPass;
 
 pub struct Target<'gl> {
     gl: &'gl glow::Context,
@@ -58,7 +59,13 @@ pub fn out_of_memory(
 
 impl<'gl> Target<'gl> {
     /// Creates the FBO and leaves it bound for drawing and reading.
-    pub fn new(gl: &'gl glow::Context, width: u32, height: u32) -> anyhow::Result<Target<'gl>> {
+    pub fn new(
+        gl: &'gl glow::Context,
+        width: u32,
+        height: u32,
+        pass: &FragmentPass,
+    ) -> anyhow::Result<Target<'gl>> {
+        let format = pass.format_name();
         // SAFETY: fresh objects on the current context; sizes were checked by `check_size`.
         unsafe {
             let colour = gl
@@ -80,12 +87,12 @@ impl<'gl> Target<'gl> {
                 height,
             };
             gl.bind_renderbuffer(glow::RENDERBUFFER, Some(colour));
-            gl.renderbuffer_storage(
-                glow::RENDERBUFFER,
-                glow::RGBA32F,
-                width as i32,
-                height as i32,
-            );
+            let internal = if pass.rgba8 {
+                glow::RGBA8
+            } else {
+                glow::RGBA32F
+            };
+            gl.renderbuffer_storage(glow::RENDERBUFFER, internal, width as i32, height as i32);
             out_of_memory(gl, "render target", width, height)?;
             gl.bind_framebuffer(glow::FRAMEBUFFER, Some(fbo));
             gl.framebuffer_renderbuffer(
@@ -105,21 +112,22 @@ impl<'gl> Target<'gl> {
             }
             if status != glow::FRAMEBUFFER_COMPLETE {
                 bail!(
-                    "the RGBA32F {width}x{height} framebuffer is incomplete (status {status:#x})"
+                    "the {format} {width}x{height} framebuffer is incomplete (status {status:#x})"
                 );
             }
             gl.viewport(0, 0, width as i32, height as i32);
             explain::step(
-                "glCreateRenderbuffer + glCreateFramebuffer (RGBA32F target)",
+                &format!("glCreateRenderbuffer + glCreateFramebuffer ({format} target)"),
                 || {
-                    format!("{width}x{height} RGBA32F renderbuffer as COLOR_ATTACHMENT0; FRAMEBUFFER_COMPLETE; glViewport")
+                    format!("{width}x{height} {format} renderbuffer as COLOR_ATTACHMENT0; FRAMEBUFFER_COMPLETE; glViewport")
                 },
             );
             Ok(target)
         }
     }
 
-    /// RGBA32F pixels. GL's first row is the bottom one, and the shader treats
+    /// RGBA pixels as floats (an RGBA8 target's converted by GL: c / 255).
+    /// GL's first row is the bottom one, and the shader treats
     /// +y as down, so that first row is the image's TOP: no flip needed.
     pub fn read(&self) -> Vec<f32> {
         let mut px = vec![0f32; self.width as usize * self.height as usize * 4];

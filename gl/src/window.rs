@@ -43,6 +43,7 @@ use std::time::Instant;
 use twinray_common::cli::RenderArgs;
 use twinray_common::error::no_device;
 use twinray_common::explain;
+use twinray_common::fragment_pass::FragmentPass;
 use twinray_common::gpu::layout::GpuFrame;
 use twinray_common::gpu::upload::GpuScene;
 use twinray_common::rays::RayKinds;
@@ -392,7 +393,7 @@ impl Renderer for GlWindow<'_> {
         };
         program.bind(&self.vao);
         let pixels = {
-            let fbo = Target::new(gl, width, height)?;
+            let fbo = Target::new(gl, width, height, &FragmentPass::default())?;
             // SAFETY: the FBO is bound for drawing; program and buffers are bound.
             unsafe { gl.draw_arrays(glow::TRIANGLES, 0, 3) };
             fbo.read()

@@ -33,79 +33,6 @@
 // The CPU reference (common/src/reference/) follows these files step by step
 // in f64; change both together.
 
-// What a hit needs for shading: the point, both normals facing the incoming
-// ray, the offset scale, the material, and whether the ray was inside.
-struct Surface {
-    vec3 p;
-    vec3 ng;
-    vec3 ns;
-    float scale;
-    uint material;
-    bool inside;
-};
-
-Surface surface_at(Hit h, vec3 o, vec3 d) {
-    Surface s;
-    s.p = o + h.t * d;
-    s.scale = max_abs(o);
-    if (h.kind == 1u) {
-        Sphere sph = sphere_buf.spheres[h.index];
-        s.ng = (s.p - sph.center) / sph.radius;
-        s.ns = s.ng;
-        s.material = sph.material;
-        // Sphere tests square their inputs (c = f.f - r^2), so a start a few
-        // ULPs inside glass can still re-hit the same sphere: 4x the margin
-        // (scenes/box's glass sphere speckled with 2^-22).
-        s.scale = 4.0 * max(s.scale, max_abs(s.p));
-    } else {
-        Triangle tri = triangle_buf.triangles[h.index];
-        // A triangle test's error grows with its vertices' magnitude (a floor
-        // quad reaching x = 8 seen from a glass sphere at |o| = 1 re-hit itself).
-        s.scale = max(s.scale, max(max_abs(tri.p0), max(max_abs(tri.p1), max_abs(tri.p2))));
-        vec3 e1 = tri.p1 - tri.p0;
-        vec3 e2 = tri.p2 - tri.p0;
-#if defined(OFFSET_SCALE_AWARE) || defined(OFFSET_ULP)
-        // These offsets assume p lies within a few ULPs of its coordinates
-        // off the plane. o + t d does not: its error grows with t and with
-        // how thin the triangle is (acne on the teapot's spout and handle).
-        // Rebuilt from the barycentrics, an error in u, v only slides p
-        // along the plane (Wachter & Binder, Ray Tracing Gems ch. 6).
-        s.p = tri.p0 + h.u * e1 + h.v * e2;
-#endif
-        s.ng = normalize(cross(e1, e2));
-        s.ns = normalize((1.0 - h.u - h.v) * tri.n0 + h.u * tri.n1 + h.v * tri.n2);
-        s.material = tri.material;
-    }
-    // Face both normals towards the incoming ray; `inside` tells glass which way it goes.
-    s.inside = dot(d, s.ng) > 0.0;
-    if (s.inside) {
-        s.ng = -s.ng;
-    }
-    if (dot(s.ns, s.ng) < 0.0) {
-        s.ns = -s.ns;
-    }
-    return s;
-}
-
-// The shadow ray towards a light, if the light faces the surface: its origin,
-// direction and length, and the cosine for the diffuse term.
-bool shadow_ray(Light light, Surface s, out vec3 p_out, out vec3 l, out float dist, out float ndl) {
-    // The offset may depend on the direction (OFFSET_RAY): aim from p first.
-    p_out = spawn_point(s.p, s.ng, normalize(light.position - s.p), s.scale);
-    vec3 to_light = light.position - p_out;
-    dist = length(to_light);
-    l = to_light / dist;
-    ndl = dot(s.ns, l);
-    return ndl > 0.0 && dot(s.ng, l) > 0.0;
-}
-
-// Phong's diffuse and specular terms of one unoccluded light.
-vec3 light_color(Light light, Material m, vec3 ns, vec3 l, float ndl, vec3 d) {
-    vec3 r = reflect(-l, ns);
-    float spec = pow(max(dot(r, -d), 0.0), m.shininess);
-    return light.color * (m.diffuse * ndl + m.specular * spec);
-}
-
 vec3 trace(vec3 origin, vec3 dir) {
     vec3 st_origin[STACK_SIZE];
     vec3 st_dir[STACK_SIZE];
@@ -127,27 +54,36 @@ vec3 trace(vec3 origin, vec3 dir) {
     st_depth[0] = 0u;
     sp = 1;
 
-#ifdef BVH_ONE_QUERY
-    // --experiment one-query: every ray, primary, secondary or shadow, goes
-    // through the one traversal call below, so a compiler that inlines
-    // traverse() keeps one copy of it instead of two. The hit being shaded
-    // and its next light stay live across the shadow queries.
-    bool pending = false;
+#ifdef ONE_QUERY
+    // --experiment one-query: every query of the loop, closest hit or shadow
+    // ray, goes through the one call of query() below, so a compiler that
+    // inlines the traversal keeps one copy of it (and of its stack) instead of
+    // one per call site. Each iteration asks one question: the closest hit of
+    // the next ray on the stack, or, while a hit is being shaded, the shadow
+    // ray towards its next lit light. The hit's state lives across iterations.
+    bool shadow_pending = false;
     uint li = 0u;
+    vec3 o;
     vec3 d;
     float w;
     uint depth;
-    Surface s;
+    vec3 p;
+    vec3 ng;
+    vec3 ns;
+    uint mat_index;
+    float scale;
+    bool inside;
+    Material m;
     vec3 local;
     vec3 p_out;
     vec3 l;
     float dist;
     float ndl;
-    while (sp > 0 || pending) {
+    while (sp > 0 || shadow_pending) {
         vec3 q_origin;
         vec3 q_dir;
         float q_t;
-        if (pending) {
+        if (shadow_pending) {
             q_origin = p_out;
             q_dir = l;
             // Stop a hair before the light: a light lying on a surface would
@@ -155,45 +91,94 @@ vec3 trace(vec3 origin, vec3 dir) {
             q_t = dist * SHADOW_REACH;
         } else {
             sp -= 1;
-            q_origin = st_origin[sp];
-            q_dir = st_dir[sp];
-            q_t = T_MAX;
+            o = st_origin[sp];
             d = st_dir[sp];
             w = st_weight[sp];
             depth = st_depth[sp];
+            q_origin = o;
+            q_dir = d;
+            q_t = T_MAX;
         }
 #ifdef COUNT_RAYS
         // This loop's shadow queries bypass occluded(), which counts the others.
-        if (pending) {
+        if (shadow_pending) {
             rays_traced.shadow += 1u;
         }
 #endif
-        Hit h = traverse(q_origin, q_dir, q_t, pending);
-        if (pending) {
+        Hit h = query(q_origin, q_dir, q_t, shadow_pending);
+        if (shadow_pending) {
             if (h.kind == 0u) {
-                local += light_color(light_buf.lights[li], material_buf.materials[s.material], s.ns, l, ndl, d);
+                Light light = light_buf.lights[li];
+                vec3 r = reflect(-l, ns);
+                float spec = pow(max(dot(r, -d), 0.0), m.shininess);
+                local += light.color * (m.diffuse * ndl + m.specular * spec);
             }
             li += 1u;
+            shadow_pending = false;
         } else {
             if (h.kind == 0u) {
                 color += w * frame.background;
                 continue;
             }
-            s = surface_at(h, q_origin, d);
-            local = material_buf.materials[s.material].ambient;
+            p = o + h.t * d;
+            scale = max_abs(o);
+            if (h.kind == 1u) {
+                Sphere s = sphere_buf.spheres[h.index];
+                ng = (p - s.center) / s.radius;
+                ns = ng;
+                mat_index = s.material;
+                // Sphere tests square their inputs (c = f.f - r^2), so a start a few
+                // ULPs inside glass can still re-hit the same sphere: 4x the margin
+                // (scenes/box's glass sphere speckled with 2^-22).
+                scale = 4.0 * max(scale, max_abs(p));
+            } else {
+                Triangle tri = triangle_buf.triangles[h.index];
+                // A triangle test's error grows with its vertices' magnitude (a floor
+                // quad reaching x = 8 seen from a glass sphere at |o| = 1 re-hit itself).
+                scale = max(scale, max(max_abs(tri.p0), max(max_abs(tri.p1), max_abs(tri.p2))));
+                vec3 e1 = tri.p1 - tri.p0;
+                vec3 e2 = tri.p2 - tri.p0;
+#if defined(OFFSET_SCALE_AWARE) || defined(OFFSET_ULP)
+                // These offsets assume p lies within a few ULPs of its coordinates
+                // off the plane. o + t d does not: its error grows with t and with
+                // how thin the triangle is (acne on the teapot's spout and handle).
+                // Rebuilt from the barycentrics, an error in u, v only slides p
+                // along the plane (Wachter & Binder, Ray Tracing Gems ch. 6).
+                p = tri.p0 + h.u * e1 + h.v * e2;
+#endif
+                ng = normalize(cross(e1, e2));
+                ns = normalize((1.0 - h.u - h.v) * tri.n0 + h.u * tri.n1 + h.v * tri.n2);
+                mat_index = tri.material;
+            }
+            // Face both normals towards the incoming ray; `inside` tells glass which way it goes.
+            inside = dot(d, ng) > 0.0;
+            if (inside) {
+                ng = -ng;
+            }
+            if (dot(ns, ng) < 0.0) {
+                ns = -ns;
+            }
+            m = material_buf.materials[mat_index];
+            local = m.ambient;
             li = 0u;
         }
-        pending = false;
+        // The next light this hit faces, if any: its shadow ray is the next query.
         for (; li < LIGHT_COUNT; li++) {
-            if (shadow_ray(light_buf.lights[li], s, p_out, l, dist, ndl)) {
-                pending = true;
+            Light light = light_buf.lights[li];
+            // The offset may depend on the direction (OFFSET_RAY): aim from p first.
+            p_out = spawn_point(p, ng, normalize(light.position - p), scale);
+            vec3 to_light = light.position - p_out;
+            dist = length(to_light);
+            l = to_light / dist;
+            ndl = dot(ns, l);
+            if (ndl > 0.0 && dot(ng, l) > 0.0) {
+                shadow_pending = true;
                 break;
             }
         }
-        if (pending) {
+        if (shadow_pending) {
             continue;
         }
-        Material m = material_buf.materials[s.material];
 #else
     while (sp > 0) {
         sp -= 1;
@@ -202,39 +187,81 @@ vec3 trace(vec3 origin, vec3 dir) {
         float w = st_weight[sp];
         uint depth = st_depth[sp];
 
+        // The shading stays written out here rather than in functions: naga's
+        // output for a struct returned by value and `out` parameters cost both
+        // APIs 2-20 % on the BVH (comparison/results/nvidia-h100/FINDINGS.md).
         Hit h = closest_hit(o, d);
         if (h.kind == 0u) {
             color += w * frame.background;
             continue;
         }
-        Surface s = surface_at(h, o, d);
-        Material m = material_buf.materials[s.material];
+
+        vec3 p = o + h.t * d;
+        vec3 ng;
+        vec3 ns;
+        uint mat_index;
+        float scale = max_abs(o);
+        if (h.kind == 1u) {
+            Sphere s = sphere_buf.spheres[h.index];
+            ng = (p - s.center) / s.radius;
+            ns = ng;
+            mat_index = s.material;
+            // Sphere tests square their inputs (c = f.f - r^2), so a start a few
+            // ULPs inside glass can still re-hit the same sphere: 4x the margin
+            // (scenes/box's glass sphere speckled with 2^-22).
+            scale = 4.0 * max(scale, max_abs(p));
+        } else {
+            Triangle tri = triangle_buf.triangles[h.index];
+            // A triangle test's error grows with its vertices' magnitude (a floor
+            // quad reaching x = 8 seen from a glass sphere at |o| = 1 re-hit itself).
+            scale = max(scale, max(max_abs(tri.p0), max(max_abs(tri.p1), max_abs(tri.p2))));
+            vec3 e1 = tri.p1 - tri.p0;
+            vec3 e2 = tri.p2 - tri.p0;
+#if defined(OFFSET_SCALE_AWARE) || defined(OFFSET_ULP)
+            // These offsets assume p lies within a few ULPs of its coordinates
+            // off the plane. o + t d does not: its error grows with t and with
+            // how thin the triangle is (acne on the teapot's spout and handle).
+            // Rebuilt from the barycentrics, an error in u, v only slides p
+            // along the plane (Wachter & Binder, Ray Tracing Gems ch. 6).
+            p = tri.p0 + h.u * e1 + h.v * e2;
+#endif
+            ng = normalize(cross(e1, e2));
+            ns = normalize((1.0 - h.u - h.v) * tri.n0 + h.u * tri.n1 + h.v * tri.n2);
+            mat_index = tri.material;
+        }
+        // Face both normals towards the incoming ray; `inside` tells glass which way it goes.
+        bool inside = dot(d, ng) > 0.0;
+        if (inside) {
+            ng = -ng;
+        }
+        if (dot(ns, ng) < 0.0) {
+            ns = -ns;
+        }
+        Material m = material_buf.materials[mat_index];
 
         vec3 local = m.ambient;
         for (uint li = 0u; li < LIGHT_COUNT; li++) {
             Light light = light_buf.lights[li];
-            vec3 p_out;
-            vec3 l;
-            float dist;
-            float ndl;
-            // Nested, not `&&`: naga's GLSL front end evaluates a call on the
-            // right of `&&` even when the left is false, which traced a shadow
-            // ray towards every light behind the surface (the ray count showed it).
-            if (shadow_ray(light, s, p_out, l, dist, ndl)) {
+            // The offset may depend on the direction (OFFSET_RAY): aim from p first.
+            vec3 p_out = spawn_point(p, ng, normalize(light.position - p), scale);
+            vec3 to_light = light.position - p_out;
+            float dist = length(to_light);
+            vec3 l = to_light / dist;
+            float ndl = dot(ns, l);
+            bool lit = ndl > 0.0 && dot(ng, l) > 0.0;
+            if (lit) {
                 // Stop a hair before the light: a light lying on a surface would
                 // otherwise be hidden by that surface at the whim of rounding.
-                if (!occluded(p_out, l, dist * SHADOW_REACH)) {
-                    local += light_color(light, m, s.ns, l, ndl, d);
-                }
+                lit = !occluded(p_out, l, dist * SHADOW_REACH);
+            }
+            if (lit) {
+                vec3 r = reflect(-l, ns);
+                float spec = pow(max(dot(r, -d), 0.0), m.shininess);
+                local += light.color * (m.diffuse * ndl + m.specular * spec);
             }
         }
 #endif
         color += w * local;
-        vec3 p = s.p;
-        vec3 ng = s.ng;
-        vec3 ns = s.ns;
-        float scale = s.scale;
-        bool inside = s.inside;
 
 #if defined(HAS_MIRROR) || defined(HAS_GLASS)
         SPEC(SPEC_MIRROR || SPEC_GLASS)

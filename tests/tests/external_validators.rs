@@ -12,6 +12,7 @@ use std::path::{Path, PathBuf};
 use std::process::Command;
 use std::sync::Mutex;
 use twinray_common::cli::{Experiment, RenderArgs, Size, Workgroup};
+use twinray_common::fragment_pass::QUAD_DEFINE;
 use twinray_common::scene::accel::Accel;
 use twinray_common::scene::numerics::{Numerics, Offset, SphereTest, TriangleTest};
 use twinray_common::scene::{Features, Scene};
@@ -158,16 +159,24 @@ fn glslang_and_spirv_val_accept_every_variant() {
     }
     let dir = scratch("external-validators");
     let mut jobs = Vec::new();
-    let vert = write(
-        &dir.join("fullscreen.vert"),
-        build::FULLSCREEN_VERT.as_bytes(),
-    );
-    jobs.push(Job {
-        what: "vertex source".into(),
-        program: "glslangValidator",
-        args: vec!["-V".into(), "--target-env".into(), "vulkan1.0".into()],
-        file: vert,
-    });
+    // The fullscreen triangle, and `--experiment quad`'s two triangles (naga's
+    // output of them goes through the validation layer in
+    // tests/tests/fragment_experiments.rs).
+    let quad = format!("-D{QUAD_DEFINE}=1");
+    for (name, define) in [("fullscreen", None), ("fullscreen-quad", Some(&quad))] {
+        let file = write(
+            &dir.join(format!("{name}.vert")),
+            build::FULLSCREEN_VERT.as_bytes(),
+        );
+        let mut args = vec!["-V".into(), "--target-env".into(), "vulkan1.0".into()];
+        args.extend(define.cloned());
+        jobs.push(Job {
+            what: format!("vertex source {name}"),
+            program: "glslangValidator",
+            args,
+            file,
+        });
+    }
     let list = variants();
     let mut fragment_sources = 0;
     let mut compute_sources = 0;

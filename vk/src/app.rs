@@ -20,9 +20,12 @@ use crate::window;
 use anyhow::{bail, Result};
 use std::sync::atomic::Ordering;
 use std::time::Instant;
-use twinray_common::cli::{FrameWait, RenderArgs, RenderPath, SceneMemory, VulkanKnobs, Workgroup};
+use twinray_common::cli::{
+    Experiment, FrameWait, RenderArgs, RenderPath, SceneMemory, VulkanKnobs, Workgroup,
+};
 use twinray_common::error::bad_input;
 use twinray_common::explain;
+use twinray_common::fragment_pass::{check_experiments, FragmentPass};
 use twinray_common::gpu::upload::GpuScene;
 use twinray_common::reference::image_io::FloatImage;
 use twinray_common::report::{dump_shaders, dump_statistics, FrameTime, RunReport};
@@ -39,6 +42,7 @@ pub fn run(args: RenderArgs, knobs: &VulkanKnobs, process_start: Instant) -> Res
             "--gl-spirv is an OpenGL option: Vulkan always runs naga's SPIR-V",
         ));
     }
+    check_experiments(&args, true)?;
     if !args.headless {
         return run_windowed(&args, knobs, process_start);
     }
@@ -92,7 +96,8 @@ fn render(
     let shaders = build_shaders(args, variant)?;
     let gpu_scene = GpuScene::new(scene, width, height);
     let instance = Instance::new(args.validate, knobs.validation, &[])?;
-    let device = Device::new(&instance, None, knobs, args.count_rays)?;
+    let compute_only = args.experiment.contains(&Experiment::ComputeQueue);
+    let device = Device::new(&instance, None, knobs, compute_only, args.count_rays)?;
     device.check_size(width, height)?;
     // --vk-wait idle waits for each frame with vkQueueWaitIdle +
     // vkDeviceWaitIdle, as the 2018 study did, instead of the frame's fence.
@@ -174,18 +179,29 @@ fn render_fragment(run: &HeadlessRun, shaders: &Shaders) -> Result<Rendered> {
     let (device, frame_loop) = (run.device, &run.frame_loop);
     let (width, height) = (run.args.size.width, run.args.size.height);
     run.dump_shaders(&shaders.stages())?;
-    let render_pass = RenderPass::offscreen(device)?;
+    let pass = FragmentPass::of(&run.args.experiment);
+    let render_pass = RenderPass::offscreen(device, &pass)?;
     let rp = render_pass.render_pass;
-    let resources = SceneResources::new(device, run.gpu_scene, shaders, rp, Some((width, height)))?;
+    // None: a pipeline whose viewport and scissor are set while recording.
+    let fixed_size = (!pass.dynamic_viewport).then_some((width, height));
+    let resources = SceneResources::new(device, run.gpu_scene, shaders, rp, fixed_size)?;
     let (pipeline, descriptors) = (&resources.pipeline, &resources.descriptors);
-    let target = Target::new(device, rp, width, height)?;
+    let target = Target::new(device, rp, width, height, &pass)?;
     let timestamps = frame_loop.timestamps;
-    let commands = Commands::record(device, rp, pipeline, descriptors, &target, timestamps)?;
+    let commands = Commands::record(
+        device,
+        rp,
+        pipeline,
+        descriptors,
+        &target,
+        timestamps,
+        &pass,
+    )?;
     let (frames, setup_ms) = frame_loop.run(&commands)?;
     let image = target.read_back(device)?;
     explain::step(
         "Readback: vkCmdCopyImageToBuffer + HOST barrier, then map",
-        || format!("{width}x{height} RGBA32F, top row first"),
+        || format!("{width}x{height} {}, top row first", pass.format_name()),
     );
     Ok((frames, setup_ms, image))
 }

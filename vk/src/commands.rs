@@ -18,6 +18,7 @@ use crate::timestamps::Timestamps;
 use anyhow::{Context, Result};
 use ash::vk;
 use twinray_common::explain;
+use twinray_common::fragment_pass::FragmentPass;
 
 pub struct Commands {
     device: ash::Device,
@@ -37,7 +38,15 @@ impl Commands {
         descriptors: &Descriptors,
         target: &Target,
         timestamps: Option<&Timestamps>,
+        pass: &FragmentPass,
     ) -> Result<Commands> {
+        // Read only by a pass whose load op is CLEAR (`--experiment load-clear`).
+        let clear = [vk::ClearValue::default()];
+        let extent = vk::Extent2D {
+            width: target.width,
+            height: target.height,
+        };
+        let (viewport, scissor) = crate::pipeline::whole(extent);
         let this = Commands::record_with(device, |d, cmd| {
             if let Some(t) = timestamps {
                 t.record_reset(cmd);
@@ -46,16 +55,16 @@ impl Commands {
             let begin = vk::RenderPassBeginInfo::default()
                 .render_pass(render_pass)
                 .framebuffer(target.framebuffer)
-                .render_area(vk::Rect2D {
-                    offset: vk::Offset2D::default(),
-                    extent: vk::Extent2D {
-                        width: target.width,
-                        height: target.height,
-                    },
-                });
+                .render_area(scissor)
+                .clear_values(if pass.clear { &clear } else { &[] });
             // SAFETY: every handle is alive and `cmd` is recording.
             unsafe {
                 d.cmd_begin_render_pass(cmd, &begin, vk::SubpassContents::INLINE);
+                // `--experiment dynamic-viewport`: the pipeline left them dynamic.
+                if pass.dynamic_viewport {
+                    d.cmd_set_viewport(cmd, 0, &[viewport]);
+                    d.cmd_set_scissor(cmd, 0, &[scissor]);
+                }
                 d.cmd_bind_pipeline(cmd, vk::PipelineBindPoint::GRAPHICS, pipeline.pipeline);
                 d.cmd_bind_descriptor_sets(
                     cmd,
@@ -65,8 +74,9 @@ impl Commands {
                     &[descriptors.set],
                     &[],
                 );
-                // Three vertices, no vertex buffer: the fullscreen triangle.
-                d.cmd_draw(cmd, 3, 1, 0, 0);
+                // No vertex buffer: the vertex shader makes the fullscreen
+                // triangle (or `--experiment quad`'s two) from the vertex index.
+                d.cmd_draw(cmd, pass.vertices(), 1, 0, 0);
                 d.cmd_end_render_pass(cmd);
             }
             if let Some(t) = timestamps {
@@ -81,8 +91,8 @@ impl Commands {
                 } else {
                     ""
                 };
-                format!("{ts}begin render pass {}x{}, bind pipeline, bind descriptor set 0, draw 3 vertices, end pass{}",
-                target.width, target.height, if timestamps.is_some() { ", timestamp BOTTOM_OF_PIPE" } else { "" })
+                format!("{ts}begin render pass {}x{}, bind pipeline, bind descriptor set 0, draw {} vertices, end pass{}",
+                target.width, target.height, pass.vertices(), if timestamps.is_some() { ", timestamp BOTTOM_OF_PIPE" } else { "" })
             },
         );
         Ok(this)

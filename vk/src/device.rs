@@ -25,6 +25,9 @@ pub struct Device {
     /// "driverName driverInfo" where Vulkan 1.2 can tell us, else the raw driverVersion.
     pub driver: String,
     pub queue_family: u32,
+    /// What the queue family can do: without GRAPHICS (`--experiment
+    /// compute-queue`) no barrier may name a graphics stage.
+    pub queue_flags: vk::QueueFlags,
     /// The queue family's timestampValidBits: 0 means no timestamps on this queue.
     pub timestamp_valid_bits: u32,
     pub device: ash::Device,
@@ -47,19 +50,25 @@ struct Candidate {
     /// The first queue family that can draw and dispatch (and present, for a window), with
     /// its timestampValidBits and flags.
     graphics_family: Option<(u32, u32, vk::QueueFlags)>,
+    /// The first family that dispatches but cannot draw, likewise
+    /// (`--experiment compute-queue`).
+    compute_family: Option<(u32, u32, vk::QueueFlags)>,
 }
 
 impl Device {
     /// `surface` is the window's, in windowed mode: the queue must also present
     /// to it, and the device must offer VK_KHR_swapchain. `knobs` may name the
-    /// device and say where scene buffers go. `count_rays` asks for
-    /// fragmentStoresAndAtomics, which the ray-counting frame needs on the
-    /// fragment path; the timed runs get the device they always had.
+    /// device and say where scene buffers go. `compute_only`: the one queue
+    /// comes from a family without GRAPHICS (`--experiment compute-queue`).
+    /// `count_rays` asks for fragmentStoresAndAtomics, which the ray-counting
+    /// frame needs on the fragment path; the timed runs get the device they
+    /// always had.
     // Long function: the walkthrough's device step read top to bottom (pick a GPU, a queue family, features, extensions, create); each block is one choice.
     pub fn new(
         instance: &Instance,
         surface: Option<&Surface>,
         knobs: &VulkanKnobs,
+        compute_only: bool,
         count_rays: bool,
     ) -> Result<Device> {
         let vk_instance = &instance.instance;
@@ -89,6 +98,13 @@ impl Device {
                     .find(|&(i, f)| f.queue_flags.contains(abilities) && presents(i))
                     .filter(|_| surface.is_none() || has_swapchain(vk_instance, physical))
                     .map(|(i, f)| (i, f.timestamp_valid_bits, f.queue_flags));
+                let compute_family = (0u32..)
+                    .zip(&families)
+                    .find(|(_, f)| {
+                        f.queue_flags.contains(vk::QueueFlags::COMPUTE)
+                            && !f.queue_flags.contains(vk::QueueFlags::GRAPHICS)
+                    })
+                    .map(|(i, f)| (i, f.timestamp_valid_bits, f.queue_flags));
                 let name = properties
                     .device_name_as_c_str()
                     .unwrap_or(c"?")
@@ -99,12 +115,22 @@ impl Device {
                     properties,
                     name,
                     graphics_family,
+                    compute_family,
                 }
             })
             .collect();
         let chosen = choose(&candidates, knobs.device())?;
-        let (queue_family, timestamp_valid_bits, flags) =
-            chosen.graphics_family.expect("choose() checks this");
+        let graphics = chosen.graphics_family.expect("choose() checks this");
+        let (queue_family, timestamp_valid_bits, flags) = if compute_only {
+            chosen.compute_family.ok_or_else(|| {
+                bad_input(format!(
+                    "--experiment compute-queue: the Vulkan device '{}' has no compute-only queue family (one with COMPUTE but not GRAPHICS)",
+                    chosen.name
+                ))
+            })?
+        } else {
+            graphics
+        };
         explain::step("VkPhysicalDevice chosen", || {
             let mut s = String::new();
             for (i, c) in candidates.iter().enumerate() {
@@ -214,6 +240,7 @@ queue family {queue_family}: {flags:?}, timestampValidBits {timestamp_valid_bits
             name: chosen.name.clone(),
             driver: driver_description(instance, chosen),
             queue_family,
+            queue_flags: flags,
             timestamp_valid_bits,
             device,
             queue,

@@ -327,18 +327,7 @@ fn record_render_pass(
             offset: vk::Offset2D::default(),
             extent,
         });
-    let viewport = vk::Viewport {
-        x: 0.0,
-        y: 0.0,
-        width: extent.width as f32,
-        height: extent.height as f32,
-        min_depth: 0.0,
-        max_depth: 1.0,
-    };
-    let scissor = vk::Rect2D {
-        offset: vk::Offset2D::default(),
-        extent,
-    };
+    let (viewport, scissor) = crate::pipeline::whole(extent);
     // SAFETY: `cmd` is recording (record() began it); the render pass, the
     // framebuffer of image `index`, the pipeline and the set belong to the window,
     // its swapchain and `scene`, which the window replaces only after waiting

@@ -267,8 +267,12 @@ impl<'a> Uploads<'a> {
                 )
             })
             .collect();
-        let shaders =
-            vk::PipelineStageFlags::FRAGMENT_SHADER | vk::PipelineStageFlags::COMPUTE_SHADER;
+        // A compute-only queue (`--experiment compute-queue`) runs no fragment stage to wait for.
+        let shaders = if self.device.queue_flags.contains(vk::QueueFlags::GRAPHICS) {
+            vk::PipelineStageFlags::FRAGMENT_SHADER | vk::PipelineStageFlags::COMPUTE_SHADER
+        } else {
+            vk::PipelineStageFlags::COMPUTE_SHADER
+        };
         self.device.run_once("uploading the scene", |cmd| {
             for (staging, buffer) in &self.copies {
                 let region = vk::BufferCopy::default().size(buffer.size);

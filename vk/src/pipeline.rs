@@ -20,11 +20,22 @@ use crate::device::Device;
 use anyhow::{Context, Result};
 use ash::vk;
 use twinray_common::explain;
+use twinray_common::fragment_pass::FragmentPass;
 use twinray_common::shader::build::Shaders;
 
 /// Float output, so the NaN count and the 8-bit rounding happen on the CPU,
 /// identically for both APIs. Every Vulkan device can render to it.
 pub const COLOR_FORMAT: vk::Format = vk::Format::R32G32B32A32_SFLOAT;
+
+/// The headless target's format: COLOR_FORMAT, or with `--experiment rgba8`
+/// 8-bit UNORM (also mandatory as a colour attachment and copy source).
+pub fn target_format(pass: &FragmentPass) -> vk::Format {
+    if pass.rgba8 {
+        vk::Format::R8G8B8A8_UNORM
+    } else {
+        COLOR_FORMAT
+    }
+}
 
 pub struct RenderPass {
     device: ash::Device,
@@ -32,28 +43,37 @@ pub struct RenderPass {
 }
 
 impl RenderPass {
-    /// The headless pass: RGBA32F, left in TRANSFER_SRC_OPTIMAL for the readback.
-    pub fn offscreen(device: &Device) -> Result<RenderPass> {
-        RenderPass::new(device, COLOR_FORMAT, vk::ImageLayout::TRANSFER_SRC_OPTIMAL)
+    /// The headless pass: RGBA32F (or as `pass` asks), left in
+    /// TRANSFER_SRC_OPTIMAL for the readback.
+    pub fn offscreen(device: &Device, pass: &FragmentPass) -> Result<RenderPass> {
+        let load = if pass.clear {
+            vk::AttachmentLoadOp::CLEAR
+        } else {
+            vk::AttachmentLoadOp::DONT_CARE
+        };
+        let layout = vk::ImageLayout::TRANSFER_SRC_OPTIMAL;
+        RenderPass::new(device, target_format(pass), layout, load)
     }
 
     /// The windowed pass: the swapchain's format, left in PRESENT_SRC_KHR.
     pub fn for_swapchain(device: &Device, format: vk::Format) -> Result<RenderPass> {
-        RenderPass::new(device, format, vk::ImageLayout::PRESENT_SRC_KHR)
+        let load = vk::AttachmentLoadOp::DONT_CARE;
+        RenderPass::new(device, format, vk::ImageLayout::PRESENT_SRC_KHR, load)
     }
 
     fn new(
         device: &Device,
         format: vk::Format,
         final_layout: vk::ImageLayout,
+        load: vk::AttachmentLoadOp,
     ) -> Result<RenderPass> {
         let d = &device.device;
         // The fullscreen triangle writes every pixel, so the old contents are not
-        // loaded.
+        // loaded (DONT_CARE) unless `--experiment load-clear` measures a CLEAR.
         let attachment = vk::AttachmentDescription::default()
             .format(format)
             .samples(vk::SampleCountFlags::TYPE_1)
-            .load_op(vk::AttachmentLoadOp::DONT_CARE)
+            .load_op(load)
             .store_op(vk::AttachmentStoreOp::STORE)
             .initial_layout(vk::ImageLayout::UNDEFINED)
             .final_layout(final_layout);
@@ -101,7 +121,7 @@ impl RenderPass {
             unsafe { d.create_render_pass(&info, None) }.context("creating the render pass")?;
         explain::step("VkRenderPass", || {
             format!(
-                "1 colour attachment {format:?}, load DONT_CARE (every pixel is written), store STORE\n\
+                "1 colour attachment {format:?}, load {load:?} (every pixel is written), store STORE\n\
                  layout UNDEFINED -> COLOR_ATTACHMENT_OPTIMAL -> {final_layout:?}; {} subpass dependencies",
                 dependencies.len()
             )
@@ -207,18 +227,8 @@ impl Pipeline {
         // A normal viewport (positive height): Vulkan's row 0 is the top, and the
         // shader builds rays with +y down, so rows go to the PNG unflipped.
         let (width, height) = fixed_size.unwrap_or((1, 1));
-        let viewports = [vk::Viewport {
-            x: 0.0,
-            y: 0.0,
-            width: width as f32,
-            height: height as f32,
-            min_depth: 0.0,
-            max_depth: 1.0,
-        }];
-        let scissors = [vk::Rect2D {
-            offset: vk::Offset2D::default(),
-            extent: vk::Extent2D { width, height },
-        }];
+        let (viewport, scissor) = whole(vk::Extent2D { width, height });
+        let (viewports, scissors) = ([viewport], [scissor]);
         let viewport = vk::PipelineViewportStateCreateInfo::default()
             .viewports(&viewports)
             .scissors(&scissors);
@@ -279,6 +289,23 @@ impl Pipeline {
         );
         Ok(this) // the shader modules are dropped here: the pipeline has its own copy.
     }
+}
+
+/// The viewport and scissor that cover the whole `extent`.
+pub fn whole(extent: vk::Extent2D) -> (vk::Viewport, vk::Rect2D) {
+    let viewport = vk::Viewport {
+        x: 0.0,
+        y: 0.0,
+        width: extent.width as f32,
+        height: extent.height as f32,
+        min_depth: 0.0,
+        max_depth: 1.0,
+    };
+    let scissor = vk::Rect2D {
+        offset: vk::Offset2D::default(),
+        extent,
+    };
+    (viewport, scissor)
 }
 
 impl Drop for Pipeline {

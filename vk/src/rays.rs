@@ -17,6 +17,7 @@ use ash::vk;
 use twinray_common::cli::RenderPath;
 use twinray_common::error::no_device;
 use twinray_common::explain;
+use twinray_common::fragment_pass::FragmentPass;
 use twinray_common::gpu::layout::{binding, GpuRayCount};
 use twinray_common::limits::pixel_count;
 use twinray_common::rays::RayKinds;
@@ -47,13 +48,16 @@ pub fn count_rays(device: &Device, run: &CountingRun) -> Result<RayKinds> {
                     )));
             }
             let shaders = build(&counting)?;
-            let render_pass = RenderPass::offscreen(device)?;
+            // The run's own fragment pass (`--experiment quad` draws two triangles).
+            let pass = FragmentPass::of(&run.variant.experiments);
+            let render_pass = RenderPass::offscreen(device, &pass)?;
             let rp = render_pass.render_pass;
             let descriptors = Descriptors::new(device, &frame, &storage)?;
-            let size = Some((width, height));
+            let size = (!pass.dynamic_viewport).then_some((width, height));
             let pipeline = Pipeline::new(device, descriptors.set_layout, &shaders, rp, size)?;
-            let target = Target::new(device, rp, width, height)?;
-            let commands = Commands::record(device, rp, &pipeline, &descriptors, &target, None)?;
+            let target = Target::new(device, rp, width, height, &pass)?;
+            let commands =
+                Commands::record(device, rp, &pipeline, &descriptors, &target, None, &pass)?;
             commands.submit()?;
             commands.wait(false)?;
         }

@@ -12,11 +12,12 @@
 use crate::device::Device;
 use crate::memory::{self, Buffer};
 use crate::memory::{buffer_barrier, pipeline_barrier};
-use crate::pipeline::COLOR_FORMAT;
+use crate::pipeline::target_format;
 use anyhow::{Context, Result};
 use ash::vk;
 use ash::vk::MemoryPropertyFlags as Flags;
 use twinray_common::explain;
+use twinray_common::fragment_pass::FragmentPass;
 use twinray_common::reference::image_io::FloatImage;
 
 pub struct Target {
@@ -28,6 +29,8 @@ pub struct Target {
     pub width: u32,
     pub height: u32,
     readback: Buffer,
+    /// `--experiment rgba8`: the image and the readback hold 8-bit UNORM texels.
+    rgba8: bool,
 }
 
 impl Target {
@@ -36,9 +39,10 @@ impl Target {
         render_pass: vk::RenderPass,
         width: u32,
         height: u32,
+        pass: &FragmentPass,
     ) -> Result<Target> {
         let d = &device.device;
-        let readback = readback_buffer(device, width, height)?;
+        let readback = sized_readback(device, width as u64 * height as u64 * pass.texel_bytes())?;
         let bytes = readback.size;
         explain::step("VkBuffer + VkDeviceMemory: readback buffer", || {
             format!(
@@ -55,17 +59,19 @@ impl Target {
             width,
             height,
             readback,
+            rgba8: pass.rgba8,
         };
+        let format = target_format(pass);
         let image_bytes = create_image_with_view(
             device,
-            COLOR_FORMAT,
+            format,
             (width, height),
             vk::ImageUsageFlags::COLOR_ATTACHMENT | vk::ImageUsageFlags::TRANSFER_SRC,
             "colour image",
             (&mut this.image, &mut this.memory, &mut this.view),
         )?;
         explain::step("VkImage + VkDeviceMemory: colour target", || {
-            format!("{width}x{height} {COLOR_FORMAT:?}, OPTIMAL tiling, usage COLOR_ATTACHMENT|TRANSFER_SRC, {image_bytes} bytes DEVICE_LOCAL")
+            format!("{width}x{height} {format:?}, OPTIMAL tiling, usage COLOR_ATTACHMENT|TRANSFER_SRC, {image_bytes} bytes DEVICE_LOCAL")
         });
         explain::step("VkImageView", || {
             "2D, COLOR aspect, 1 mip level, 1 layer".into()
@@ -101,6 +107,14 @@ impl Target {
                 self.height,
             );
         })?;
+        if self.rgba8 {
+            let rgba: Vec<u8> = self
+                .readback
+                .read()
+                .context("reading the readback buffer")?;
+            let rgba: Vec<f32> = rgba.iter().map(|&c| c as f32 / 255.0).collect();
+            return Ok(FloatImage::from_rgba(self.width, self.height, &rgba));
+        }
         read_image(&self.readback, self.width, self.height)
     }
 }
@@ -138,7 +152,7 @@ pub fn record_copy_to_host(
     let d = &device.device;
     // SAFETY: `cmd` is run_once's, recording; the caller owns `image` (in
     // TRANSFER_SRC_OPTIMAL, as the region's layout says) and `readback`, which
-    // holds width x height RGBA32F texels (readback_buffer sized it so).
+    // holds width x height texels of the image's format (its maker sized it so).
     unsafe {
         d.cmd_copy_image_to_buffer(
             cmd,
@@ -168,7 +182,10 @@ pub fn read_image(readback: &Buffer, width: u32, height: u32) -> Result<FloatIma
 /// packed tightly. Cached memory where there is some: uncached reads of mapped
 /// memory are very slow.
 pub fn readback_buffer(device: &Device, width: u32, height: u32) -> Result<Buffer> {
-    let bytes = width as u64 * height as u64 * 16;
+    sized_readback(device, width as u64 * height as u64 * 16)
+}
+
+fn sized_readback(device: &Device, bytes: u64) -> Result<Buffer> {
     let wishes = [
         Flags::HOST_VISIBLE | Flags::HOST_CACHED,
         Flags::HOST_VISIBLE,

@@ -32,6 +32,7 @@ use std::time::Instant;
 use twinray_common::cli::{RenderArgs, VulkanKnobs};
 use twinray_common::error::no_device;
 use twinray_common::explain;
+use twinray_common::fragment_pass::FragmentPass;
 use twinray_common::gpu::layout::GpuFrame;
 use twinray_common::gpu::upload::GpuScene;
 use twinray_common::rays::RayKinds;
@@ -104,7 +105,7 @@ pub fn run(
         surface::required_extensions(&window)?,
     )?;
     let surface = Surface::new(&instance, &window)?;
-    let device = Device::new(&instance, Some(&surface), knobs, args.count_rays)?;
+    let device = Device::new(&instance, Some(&surface), knobs, false, args.count_rays)?;
     let loader = khr::swapchain::Device::new(&instance.instance, &device.device);
     let format = swapchain::choose_format(&device, &surface)?;
     let present_mode = swapchain::choose_present_mode(&device, &surface, args.vsync)?;
@@ -358,7 +359,8 @@ impl Renderer for VkWindow {
                 return compute.read_back(device);
             }
         };
-        let render_pass = RenderPass::offscreen(device)?;
+        let pass = FragmentPass::default();
+        let render_pass = RenderPass::offscreen(device, &pass)?;
         let set_layout = scene.descriptors.set_layout;
         let pipeline = Pipeline::new(
             device,
@@ -367,7 +369,7 @@ impl Renderer for VkWindow {
             render_pass.render_pass,
             Some((width, height)),
         )?;
-        let target = Target::new(device, render_pass.render_pass, width, height)?;
+        let target = Target::new(device, render_pass.render_pass, width, height, &pass)?;
         let commands = Commands::record(
             device,
             render_pass.render_pass,
@@ -375,6 +377,7 @@ impl Renderer for VkWindow {
             &scene.descriptors,
             &target,
             None,
+            &pass,
         )?;
         commands.submit()?;
         commands.wait(false)?;

@@ -6,6 +6,7 @@
 //! numerical choices, and any `--experiment`.
 
 use crate::cli::{Experiment, RenderArgs, RenderPath, Workgroup};
+use crate::fragment_pass::QUAD_DEFINE;
 use crate::gpu::upload::GpuScene;
 use crate::limits::MAX_DEPTH;
 use crate::scene::numerics::Numerics;
@@ -149,10 +150,10 @@ impl Variant {
         v.experiments = args.experiment.clone();
         v.experiments.sort();
         v.experiments.dedup();
+        if v.experiments.contains(&Experiment::OneQuery) {
+            v.defines.insert("ONE_QUERY".into(), "1".into());
+        }
         if v.defines.contains_key("USE_BVH") {
-            if v.experiments.contains(&Experiment::OneQuery) {
-                v.defines.insert("BVH_ONE_QUERY".into(), "1".into());
-            }
             if v.experiments.contains(&Experiment::StacklessBvh) {
                 v.defines.insert("BVH_STACKLESS".into(), "1".into());
             }
@@ -169,6 +170,9 @@ impl Variant {
         }
         if v.experiments.contains(&Experiment::StorageCounts) {
             v.defines.insert("COUNTS_FROM_STORAGE".into(), "1".into());
+        }
+        if v.experiments.contains(&Experiment::Quad) {
+            v.defines.insert(QUAD_DEFINE.into(), "1".into());
         }
         v
     }
