@@ -144,20 +144,11 @@ fn the_window_counts_rays_and_still_draws_its_view() {
     let out = dir.join("window.png");
     for app in App::BOTH {
         // To compute, to spherelist, back to box, back to fragment: each a recount.
-        let args = [
-            "--scene",
-            "box",
-            "--size",
-            "96x72",
-            "--frames",
-            "12",
-            "--count-rays",
-            "--explain",
-            "--validate",
-            "--json",
-            "--out",
-            out.to_str().unwrap(),
-        ];
+        let out_s = out.to_str().unwrap();
+        let mut args = vec!["--count-rays", "--explain", "--validate", "--json"];
+        args.extend([
+            "--scene", "box", "--size", "96x72", "--frames", "12", "--out", out_s,
+        ]);
         let o = x.run(&app.exe(), &args, &[("TWINRAY_TEST_KEYS", "c,3,2,c")], &dir);
         let stderr = String::from_utf8_lossy(&o.stderr);
         assert!(o.status.success(), "{app:?}: {stderr}");
