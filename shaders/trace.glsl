@@ -154,6 +154,26 @@ layout(std430, set = 0, binding = 8) readonly buffer BvhLinks {
 
 const float T_MAX = 1.0e30;
 
+#ifdef COUNT_RAYS
+// The counting variant (COUNT_RAYS: one untimed frame, never the timed shader)
+// counts each pixel's rays by kind in `rays_traced` and stores them in the
+// pixel's own slot; the apps add the slots up. A slot per pixel needs no
+// atomics, which naga's GLSL front end does not parse.
+struct RayCount {
+    uint primary;
+    uint shadow;
+    uint mirror;           // reflected from a surface that is not glass
+    uint glass_reflected;
+    uint glass_refracted;
+};
+
+layout(std430, set = 0, binding = 10) buffer RayCounts {
+    RayCount pixels[];
+} ray_count_buf;
+
+RayCount rays_traced;
+#endif
+
 // trace/intersect.glsl — where one ray meets one sphere or one triangle, and
 // the per-primitive steps that the brute-force loops and the BVH leaves share.
 
@@ -691,6 +711,9 @@ Hit closest_hit(vec3 origin, vec3 dir) {
 }
 
 bool occluded(vec3 origin, vec3 dir, float dist) {
+#ifdef COUNT_RAYS
+    rays_traced.shadow += 1u;
+#endif
 #ifdef USE_BVH
     return traverse(origin, dir, dist, true).kind != 0u;
 #else
@@ -884,6 +907,12 @@ vec3 trace(vec3 origin, vec3 dir) {
             q_dir = d;
             q_t = T_MAX;
         }
+#ifdef COUNT_RAYS
+        // This loop's shadow queries bypass occluded(), which counts the others.
+        if (shadow_pending) {
+            rays_traced.shadow += 1u;
+        }
+#endif
         Hit h = query(q_origin, q_dir, q_t, shadow_pending);
         if (shadow_pending) {
             if (h.kind == 0u) {
@@ -1067,6 +1096,9 @@ vec3 trace(vec3 origin, vec3 dir) {
                         st_weight[sp] = wt;
                         st_depth[sp] = depth + 1u;
                         sp += 1;
+#ifdef COUNT_RAYS
+                        rays_traced.glass_refracted += 1u;
+#endif
                     }
                 }
             }
@@ -1079,6 +1111,13 @@ vec3 trace(vec3 origin, vec3 dir) {
                 st_weight[sp] = wr;
                 st_depth[sp] = depth + 1u;
                 sp += 1;
+#ifdef COUNT_RAYS
+                if (m.transparency > 0.0) {
+                    rays_traced.glass_reflected += 1u;
+                } else {
+                    rays_traced.mirror += 1u;
+                }
+#endif
             }
         }
 #endif

@@ -92,6 +92,9 @@ Hit closest_hit(vec3 origin, vec3 dir) {
 }
 
 bool occluded(vec3 origin, vec3 dir, float dist) {
+#ifdef COUNT_RAYS
+    rays_traced.shadow += 1u;
+#endif
 #ifdef USE_BVH
     return traverse(origin, dir, dist, true).kind != 0u;
 #else
