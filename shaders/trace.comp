@@ -26,6 +26,12 @@ void main() {
     if (p.x >= frame.width || p.y >= frame.height) {
         return;
     }
+#ifdef COUNT_RAYS
+    rays_traced = RayCount(1u, 0u, 0u, 0u, 0u);
+#endif
     vec3 dir = primary_dir(vec2(p) + 0.5);
     imageStore(out_image, ivec2(p), vec4(trace(frame.eye, dir), 1.0));
+#ifdef COUNT_RAYS
+    ray_count_buf.pixels[p.y * frame.width + p.x] = rays_traced;
+#endif
 }

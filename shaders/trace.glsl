@@ -154,6 +154,26 @@ layout(std430, set = 0, binding = 8) readonly buffer BvhLinks {
 
 const float T_MAX = 1.0e30;
 
+#ifdef COUNT_RAYS
+// The counting variant (COUNT_RAYS: one untimed frame, never the timed shader)
+// counts each pixel's rays by kind in `rays_traced` and stores them in the
+// pixel's own slot; the apps add the slots up. A slot per pixel needs no
+// atomics, which naga's GLSL front end does not parse.
+struct RayCount {
+    uint primary;
+    uint shadow;
+    uint mirror;           // reflected from a surface that is not glass
+    uint glass_reflected;
+    uint glass_refracted;
+};
+
+layout(std430, set = 0, binding = 10) buffer RayCounts {
+    RayCount pixels[];
+} ray_count_buf;
+
+RayCount rays_traced;
+#endif
+
 // trace/intersect.glsl — where one ray meets one sphere or one triangle, and
 // the per-primitive steps that the brute-force loops and the BVH leaves share.
 
@@ -274,7 +294,12 @@ vec3 hit_triangle(TriRay r, Triangle tri, float t_min, float t_max) {
     float tz = eu * (r.s.z * a[r.k.z]) + ev * (r.s.z * b[r.k.z]) + ew * (r.s.z * c[r.k.z]);
     float inv = 1.0 / det;
     float t = tz * inv;
-    if (!(t > t_min && t < t_max) || is_degenerate(tri)) {
+    // Computed on every call, as naga always did for the call right of `||`
+    // this once was (the product's timings include it; testing it only
+    // inside the branch was slower on the H100's brute-force teapot, along
+    // with early exits in the shadow test).
+    bool degenerate = is_degenerate(tri);
+    if (!(t > t_min && t < t_max) || degenerate) {
         return miss;
     }
     return vec3(t, ev * inv, ew * inv);
@@ -299,7 +324,12 @@ vec3 hit_triangle(TriRay r, Triangle tri, float t_min, float t_max) {
         return miss;
     }
     float t = dot(e2, qv) * inv;
-    if (!(t > t_min && t < t_max) || is_degenerate(tri)) {
+    // Computed on every call, as naga always did for the call right of `||`
+    // this once was (the product's timings include it; testing it only
+    // inside the branch was slower on the H100's brute-force teapot, along
+    // with early exits in the shadow test).
+    bool degenerate = is_degenerate(tri);
+    if (!(t > t_min && t < t_max) || degenerate) {
         return miss;
     }
     return vec3(t, u, v);
@@ -495,8 +525,11 @@ Hit traverse(vec3 origin, vec3 dir, float t_max, bool any_hit) {
             state = FROM_PARENT;
             continue;
         }
-        if (enter && hit_leaf(h, origin, dir, ray, bvh_buf.nodes[node].left_or_first, count, any_hit)) {
-            return h;
+        // Nested, not `&&`: naga would test the leaf of every box, entered or not.
+        if (enter) {
+            if (hit_leaf(h, origin, dir, ray, bvh_buf.nodes[node].left_or_first, count, any_hit)) {
+                return h;
+            }
         }
         // Done with this subtree: the far sibling is next after the near
         // child, the parent after the far one.
@@ -619,12 +652,20 @@ Hit closest_hit_brute(vec3 origin, vec3 dir) {
     return h;
 }
 
+// naga's GLSL front end does not short-circuit && and ||: whatever stands
+// right of them is evaluated every time (gfx-rs/wgpu#4394), so the code says
+// so. The four tests of a group all run and are or-ed, which is what the GPU
+// runs fastest (early exits after each cost the brute-force sphere list 6-10 %
+// on an H100); the index is clamped so that the tests past the last primitive
+// read a real one, and `i < COUNT` then discards them.
 bool sphere_blocks(vec3 origin, vec3 dir, float dist, uint i) {
-    return i < SPHERE_COUNT && hit_sphere(origin, dir, sphere_buf.spheres[i], 0.0, dist) > 0.0;
+    bool blocks = hit_sphere(origin, dir, sphere_buf.spheres[min(i, SPHERE_COUNT - 1u)], 0.0, dist) > 0.0;
+    return i < SPHERE_COUNT && blocks;
 }
 
 bool triangle_blocks(TriRay ray, float dist, uint i) {
-    return i < TRIANGLE_COUNT && hit_triangle(ray, triangle_buf.triangles[i], 0.0, dist).x > 0.0;
+    bool blocks = hit_triangle(ray, triangle_buf.triangles[min(i, TRIANGLE_COUNT - 1u)], 0.0, dist).x > 0.0;
+    return i < TRIANGLE_COUNT && blocks;
 }
 
 // Shadow rays need any hit before the light, not the closest one.
@@ -632,8 +673,11 @@ bool occluded_brute(vec3 origin, vec3 dir, float dist) {
 #ifdef HAS_SPHERES
     SPEC(SPEC_SPHERES) {
         for (uint i = 0u; i < SPHERE_COUNT; i += PRIMS_PER_ITERATION) {
-            if (sphere_blocks(origin, dir, dist, i) || sphere_blocks(origin, dir, dist, i + 1u)
-                || sphere_blocks(origin, dir, dist, i + 2u) || sphere_blocks(origin, dir, dist, i + 3u)) {
+            bool b0 = sphere_blocks(origin, dir, dist, i);
+            bool b1 = sphere_blocks(origin, dir, dist, i + 1u);
+            bool b2 = sphere_blocks(origin, dir, dist, i + 2u);
+            bool b3 = sphere_blocks(origin, dir, dist, i + 3u);
+            if (b0 || b1 || b2 || b3) {
                 return true;
             }
         }
@@ -643,8 +687,11 @@ bool occluded_brute(vec3 origin, vec3 dir, float dist) {
     SPEC(SPEC_TRIANGLES) {
         TriRay ray = tri_ray(origin, dir);
         for (uint i = 0u; i < TRIANGLE_COUNT; i += PRIMS_PER_ITERATION) {
-            if (triangle_blocks(ray, dist, i) || triangle_blocks(ray, dist, i + 1u)
-                || triangle_blocks(ray, dist, i + 2u) || triangle_blocks(ray, dist, i + 3u)) {
+            bool b0 = triangle_blocks(ray, dist, i);
+            bool b1 = triangle_blocks(ray, dist, i + 1u);
+            bool b2 = triangle_blocks(ray, dist, i + 2u);
+            bool b3 = triangle_blocks(ray, dist, i + 3u);
+            if (b0 || b1 || b2 || b3) {
                 return true;
             }
         }
@@ -664,6 +711,9 @@ Hit closest_hit(vec3 origin, vec3 dir) {
 }
 
 bool occluded(vec3 origin, vec3 dir, float dist) {
+#ifdef COUNT_RAYS
+    rays_traced.shadow += 1u;
+#endif
 #ifdef USE_BVH
     return traverse(origin, dir, dist, true).kind != 0u;
 #else
@@ -857,6 +907,12 @@ vec3 trace(vec3 origin, vec3 dir) {
             q_dir = d;
             q_t = T_MAX;
         }
+#ifdef COUNT_RAYS
+        // This loop's shadow queries bypass occluded(), which counts the others.
+        if (shadow_pending) {
+            rays_traced.shadow += 1u;
+        }
+#endif
         Hit h = query(q_origin, q_dir, q_t, shadow_pending);
         if (shadow_pending) {
             if (h.kind == 0u) {
@@ -1040,6 +1096,9 @@ vec3 trace(vec3 origin, vec3 dir) {
                         st_weight[sp] = wt;
                         st_depth[sp] = depth + 1u;
                         sp += 1;
+#ifdef COUNT_RAYS
+                        rays_traced.glass_refracted += 1u;
+#endif
                     }
                 }
             }
@@ -1052,6 +1111,13 @@ vec3 trace(vec3 origin, vec3 dir) {
                 st_weight[sp] = wr;
                 st_depth[sp] = depth + 1u;
                 sp += 1;
+#ifdef COUNT_RAYS
+                if (m.transparency > 0.0) {
+                    rays_traced.glass_reflected += 1u;
+                } else {
+                    rays_traced.mirror += 1u;
+                }
+#endif
             }
         }
 #endif

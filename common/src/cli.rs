@@ -33,6 +33,10 @@ pub struct RenderArgs {
     /// Print one JSON object describing the run on stdout.
     #[arg(long)]
     pub json: bool,
+    /// Count the rays of one frame by kind, in an extra untimed frame of the
+    /// shader's counting variant: adds `rays` and `grays_per_s` to `--json`.
+    #[arg(long)]
+    pub count_rays: bool,
     /// Scene parameter override KEY=VALUE (repeatable), e.g. extra_spheres=2500, max_depth=3.
     #[arg(long = "set", value_name = "KEY=VALUE")]
     pub set: Vec<String>,
@@ -266,6 +270,7 @@ impl RenderArgs {
             frames: None,
             out: None,
             json: false,
+            count_rays: false,
             set: Vec::new(),
             validate: false,
             generic: false,

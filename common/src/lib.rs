@@ -7,7 +7,7 @@
 //! |---|---|
 //! | `error`, `explain`, `stats`, `value_name` | exit codes and clear errors; `--explain`'s log; frame statistics; the one spelling of every enum value |
 //! | `gpu::layout` | the `#[repr(C)]` mirror of every shader struct, binding numbers, the flattened BVH |
-//! | `limits` | one limit per user-controlled quantity |
+//! | `limits`, `rays` | one limit per user-controlled quantity; rays counted by kind (the counting frame's and the reference's), `--json`'s `rays`, Grays/s |
 //! | `reference::image_io`, `reference::metrics` | float images and PNG files; how far one image is from another |
 //! | `scene/` | the scene model; loading (`load`, `format`, `overrides`, `resolve`, `check`, `mesh`, `teapot`); `camera`, `numerics`, `accel` (`--accel` and the BVH builder); the `random` and `hard` scenes |
 //! | `gpu::upload` | a scene as the bytes both apps upload |
@@ -23,6 +23,7 @@ pub mod explain;
 pub mod fragment_pass;
 pub mod gpu;
 pub mod limits;
+pub mod rays;
 pub mod reference;
 pub mod report;
 pub mod scene;

@@ -2,6 +2,7 @@
 //! and the `twinray` orchestrator (which reads it back with the same struct).
 
 use crate::cli::{RenderPath, Workgroup};
+use crate::rays::{grays_per_s, RateClock, RayCounts, RayKinds};
 use crate::scene::SceneStats;
 use crate::stats::{summarize, Summary};
 use serde::{Deserialize, Serialize};
@@ -46,6 +47,17 @@ pub struct RunReport {
     /// (Vulkan's pipeline executable statistics, OpenGL's program binary).
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub shader_stats: Vec<ShaderStats>,
+    /// With `--count-rays`: the rays of one frame by kind, counted in a
+    /// separate untimed frame by the counting variant of the shader.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub rays: Option<RayCounts>,
+    /// With `--count-rays`: `rays.total` / the median frame time, in billions
+    /// of rays per second; `grays_clock` says which median (GPU, or wall
+    /// where the run has no GPU timer).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub grays_per_s: Option<f64>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub grays_clock: Option<RateClock>,
 }
 
 /// One compiled stage and the figures its driver gives for it, as the driver
@@ -104,6 +116,9 @@ impl RunReport {
                 setup_ms: 0.0,
                 validation_messages: 0,
                 shader_stats: Vec::new(),
+                rays: None,
+                grays_per_s: None,
+                grays_clock: None,
             },
         }
     }
@@ -116,12 +131,27 @@ impl RunReport {
         Ok(())
     }
 
+    /// Adds the counting frame's rays (`--count-rays`) and the rate they give.
+    pub fn add_rays(&mut self, kinds: RayKinds) {
+        self.rays = Some(kinds.counts());
+        self.summarise();
+    }
+
     /// Fills the summaries from `frames`.
     pub fn summarise(&mut self) {
         let wall: Vec<f64> = self.frames.iter().map(|f| f.wall_ms).collect();
         self.wall_ms = summarize(&wall);
         let gpu: Option<Vec<f64>> = self.frames.iter().map(|f| f.gpu_ms).collect();
         self.gpu_ms = gpu.and_then(|g| summarize(&g));
+        if let Some(rays) = &self.rays {
+            let (clock, median) = match (&self.gpu_ms, &self.wall_ms) {
+                (Some(g), _) => (RateClock::Gpu, g.median),
+                (None, Some(w)) => (RateClock::Wall, w.median),
+                (None, None) => return,
+            };
+            self.grays_per_s = Some(grays_per_s(rays.total, median));
+            self.grays_clock = Some(clock);
+        }
     }
 }
 

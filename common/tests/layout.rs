@@ -172,6 +172,32 @@ fn naga_layout_matches_rust_for_every_shader_struct() {
     );
 }
 
+/// The counting variant's per-pixel slots (`--count-rays`), which only it declares.
+#[test]
+fn naga_layout_matches_rust_for_the_ray_counts() {
+    let (counting, _) = parse(
+        &fragment_source(),
+        naga::ShaderStage::Fragment,
+        &Variant::generic(Default::default()).counting(),
+    )
+    .unwrap();
+    let (_, count) = block(&counting, binding::RAY_COUNTS);
+    let (ty, stride) = count.expect("ray counts are a runtime array");
+    assert_eq!(stride as usize, size_of::<GpuRayCount>(), "RayCount stride");
+    check(
+        "RayCount",
+        naga_members(&counting, ty),
+        rust_offsets!(GpuRayCount {
+            primary,
+            shadow,
+            mirror,
+            glass_reflected,
+            glass_refracted
+        }),
+        size_of::<GpuRayCount>(),
+    );
+}
+
 #[test]
 fn every_builtin_variant_and_the_generic_one_compile_for_both_apis() {
     let mut variants = vec![Variant::generic(Default::default())];

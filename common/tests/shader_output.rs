@@ -151,3 +151,90 @@ fn trace_glsl_is_its_parts_assembled() {
         "shaders/trace.glsl differs from shaders/trace/*.glsl put together; run\n  TWINRAY_UPDATE_DOCS=1 cargo test --release -p twinray-common --test shader_output"
     );
 }
+
+/// GLSL built-ins and constructors: pure and cheap, so evaluating them right
+/// of `&&` or `||` regardless of the left side changes nothing.
+const PURE_BUILTINS: &str = "abs all any bool clamp cross dot float greaterThan int length \
+    max min mix normalize sign sqrt uint uvec2 uvec4 vec2 vec3 vec4";
+
+/// Each `&&` or `||` whose right operand calls a function of the tracer or
+/// indexes an array, as `part:line: operand`. naga's GLSL front end does not
+/// short-circuit (gfx-rs/wgpu#4394): it evaluates that operand every time, so
+/// a guard written as `i < COUNT && buf[i]...` reads past the buffer and
+/// `cheap || costly()` always pays for the call.
+fn unguarded_operands(part: &str, src: &str) -> Vec<String> {
+    let code: String = src
+        .lines()
+        .map(|l| {
+            let l = l.split("//").next().unwrap_or("");
+            if l.trim_start().starts_with('#') {
+                "\n".to_string()
+            } else {
+                format!("{l}\n")
+            }
+        })
+        .collect();
+    let bytes = code.as_bytes();
+    let mut found = Vec::new();
+    let mut i = 0;
+    while i + 1 < bytes.len() {
+        let op = &code[i..i + 2];
+        if op != "&&" && op != "||" {
+            i += 1;
+            continue;
+        }
+        // The right operand: up to the next `&&`/`||`, `;`, `{` or `,` at its
+        // own nesting level, or the `)` that closes the enclosing group.
+        let start = i + 2;
+        let mut depth = 0i32;
+        let mut end = start;
+        while end < bytes.len() {
+            let rest = &code[end..];
+            match bytes[end] {
+                b'(' | b'[' => depth += 1,
+                b')' | b']' if depth == 0 => break,
+                b')' | b']' => depth -= 1,
+                b';' | b'{' | b',' if depth == 0 => break,
+                _ if depth == 0 && (rest.starts_with("&&") || rest.starts_with("||")) => break,
+                _ => {}
+            }
+            end += 1;
+        }
+        let operand = &code[start..end];
+        let calls_tracer = operand
+            .split(|c: char| !(c.is_ascii_alphanumeric() || c == '_' || c == '('))
+            .filter_map(|w| w.split_once('(').map(|(name, _)| name))
+            .any(|name| !name.is_empty() && !PURE_BUILTINS.split_whitespace().any(|b| b == name));
+        if calls_tracer || operand.contains('[') {
+            let line = code[..i].matches('\n').count() + 1;
+            found.push(format!("{part}:{line}: {}", operand.trim()));
+        }
+        i = start;
+    }
+    found
+}
+
+#[test]
+fn no_call_or_index_stands_right_of_and_or() {
+    let found: Vec<String> = build::TRACE_PARTS
+        .iter()
+        .flat_map(|(part, src)| unguarded_operands(part, src))
+        .collect();
+    assert!(
+        found.is_empty(),
+        "naga evaluates the right of && and || every time (gfx-rs/wgpu#4394); \
+         write these guards as ifs:\n{}",
+        found.join("\n")
+    );
+}
+
+#[test]
+fn the_operand_check_catches_what_it_should() {
+    let src = "bool f(uint i) {\n    return i < N && hit(buf[i]) > 0.0;\n}\n\
+               bool g(float a) {\n    if (a > 0.0 || (x[0] == 1.0)) { return dot(v, v) > 0.0 && abs(a) < 1.0; }\n}\n\
+               // a comment: ok && fine(x)\n";
+    let found = unguarded_operands("t", src);
+    assert_eq!(found.len(), 2, "{found:?}");
+    assert!(found[0].starts_with("t:2: hit(buf[i]) > 0.0"), "{found:?}");
+    assert!(found[1].starts_with("t:5: (x[0] == 1.0)"), "{found:?}");
+}

@@ -94,6 +94,7 @@ pub fn app_args(args: &RenderArgs) -> Vec<String> {
         frames,
         out,
         json,
+        count_rays,
         set,
         validate,
         generic,
@@ -125,6 +126,7 @@ pub fn app_args(args: &RenderArgs) -> Vec<String> {
     }
     let flags = [
         (json, "--json"),
+        (count_rays, "--count-rays"),
         (validate, "--validate"),
         (generic, "--generic"),
         (specialize, "--specialize"),
@@ -253,12 +255,16 @@ pub fn render_reference(args: &RenderArgs) -> anyhow::Result<()> {
             wall_ms: ms,
         }];
         let setup_ms = (t - start).as_secs_f64() * 1e3;
-        RunReport::builder("reference", info, scene.stats(), "f64".into())
+        let mut report = RunReport::builder("reference", info, scene.stats(), "f64".into())
             .size(w, h)
             .frames(frames, setup_ms)
             .nonfinite_pixels(img.nonfinite_pixels())
-            .build()
-            .print_json()?;
+            .build();
+        // Counted in a pass of its own, like the apps' untimed counting frame.
+        if args.count_rays {
+            report.add_rays(twinray_common::reference::count_rays(&scene, w, h));
+        }
+        report.print_json()?;
     }
     Ok(())
 }
@@ -335,6 +341,7 @@ mod tests {
             frames: Some(7),
             out: Some(PathBuf::from("out dir/a.png")),
             json: true,
+            count_rays: true,
             set: vec!["max_depth=3".into(), "extra_spheres=10".into()],
             validate: true,
             generic: false,

@@ -47,6 +47,12 @@ pub struct CompareArgs {
     /// The compute path's workgroup WxH (default: the apps' default).
     #[arg(long, value_name = "WxH", value_parser = parse_workgroup)]
     pub workgroup: Option<Workgroup>,
+    /// Count every point's rays (one untimed frame more per run) for the
+    /// Grays/s columns and plots. Always on outside the quick preset; the
+    /// quick one (software drivers) skips it unless asked, as the counting
+    /// variant's compile doubles its time there.
+    #[arg(long)]
+    pub count_rays: bool,
 }
 
 /// What `--only` can pick: the three sweeps, "accel", the runs of "model
@@ -328,6 +334,8 @@ fn sweep(
                 frames: Some(frames),
                 out: None,
                 json: true,
+                // One untimed frame more per point, for the Grays/s column and plot.
+                count_rays: args.count_rays || !args.quick,
                 set: point.set.clone(),
                 // The study's tracer tests every primitive: so do the sweeps.
                 accel: Accel::None,

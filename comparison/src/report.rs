@@ -58,6 +58,12 @@ pub fn write_all(out: &Path, results: &Results) -> anyhow::Result<()> {
         plots::plot(&out.join(&file), exp, &rows, &study)
             .with_context(|| format!("plotting {file}"))?;
         plots.push(file);
+        let file = format!("{exp}-grays.svg");
+        if plots::plot_grays(&out.join(&file), exp, &rows)
+            .with_context(|| format!("plotting {file}"))?
+        {
+            plots.push(file);
+        }
     }
     if results.accel.iter().any(|r| r.result.is_ok()) {
         plots::plot_scaling(&out.join("scaling.svg"), results.outcomes, results.accel)

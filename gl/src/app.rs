@@ -7,6 +7,7 @@ use crate::compute::Compute;
 use crate::context::{self, Gl};
 use crate::debug::DebugLog;
 use crate::program::{self, EmptyVertexArray, Program};
+use crate::rays::count_rays;
 use crate::target::{self, Target};
 use crate::timer::Timer;
 use anyhow::anyhow;
@@ -20,7 +21,7 @@ use twinray_common::gpu::upload::{check_storage_limit, GpuScene};
 use twinray_common::reference::image_io::FloatImage;
 use twinray_common::report::{dump_shaders, dump_statistics, FrameTime, RunReport};
 use twinray_common::shader::build::{build, build_compute};
-use twinray_common::shader::variant::Variant;
+use twinray_common::shader::variant::{CountingRun, Variant};
 
 /// `started` is taken first thing in main, so `setup_ms` includes process,
 /// driver and shader start-up, as in the Vulkan app.
@@ -148,6 +149,19 @@ pub fn run(args: RenderArgs, knobs: &OpenGlKnobs, started: Instant) -> anyhow::R
     explain::step("Readback", || {
         format!("{width}x{height} RGBA32F, top row first")
     });
+    let rays = if args.count_rays {
+        let counting = CountingRun {
+            scene: &gpu_scene,
+            variant: &variant,
+            path: args.path,
+            workgroup,
+            width,
+            height,
+        };
+        Some(count_rays(gl, &counting)?)
+    } else {
+        None
+    };
     log.check(gl, "after the frame loop");
 
     if let Some(out) = &args.out {
@@ -160,7 +174,7 @@ pub fn run(args: RenderArgs, knobs: &OpenGlKnobs, started: Instant) -> anyhow::R
         } else {
             variant.label()
         };
-        let report = RunReport::builder("opengl", info, scene.stats(), label)
+        let mut report = RunReport::builder("opengl", info, scene.stats(), label)
             .size(width, height)
             .path(args.path, workgroup)
             .frames(frames, setup_ms)
@@ -168,6 +182,9 @@ pub fn run(args: RenderArgs, knobs: &OpenGlKnobs, started: Instant) -> anyhow::R
             .validation_messages(errors)
             .shader_stats(shader_stats)
             .build();
+        if let Some(kinds) = rays {
+            report.add_rays(kinds);
+        }
         report.print_json()?;
     }
     if args.validate && errors > 0 {

@@ -9,6 +9,7 @@ pub mod compute;
 pub mod context;
 pub mod debug;
 pub mod program;
+pub mod rays;
 pub mod target;
 pub mod timer;
 pub mod window;

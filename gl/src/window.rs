@@ -46,9 +46,10 @@ use twinray_common::explain;
 use twinray_common::fragment_pass::FragmentPass;
 use twinray_common::gpu::layout::GpuFrame;
 use twinray_common::gpu::upload::GpuScene;
+use twinray_common::rays::RayKinds;
 use twinray_common::reference::image_io::FloatImage;
 use twinray_common::report::DeviceInfo;
-use twinray_common::shader::variant::Variant;
+use twinray_common::shader::variant::{CountingRun, Variant};
 use twinray_common::window::{self, Drawn, PathShaders, Renderer, WindowedRun};
 use winit::window::Window;
 
@@ -285,6 +286,19 @@ struct GlWindow<'gl> {
 }
 
 impl Renderer for GlWindow<'_> {
+    /// The headless counting frame; it binds buffers, a program and a
+    /// framebuffer of its own, so the window's are made and bound again after it.
+    fn count_rays(&mut self, run: &CountingRun, shaders: &PathShaders) -> Result<RayKinds> {
+        let kinds = crate::rays::count_rays(self.gl, run)?;
+        self.load_scene(run.scene, shaders)?;
+        // SAFETY: plain state on the current context.
+        unsafe {
+            self.gl
+                .viewport(0, 0, self.size.0 as i32, self.size.1 as i32)
+        };
+        Ok(kinds)
+    }
+
     fn api(&self) -> &'static str {
         "OpenGL"
     }

@@ -148,8 +148,11 @@ Hit traverse(vec3 origin, vec3 dir, float t_max, bool any_hit) {
             state = FROM_PARENT;
             continue;
         }
-        if (enter && hit_leaf(h, origin, dir, ray, bvh_buf.nodes[node].left_or_first, count, any_hit)) {
-            return h;
+        // Nested, not `&&`: naga would test the leaf of every box, entered or not.
+        if (enter) {
+            if (hit_leaf(h, origin, dir, ray, bvh_buf.nodes[node].left_or_first, count, any_hit)) {
+                return h;
+            }
         }
         // Done with this subtree: the far sibling is next after the near
         // child, the parent after the far one.

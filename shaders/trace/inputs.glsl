@@ -153,3 +153,23 @@ layout(std430, set = 0, binding = 8) readonly buffer BvhLinks {
 
 const float T_MAX = 1.0e30;
 
+#ifdef COUNT_RAYS
+// The counting variant (COUNT_RAYS: one untimed frame, never the timed shader)
+// counts each pixel's rays by kind in `rays_traced` and stores them in the
+// pixel's own slot; the apps add the slots up. A slot per pixel needs no
+// atomics, which naga's GLSL front end does not parse.
+struct RayCount {
+    uint primary;
+    uint shadow;
+    uint mirror;           // reflected from a surface that is not glass
+    uint glass_reflected;
+    uint glass_refracted;
+};
+
+layout(std430, set = 0, binding = 10) buffer RayCounts {
+    RayCount pixels[];
+} ray_count_buf;
+
+RayCount rays_traced;
+#endif
+

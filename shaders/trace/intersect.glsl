@@ -118,7 +118,12 @@ vec3 hit_triangle(TriRay r, Triangle tri, float t_min, float t_max) {
     float tz = eu * (r.s.z * a[r.k.z]) + ev * (r.s.z * b[r.k.z]) + ew * (r.s.z * c[r.k.z]);
     float inv = 1.0 / det;
     float t = tz * inv;
-    if (!(t > t_min && t < t_max) || is_degenerate(tri)) {
+    // Computed on every call, as naga always did for the call right of `||`
+    // this once was (the product's timings include it; testing it only
+    // inside the branch was slower on the H100's brute-force teapot, along
+    // with early exits in the shadow test).
+    bool degenerate = is_degenerate(tri);
+    if (!(t > t_min && t < t_max) || degenerate) {
         return miss;
     }
     return vec3(t, ev * inv, ew * inv);
@@ -143,7 +148,12 @@ vec3 hit_triangle(TriRay r, Triangle tri, float t_min, float t_max) {
         return miss;
     }
     float t = dot(e2, qv) * inv;
-    if (!(t > t_min && t < t_max) || is_degenerate(tri)) {
+    // Computed on every call, as naga always did for the call right of `||`
+    // this once was (the product's timings include it; testing it only
+    // inside the branch was slower on the H100's brute-force teapot, along
+    // with early exits in the shadow test).
+    bool degenerate = is_degenerate(tri);
+    if (!(t > t_min && t < t_max) || degenerate) {
         return miss;
     }
     return vec3(t, u, v);

@@ -99,6 +99,12 @@ vec3 trace(vec3 origin, vec3 dir) {
             q_dir = d;
             q_t = T_MAX;
         }
+#ifdef COUNT_RAYS
+        // This loop's shadow queries bypass occluded(), which counts the others.
+        if (shadow_pending) {
+            rays_traced.shadow += 1u;
+        }
+#endif
         Hit h = query(q_origin, q_dir, q_t, shadow_pending);
         if (shadow_pending) {
             if (h.kind == 0u) {
@@ -282,6 +288,9 @@ vec3 trace(vec3 origin, vec3 dir) {
                         st_weight[sp] = wt;
                         st_depth[sp] = depth + 1u;
                         sp += 1;
+#ifdef COUNT_RAYS
+                        rays_traced.glass_refracted += 1u;
+#endif
                     }
                 }
             }
@@ -294,6 +303,13 @@ vec3 trace(vec3 origin, vec3 dir) {
                 st_weight[sp] = wr;
                 st_depth[sp] = depth + 1u;
                 sp += 1;
+#ifdef COUNT_RAYS
+                if (m.transparency > 0.0) {
+                    rays_traced.glass_reflected += 1u;
+                } else {
+                    rays_traced.mirror += 1u;
+                }
+#endif
             }
         }
 #endif

@@ -129,6 +129,17 @@ fn variants() -> Vec<(String, Variant)> {
             chosen(d, Accel::Bvh, true, experiments),
         ));
     }
+    // The ray-counting variant (--count-rays) of brute force, the BVH and one-query.
+    for (label, accel, experiments) in [
+        ("generic", Accel::None, vec![]),
+        ("generic+bvh", Accel::Bvh, vec![]),
+        ("generic+bvh one-query", Accel::Bvh, vec![OneQuery]),
+    ] {
+        v.push((
+            format!("{label} counting rays"),
+            chosen(d, accel, true, experiments).counting(),
+        ));
+    }
     v
 }
 

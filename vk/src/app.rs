@@ -12,6 +12,7 @@ use crate::compute::Compute;
 use crate::device::Device;
 use crate::instance::{Instance, VALIDATION_MESSAGES};
 use crate::pipeline::RenderPass;
+use crate::rays::count_rays;
 use crate::scene::SceneResources;
 use crate::target::Target;
 use crate::timestamps::Timestamps;
@@ -30,7 +31,7 @@ use twinray_common::reference::image_io::FloatImage;
 use twinray_common::report::{dump_shaders, dump_statistics, FrameTime, RunReport};
 use twinray_common::scene::Scene;
 use twinray_common::shader::build::{build, build_compute, ComputeShader, Shaders};
-use twinray_common::shader::variant::Variant;
+use twinray_common::shader::variant::{CountingRun, Variant};
 
 pub fn run(args: RenderArgs, knobs: &VulkanKnobs, process_start: Instant) -> Result<()> {
     if args.explain {
@@ -96,7 +97,7 @@ fn render(
     let gpu_scene = GpuScene::new(scene, width, height);
     let instance = Instance::new(args.validate, knobs.validation, &[])?;
     let compute_only = args.experiment.contains(&Experiment::ComputeQueue);
-    let device = Device::new(&instance, None, knobs, compute_only)?;
+    let device = Device::new(&instance, None, knobs, compute_only, args.count_rays)?;
     device.check_size(width, height)?;
     // --vk-wait idle waits for each frame with vkQueueWaitIdle +
     // vkDeviceWaitIdle, as the 2018 study did, instead of the frame's fence.
@@ -120,7 +121,19 @@ fn render(
         RenderPath::Compute => render_compute(&run, &build_compute(variant, workgroup)?)?,
     };
     let label = variant_label(variant, host_memory, idle_wait);
-    report(args, scene, &device, label, workgroup, rendered)
+    let (mut report, image) = report(args, scene, &device, label, workgroup, rendered)?;
+    if args.count_rays {
+        let counting = CountingRun {
+            scene: &gpu_scene,
+            variant,
+            path: args.path,
+            workgroup,
+            width,
+            height,
+        };
+        report.add_rays(count_rays(&device, &counting)?);
+    }
+    Ok((report, image))
     // Every Vulkan object is dropped here, newest first: ..., device, instance.
 }
 

@@ -37,6 +37,9 @@ pub struct Device {
     pub executable_properties: Option<khr::pipeline_executable_properties::Device>,
     /// Where the scene's buffers go on this device (`--vk-memory`).
     pub scene_memory: SceneMemory,
+    /// fragmentStoresAndAtomics, enabled where offered: the fragment path's
+    /// ray-counting frame writes a storage buffer (`--count-rays`).
+    pub fragment_stores: bool,
 }
 
 /// One physical device as the chooser sees it.
@@ -57,12 +60,16 @@ impl Device {
     /// to it, and the device must offer VK_KHR_swapchain. `knobs` may name the
     /// device and say where scene buffers go. `compute_only`: the one queue
     /// comes from a family without GRAPHICS (`--experiment compute-queue`).
+    /// `count_rays` asks for fragmentStoresAndAtomics, which the ray-counting
+    /// frame needs on the fragment path; the timed runs get the device they
+    /// always had.
     // Long function: the walkthrough's device step read top to bottom (pick a GPU, a queue family, features, extensions, create); each block is one choice.
     pub fn new(
         instance: &Instance,
         surface: Option<&Surface>,
         knobs: &VulkanKnobs,
         compute_only: bool,
+        count_rays: bool,
     ) -> Result<Device> {
         let vk_instance = &instance.instance;
         // SAFETY: `instance` is alive for the whole call (borrowed) and is used from this thread
@@ -182,9 +189,16 @@ queue family {queue_family}: {flags:?}, timestampValidBits {timestamp_valid_bits
         let mut executable_features =
             vk::PhysicalDevicePipelineExecutablePropertiesFeaturesKHR::default()
                 .pipeline_executable_info(true);
+        // SAFETY: a query on the chosen physical device of the live instance.
+        let fragment_stores = unsafe { vk_instance.get_physical_device_features(chosen.physical) }
+            .fragment_stores_and_atomics
+            == vk::TRUE;
+        let features = vk::PhysicalDeviceFeatures::default()
+            .fragment_stores_and_atomics(fragment_stores && count_rays);
         let mut info = vk::DeviceCreateInfo::default()
             .queue_create_infos(&queue_infos)
-            .enabled_extension_names(&extensions);
+            .enabled_extension_names(&extensions)
+            .enabled_features(&features);
         if executable_info {
             info = info.push_next(&mut executable_features);
         }
@@ -205,7 +219,12 @@ queue family {queue_family}: {flags:?}, timestampValidBits {timestamp_valid_bits
                 } else {
                     "none"
                 };
-                format!("1 queue from family {queue_family}, priority 1.0; device extensions: {ext}; no optional features")
+                let features = if fragment_stores && count_rays {
+                    "fragmentStoresAndAtomics (--count-rays)"
+                } else {
+                    "no optional features"
+                };
+                format!("1 queue from family {queue_family}, priority 1.0; device extensions: {ext}; {features}")
             },
         );
         let executable_properties = executable_info
@@ -225,6 +244,7 @@ queue family {queue_family}: {flags:?}, timestampValidBits {timestamp_valid_bits
             timestamp_valid_bits,
             device,
             queue,
+            fragment_stores: fragment_stores && count_rays,
             scene_memory: knobs.memory,
         })
     }

@@ -23,6 +23,8 @@ pub mod surface;
 pub mod swapchain;
 pub mod frames;
 pub mod window;
-// Part 3, the compute path, and what the driver made of the shaders.
+// Part 3, the compute path, what the driver made of the shaders, and the
+// untimed frame that counts rays.
 pub mod compute;
 pub mod statistics;
+pub mod rays;

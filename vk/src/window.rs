@@ -35,10 +35,11 @@ use twinray_common::explain;
 use twinray_common::fragment_pass::FragmentPass;
 use twinray_common::gpu::layout::GpuFrame;
 use twinray_common::gpu::upload::GpuScene;
+use twinray_common::rays::RayKinds;
 use twinray_common::reference::image_io::FloatImage;
 use twinray_common::report::DeviceInfo;
 use twinray_common::shader::build::Shaders;
-use twinray_common::shader::variant::Variant;
+use twinray_common::shader::variant::{CountingRun, Variant};
 use twinray_common::window::{self, Drawn, PathShaders, Renderer, WindowedRun};
 use winit::window::Window;
 
@@ -104,7 +105,7 @@ pub fn run(
         surface::required_extensions(&window)?,
     )?;
     let surface = Surface::new(&instance, &window)?;
-    let device = Device::new(&instance, Some(&surface), knobs, false)?;
+    let device = Device::new(&instance, Some(&surface), knobs, false, args.count_rays)?;
     let loader = khr::swapchain::Device::new(&instance.instance, &device.device);
     let format = swapchain::choose_format(&device, &surface)?;
     let present_mode = swapchain::choose_present_mode(&device, &surface, args.vsync)?;
@@ -231,6 +232,12 @@ impl VkWindow {
 }
 
 impl Renderer for VkWindow {
+    /// The headless counting frame on the window's device: its own buffers,
+    /// pipeline and target, so the window's are untouched.
+    fn count_rays(&mut self, run: &CountingRun, _shaders: &PathShaders) -> Result<RayKinds> {
+        crate::rays::count_rays(&self.device, run)
+    }
+
     fn api(&self) -> &'static str {
         "Vulkan"
     }

@@ -111,6 +111,19 @@ impl GpuBvhNode {
     }
 }
 
+/// `RayCount` (std430 array element, binding 10): one pixel's rays by kind, as
+/// the counting variant (COUNT_RAYS) traced them.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, Pod, Zeroable, PartialEq, Eq)]
+pub struct GpuRayCount {
+    pub primary: u32,
+    pub shadow: u32,
+    /// Reflected from a surface that is not glass.
+    pub mirror: u32,
+    pub glass_reflected: u32,
+    pub glass_refracted: u32,
+}
+
 /// In the BVH's primitive list (binding 7): set for a sphere index, clear for a triangle index.
 pub const PRIM_SPHERE_BIT: u32 = 1 << 31;
 
@@ -136,7 +149,10 @@ pub mod binding {
     /// The sphere, triangle and light counts, where the shader reads them at
     /// run time (`--experiment storage-counts`) instead of baking them in.
     pub const COUNTS: u32 = 9;
-    pub const LAST: u32 = COUNTS;
+    /// The counting variant's per-pixel ray counts (`GpuRayCount`), written
+    /// only by the untimed counting frame; no other variant declares it.
+    pub const RAY_COUNTS: u32 = 10;
+    pub const LAST: u32 = RAY_COUNTS;
     /// The storage buffers in binding order.
     pub const STORAGE: [u32; 8] = [
         SPHERES, TRIANGLES, MATERIALS, LIGHTS, BVH_NODES, BVH_PRIMS, BVH_LINKS, COUNTS,

@@ -16,6 +16,7 @@ pub mod image_io;
 mod intersect;
 pub mod metrics;
 
+use crate::rays::RayKinds;
 use crate::reference::image_io::FloatImage;
 use crate::reference::intersect::{closest_hit, occluded, Hit, Tracer};
 use crate::scene::camera::{in_local_frame, RayFrame};
@@ -73,8 +74,32 @@ pub fn render_counting(
 }
 impl Tracer<'_> {
     pub fn trace(&self, origin: DVec3, dir: DVec3) -> DVec3 {
-        trace_with(self, origin, dir)
+        trace_with(self, origin, dir, &mut RayKinds::default())
     }
+}
+
+/// The rays the GPU's counting variant would trace for `scene` at width ×
+/// height, by kind: the same frame and scene as `render`, through the BVH
+/// where the scene has one.
+pub fn count_rays(scene: &Scene, width: u32, height: u32) -> RayKinds {
+    let frame = RayFrame::local(scene, &scene.camera, width, height).rounded_to_f32();
+    let scene = in_local_frame(scene).rounded_to_f32();
+    let tracer = Tracer::new(&scene);
+    (0..height)
+        .into_par_iter()
+        .map(|y| {
+            let mut kinds = RayKinds::default();
+            for x in 0..width {
+                trace_with(
+                    &tracer,
+                    frame.eye,
+                    frame.dir(x as f64, y as f64),
+                    &mut kinds,
+                );
+            }
+            kinds
+        })
+        .reduce(RayKinds::default, |a, b| a + b)
 }
 
 /// The shader's `ulp_offset_1`. The offset is a distance on the f32 grid (256
@@ -134,8 +159,10 @@ struct Ray {
     depth: u32,
 }
 
-/// One pixel: the shader's `trace`, with its stack capacity of max_depth + 1.
-fn trace_with(tracer: &Tracer, origin: DVec3, dir: DVec3) -> DVec3 {
+/// One pixel: the shader's `trace`, with its stack capacity of max_depth + 1,
+/// adding its rays to `kinds` where the counting variant counts them.
+fn trace_with(tracer: &Tracer, origin: DVec3, dir: DVec3, kinds: &mut RayKinds) -> DVec3 {
+    kinds.primary += 1;
     let scene = tracer.scene;
     let capacity = scene.max_depth as usize + 1;
     let mut stack = Vec::with_capacity(capacity);
@@ -190,7 +217,9 @@ fn trace_with(tracer: &Tracer, origin: DVec3, dir: DVec3) -> DVec3 {
             let dist = to_light.length();
             let l = to_light / dist;
             let ndl = ns.dot(l);
-            if ndl > 0.0 && ng.dot(l) > 0.0 && !occluded(tracer, p_out, l, dist * SHADOW_REACH) {
+            let faces = ndl > 0.0 && ng.dot(l) > 0.0;
+            kinds.shadow += u64::from(faces);
+            if faces && !occluded(tracer, p_out, l, dist * SHADOW_REACH) {
                 let r = reflect(-l, ns);
                 let spec = r.dot(-d).max(0.0).powf(m.shininess);
                 local += light.color * (m.diffuse * ndl + m.specular * spec);
@@ -220,6 +249,7 @@ fn trace_with(tracer: &Tracer, origin: DVec3, dir: DVec3) -> DVec3 {
                             w: wt,
                             depth: depth + 1,
                         });
+                        kinds.glass_refracted += 1;
                     }
                 }
             }
@@ -232,6 +262,11 @@ fn trace_with(tracer: &Tracer, origin: DVec3, dir: DVec3) -> DVec3 {
                     w: wr,
                     depth: depth + 1,
                 });
+                if kt > 0.0 {
+                    kinds.glass_reflected += 1;
+                } else {
+                    kinds.mirror += 1;
+                }
             }
         }
     }

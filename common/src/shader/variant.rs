@@ -5,8 +5,9 @@
 //! compiles: only the features the scene uses, its counts and BVH stack, its
 //! numerical choices, and any `--experiment`.
 
-use crate::cli::{Experiment, RenderArgs};
+use crate::cli::{Experiment, RenderArgs, RenderPath, Workgroup};
 use crate::fragment_pass::QUAD_DEFINE;
+use crate::gpu::upload::GpuScene;
 use crate::limits::MAX_DEPTH;
 use crate::scene::numerics::Numerics;
 use crate::scene::{Features, Scene};
@@ -24,6 +25,17 @@ pub struct Variant {
     pub numerics: Numerics,
     pub constants: BTreeMap<String, bool>,
     pub experiments: Vec<Experiment>,
+}
+
+/// What the untimed ray-counting frame renders (`--count-rays`), in either
+/// app: the run's scene at its size, on its path, with `variant.counting()`.
+pub struct CountingRun<'a> {
+    pub scene: &'a GpuScene,
+    pub variant: &'a Variant,
+    pub path: RenderPath,
+    pub workgroup: Workgroup,
+    pub width: u32,
+    pub height: u32,
 }
 
 /// The feature switches trace.glsl declares with `layout(constant_id = N)`
@@ -110,6 +122,15 @@ impl Variant {
         {
             v.constants.insert(name.to_string(), on);
         }
+        v
+    }
+
+    /// This variant with the ray counters compiled in (COUNT_RAYS): the shader
+    /// of the one untimed frame that counts rays. Every other define is the
+    /// timed variant's, so both trace the same rays.
+    pub fn counting(&self) -> Variant {
+        let mut v = self.clone();
+        v.defines.insert("COUNT_RAYS".into(), "1".into());
         v
     }
 

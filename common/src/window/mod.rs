@@ -18,11 +18,12 @@ use crate::cli::{RenderArgs, RenderPath, Workgroup};
 use crate::error::{no_device, without_source_location};
 use crate::gpu::layout::GpuFrame;
 use crate::gpu::upload::GpuScene;
+use crate::rays::RayKinds;
 use crate::reference::image_io::FloatImage;
 use crate::report::{DeviceInfo, FrameTime, RunReport};
 use crate::scene::Scene;
 use crate::shader::build::{build, build_compute, ComputeShader, Shaders};
-use crate::shader::variant::Variant;
+use crate::shader::variant::{CountingRun, Variant};
 use crate::window::title::window_title;
 use winit::dpi::PhysicalSize;
 use winit::event_loop::EventLoop;
@@ -48,6 +49,10 @@ pub trait Renderer {
     /// row first, so that a screenshot is quantised by `image_io` exactly like
     /// `--headless --out`.
     fn capture(&mut self, frame: &GpuFrame, width: u32, height: u32) -> anyhow::Result<FloatImage>;
+    /// `--count-rays`: renders `run`'s counting frame, untimed, and returns its
+    /// rays; afterwards the window draws with `shaders` as before (OpenGL
+    /// rebinds what the counting frame bound in its place).
+    fn count_rays(&mut self, run: &CountingRun, shaders: &PathShaders) -> anyhow::Result<RayKinds>;
 }
 
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -97,7 +102,7 @@ pub fn event_loop() -> anyhow::Result<EventLoop<()>> {
 /// the first FPS figure.
 pub fn window_attributes(args: &RenderArgs, scene: &str, api: &str) -> WindowAttributes {
     Window::default_attributes()
-        .with_title(window_title(scene, api, args.path, None))
+        .with_title(window_title(scene, api, args.path, None, None))
         .with_inner_size(PhysicalSize::new(args.size.width, args.size.height))
 }
 

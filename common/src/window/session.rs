@@ -9,7 +9,7 @@ use crate::limits::MAX_DEPTH;
 use crate::report::FrameTime;
 use crate::scene::camera::Orbit;
 use crate::scene::Scene;
-use crate::shader::variant::Variant;
+use crate::shader::variant::{CountingRun, Variant};
 use crate::window::keys::{action_for_key, Action};
 use crate::window::title::{window_title, TitleClock};
 use crate::window::{hooks, PathShaders, Renderer, WindowedRun};
@@ -56,6 +56,8 @@ pub fn run<R: Renderer>(
         cursor: None,
         screenshots: 0,
         error: None,
+        rays: None,
+        rays_stale: args.count_rays,
         resize_test: hooks::resize_test()?.then(ResizeTest::default),
         test_keys: hooks::test_keys()?,
     };
@@ -109,6 +111,10 @@ struct Session<R: Renderer> {
     cursor: Option<PhysicalPosition<f64>>,
     screenshots: u32,
     error: Option<anyhow::Error>,
+    /// `--count-rays`: the current view's rays, for the title's Grays/s, and
+    /// whether the view changed since they were counted.
+    rays: Option<u64>,
+    rays_stale: bool,
     resize_test: Option<ResizeTest>,
     test_keys: Vec<Action>,
 }
@@ -175,6 +181,7 @@ impl<R: Renderer> Session<R> {
             return Ok(());
         }
         self.size = size;
+        self.rays_stale = true;
         if let Some(r) = self.renderer.as_mut() {
             r.resize(size.width, size.height)?;
         }
@@ -194,7 +201,10 @@ impl<R: Renderer> Session<R> {
     fn act(&mut self, event_loop: &ActiveEventLoop, action: Action) -> anyhow::Result<()> {
         match action {
             Action::Quit => self.finish(event_loop, Ok(())),
-            Action::ResetCamera => self.orbit.reset(),
+            Action::ResetCamera => {
+                self.orbit.reset();
+                self.rays_stale = true;
+            }
             Action::Screenshot => {
                 self.screenshots += 1;
                 let api = if self.program.ends_with("vk") {
@@ -243,6 +253,7 @@ impl<R: Renderer> Session<R> {
                     d.saturating_sub(1).max(1)
                 };
                 self.scene.max_depth = d;
+                self.rays_stale = true;
                 // The uniform block carries the depth; only a deeper stack or a
                 // feature the current shader compiled out needs a new variant.
                 let needed = Variant::chosen(&self.scene, &self.args);
@@ -275,15 +286,45 @@ impl<R: Renderer> Session<R> {
         Ok(())
     }
 
+    /// `--count-rays`: once the view has changed (a switch, a resize, the end
+    /// of a drag, a zoom) its rays are counted again, between two frames and
+    /// outside both of them: the next frame's wall time starts after the count.
+    fn recount_rays(&mut self) -> anyhow::Result<()> {
+        if !(self.args.count_rays && self.rays_stale) || self.dragging || self.minimized() {
+            return Ok(());
+        }
+        self.rays_stale = false;
+        let (width, height) = (self.size.width, self.size.height);
+        let mut gpu = GpuScene::new(&self.scene, width, height);
+        gpu.frame = self.frame_uniform();
+        let shaders = PathShaders::build(&self.variant, self.path, self.workgroup)?;
+        let run = CountingRun {
+            scene: &gpu,
+            variant: &self.variant,
+            path: self.path,
+            workgroup: self.workgroup,
+            width,
+            height,
+        };
+        if let Some(r) = self.renderer.as_mut() {
+            self.rays = Some(r.count_rays(&run, &shaders)?.total());
+        }
+        self.last_frame_end = Instant::now();
+        self.clock = TitleClock::new(self.last_frame_end);
+        Ok(())
+    }
+
     fn set_title(&self, fps_gpu: Option<(f64, Option<f64>)>) {
         if let Some(r) = &self.renderer {
-            let title = window_title(&self.scene.name, r.api(), self.path, fps_gpu);
+            let title = window_title(&self.scene.name, r.api(), self.path, fps_gpu, self.rays);
             r.window().set_title(&title);
         }
     }
 
     /// After a switch: the old figures belong to the old scene or path.
     fn restart_title(&mut self) {
+        self.rays = None;
+        self.rays_stale = true;
         self.clock = TitleClock::new(Instant::now());
         self.set_title(None);
     }
@@ -316,6 +357,7 @@ impl<R: Renderer> Session<R> {
                     self.finish(event_loop, Ok(()));
                     return Ok(());
                 }
+                self.recount_rays()?;
             }
         }
         self.drive_resize_test()
@@ -418,6 +460,7 @@ impl<R: Renderer> ApplicationHandler for Session<R> {
                 ..
             } => {
                 self.dragging = state == ElementState::Pressed;
+                self.rays_stale = true;
                 Ok(())
             }
             WindowEvent::CursorMoved { position, .. } => {
@@ -435,6 +478,7 @@ impl<R: Renderer> ApplicationHandler for Session<R> {
                     MouseScrollDelta::PixelDelta(p) => p.y / 40.0,
                 };
                 self.orbit.zoom(lines);
+                self.rays_stale = true;
                 Ok(())
             }
             _ => Ok(()),

@@ -1,24 +1,35 @@
 //! The window title both apps show, and the clock that refreshes it twice a second.
 
 use crate::cli::RenderPath;
+use crate::rays::grays_per_s;
 use std::time::{Duration, Instant};
 
 /// The window title, identical in both apps:
 /// `twinray — box — Vulkan compute — 61.3 FPS — 12.41 ms` (`n/a ms` where the
 /// GPU time is unknown, e.g. OpenGL on llvmpipe; `— starting` until the first
-/// figures, and after a switch until new ones).
+/// figures, and after a switch until new ones). With `--count-rays`, `rays` is
+/// the current view's ray count and the title ends with `— 0.52 Grays/s`: the
+/// rays over the mean GPU time, or over the frame time where that is unknown.
 pub fn window_title(
     scene: &str,
     api: &str,
     path: RenderPath,
     fps_gpu: Option<(f64, Option<f64>)>,
+    rays: Option<u64>,
 ) -> String {
     let head = format!("twinray — {scene} — {api} {path}");
     match fps_gpu {
         None => format!("{head} — starting"),
         Some((fps, gpu_ms)) => {
             let gpu = gpu_ms.map_or_else(|| "n/a".to_string(), |ms| format!("{ms:.2}"));
-            format!("{head} — {fps:.1} FPS — {gpu} ms")
+            let rate = match rays {
+                Some(total) if fps > 0.0 => {
+                    let ms = gpu_ms.unwrap_or(1e3 / fps);
+                    format!(" — {:.2} Grays/s", grays_per_s(total, ms))
+                }
+                _ => String::new(),
+            };
+            format!("{head} — {fps:.1} FPS — {gpu} ms{rate}")
         }
     }
 }
@@ -73,16 +84,44 @@ mod tests {
                 "box",
                 "Vulkan",
                 RenderPath::Compute,
-                Some((61.26, Some(12.414)))
+                Some((61.26, Some(12.414))),
+                None
             ),
             "twinray — box — Vulkan compute — 61.3 FPS — 12.41 ms"
         );
         assert_eq!(
-            window_title("teapot", "OpenGL", RenderPath::Fragment, Some((5.0, None))),
+            window_title(
+                "box",
+                "Vulkan",
+                RenderPath::Compute,
+                Some((61.26, Some(12.5))),
+                Some(6_500_000)
+            ),
+            "twinray — box — Vulkan compute — 61.3 FPS — 12.50 ms — 0.52 Grays/s"
+        );
+        assert_eq!(
+            window_title(
+                "box",
+                "OpenGL",
+                RenderPath::Fragment,
+                Some((50.0, None)),
+                Some(10_000_000)
+            ),
+            "twinray — box — OpenGL fragment — 50.0 FPS — n/a ms — 0.50 Grays/s",
+            "without a GPU time, the frame time"
+        );
+        assert_eq!(
+            window_title(
+                "teapot",
+                "OpenGL",
+                RenderPath::Fragment,
+                Some((5.0, None)),
+                None
+            ),
             "twinray — teapot — OpenGL fragment — 5.0 FPS — n/a ms"
         );
         assert_eq!(
-            window_title("box", "OpenGL", RenderPath::Compute, None),
+            window_title("box", "OpenGL", RenderPath::Compute, None, Some(1)),
             "twinray — box — OpenGL compute — starting"
         );
     }

@@ -4,6 +4,7 @@
 use crate::csv_out::{self, Decimals};
 use crate::runs::{api_name, Outcome};
 use serde::Serialize;
+use twinray_common::rays::RateClock;
 use twinray_common::stats::Summary;
 
 /// One line of results.csv; the field order is the column order that the
@@ -37,6 +38,15 @@ struct Row<'a> {
     api_version: &'a str,
     os: &'a str,
     cpu: &'a str,
+    /// The counting frame's rays and the rate they give (empty where the run
+    /// did not count them); after the older columns, which readers rely on.
+    rays_primary: Option<u64>,
+    rays_shadow: Option<u64>,
+    rays_secondary: Option<u64>,
+    rays_total: Option<u64>,
+    grays_per_s: Option<Decimals<6>>,
+    /// "gpu" or "wall": which median frame time `grays_per_s` divides by.
+    grays_clock: Option<RateClock>,
 }
 
 type Stats = [Option<Decimals<6>>; 4];
@@ -85,6 +95,12 @@ fn row<'a>(o: &'a Outcome, cpu: &'a str) -> Row<'a> {
                 driver: &r.driver,
                 api_version: &r.api_version,
                 os: &r.os,
+                rays_primary: r.rays.map(|c| c.primary),
+                rays_shadow: r.rays.map(|c| c.shadow),
+                rays_secondary: r.rays.map(|c| c.secondary),
+                rays_total: r.rays.map(|c| c.total),
+                grays_per_s: r.grays_per_s.map(Decimals),
+                grays_clock: r.grays_clock,
                 ..row
             }
         }
@@ -113,27 +129,36 @@ mod tests {
     fn csv_has_a_path_column_and_a_workgroup_for_compute_rows() {
         let mut failed = test_outcome(Api::Opengl, RenderPath::Compute, 1.0);
         failed.result = Err("twinray-gl exited with 1: \"no\", device".into());
+        let mut counted = test_outcome(Api::Vulkan, RenderPath::Compute, 1.0);
+        if let Ok(r) = &mut counted.result {
+            r.add_rays(twinray_common::rays::RayKinds {
+                primary: 64,
+                shadow: 10,
+                mirror: 5,
+                ..Default::default()
+            });
+        }
         let rows = [
             test_outcome(Api::Vulkan, RenderPath::Fragment, 10.0),
             test_outcome(Api::Opengl, RenderPath::Fragment, 10.0),
-            test_outcome(Api::Vulkan, RenderPath::Compute, 1.0),
+            counted,
             failed,
         ];
         let text = csv(&rows, "cpu, 2 threads").unwrap();
         let mut lines = text.lines();
         assert_eq!(
             lines.next().unwrap(),
-            "experiment,param_name,param_value,api,path,workgroup,status,frames,wall_mean_ms,wall_median_ms,wall_min_ms,wall_max_ms,gpu_mean_ms,gpu_median_ms,gpu_min_ms,gpu_max_ms,setup_ms,nonfinite_pixels,variant,width,height,device,driver,api_version,os,cpu",
+            "experiment,param_name,param_value,api,path,workgroup,status,frames,wall_mean_ms,wall_median_ms,wall_min_ms,wall_max_ms,gpu_mean_ms,gpu_median_ms,gpu_min_ms,gpu_max_ms,setup_ms,nonfinite_pixels,variant,width,height,device,driver,api_version,os,cpu,rays_primary,rays_shadow,rays_secondary,rays_total,grays_per_s,grays_clock",
             "the committed results and their readers rely on these columns in this order"
         );
         let body: Vec<&str> = lines.collect();
         assert_eq!(
             body,
             [
-                "box,resolution,8x8,vulkan,fragment,,ok,1,10.000000,10.000000,10.000000,10.000000,10.000000,10.000000,10.000000,10.000000,1.000,0,v,8,8,d,v,1,o,\"cpu, 2 threads\"",
-                "box,resolution,8x8,opengl,fragment,,ok,1,10.000000,10.000000,10.000000,10.000000,10.000000,10.000000,10.000000,10.000000,1.000,0,v,8,8,d,v,1,o,\"cpu, 2 threads\"",
-                "box,resolution,8x8,vulkan,compute,16x8,ok,1,1.000000,1.000000,1.000000,1.000000,1.000000,1.000000,1.000000,1.000000,1.000,0,v,8,8,d,v,1,o,\"cpu, 2 threads\"",
-                "box,resolution,8x8,opengl,compute,,\"failed: twinray-gl exited with 1: \"\"no\"\", device\",0,,,,,,,,,,,,8,8,,,,,\"cpu, 2 threads\"",
+                "box,resolution,8x8,vulkan,fragment,,ok,1,10.000000,10.000000,10.000000,10.000000,10.000000,10.000000,10.000000,10.000000,1.000,0,v,8,8,d,v,1,o,\"cpu, 2 threads\",,,,,,",
+                "box,resolution,8x8,opengl,fragment,,ok,1,10.000000,10.000000,10.000000,10.000000,10.000000,10.000000,10.000000,10.000000,1.000,0,v,8,8,d,v,1,o,\"cpu, 2 threads\",,,,,,",
+                "box,resolution,8x8,vulkan,compute,16x8,ok,1,1.000000,1.000000,1.000000,1.000000,1.000000,1.000000,1.000000,1.000000,1.000,0,v,8,8,d,v,1,o,\"cpu, 2 threads\",64,10,5,79,0.000079,gpu",
+                "box,resolution,8x8,opengl,compute,,\"failed: twinray-gl exited with 1: \"\"no\"\", device\",0,,,,,,,,,,,,8,8,,,,,\"cpu, 2 threads\",,,,,,",
             ]
         );
     }

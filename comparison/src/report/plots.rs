@@ -42,26 +42,37 @@ fn x_of(exp: &str, value: &str) -> f64 {
     }
 }
 
+/// Each API's line on each path: fragment in the full colour, compute in a
+/// lighter shade of it.
+const API_PATH_COLOURS: [(Api, RenderPath, RGBColor); 6] = [
+    (Api::Vulkan, RenderPath::Fragment, RGBColor(200, 30, 30)),
+    (Api::Opengl, RenderPath::Fragment, RGBColor(30, 80, 200)),
+    (
+        Api::OpenglSpirv,
+        RenderPath::Fragment,
+        RGBColor(120, 60, 160),
+    ),
+    (Api::Vulkan, RenderPath::Compute, RGBColor(250, 120, 110)),
+    (Api::Opengl, RenderPath::Compute, RGBColor(100, 170, 250)),
+    (
+        Api::OpenglSpirv,
+        RenderPath::Compute,
+        RGBColor(190, 140, 220),
+    ),
+];
+
+/// The sweep's parameter, as the x axis names it.
+fn x_label(exp: &str) -> &'static str {
+    if exp == "spherelist" {
+        "extra spheres"
+    } else {
+        "image width = height (pixels)"
+    }
+}
+
 pub fn plot(path: &Path, exp: &str, rows: &[&Outcome], study: &[StudyRow]) -> anyhow::Result<()> {
     let mut series: Vec<Series> = Vec::new();
-    // Fragment in the full colour, compute in a lighter shade of it.
-    let colours = [
-        (Api::Vulkan, RenderPath::Fragment, RGBColor(200, 30, 30)),
-        (Api::Opengl, RenderPath::Fragment, RGBColor(30, 80, 200)),
-        (
-            Api::OpenglSpirv,
-            RenderPath::Fragment,
-            RGBColor(120, 60, 160),
-        ),
-        (Api::Vulkan, RenderPath::Compute, RGBColor(250, 120, 110)),
-        (Api::Opengl, RenderPath::Compute, RGBColor(100, 170, 250)),
-        (
-            Api::OpenglSpirv,
-            RenderPath::Compute,
-            RGBColor(190, 140, 220),
-        ),
-    ];
-    for (api, path, colour) in colours {
+    for (api, path, colour) in API_PATH_COLOURS {
         for gpu in [false, true] {
             let pts: Vec<(f64, f64)> = rows
                 .iter()
@@ -106,13 +117,8 @@ pub fn plot(path: &Path, exp: &str, rows: &[&Outcome], study: &[StudyRow]) -> an
     let all = positive_points(&series);
     let root = SVGBackend::new(path, (900, 560)).into_drawing_area();
     root.fill(&WHITE)?;
-    let xlabel = if exp == "spherelist" {
-        "extra spheres"
-    } else {
-        "image width = height (pixels)"
-    };
     let caption = format!("{exp}: time per frame (log scale)");
-    let mut chart = log_log_chart(&root, &caption, &all, xlabel, "milliseconds")?;
+    let mut chart = log_log_chart(&root, &caption, &all, x_label(exp), "milliseconds")?;
     for Series {
         name,
         colour,
@@ -143,6 +149,60 @@ pub fn plot(path: &Path, exp: &str, rows: &[&Outcome], study: &[StudyRow]) -> an
         }
     }
     finish_chart(&mut chart, &root, SeriesLabelPosition::UpperLeft)
+}
+
+/// Billions of rays per second against the sweep's parameter, one line per
+/// API and path: each run's counted rays over its median frame time (GPU, or
+/// wall where the run has no GPU timer). Writes nothing and returns false
+/// when no run counted its rays.
+pub fn plot_grays(path: &Path, exp: &str, rows: &[&Outcome]) -> anyhow::Result<bool> {
+    let series: Vec<Series> = API_PATH_COLOURS
+        .into_iter()
+        .map(|(api, p, colour)| Series {
+            name: format!("{} {p}", api_name(api)),
+            colour,
+            points: rows
+                .iter()
+                .filter(|o| o.api == api && o.path == p)
+                .filter_map(|o| {
+                    let rate = o.result.as_ref().ok()?.grays_per_s?;
+                    Some((x_of(exp, &o.point.param_value), rate))
+                })
+                .collect(),
+        })
+        .filter(|s| !s.points.is_empty())
+        .collect();
+    let all = positive_points(&series);
+    if all.is_empty() {
+        return Ok(false);
+    }
+    let root = SVGBackend::new(path, (900, 560)).into_drawing_area();
+    root.fill(&WHITE)?;
+    let caption = format!("{exp}: billions of rays per second (log scale)");
+    let mut chart = log_log_chart(&root, &caption, &all, x_label(exp), "Grays/s")?;
+    draw_dotted_lines(&mut chart, series)?;
+    finish_chart(&mut chart, &root, SeriesLabelPosition::LowerRight)?;
+    Ok(true)
+}
+
+/// Each series as a line with a dot at each point, in the legend by its name.
+fn draw_dotted_lines(chart: &mut LogLogChart, series: Vec<Series>) -> anyhow::Result<()> {
+    for Series {
+        name,
+        colour,
+        points: mut pts,
+    } in series
+    {
+        pts.sort_by(|a, b| a.0.total_cmp(&b.0));
+        chart
+            .draw_series(LineSeries::new(pts.clone(), colour.stroke_width(2)))?
+            .label(name)
+            .legend(move |(x, y)| {
+                PathElement::new(vec![(x, y), (x + 20, y)], colour.stroke_width(2))
+            });
+        chart.draw_series(pts.iter().map(|p| Circle::new(*p, 3, colour.filled())))?;
+    }
+    Ok(())
 }
 
 /// The chart every plot here draws on: log scales on both axes, padded around
@@ -278,20 +338,6 @@ pub fn plot_scaling(path: &Path, outcomes: &[Outcome], accel: &[AccelRun]) -> an
         "spheres + triangles",
         "milliseconds",
     )?;
-    for Series {
-        name,
-        colour,
-        points: mut pts,
-    } in series
-    {
-        pts.sort_by(|a, b| a.0.total_cmp(&b.0));
-        chart
-            .draw_series(LineSeries::new(pts.clone(), colour.stroke_width(2)))?
-            .label(name)
-            .legend(move |(x, y)| {
-                PathElement::new(vec![(x, y), (x + 20, y)], colour.stroke_width(2))
-            });
-        chart.draw_series(pts.iter().map(|p| Circle::new(*p, 3, colour.filled())))?;
-    }
+    draw_dotted_lines(&mut chart, series)?;
     finish_chart(&mut chart, &root, SeriesLabelPosition::UpperLeft)
 }

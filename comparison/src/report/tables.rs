@@ -72,16 +72,22 @@ pub fn experiments(outcomes: &[Outcome], study: &[StudyRow], plots: &[String]) -
                 let _ = writeln!(s, "### {} path\n", path);
             }
             let has_spirv = rows.iter().any(|o| o.api == Api::OpenglSpirv);
+            // Only where the runs counted their rays: older results keep their table.
+            let has_rays = rows
+                .iter()
+                .any(|o| o.result.as_ref().is_ok_and(|r| r.grays_per_s.is_some()));
             let _ = writeln!(
             s,
-            "| {} | study VK mean / median (s) | study GL mean / median (s) | study VK/GL | VK wall (ms) | GL wall (ms) | VK/GL wall | VK GPU (ms) | GL GPU (ms) | VK/GL GPU | frames VK/GL |{}",
+            "| {} | study VK mean / median (s) | study GL mean / median (s) | study VK/GL | VK wall (ms) | GL wall (ms) | VK/GL wall | VK GPU (ms) | GL GPU (ms) | VK/GL GPU | frames VK/GL |{}{}",
             first.param_name,
-            if has_spirv { " GL SPIR-V GPU (ms) | VK/GL-SPIR-V GPU |" } else { "" }
+            if has_spirv { " GL SPIR-V GPU (ms) | VK/GL-SPIR-V GPU |" } else { "" },
+            if has_rays { " VK Grays/s | GL Grays/s |" } else { "" }
         );
             let _ = writeln!(
                 s,
-                "|---|---|---|---|---|---|---|---|---|---|---|{}",
-                if has_spirv { "---|---|" } else { "" }
+                "|---|---|---|---|---|---|---|---|---|---|---|{}{}",
+                if has_spirv { "---|---|" } else { "" },
+                if has_rays { "---|---|" } else { "" }
             );
             let mut values: Vec<String> =
                 rows.iter().map(|o| o.point.param_value.clone()).collect();
@@ -108,9 +114,15 @@ pub fn experiments(outcomes: &[Outcome], study: &[StudyRow], plots: &[String]) -
                 } else {
                     String::new()
                 };
+                let rate = |r: Option<&RunReport>| f(r.and_then(|r| r.grays_per_s), 3);
+                let rays = if has_rays {
+                    format!(" {} | {} |", rate(vk), rate(gl))
+                } else {
+                    String::new()
+                };
                 let _ = writeln!(
                     s,
-                    "| {v} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {}/{} |{extra}",
+                    "| {v} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {}/{} |{extra}{rays}",
                     st.map(|x| format!("{:.5} / {:.5}", x.vulkan_mean_s, x.vulkan_median_s))
                         .unwrap_or_else(|| "–".into()),
                     st.map(|x| format!("{:.5} / {:.5}", x.opengl_mean_s, x.opengl_median_s))

@@ -1,0 +1,103 @@
+//! The ray-counting frame (`--count-rays`): the run's own shader variant with
+//! COUNT_RAYS, drawn or dispatched once on the run's path, untimed and after
+//! the timed frames, on scene buffers of its own. Each pixel writes its rays
+//! by kind into its slot of a host-visible storage buffer (binding 10), which
+//! is read back and added up. The timed pipeline never sees that buffer.
+
+use crate::commands::Commands;
+use crate::compute::Compute;
+use crate::descriptors::Descriptors;
+use crate::device::Device;
+use crate::memory::{buffer_barrier, pipeline_barrier, Buffer};
+use crate::pipeline::{Pipeline, RenderPass};
+use crate::scene::scene_buffers;
+use crate::target::Target;
+use anyhow::Result;
+use ash::vk;
+use twinray_common::cli::RenderPath;
+use twinray_common::error::no_device;
+use twinray_common::explain;
+use twinray_common::fragment_pass::FragmentPass;
+use twinray_common::gpu::layout::{binding, GpuRayCount};
+use twinray_common::limits::pixel_count;
+use twinray_common::rays::RayKinds;
+use twinray_common::shader::build::{build, build_compute};
+use twinray_common::shader::variant::CountingRun;
+
+/// Renders the counting frame of `run` and returns its rays by kind.
+pub fn count_rays(device: &Device, run: &CountingRun) -> Result<RayKinds> {
+    let (width, height) = (run.width, run.height);
+    let counting = run.variant.counting();
+    // Declared first, so dropped last: after the pipelines that use them.
+    let (frame, mut storage) = scene_buffers(device, run.scene)?;
+    let bytes = pixel_count(width, height) * size_of::<GpuRayCount>();
+    let counts = Buffer::host_visible_with(
+        device,
+        &vec![0u8; bytes],
+        vk::BufferUsageFlags::STORAGE_BUFFER,
+        "ray count buffer",
+    )?;
+    let counts_handle = counts.buffer;
+    storage.push((binding::RAY_COUNTS, counts));
+    match run.path {
+        RenderPath::Fragment => {
+            if !device.fragment_stores {
+                return Err(no_device(format!(
+                        "--count-rays on the fragment path needs fragmentStoresAndAtomics, which '{}' does not offer; count with --path compute",
+                        device.name
+                    )));
+            }
+            let shaders = build(&counting)?;
+            // The run's own fragment pass (`--experiment quad` draws two triangles).
+            let pass = FragmentPass::of(&run.variant.experiments);
+            let render_pass = RenderPass::offscreen(device, &pass)?;
+            let rp = render_pass.render_pass;
+            let descriptors = Descriptors::new(device, &frame, &storage)?;
+            let size = (!pass.dynamic_viewport).then_some((width, height));
+            let pipeline = Pipeline::new(device, descriptors.set_layout, &shaders, rp, size)?;
+            let target = Target::new(device, rp, width, height, &pass)?;
+            let commands =
+                Commands::record(device, rp, &pipeline, &descriptors, &target, None, &pass)?;
+            commands.submit()?;
+            commands.wait(false)?;
+        }
+        RenderPath::Compute => {
+            let shader = build_compute(&counting, run.workgroup)?;
+            let compute = Compute::new(device, &frame, &storage, &shader, width, height, None)?;
+            compute.commands.submit()?;
+            compute.commands.wait(false)?;
+        }
+    }
+    // Read after write: the CPU maps what the shader wrote. A barrier in a
+    // later submission still orders the frame's writes, submitted before it.
+    device.run_once("making the ray counts visible to the CPU", |cmd| {
+        let to_host = buffer_barrier(
+            counts_handle,
+            vk::AccessFlags::SHADER_WRITE,
+            vk::AccessFlags::HOST_READ,
+        );
+        let shaders =
+            vk::PipelineStageFlags::FRAGMENT_SHADER | vk::PipelineStageFlags::COMPUTE_SHADER;
+        // SAFETY: `cmd` is recording (inside run_once); the buffer is
+        // alive in `storage` until the end of this function.
+        unsafe {
+            pipeline_barrier(
+                &device.device,
+                cmd,
+                shaders,
+                vk::PipelineStageFlags::HOST,
+                &[to_host],
+                &[],
+            )
+        };
+    })?;
+    let (_, counts) = storage
+        .last()
+        .expect("the ray count buffer was pushed last");
+    let kinds = RayKinds::from_pixels(&counts.read::<GpuRayCount>()?);
+    explain::step(
+        "Ray count: one untimed frame of the COUNT_RAYS variant",
+        || kinds.to_string(),
+    );
+    Ok(kinds)
+}
