@@ -220,7 +220,12 @@ pub fn run(args: &CompareArgs) -> anyhow::Result<()> {
     crate::shaders::append_to_report(&args.out.join("report.md"), &shader_rows)?;
     let why_wanted = args.only.is_empty() || args.only.iter().any(|o| o == "why");
     if why_wanted && !interrupted && !stop.load(Ordering::SeqCst) {
-        let why = crate::why::run(&args.out, &Preset::of(args.quick).why, &paths, &stop);
+        // The step keeps its own sizes, but --frames and --seconds-per-point
+        // bound its runs too, so a short GPU lease can afford it.
+        let mut why_plan = Preset::of(args.quick).why;
+        why_plan.frames = args.frames.unwrap_or(why_plan.frames);
+        why_plan.seconds_per_point = args.seconds_per_point.unwrap_or(why_plan.seconds_per_point);
+        let why = crate::why::run(&args.out, &why_plan, &paths, &stop);
         crate::report::why::write(&args.out, &why)?;
         interrupted = stop.load(Ordering::SeqCst);
     }
