@@ -216,8 +216,10 @@ pub fn run(args: &CompareArgs) -> anyhow::Result<()> {
         agreement: &agreement,
         interrupted,
     };
-    crate::report::write_all(&args.out, &results)?;
-    crate::shaders::append_to_report(&args.out.join("report.md"), &shader_rows)?;
+    if !only_why {
+        crate::report::write_all(&args.out, &results)?;
+        crate::shaders::append_to_report(&args.out.join("report.md"), &shader_rows)?;
+    }
     let why_wanted = args.only.is_empty() || args.only.iter().any(|o| o == "why");
     if why_wanted && !interrupted && !stop.load(Ordering::SeqCst) {
         // The step keeps its own sizes, but --frames and --seconds-per-point
@@ -226,6 +228,14 @@ pub fn run(args: &CompareArgs) -> anyhow::Result<()> {
         why_plan.frames = args.frames.unwrap_or(why_plan.frames);
         why_plan.seconds_per_point = args.seconds_per_point.unwrap_or(why_plan.seconds_per_point);
         let why = crate::why::run(&args.out, &why_plan, &paths, &stop);
+        if only_why {
+            // No study ran, so no study sections: a title naming the device
+            // the why step measured, then its section.
+            let device = why.device.as_deref().unwrap_or("no device");
+            let report = args.out.join("report.md");
+            std::fs::write(&report, format!("# twinray compare — {device}\n"))
+                .with_context(|| format!("writing '{}'", report.display()))?;
+        }
         crate::report::why::write(&args.out, &why)?;
         interrupted = stop.load(Ordering::SeqCst);
     }

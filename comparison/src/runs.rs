@@ -159,11 +159,12 @@ pub struct WhyRow {
     pub result: Result<WhyFigures, String>,
 }
 
-/// The why step's rows, and whether they came from a software driver (whose
-/// ratios say nothing about GPUs).
+/// The why step's rows, the device they ran on, and whether it is a software
+/// driver (whose ratios say nothing about GPUs).
 #[derive(Debug, Clone, Default)]
 pub struct Why {
     pub rows: Vec<WhyRow>,
+    pub device: Option<String>,
     pub software: bool,
 }
 

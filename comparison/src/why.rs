@@ -204,6 +204,7 @@ pub fn run(out: &Path, plan: &WhyPlan, paths: &[RenderPath], stop: &AtomicBool) 
         let measured = measure(&dir, gap, size, plan, &order, i, stop);
         if let Some(r) = measured.values().find_map(|r| r.first()?.as_ref().ok()) {
             why.software |= crate::apps::is_software(&r.device);
+            why.device.get_or_insert_with(|| r.device.clone());
         }
         for case in cases {
             let result = figures(gap, &case, &measured, &dir);
