@@ -869,6 +869,9 @@ vec3 trace(vec3 origin, vec3 dir) {
     // one per call site. Each iteration asks one question: the closest hit of
     // the next ray on the stack, or, while a hit is being shaded, the shadow
     // ray towards its next lit light. The hit's state lives across iterations.
+    // Measured and rejected (comparison/results/nvidia-h100/FINDINGS.md), kept
+    // for reruns; its surface code repeats the product's below #else, so a
+    // change to one must be made to both.
     bool shadow_pending = false;
     uint li = 0u;
     vec3 o;
