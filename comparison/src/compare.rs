@@ -231,9 +231,10 @@ pub fn run(args: &CompareArgs) -> anyhow::Result<()> {
         if only_why {
             // No study ran, so no study sections: a title naming the device
             // the why step measured, then its section.
-            let device = why.device.as_deref().unwrap_or("no device");
+            let title =
+                crate::report::title(why.vulkan_device.as_deref(), why.opengl_device.as_deref());
             let report = args.out.join("report.md");
-            std::fs::write(&report, format!("# twinray compare — {device}\n"))
+            std::fs::write(&report, format!("{title}\n"))
                 .with_context(|| format!("writing '{}'", report.display()))?;
         }
         crate::report::why::write(&args.out, &why)?;

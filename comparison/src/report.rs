@@ -11,6 +11,8 @@ mod summary;
 mod tables;
 pub mod why;
 
+pub use summary::title;
+
 use crate::runs::{Outcome, Results, EXPERIMENTS};
 use crate::study::{self, StudyRow};
 use anyhow::Context;

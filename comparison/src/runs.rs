@@ -159,12 +159,16 @@ pub struct WhyRow {
     pub result: Result<WhyFigures, String>,
 }
 
-/// The why step's rows, the device they ran on, and whether it is a software
+/// The why step's rows, the devices they ran on, and whether it is a software
 /// driver (whose ratios say nothing about GPUs).
 #[derive(Debug, Clone, Default)]
 pub struct Why {
     pub rows: Vec<WhyRow>,
-    pub device: Option<String>,
+    /// The device of the first Vulkan run that succeeded: the title's choice
+    /// (report::title).
+    pub vulkan_device: Option<String>,
+    /// The device of the first OpenGL run that succeeded: the title's fallback.
+    pub opengl_device: Option<String>,
     pub software: bool,
 }
 

@@ -202,10 +202,7 @@ pub fn run(out: &Path, plan: &WhyPlan, paths: &[RenderPath], stop: &AtomicBool) 
             }
         }
         let measured = measure(&dir, gap, size, plan, &order, i, stop);
-        if let Some(r) = measured.values().find_map(|r| r.first()?.as_ref().ok()) {
-            why.software |= crate::apps::is_software(&r.device);
-            why.device.get_or_insert_with(|| r.device.clone());
-        }
+        note_devices(&mut why, &order, &measured);
         for case in cases {
             let result = figures(gap, &case, &measured, &dir);
             if let Err(e) = &result {
@@ -221,6 +218,33 @@ pub fn run(out: &Path, plan: &WhyPlan, paths: &[RenderPath], stop: &AtomicBool) 
         }
     }
     why
+}
+
+/// Keeps the device of the gap's first Vulkan run and first OpenGL run that
+/// succeeded where no earlier gap gave one, so the title can prefer Vulkan's
+/// name whichever API a gap's runs reached first.
+fn note_devices(why: &mut Why, order: &[Run], measured: &Measured) {
+    let first = |vulkan: bool| {
+        order
+            .iter()
+            .filter(|run| (run.0 == Api::Vulkan) == vulkan)
+            .find_map(|&run| {
+                measured
+                    .get(&run_label(run))?
+                    .iter()
+                    .find_map(|r| r.as_ref().ok())
+            })
+    };
+    let (vk, gl) = (first(true), first(false));
+    why.software |= vk
+        .iter()
+        .chain(&gl)
+        .any(|r| crate::apps::is_software(&r.device));
+    for (slot, r) in [(&mut why.vulkan_device, vk), (&mut why.opengl_device, gl)] {
+        if let (None, Some(r)) = (&slot, r) {
+            *slot = Some(r.device.clone());
+        }
+    }
 }
 
 /// Each run's reports at one gap, rounds in alternating order.
@@ -398,6 +422,46 @@ mod tests {
         assert!(on_path("glslangValidator", Some(&joined)));
         assert!(!on_path("glslangValidator", None));
         std::fs::remove_dir_all(&dir).ok();
+    }
+
+    #[test]
+    fn the_title_names_the_vulkan_device_and_else_the_opengl_one() {
+        const VK: &str = "NVIDIA H100 80GB HBM3";
+        const GL: &str = "NVIDIA H100 80GB HBM3/PCIe/SSE2";
+        let report = |device: &str| {
+            let mut r = crate::runs::test_outcome(Api::Vulkan, RenderPath::Fragment, 1.0)
+                .result
+                .expect("a test outcome succeeds");
+            r.device = device.into();
+            Ok(r)
+        };
+        let gap = |vulkan: Result<RunReport, String>| -> Measured {
+            [
+                ("vulkan".to_string(), vec![vulkan]),
+                ("opengl".to_string(), vec![report(GL)]),
+                ("opengl-spirv".to_string(), vec![report(GL)]),
+            ]
+            .into()
+        };
+        let order: Vec<Run> = vec![
+            (Api::Vulkan, &[]),
+            (Api::Opengl, &[]),
+            (Api::OpenglSpirv, &[]),
+        ];
+        let title = |why: &Why| {
+            crate::report::title(why.vulkan_device.as_deref(), why.opengl_device.as_deref())
+        };
+        let mut why = Why::default();
+        note_devices(&mut why, &order, &gap(Err("failed: no device".into())));
+        assert_eq!(title(&why), format!("# twinray compare — {GL}"));
+        // A later gap's Vulkan run still wins over an earlier gap's OpenGL one.
+        note_devices(&mut why, &order, &gap(report(VK)));
+        assert_eq!(title(&why), format!("# twinray compare — {VK}"));
+        let mut why = Why::default();
+        note_devices(&mut why, &order, &gap(report(VK)));
+        assert_eq!(title(&why), format!("# twinray compare — {VK}"));
+        assert!(!why.software);
+        assert_eq!(title(&Why::default()), "# twinray compare — no device");
     }
 
     #[test]

@@ -9,15 +9,22 @@ use crate::study::{self, StudyRow};
 use std::fmt::Write as _;
 use twinray_common::cli::RenderPath;
 
+/// report.md's title line, naming the device: Vulkan's where a Vulkan run
+/// succeeded, the driver's plain name ("NVIDIA H100 80GB HBM3"), else OpenGL's
+/// renderer string, which carries the bus and CPU extensions ("…/PCIe/SSE2").
+pub fn title(vulkan: Option<&str>, opengl: Option<&str>) -> String {
+    format!(
+        "# twinray compare — {}",
+        vulkan.or(opengl).unwrap_or("no device")
+    )
+}
+
 /// The title and the three-line summary: one line per experiment, computed
 /// from the rows of the tables below it.
 pub fn headline(outcomes: &[Outcome], study: &[StudyRow]) -> String {
     let mut s = String::new();
-    let device = first_report(outcomes, Api::Vulkan)
-        .or(first_report(outcomes, Api::Opengl))
-        .map(|r| r.device.clone())
-        .unwrap_or_else(|| "no device".into());
-    let _ = writeln!(s, "# twinray compare — {device}\n");
+    let device = |api| first_report(outcomes, api).map(|r| r.device.as_str());
+    let _ = writeln!(s, "{}\n", title(device(Api::Vulkan), device(Api::Opengl)));
 
     let paths = paths_in(outcomes);
     let med = |v: &[f64]| range(v).map(|(_, m, _)| m);
