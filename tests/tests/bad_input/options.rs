@@ -1,0 +1,72 @@
+//! Options with values the apps refuse: sizes, scene overrides past a limit,
+//! and the compute path's options.
+
+use crate::common::expect_both;
+use twinray_tests::{fail, App};
+
+#[test]
+fn bad_sizes() {
+    // clap prints its own usage error naming the option; the exit code is 2.
+    for app in App::BOTH {
+        let (code, stderr) = fail(&app.exe(), &["--headless", "--size", "0x10"], &[]);
+        assert_eq!(code, 2, "{stderr}");
+        assert!(
+            stderr.contains("--size") && stderr.contains("zero"),
+            "{stderr}"
+        );
+    }
+    expect_both(
+        &["--headless", "--size", "20000x16"],
+        &[],
+        2,
+        &["--size 20000x16", "limit"],
+    );
+}
+
+#[test]
+fn too_many_primitives_for_the_storage_buffer_limit() {
+    // 5 million 32-byte spheres: 160 MB, above Mesa's 128 MiB limit (and most GPUs' 2^27..2^32).
+    expect_both(
+        &[
+            "--headless",
+            "--size",
+            "16x16",
+            "--scene",
+            "spherelist",
+            "--set",
+            "extra_spheres=5000000",
+        ],
+        &[],
+        2,
+        &["spheres", "limit"],
+    );
+}
+
+#[test]
+fn unknown_override_key() {
+    expect_both(&["--headless", "--set", "warp=9"], &[], 2, &["warp"]);
+}
+
+#[test]
+fn bad_path_and_workgroup_options() {
+    // A workgroup means nothing to the fragment path: said, not ignored.
+    expect_both(
+        &["--headless", "--size", "16x16", "--workgroup", "8x8"],
+        &[],
+        2,
+        &["--workgroup", "--path compute"],
+    );
+    for app in App::BOTH {
+        for args in [
+            ["--path", "warp"],
+            ["--workgroup", "0x8"],
+            ["--workgroup", "64x64"],
+        ] {
+            let mut all = vec!["--headless", "--size", "16x16", "--path", "compute"];
+            all.extend(args);
+            let (code, stderr) = fail(&app.exe(), &all, &[]);
+            assert_eq!(code, 2, "{args:?}: {stderr}");
+            assert!(stderr.contains(args[0]), "{args:?}: {stderr}");
+        }
+    }
+}

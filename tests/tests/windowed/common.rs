@@ -1,0 +1,62 @@
+//! What the windowed scenarios share: a run's stderr, its clean validated
+//! report, the resize hook's counts, and xdotool that retries a refused connection.
+
+use std::process::Output;
+use twinray_common::report::RunReport;
+use twinray_tests::{App, Xvfb};
+
+pub fn stderr(o: &Output) -> String {
+    String::from_utf8_lossy(&o.stderr).into_owned()
+}
+
+/// Asserts success, no panic and a clean validated JSON report.
+pub fn clean_report(app: App, o: &Output) -> RunReport {
+    let err = stderr(o);
+    assert!(o.status.success(), "{app:?} failed ({}): {err}", o.status);
+    assert!(!err.contains("panicked"), "{app:?} panicked: {err}");
+    let out = String::from_utf8_lossy(&o.stdout);
+    let report: RunReport = serde_json::from_str(out.trim())
+        .unwrap_or_else(|e| panic!("{app:?}: not JSON ({e}): {out}"));
+    assert_eq!(report.validation_messages, 0, "{app:?}: {err}");
+    report
+}
+
+/// Asserts that the resize hook's line on stderr (`TWINRAY_TEST_RESIZE`)
+/// counts at least `resizes` resizes and one minimize/restore.
+pub fn assert_resized(app: App, err: &str, resizes: u32) {
+    let line = err
+        .lines()
+        .find(|l| l.contains("test resize:"))
+        .unwrap_or_else(|| panic!("{app:?}: {err}"));
+    let numbers: Vec<u32> = line
+        .split_whitespace()
+        .filter_map(|w| w.parse().ok())
+        .collect();
+    assert!(
+        numbers[0] >= resizes,
+        "{app:?}: only {} resizes: {line}",
+        numbers[0]
+    );
+    assert!(numbers[1] >= 1, "{app:?}: no minimize/restore: {line}");
+}
+
+/// Under load (a fresh shader cache, other windows in parallel tests) the X
+/// server now and then refuses xdotool's connection outright ("Can't open
+/// display"): nothing has happened yet, so try again.
+pub fn xdotool_retrying(x: &Xvfb, app: App, cmd: &[&str]) -> Output {
+    let mut xd = x.xdotool(cmd);
+    for _ in 0..10 {
+        if xd.status.success()
+            || !String::from_utf8_lossy(&xd.stderr).contains("Can't open display")
+        {
+            break;
+        }
+        eprintln!(
+            "{app:?}: xdotool could not connect to {}; trying again",
+            x.display
+        );
+        std::thread::sleep(std::time::Duration::from_millis(300));
+        xd = x.xdotool(cmd);
+    }
+    xd
+}
