@@ -721,27 +721,6 @@ bool occluded(vec3 origin, vec3 dir, float dist) {
 #endif
 }
 
-
-#ifdef ONE_QUERY
-// --experiment one-query: both questions behind one call, for the ray loop's
-// single query site (trace/loop.glsl).
-Hit query(vec3 origin, vec3 dir, float t_max, bool any_hit) {
-#ifdef USE_BVH
-    return traverse(origin, dir, t_max, any_hit);
-#else
-    if (any_hit) {
-        Hit h;
-        h.t = t_max;
-        h.kind = occluded_brute(origin, dir, t_max) ? 1u : 0u;
-        h.index = 0u;
-        h.u = 0.0;
-        h.v = 0.0;
-        return h;
-    }
-    return closest_hit_brute(origin, dir);
-#endif
-}
-#endif
 // trace/secondary.glsl — where a secondary ray starts, and how much of it glass
 // reflects.
 
@@ -862,135 +841,6 @@ vec3 trace(vec3 origin, vec3 dir) {
     st_depth[0] = 0u;
     sp = 1;
 
-#ifdef ONE_QUERY
-    // --experiment one-query: every query of the loop, closest hit or shadow
-    // ray, goes through the one call of query() below, so a compiler that
-    // inlines the traversal keeps one copy of it (and of its stack) instead of
-    // one per call site. Each iteration asks one question: the closest hit of
-    // the next ray on the stack, or, while a hit is being shaded, the shadow
-    // ray towards its next lit light. The hit's state lives across iterations.
-    // Measured and rejected (comparison/results/nvidia-h100/FINDINGS.md), kept
-    // for reruns; its surface code repeats the product's below #else, so a
-    // change to one must be made to both.
-    bool shadow_pending = false;
-    uint li = 0u;
-    vec3 o;
-    vec3 d;
-    float w;
-    uint depth;
-    vec3 p;
-    vec3 ng;
-    vec3 ns;
-    uint mat_index;
-    float scale;
-    bool inside;
-    Material m;
-    vec3 local;
-    vec3 p_out;
-    vec3 l;
-    float dist;
-    float ndl;
-    while (sp > 0 || shadow_pending) {
-        vec3 q_origin;
-        vec3 q_dir;
-        float q_t;
-        if (shadow_pending) {
-            q_origin = p_out;
-            q_dir = l;
-            // Stop a hair before the light: a light lying on a surface would
-            // otherwise be hidden by that surface at the whim of rounding.
-            q_t = dist * SHADOW_REACH;
-        } else {
-            sp -= 1;
-            o = st_origin[sp];
-            d = st_dir[sp];
-            w = st_weight[sp];
-            depth = st_depth[sp];
-            q_origin = o;
-            q_dir = d;
-            q_t = T_MAX;
-        }
-#ifdef COUNT_RAYS
-        // This loop's shadow queries bypass occluded(), which counts the others.
-        if (shadow_pending) {
-            rays_traced.shadow += 1u;
-        }
-#endif
-        Hit h = query(q_origin, q_dir, q_t, shadow_pending);
-        if (shadow_pending) {
-            if (h.kind == 0u) {
-                Light light = light_buf.lights[li];
-                vec3 r = reflect(-l, ns);
-                float spec = pow(max(dot(r, -d), 0.0), m.shininess);
-                local += light.color * (m.diffuse * ndl + m.specular * spec);
-            }
-            li += 1u;
-            shadow_pending = false;
-        } else {
-            if (h.kind == 0u) {
-                color += w * frame.background;
-                continue;
-            }
-            p = o + h.t * d;
-            scale = max_abs(o);
-            if (h.kind == 1u) {
-                Sphere s = sphere_buf.spheres[h.index];
-                ng = (p - s.center) / s.radius;
-                ns = ng;
-                mat_index = s.material;
-                // Sphere tests square their inputs (c = f.f - r^2), so a start a few
-                // ULPs inside glass can still re-hit the same sphere: 4x the margin
-                // (scenes/box's glass sphere speckled with 2^-22).
-                scale = 4.0 * max(scale, max_abs(p));
-            } else {
-                Triangle tri = triangle_buf.triangles[h.index];
-                // A triangle test's error grows with its vertices' magnitude (a floor
-                // quad reaching x = 8 seen from a glass sphere at |o| = 1 re-hit itself).
-                scale = max(scale, max(max_abs(tri.p0), max(max_abs(tri.p1), max_abs(tri.p2))));
-                vec3 e1 = tri.p1 - tri.p0;
-                vec3 e2 = tri.p2 - tri.p0;
-#if defined(OFFSET_SCALE_AWARE) || defined(OFFSET_ULP)
-                // These offsets assume p lies within a few ULPs of its coordinates
-                // off the plane. o + t d does not: its error grows with t and with
-                // how thin the triangle is (acne on the teapot's spout and handle).
-                // Rebuilt from the barycentrics, an error in u, v only slides p
-                // along the plane (Wachter & Binder, Ray Tracing Gems ch. 6).
-                p = tri.p0 + h.u * e1 + h.v * e2;
-#endif
-                ng = normalize(cross(e1, e2));
-                ns = normalize((1.0 - h.u - h.v) * tri.n0 + h.u * tri.n1 + h.v * tri.n2);
-                mat_index = tri.material;
-            }
-            // Face both normals towards the incoming ray; `inside` tells glass which way it goes.
-            inside = dot(d, ng) > 0.0;
-            if (inside) {
-                ng = -ng;
-            }
-            if (dot(ns, ng) < 0.0) {
-                ns = -ns;
-            }
-            m = material_buf.materials[mat_index];
-            local = m.ambient;
-            li = 0u;
-        }
-        // The next light this hit faces, if any: its shadow ray is the next query.
-        for (; li < LIGHT_COUNT; li++) {
-            Light light = light_buf.lights[li];
-            // The offset may depend on the direction (OFFSET_RAY): aim from p first.
-            p_out = spawn_point(p, ng, normalize(light.position - p), scale);
-            vec3 to_light = light.position - p_out;
-            dist = length(to_light);
-            l = to_light / dist;
-            ndl = dot(ns, l);
-            if (ndl > 0.0 && dot(ng, l) > 0.0) {
-                shadow_pending = true;
-                break;
-            }
-        }
-        if (shadow_pending) {
-            continue;
-        }
-#else
     while (sp > 0) {
         sp -= 1;
         vec3 o = st_origin[sp];
@@ -1071,7 +921,6 @@ vec3 trace(vec3 origin, vec3 dir) {
                 local += light.color * (m.diffuse * ndl + m.specular * spec);
             }
         }
-#endif
         color += w * local;
 
 #if defined(HAS_MIRROR) || defined(HAS_GLASS)

@@ -118,10 +118,6 @@ pub enum Experiment {
     /// (SPV_KHR_float_controls: denormals preserved, signed zero, Inf and NaN
     /// preserved), to see whether Vulkan's defaults explain its pixels.
     FloatControls,
-    /// One call site for the closest hit and the shadow rays of each hit
-    /// (they take turns in a small loop), so that a compiler that inlines the
-    /// traversal keeps one copy of it instead of two.
-    OneQuery,
     /// The SPIR-V (what Vulkan runs) from Khronos' reference compiler,
     /// glslangValidator (on PATH; Debian's glslang-tools), given the same
     /// GLSL and defines, instead of from naga.
@@ -534,7 +530,6 @@ mod tests {
                 "uniform-counts",
                 "no-contraction",
                 "float-controls",
-                "one-query",
                 "glslang",
                 "quad",
                 "load-clear",

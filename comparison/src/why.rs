@@ -99,7 +99,6 @@ pub const CASES: &[Case] = &[
     gl_spirv(&TEAPOT_FRAGMENT),
     both(&TEAPOT_BVH_COMPUTE, &[Experiment::StacklessBvh]),
     both(&TEAPOT_BVH_COMPUTE, &[Experiment::UnpairedBvhStack]),
-    both(&TEAPOT_BVH_COMPUTE, &[Experiment::OneQuery]),
     both(&BOX_IMAGES, &[Experiment::NoContraction]),
     vulkan(&BOX_IMAGES, &[Experiment::NoContraction]),
     vulkan(&BOX_IMAGES, &[Experiment::FloatControls]),

@@ -205,7 +205,6 @@ fn why_table_has_a_verdict_per_gap_and_experiment(report: &str, out: &std::path:
         "opengl-spirv",
         "stackless-bvh",
         "unpaired-bvh-stack",
-        "one-query",
         "no-contraction",
         "float-controls",
         "quad",

@@ -117,7 +117,6 @@ fn variants() -> Vec<(String, Variant)> {
         vec![NoContraction],
         vec![Glslang],
         vec![FloatControls],
-        vec![OneQuery],
     ] {
         let label = experiments
             .iter()
@@ -129,11 +128,10 @@ fn variants() -> Vec<(String, Variant)> {
             chosen(d, Accel::Bvh, true, experiments),
         ));
     }
-    // The ray-counting variant (--count-rays) of brute force, the BVH and one-query.
+    // The ray-counting variant (--count-rays) of brute force and the BVH.
     for (label, accel, experiments) in [
         ("generic", Accel::None, vec![]),
         ("generic+bvh", Accel::Bvh, vec![]),
-        ("generic+bvh one-query", Accel::Bvh, vec![OneQuery]),
     ] {
         v.push((
             format!("{label} counting rays"),

@@ -150,9 +150,6 @@ impl Variant {
         v.experiments = args.experiment.clone();
         v.experiments.sort();
         v.experiments.dedup();
-        if v.experiments.contains(&Experiment::OneQuery) {
-            v.defines.insert("ONE_QUERY".into(), "1".into());
-        }
         if v.defines.contains_key("USE_BVH") {
             if v.experiments.contains(&Experiment::StacklessBvh) {
                 v.defines.insert("BVH_STACKLESS".into(), "1".into());
