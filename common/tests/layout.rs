@@ -145,10 +145,14 @@ fn naga_layout_matches_rust_for_every_shader_struct() {
         "BvhNode",
         naga_members(&module, ty),
         rust_offsets!(GpuBvhNode {
-            min,
-            left_or_first,
-            max,
-            count
+            left_min,
+            left,
+            left_max,
+            pad0,
+            right_min,
+            right,
+            right_max,
+            pad1
         }),
         size_of::<GpuBvhNode>(),
     );

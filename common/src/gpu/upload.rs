@@ -20,7 +20,6 @@ pub struct GpuScene {
     /// Empty unless the scene traces through a BVH.
     pub bvh_nodes: Vec<GpuBvhNode>,
     pub bvh_prims: Vec<u32>,
-    pub bvh_links: Vec<u32>,
     /// Spheres, triangles, lights, and a pad word.
     pub counts: [u32; 4],
 }
@@ -114,7 +113,6 @@ impl GpuScene {
                 .collect(),
             bvh_nodes: bvh.nodes.clone(),
             bvh_prims: bvh.prims.clone(),
-            bvh_links: bvh.links.clone(),
             counts: [
                 scene.spheres.len() as u32,
                 scene.triangles.len() as u32,
@@ -149,7 +147,6 @@ impl GpuScene {
             binding::LIGHTS => bytes(&self.lights),
             binding::BVH_NODES => bytes(&self.bvh_nodes),
             binding::BVH_PRIMS => bytes(&self.bvh_prims),
-            binding::BVH_LINKS => bytes(&self.bvh_links),
             binding::COUNTS => bytes(&self.counts),
             _ => panic!("binding {binding} is not a storage buffer"),
         }
@@ -173,7 +170,6 @@ pub fn storage_name(binding: u32) -> &'static str {
         binding::LIGHTS => "lights",
         binding::BVH_NODES => "BVH node",
         binding::BVH_PRIMS => "BVH primitive",
-        binding::BVH_LINKS => "BVH link",
         binding::COUNTS => "counts",
         _ => "frame",
     }
