@@ -130,9 +130,8 @@ layout(std430, set = 0, binding = 4) readonly buffer Lights {
 // The BVH (common/src/scene/accel.rs): interior nodes, each holding both of
 // its children's boxes (one 64-byte read per step), node 0 the root. A child
 // is a reference: an interior node's index, or with the top bit set a leaf,
-// prims[first .. first + count] with first above bit 2 and count - 1 below;
-// each prim is a triangle index or a sphere index with the top bit set. Bound
-// always; read only by the USE_BVH variant.
+// prims[first .. first + count] with first above bit 2 and count - 1 below.
+// Bound always; read only by the USE_BVH variant.
 struct BvhNode {
     vec3 left_min;
     uint left;
@@ -148,8 +147,21 @@ layout(std430, set = 0, binding = 6) readonly buffer BvhNodes {
     BvhNode nodes[];
 } bvh_buf;
 
+// The leaves' primitives in leaf order, each with only what its test reads
+// (a triangle's corners, or a sphere's centre and radius in b.x), so a leaf
+// is one contiguous read. `code` is a triangle index, or a sphere index with
+// the top bit set: the hit keeps it for shading.
+struct BvhPrim {
+    vec3 a;
+    uint code;
+    vec3 b;
+    uint pad0;
+    vec3 c;
+    uint pad1;
+};
+
 layout(std430, set = 0, binding = 7) readonly buffer BvhPrims {
-    uint prims[];
+    BvhPrim prims[];
 } prim_buf;
 
 const float T_MAX = 1.0e30;
@@ -439,17 +451,20 @@ vec3 inverse_dir(vec3 dir) {
 // True when an any-hit query (shadow rays) may stop.
 bool hit_leaf(inout Hit h, vec3 origin, vec3 dir, TriRay ray, uint first, uint count, bool any_hit) {
     for (uint k = 0u; k < count; k++) {
-        uint prim = prim_buf.prims[first + k];
+        BvhPrim p = prim_buf.prims[first + k];
+        uint prim = p.code;
+        // The tests take whole structs; they read only the positions.
         if ((prim & SPHERE_BIT) != 0u) {
             uint i = prim & ~SPHERE_BIT;
-            float t = hit_sphere(origin, dir, sphere_buf.spheres[i], 0.0, h.t);
+            float t = hit_sphere(origin, dir, Sphere(p.a, p.b.x, 0u, 0u, 0u, 0u), 0.0, h.t);
             if (t > 0.0) {
                 h.t = t;
                 h.kind = 1u;
                 h.index = i;
             }
         } else {
-            vec3 r = hit_triangle(ray, triangle_buf.triangles[prim], 0.0, h.t);
+            Triangle tri = Triangle(p.a, 0u, p.b, 0u, p.c, 0u, vec3(0.0), 0u, vec3(0.0), 0u, vec3(0.0), 0u);
+            vec3 r = hit_triangle(ray, tri, 0.0, h.t);
             if (r.x > 0.0) {
                 h.t = r.x;
                 h.kind = 2u;

@@ -62,17 +62,20 @@ vec3 inverse_dir(vec3 dir) {
 // True when an any-hit query (shadow rays) may stop.
 bool hit_leaf(inout Hit h, vec3 origin, vec3 dir, TriRay ray, uint first, uint count, bool any_hit) {
     for (uint k = 0u; k < count; k++) {
-        uint prim = prim_buf.prims[first + k];
+        BvhPrim p = prim_buf.prims[first + k];
+        uint prim = p.code;
+        // The tests take whole structs; they read only the positions.
         if ((prim & SPHERE_BIT) != 0u) {
             uint i = prim & ~SPHERE_BIT;
-            float t = hit_sphere(origin, dir, sphere_buf.spheres[i], 0.0, h.t);
+            float t = hit_sphere(origin, dir, Sphere(p.a, p.b.x, 0u, 0u, 0u, 0u), 0.0, h.t);
             if (t > 0.0) {
                 h.t = t;
                 h.kind = 1u;
                 h.index = i;
             }
         } else {
-            vec3 r = hit_triangle(ray, triangle_buf.triangles[prim], 0.0, h.t);
+            Triangle tri = Triangle(p.a, 0u, p.b, 0u, p.c, 0u, vec3(0.0), 0u, vec3(0.0), 0u, vec3(0.0), 0u);
+            vec3 r = hit_triangle(ray, tri, 0.0, h.t);
             if (r.x > 0.0) {
                 h.t = r.x;
                 h.kind = 2u;

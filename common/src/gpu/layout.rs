@@ -98,6 +98,25 @@ pub struct GpuBvhNode {
     pub pad1: u32,
 }
 
+/// `BvhPrim` (std430 array element, binding 7): one primitive of a leaf, in
+/// leaf order, holding only what the intersection tests read, so that a
+/// leaf's primitives are one contiguous read (48 bytes each) instead of an
+/// index each and then a 96-byte triangle elsewhere. `code` is the primitive
+/// (`PRIM_SPHERE_BIT` for a sphere), which the hit keeps for shading.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, Pod, Zeroable, PartialEq)]
+pub struct GpuBvhPrim {
+    /// A triangle's p0, a sphere's centre.
+    pub a: [f32; 3],
+    pub code: u32,
+    /// A triangle's p1; a sphere's radius in x.
+    pub b: [f32; 3],
+    pub pad0: u32,
+    /// A triangle's p2; zero for a sphere.
+    pub c: [f32; 3],
+    pub pad1: u32,
+}
+
 /// A child box, as f32 corners rounded outwards.
 pub type Bounds = ([f32; 3], [f32; 3]);
 
@@ -160,7 +179,7 @@ pub struct GpuRayCount {
     pub glass_refracted: u32,
 }
 
-/// In the BVH's primitive list (binding 7): set for a sphere index, clear for a triangle index.
+/// In a BVH primitive's code (`Bvh::prims`, `GpuBvhPrim::code`): set for a sphere index, clear for a triangle index.
 pub const PRIM_SPHERE_BIT: u32 = 1 << 31;
 
 /// Binding numbers, shared by the shader build (GLSL binding map) and both apps.
@@ -190,8 +209,9 @@ pub mod binding {
     ];
 }
 
-/// A flattened BVH, ready to upload: the two arrays the shader walks
-/// (bindings 6 and 7). `Bvh::build` (scene/accel.rs) makes one.
+/// A flattened BVH: the nodes the shader walks (binding 6) and the primitive
+/// codes in leaf order, from which the upload makes the leaves' `GpuBvhPrim`s
+/// (binding 7). `Bvh::build` (scene/accel.rs) makes one.
 #[derive(Debug, Clone, Default)]
 pub struct Bvh {
     pub nodes: Vec<GpuBvhNode>,

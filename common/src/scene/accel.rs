@@ -4,7 +4,7 @@
 //! walks (`gpu::layout::Bvh`, mirrored in shaders/trace.glsl and layout-tested),
 //! plus the primitive list its leaves point into.
 
-use crate::gpu::layout::{child_ref, Bounds, Bvh, GpuBvhNode, PRIM_SPHERE_BIT};
+use crate::gpu::layout::{child_ref, Bounds, Bvh, GpuBvhNode, GpuBvhPrim, PRIM_SPHERE_BIT};
 use crate::scene::camera::in_local_frame;
 use crate::scene::{BvhCache, Scene};
 use glam::DVec3;
@@ -140,9 +140,10 @@ impl Bvh {
         self.depth.saturating_sub(1).max(1)
     }
 
-    /// Bytes on the GPU: nodes plus the leaf primitive list.
+    /// Bytes on the GPU: the nodes plus the leaves' primitives (`GpuBvhPrim`).
     pub fn bytes(&self) -> usize {
-        std::mem::size_of_val(self.nodes.as_slice()) + std::mem::size_of_val(self.prims.as_slice())
+        std::mem::size_of_val(self.nodes.as_slice())
+            + self.prims.len() * std::mem::size_of::<GpuBvhPrim>()
     }
 }
 
