@@ -100,8 +100,6 @@ pub enum Experiment {
     NoLoopBounding,
     /// Compute path: put the BVH stack in shared memory wherever it fits (the default keeps it local).
     SharedBvhStack,
-    /// Traverse the BVH without a stack (parent links), on both paths.
-    StacklessBvh,
     /// One BVH stack entry per array element (uvec2) instead of two per uvec4.
     UnpairedBvhStack,
     /// Read the primitive and light counts from a storage buffer instead of
@@ -524,7 +522,6 @@ mod tests {
                 "naga-loop-bounding",
                 "no-loop-bounding",
                 "shared-bvh-stack",
-                "stackless-bvh",
                 "unpaired-bvh-stack",
                 "storage-counts",
                 "uniform-counts",

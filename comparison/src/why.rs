@@ -97,7 +97,6 @@ pub const CASES: &[Case] = &[
     vulkan(&TEAPOT_FRAGMENT, &[Experiment::Glslang]),
     vulkan(&TEAPOT_FRAGMENT, &[Experiment::NoLoopBounding]),
     gl_spirv(&TEAPOT_FRAGMENT),
-    both(&TEAPOT_BVH_COMPUTE, &[Experiment::StacklessBvh]),
     both(&TEAPOT_BVH_COMPUTE, &[Experiment::UnpairedBvhStack]),
     both(&BOX_IMAGES, &[Experiment::NoContraction]),
     vulkan(&BOX_IMAGES, &[Experiment::NoContraction]),

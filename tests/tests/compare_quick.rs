@@ -203,7 +203,6 @@ fn why_table_has_a_verdict_per_gap_and_experiment(report: &str, out: &std::path:
         "glslang",
         "no-loop-bounding",
         "opengl-spirv",
-        "stackless-bvh",
         "unpaired-bvh-stack",
         "no-contraction",
         "float-controls",

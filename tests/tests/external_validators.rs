@@ -113,7 +113,6 @@ fn variants() -> Vec<(String, Variant)> {
             UniformCounts,
         ],
         vec![NoLoopBounding, UnpairedBvhStack, StorageCounts],
-        vec![StacklessBvh],
         vec![NoContraction],
         vec![Glslang],
         vec![FloatControls],
