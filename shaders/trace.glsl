@@ -127,30 +127,42 @@ layout(std430, set = 0, binding = 4) readonly buffer Lights {
     Light lights[];
 } light_buf;
 
-// The BVH (common/src/scene/accel.rs), depth-first: an interior node's left child is the
-// next node and `left_or_first` its right child; a leaf (count > 0) holds
-// prims[left_or_first .. +count], each a triangle index or a sphere index with
-// the top bit set. Bound always; read only by the USE_BVH variant.
+// The BVH (common/src/scene/accel.rs): interior nodes, each holding both of
+// its children's boxes (one 64-byte read per step), node 0 the root. A child
+// is a reference: an interior node's index, or with the top bit set a leaf,
+// prims[first .. first + count] with first above bit 2 and count - 1 below.
+// Bound always; read only by the USE_BVH variant.
 struct BvhNode {
-    vec3 bmin;
-    uint left_or_first;
-    vec3 bmax;
-    uint count;
+    vec3 left_min;
+    uint left;
+    vec3 left_max;
+    uint pad0;
+    vec3 right_min;
+    uint right;
+    vec3 right_max;
+    uint pad1;
 };
 
 layout(std430, set = 0, binding = 6) readonly buffer BvhNodes {
     BvhNode nodes[];
 } bvh_buf;
 
-layout(std430, set = 0, binding = 7) readonly buffer BvhPrims {
-    uint prims[];
-} prim_buf;
+// The leaves' primitives in leaf order, each with only what its test reads
+// (a triangle's corners, or a sphere's centre and radius in b.x), so a leaf
+// is one contiguous read. `code` is a triangle index, or a sphere index with
+// the top bit set: the hit keeps it for shading.
+struct BvhPrim {
+    vec3 a;
+    uint code;
+    vec3 b;
+    uint pad0;
+    vec3 c;
+    uint pad1;
+};
 
-// Per node: the parent's index (low 30 bits) and the axis the node's children
-// were split on (top 2 bits). Read only by the BVH_STACKLESS traversal.
-layout(std430, set = 0, binding = 8) readonly buffer BvhLinks {
-    uint links[];
-} link_buf;
+layout(std430, set = 0, binding = 7) readonly buffer BvhPrims {
+    BvhPrim prims[];
+} prim_buf;
 
 const float T_MAX = 1.0e30;
 
@@ -393,7 +405,7 @@ const uint SPHERE_BIT = 0x80000000u;
 // Experiments (--experiment, common/src/cli.rs): BVH_STACK_UNPAIRED keeps
 // one uvec2 per element; BVH_STACK_SHARED (compute only, where it fits)
 // keeps the stack in shared memory, entry-major so that a warp's pushes hit
-// distinct banks; BVH_STACKLESS below has no stack at all.
+// distinct banks.
 #ifndef BVH_STACK
 // Only a source compiled without the build's defines (an external compiler
 // checking trace.glsl on its own) gets here: the apps always size the stack
@@ -416,11 +428,13 @@ shared uvec2 bvh_stack[BVH_STACK * WG_X * WG_Y];
 #define BVH_POP(i) (((i) & 1u) == 0u ? stack[(i) >> 1u].xy : stack[(i) >> 1u].zw)
 #endif
 
+const uint LEAF_BIT = 0x80000000u;
+
 // Where the ray enters the box, or -1 if it misses it before t_max. Zero
 // direction components are nudged so 0 * inf never makes a NaN.
-float enter_box(vec3 origin, vec3 inv_dir, uint node, float t_max) {
-    vec3 t0 = (bvh_buf.nodes[node].bmin - origin) * inv_dir;
-    vec3 t1 = (bvh_buf.nodes[node].bmax - origin) * inv_dir;
+float enter_box(vec3 origin, vec3 inv_dir, vec3 bmin, vec3 bmax, float t_max) {
+    vec3 t0 = (bmin - origin) * inv_dir;
+    vec3 t1 = (bmax - origin) * inv_dir;
     vec3 tn = min(t0, t1);
     vec3 tf = max(t0, t1);
     float enter = max(max(tn.x, tn.y), max(tn.z, 0.0));
@@ -437,17 +451,20 @@ vec3 inverse_dir(vec3 dir) {
 // True when an any-hit query (shadow rays) may stop.
 bool hit_leaf(inout Hit h, vec3 origin, vec3 dir, TriRay ray, uint first, uint count, bool any_hit) {
     for (uint k = 0u; k < count; k++) {
-        uint prim = prim_buf.prims[first + k];
+        BvhPrim p = prim_buf.prims[first + k];
+        uint prim = p.code;
+        // The tests take whole structs; they read only the positions.
         if ((prim & SPHERE_BIT) != 0u) {
             uint i = prim & ~SPHERE_BIT;
-            float t = hit_sphere(origin, dir, sphere_buf.spheres[i], 0.0, h.t);
+            float t = hit_sphere(origin, dir, Sphere(p.a, p.b.x, 0u, 0u, 0u, 0u), 0.0, h.t);
             if (t > 0.0) {
                 h.t = t;
                 h.kind = 1u;
                 h.index = i;
             }
         } else {
-            vec3 r = hit_triangle(ray, triangle_buf.triangles[prim], 0.0, h.t);
+            Triangle tri = Triangle(p.a, 0u, p.b, 0u, p.c, 0u, vec3(0.0), 0u, vec3(0.0), 0u, vec3(0.0), 0u);
+            vec3 r = hit_triangle(ray, tri, 0.0, h.t);
             if (r.x > 0.0) {
                 h.t = r.x;
                 h.kind = 2u;
@@ -463,88 +480,6 @@ bool hit_leaf(inout Hit h, vec3 origin, vec3 dir, TriRay ray, uint first, uint c
     return false;
 }
 
-#ifdef BVH_STACKLESS
-// The stackless alternative (Hapala, Davidovic, Wald, Havran 2011): no array
-// at all. From each node's parent link and split axis the traversal knows
-// where to go next: down to the near child (the lower side when the ray runs
-// towards +axis), across to the sibling, or back up. Each box is tested at
-// most once; going up costs a link read instead of a stack pop.
-const uint FROM_PARENT = 0u;
-const uint FROM_SIBLING = 1u;
-const uint FROM_CHILD = 2u;
-
-uint parent_of(uint node) {
-    return link_buf.links[node] & 0x3FFFFFFFu;
-}
-
-uint near_child(uint node, vec3 dir) {
-    uint axis = link_buf.links[node] >> 30u;
-    return dir[axis] >= 0.0 ? node + 1u : bvh_buf.nodes[node].left_or_first;
-}
-
-uint sibling_of(uint node, uint parent) {
-    return node == parent + 1u ? bvh_buf.nodes[parent].left_or_first : parent + 1u;
-}
-
-Hit traverse(vec3 origin, vec3 dir, float t_max, bool any_hit) {
-    Hit h;
-    h.t = t_max;
-    h.kind = 0u;
-    h.index = 0u;
-    h.u = 0.0;
-    h.v = 0.0;
-    vec3 inv_dir = inverse_dir(dir);
-    TriRay ray = tri_ray(origin, dir);
-    if (enter_box(origin, inv_dir, 0u, t_max) < 0.0) {
-        return h;
-    }
-    if (bvh_buf.nodes[0].count > 0u) {
-        hit_leaf(h, origin, dir, ray, bvh_buf.nodes[0].left_or_first, bvh_buf.nodes[0].count, any_hit);
-        return h;
-    }
-    uint node = near_child(0u, dir);
-    uint state = FROM_PARENT;
-    while (true) {
-        if (state == FROM_CHILD) {
-            if (node == 0u) {
-                break;
-            }
-            uint parent = parent_of(node);
-            if (node == near_child(parent, dir)) {
-                node = sibling_of(node, parent);
-                state = FROM_SIBLING;
-            } else {
-                node = parent;
-            }
-            continue;
-        }
-        bool enter = enter_box(origin, inv_dir, node, h.t) >= 0.0;
-        uint count = bvh_buf.nodes[node].count;
-        if (enter && count == 0u) {
-            node = near_child(node, dir);
-            state = FROM_PARENT;
-            continue;
-        }
-        // Nested, not `&&`: naga would test the leaf of every box, entered or not.
-        if (enter) {
-            if (hit_leaf(h, origin, dir, ray, bvh_buf.nodes[node].left_or_first, count, any_hit)) {
-                return h;
-            }
-        }
-        // Done with this subtree: the far sibling is next after the near
-        // child, the parent after the far one.
-        uint parent = parent_of(node);
-        if (state == FROM_PARENT) {
-            node = sibling_of(node, parent);
-            state = FROM_SIBLING;
-        } else {
-            node = parent;
-            state = FROM_CHILD;
-        }
-    }
-    return h;
-}
-#else
 // Visits the tree near child first and skips subtrees that start beyond the
 // closest hit so far. With `any_hit` (shadow rays) it stops at the first hit
 // before t_max and reports it with kind != 0.
@@ -561,41 +496,38 @@ Hit traverse(vec3 origin, vec3 dir, float t_max, bool any_hit) {
     BVH_STACK_DECLARE;
 #endif
     uint sp = 0u;
-    if (enter_box(origin, inv_dir, 0u, t_max) < 0.0) {
-        return h;
-    }
-    uint node = 0u;
+    // The child reference being visited; the root is interior node 0.
+    uint child = 0u;
     while (true) {
-        uint count = bvh_buf.nodes[node].count;
-        uint first = bvh_buf.nodes[node].left_or_first;
-        if (count > 0u) {
+        if ((child & LEAF_BIT) != 0u) {
+            uint first = (child & ~LEAF_BIT) >> 2u;
+            uint count = (child & 3u) + 1u;
             if (hit_leaf(h, origin, dir, ray, first, count, any_hit)) {
                 return h;
             }
         } else {
-            uint left = node + 1u;
-            uint right = first;
-            float tl = enter_box(origin, inv_dir, left, h.t);
-            float tr = enter_box(origin, inv_dir, right, h.t);
+            BvhNode node = bvh_buf.nodes[child];
+            float tl = enter_box(origin, inv_dir, node.left_min, node.left_max, h.t);
+            float tr = enter_box(origin, inv_dir, node.right_min, node.right_max, h.t);
             if (tl >= 0.0 && tr >= 0.0) {
                 bool left_first = tl <= tr;
-                node = left_first ? left : right;
+                child = left_first ? node.left : node.right;
                 // sp < BVH_STACK here: the stack is as deep as the tree.
 #ifdef BVH_STACK_FIXED
                 if (sp < uint(BVH_STACK))
 #endif
                 {
-                    BVH_PUSH(sp, uvec2(left_first ? right : left, floatBitsToUint(left_first ? tr : tl)));
+                    BVH_PUSH(sp, uvec2(left_first ? node.right : node.left, floatBitsToUint(left_first ? tr : tl)));
                     sp += 1u;
                 }
                 continue;
             }
             if (tl >= 0.0) {
-                node = left;
+                child = node.left;
                 continue;
             }
             if (tr >= 0.0) {
-                node = right;
+                child = node.right;
                 continue;
             }
         }
@@ -605,7 +537,7 @@ Hit traverse(vec3 origin, vec3 dir, float t_max, bool any_hit) {
             sp -= 1u;
             uvec2 entry = BVH_POP(sp);
             if (uintBitsToFloat(entry.y) < h.t) {
-                node = entry.x;
+                child = entry.x;
                 found = true;
             }
         }
@@ -615,7 +547,6 @@ Hit traverse(vec3 origin, vec3 dir, float t_max, bool any_hit) {
     }
     return h;
 }
-#endif
 #endif
 // trace/hit.glsl — the two questions the ray loop asks (the closest hit, and is
 // anything in the way of a light), answered by testing every primitive or,
@@ -721,27 +652,6 @@ bool occluded(vec3 origin, vec3 dir, float dist) {
 #endif
 }
 
-
-#ifdef ONE_QUERY
-// --experiment one-query: both questions behind one call, for the ray loop's
-// single query site (trace/loop.glsl).
-Hit query(vec3 origin, vec3 dir, float t_max, bool any_hit) {
-#ifdef USE_BVH
-    return traverse(origin, dir, t_max, any_hit);
-#else
-    if (any_hit) {
-        Hit h;
-        h.t = t_max;
-        h.kind = occluded_brute(origin, dir, t_max) ? 1u : 0u;
-        h.index = 0u;
-        h.u = 0.0;
-        h.v = 0.0;
-        return h;
-    }
-    return closest_hit_brute(origin, dir);
-#endif
-}
-#endif
 // trace/secondary.glsl — where a secondary ray starts, and how much of it glass
 // reflects.
 
@@ -862,135 +772,6 @@ vec3 trace(vec3 origin, vec3 dir) {
     st_depth[0] = 0u;
     sp = 1;
 
-#ifdef ONE_QUERY
-    // --experiment one-query: every query of the loop, closest hit or shadow
-    // ray, goes through the one call of query() below, so a compiler that
-    // inlines the traversal keeps one copy of it (and of its stack) instead of
-    // one per call site. Each iteration asks one question: the closest hit of
-    // the next ray on the stack, or, while a hit is being shaded, the shadow
-    // ray towards its next lit light. The hit's state lives across iterations.
-    // Measured and rejected (comparison/results/nvidia-h100/FINDINGS.md), kept
-    // for reruns; its surface code repeats the product's below #else, so a
-    // change to one must be made to both.
-    bool shadow_pending = false;
-    uint li = 0u;
-    vec3 o;
-    vec3 d;
-    float w;
-    uint depth;
-    vec3 p;
-    vec3 ng;
-    vec3 ns;
-    uint mat_index;
-    float scale;
-    bool inside;
-    Material m;
-    vec3 local;
-    vec3 p_out;
-    vec3 l;
-    float dist;
-    float ndl;
-    while (sp > 0 || shadow_pending) {
-        vec3 q_origin;
-        vec3 q_dir;
-        float q_t;
-        if (shadow_pending) {
-            q_origin = p_out;
-            q_dir = l;
-            // Stop a hair before the light: a light lying on a surface would
-            // otherwise be hidden by that surface at the whim of rounding.
-            q_t = dist * SHADOW_REACH;
-        } else {
-            sp -= 1;
-            o = st_origin[sp];
-            d = st_dir[sp];
-            w = st_weight[sp];
-            depth = st_depth[sp];
-            q_origin = o;
-            q_dir = d;
-            q_t = T_MAX;
-        }
-#ifdef COUNT_RAYS
-        // This loop's shadow queries bypass occluded(), which counts the others.
-        if (shadow_pending) {
-            rays_traced.shadow += 1u;
-        }
-#endif
-        Hit h = query(q_origin, q_dir, q_t, shadow_pending);
-        if (shadow_pending) {
-            if (h.kind == 0u) {
-                Light light = light_buf.lights[li];
-                vec3 r = reflect(-l, ns);
-                float spec = pow(max(dot(r, -d), 0.0), m.shininess);
-                local += light.color * (m.diffuse * ndl + m.specular * spec);
-            }
-            li += 1u;
-            shadow_pending = false;
-        } else {
-            if (h.kind == 0u) {
-                color += w * frame.background;
-                continue;
-            }
-            p = o + h.t * d;
-            scale = max_abs(o);
-            if (h.kind == 1u) {
-                Sphere s = sphere_buf.spheres[h.index];
-                ng = (p - s.center) / s.radius;
-                ns = ng;
-                mat_index = s.material;
-                // Sphere tests square their inputs (c = f.f - r^2), so a start a few
-                // ULPs inside glass can still re-hit the same sphere: 4x the margin
-                // (scenes/box's glass sphere speckled with 2^-22).
-                scale = 4.0 * max(scale, max_abs(p));
-            } else {
-                Triangle tri = triangle_buf.triangles[h.index];
-                // A triangle test's error grows with its vertices' magnitude (a floor
-                // quad reaching x = 8 seen from a glass sphere at |o| = 1 re-hit itself).
-                scale = max(scale, max(max_abs(tri.p0), max(max_abs(tri.p1), max_abs(tri.p2))));
-                vec3 e1 = tri.p1 - tri.p0;
-                vec3 e2 = tri.p2 - tri.p0;
-#if defined(OFFSET_SCALE_AWARE) || defined(OFFSET_ULP)
-                // These offsets assume p lies within a few ULPs of its coordinates
-                // off the plane. o + t d does not: its error grows with t and with
-                // how thin the triangle is (acne on the teapot's spout and handle).
-                // Rebuilt from the barycentrics, an error in u, v only slides p
-                // along the plane (Wachter & Binder, Ray Tracing Gems ch. 6).
-                p = tri.p0 + h.u * e1 + h.v * e2;
-#endif
-                ng = normalize(cross(e1, e2));
-                ns = normalize((1.0 - h.u - h.v) * tri.n0 + h.u * tri.n1 + h.v * tri.n2);
-                mat_index = tri.material;
-            }
-            // Face both normals towards the incoming ray; `inside` tells glass which way it goes.
-            inside = dot(d, ng) > 0.0;
-            if (inside) {
-                ng = -ng;
-            }
-            if (dot(ns, ng) < 0.0) {
-                ns = -ns;
-            }
-            m = material_buf.materials[mat_index];
-            local = m.ambient;
-            li = 0u;
-        }
-        // The next light this hit faces, if any: its shadow ray is the next query.
-        for (; li < LIGHT_COUNT; li++) {
-            Light light = light_buf.lights[li];
-            // The offset may depend on the direction (OFFSET_RAY): aim from p first.
-            p_out = spawn_point(p, ng, normalize(light.position - p), scale);
-            vec3 to_light = light.position - p_out;
-            dist = length(to_light);
-            l = to_light / dist;
-            ndl = dot(ns, l);
-            if (ndl > 0.0 && dot(ng, l) > 0.0) {
-                shadow_pending = true;
-                break;
-            }
-        }
-        if (shadow_pending) {
-            continue;
-        }
-#else
     while (sp > 0) {
         sp -= 1;
         vec3 o = st_origin[sp];
@@ -1071,7 +852,6 @@ vec3 trace(vec3 origin, vec3 dir) {
                 local += light.color * (m.diffuse * ndl + m.specular * spec);
             }
         }
-#endif
         color += w * local;
 
 #if defined(HAS_MIRROR) || defined(HAS_GLASS)

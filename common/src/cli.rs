@@ -100,8 +100,6 @@ pub enum Experiment {
     NoLoopBounding,
     /// Compute path: put the BVH stack in shared memory wherever it fits (the default keeps it local).
     SharedBvhStack,
-    /// Traverse the BVH without a stack (parent links), on both paths.
-    StacklessBvh,
     /// One BVH stack entry per array element (uvec2) instead of two per uvec4.
     UnpairedBvhStack,
     /// Read the primitive and light counts from a storage buffer instead of
@@ -118,10 +116,6 @@ pub enum Experiment {
     /// (SPV_KHR_float_controls: denormals preserved, signed zero, Inf and NaN
     /// preserved), to see whether Vulkan's defaults explain its pixels.
     FloatControls,
-    /// One call site for the closest hit and the shadow rays of each hit
-    /// (they take turns in a small loop), so that a compiler that inlines the
-    /// traversal keeps one copy of it instead of two.
-    OneQuery,
     /// The SPIR-V (what Vulkan runs) from Khronos' reference compiler,
     /// glslangValidator (on PATH; Debian's glslang-tools), given the same
     /// GLSL and defines, instead of from naga.
@@ -528,13 +522,11 @@ mod tests {
                 "naga-loop-bounding",
                 "no-loop-bounding",
                 "shared-bvh-stack",
-                "stackless-bvh",
                 "unpaired-bvh-stack",
                 "storage-counts",
                 "uniform-counts",
                 "no-contraction",
                 "float-controls",
-                "one-query",
                 "glslang",
                 "quad",
                 "load-clear",

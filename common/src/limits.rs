@@ -6,7 +6,7 @@
 //! are checked by each app against its own device, after these.
 
 use crate::error::bad_input;
-use crate::gpu::layout::{GpuBvhNode, GpuSphere, GpuTriangle};
+use crate::gpu::layout::{GpuBvhNode, GpuBvhPrim, GpuSphere, GpuTriangle};
 
 /// Width or height: twice the largest maxImageDimension2D / GL_MAX_TEXTURE_SIZE
 /// any device reports (32768), so no device could render beyond it.
@@ -24,10 +24,16 @@ pub const MAX_SPHERES: usize = (MAX_STORAGE_BUFFER_BYTES as usize) / size_of::<G
 /// Triangles (inline, quads and meshes together): what one storage buffer can hold (44 million).
 pub const MAX_TRIANGLES: usize = (MAX_STORAGE_BUFFER_BYTES as usize) / size_of::<GpuTriangle>();
 
-/// BVH nodes of a scene whose primitives fit: a binary tree over n primitives
-/// has fewer than 2n nodes, and a node must fit the same 32-bit range.
-pub const MAX_BVH_PRIMITIVES: usize =
-    (MAX_STORAGE_BUFFER_BYTES as usize) / (2 * size_of::<GpuBvhNode>());
+/// Primitives a BVH can hold: its n leaf primitives (`GpuBvhPrim`) and its
+/// fewer than n interior nodes must each fit the same 32-bit range.
+pub const MAX_BVH_PRIMITIVES: usize = (MAX_STORAGE_BUFFER_BYTES as usize)
+    / if size_of::<GpuBvhNode>() > size_of::<GpuBvhPrim>() {
+        size_of::<GpuBvhNode>()
+    } else {
+        size_of::<GpuBvhPrim>()
+    };
+// A leaf's first primitive must fit its child reference's bits.
+const _: () = assert!(MAX_BVH_PRIMITIVES <= crate::gpu::layout::child_ref::MAX_PRIMS);
 
 /// Point lights: each adds a shadow ray at every hit; more than this is a mistake, not a scene.
 pub const MAX_LIGHTS: usize = 4096;

@@ -145,16 +145,33 @@ fn naga_layout_matches_rust_for_every_shader_struct() {
         "BvhNode",
         naga_members(&module, ty),
         rust_offsets!(GpuBvhNode {
-            min,
-            left_or_first,
-            max,
-            count
+            left_min,
+            left,
+            left_max,
+            pad0,
+            right_min,
+            right,
+            right_max,
+            pad1
         }),
         size_of::<GpuBvhNode>(),
     );
-    let (_, prims) = block(&module, binding::BVH_PRIMS);
-    let (_, stride) = prims.expect("BVH primitives are a runtime array");
-    assert_eq!(stride, 4, "BVH primitive stride");
+    let (_, prim) = block(&module, binding::BVH_PRIMS);
+    let (ty, stride) = prim.expect("BVH primitives are a runtime array");
+    assert_eq!(stride as usize, size_of::<GpuBvhPrim>(), "BvhPrim stride");
+    check(
+        "BvhPrim",
+        naga_members(&module, ty),
+        rust_offsets!(GpuBvhPrim {
+            a,
+            code,
+            b,
+            pad0,
+            c,
+            pad1
+        }),
+        size_of::<GpuBvhPrim>(),
+    );
 
     let (_, light) = block(&module, binding::LIGHTS);
     let (ty, stride) = light.expect("lights is a runtime array");

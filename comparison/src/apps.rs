@@ -352,7 +352,7 @@ mod tests {
             explain: true,
             path: RenderPath::Compute,
             workgroup: Some(Workgroup { x: 8, y: 4 }),
-            experiment: vec![Experiment::NagaZeroInit, Experiment::StacklessBvh],
+            experiment: vec![Experiment::NagaZeroInit, Experiment::UnpairedBvhStack],
             dump_shaders: Some(PathBuf::from("dump")),
         }
     }

@@ -16,7 +16,7 @@ const uint SPHERE_BIT = 0x80000000u;
 // Experiments (--experiment, common/src/cli.rs): BVH_STACK_UNPAIRED keeps
 // one uvec2 per element; BVH_STACK_SHARED (compute only, where it fits)
 // keeps the stack in shared memory, entry-major so that a warp's pushes hit
-// distinct banks; BVH_STACKLESS below has no stack at all.
+// distinct banks.
 #ifndef BVH_STACK
 // Only a source compiled without the build's defines (an external compiler
 // checking trace.glsl on its own) gets here: the apps always size the stack
@@ -39,11 +39,13 @@ shared uvec2 bvh_stack[BVH_STACK * WG_X * WG_Y];
 #define BVH_POP(i) (((i) & 1u) == 0u ? stack[(i) >> 1u].xy : stack[(i) >> 1u].zw)
 #endif
 
+const uint LEAF_BIT = 0x80000000u;
+
 // Where the ray enters the box, or -1 if it misses it before t_max. Zero
 // direction components are nudged so 0 * inf never makes a NaN.
-float enter_box(vec3 origin, vec3 inv_dir, uint node, float t_max) {
-    vec3 t0 = (bvh_buf.nodes[node].bmin - origin) * inv_dir;
-    vec3 t1 = (bvh_buf.nodes[node].bmax - origin) * inv_dir;
+float enter_box(vec3 origin, vec3 inv_dir, vec3 bmin, vec3 bmax, float t_max) {
+    vec3 t0 = (bmin - origin) * inv_dir;
+    vec3 t1 = (bmax - origin) * inv_dir;
     vec3 tn = min(t0, t1);
     vec3 tf = max(t0, t1);
     float enter = max(max(tn.x, tn.y), max(tn.z, 0.0));
@@ -60,17 +62,20 @@ vec3 inverse_dir(vec3 dir) {
 // True when an any-hit query (shadow rays) may stop.
 bool hit_leaf(inout Hit h, vec3 origin, vec3 dir, TriRay ray, uint first, uint count, bool any_hit) {
     for (uint k = 0u; k < count; k++) {
-        uint prim = prim_buf.prims[first + k];
+        BvhPrim p = prim_buf.prims[first + k];
+        uint prim = p.code;
+        // The tests take whole structs; they read only the positions.
         if ((prim & SPHERE_BIT) != 0u) {
             uint i = prim & ~SPHERE_BIT;
-            float t = hit_sphere(origin, dir, sphere_buf.spheres[i], 0.0, h.t);
+            float t = hit_sphere(origin, dir, Sphere(p.a, p.b.x, 0u, 0u, 0u, 0u), 0.0, h.t);
             if (t > 0.0) {
                 h.t = t;
                 h.kind = 1u;
                 h.index = i;
             }
         } else {
-            vec3 r = hit_triangle(ray, triangle_buf.triangles[prim], 0.0, h.t);
+            Triangle tri = Triangle(p.a, 0u, p.b, 0u, p.c, 0u, vec3(0.0), 0u, vec3(0.0), 0u, vec3(0.0), 0u);
+            vec3 r = hit_triangle(ray, tri, 0.0, h.t);
             if (r.x > 0.0) {
                 h.t = r.x;
                 h.kind = 2u;
@@ -86,88 +91,6 @@ bool hit_leaf(inout Hit h, vec3 origin, vec3 dir, TriRay ray, uint first, uint c
     return false;
 }
 
-#ifdef BVH_STACKLESS
-// The stackless alternative (Hapala, Davidovic, Wald, Havran 2011): no array
-// at all. From each node's parent link and split axis the traversal knows
-// where to go next: down to the near child (the lower side when the ray runs
-// towards +axis), across to the sibling, or back up. Each box is tested at
-// most once; going up costs a link read instead of a stack pop.
-const uint FROM_PARENT = 0u;
-const uint FROM_SIBLING = 1u;
-const uint FROM_CHILD = 2u;
-
-uint parent_of(uint node) {
-    return link_buf.links[node] & 0x3FFFFFFFu;
-}
-
-uint near_child(uint node, vec3 dir) {
-    uint axis = link_buf.links[node] >> 30u;
-    return dir[axis] >= 0.0 ? node + 1u : bvh_buf.nodes[node].left_or_first;
-}
-
-uint sibling_of(uint node, uint parent) {
-    return node == parent + 1u ? bvh_buf.nodes[parent].left_or_first : parent + 1u;
-}
-
-Hit traverse(vec3 origin, vec3 dir, float t_max, bool any_hit) {
-    Hit h;
-    h.t = t_max;
-    h.kind = 0u;
-    h.index = 0u;
-    h.u = 0.0;
-    h.v = 0.0;
-    vec3 inv_dir = inverse_dir(dir);
-    TriRay ray = tri_ray(origin, dir);
-    if (enter_box(origin, inv_dir, 0u, t_max) < 0.0) {
-        return h;
-    }
-    if (bvh_buf.nodes[0].count > 0u) {
-        hit_leaf(h, origin, dir, ray, bvh_buf.nodes[0].left_or_first, bvh_buf.nodes[0].count, any_hit);
-        return h;
-    }
-    uint node = near_child(0u, dir);
-    uint state = FROM_PARENT;
-    while (true) {
-        if (state == FROM_CHILD) {
-            if (node == 0u) {
-                break;
-            }
-            uint parent = parent_of(node);
-            if (node == near_child(parent, dir)) {
-                node = sibling_of(node, parent);
-                state = FROM_SIBLING;
-            } else {
-                node = parent;
-            }
-            continue;
-        }
-        bool enter = enter_box(origin, inv_dir, node, h.t) >= 0.0;
-        uint count = bvh_buf.nodes[node].count;
-        if (enter && count == 0u) {
-            node = near_child(node, dir);
-            state = FROM_PARENT;
-            continue;
-        }
-        // Nested, not `&&`: naga would test the leaf of every box, entered or not.
-        if (enter) {
-            if (hit_leaf(h, origin, dir, ray, bvh_buf.nodes[node].left_or_first, count, any_hit)) {
-                return h;
-            }
-        }
-        // Done with this subtree: the far sibling is next after the near
-        // child, the parent after the far one.
-        uint parent = parent_of(node);
-        if (state == FROM_PARENT) {
-            node = sibling_of(node, parent);
-            state = FROM_SIBLING;
-        } else {
-            node = parent;
-            state = FROM_CHILD;
-        }
-    }
-    return h;
-}
-#else
 // Visits the tree near child first and skips subtrees that start beyond the
 // closest hit so far. With `any_hit` (shadow rays) it stops at the first hit
 // before t_max and reports it with kind != 0.
@@ -184,41 +107,38 @@ Hit traverse(vec3 origin, vec3 dir, float t_max, bool any_hit) {
     BVH_STACK_DECLARE;
 #endif
     uint sp = 0u;
-    if (enter_box(origin, inv_dir, 0u, t_max) < 0.0) {
-        return h;
-    }
-    uint node = 0u;
+    // The child reference being visited; the root is interior node 0.
+    uint child = 0u;
     while (true) {
-        uint count = bvh_buf.nodes[node].count;
-        uint first = bvh_buf.nodes[node].left_or_first;
-        if (count > 0u) {
+        if ((child & LEAF_BIT) != 0u) {
+            uint first = (child & ~LEAF_BIT) >> 2u;
+            uint count = (child & 3u) + 1u;
             if (hit_leaf(h, origin, dir, ray, first, count, any_hit)) {
                 return h;
             }
         } else {
-            uint left = node + 1u;
-            uint right = first;
-            float tl = enter_box(origin, inv_dir, left, h.t);
-            float tr = enter_box(origin, inv_dir, right, h.t);
+            BvhNode node = bvh_buf.nodes[child];
+            float tl = enter_box(origin, inv_dir, node.left_min, node.left_max, h.t);
+            float tr = enter_box(origin, inv_dir, node.right_min, node.right_max, h.t);
             if (tl >= 0.0 && tr >= 0.0) {
                 bool left_first = tl <= tr;
-                node = left_first ? left : right;
+                child = left_first ? node.left : node.right;
                 // sp < BVH_STACK here: the stack is as deep as the tree.
 #ifdef BVH_STACK_FIXED
                 if (sp < uint(BVH_STACK))
 #endif
                 {
-                    BVH_PUSH(sp, uvec2(left_first ? right : left, floatBitsToUint(left_first ? tr : tl)));
+                    BVH_PUSH(sp, uvec2(left_first ? node.right : node.left, floatBitsToUint(left_first ? tr : tl)));
                     sp += 1u;
                 }
                 continue;
             }
             if (tl >= 0.0) {
-                node = left;
+                child = node.left;
                 continue;
             }
             if (tr >= 0.0) {
-                node = right;
+                child = node.right;
                 continue;
             }
         }
@@ -228,7 +148,7 @@ Hit traverse(vec3 origin, vec3 dir, float t_max, bool any_hit) {
             sp -= 1u;
             uvec2 entry = BVH_POP(sp);
             if (uintBitsToFloat(entry.y) < h.t) {
-                node = entry.x;
+                child = entry.x;
                 found = true;
             }
         }
@@ -238,5 +158,4 @@ Hit traverse(vec3 origin, vec3 dir, float t_max, bool any_hit) {
     }
     return h;
 }
-#endif
 #endif

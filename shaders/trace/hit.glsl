@@ -102,24 +102,3 @@ bool occluded(vec3 origin, vec3 dir, float dist) {
 #endif
 }
 
-
-#ifdef ONE_QUERY
-// --experiment one-query: both questions behind one call, for the ray loop's
-// single query site (trace/loop.glsl).
-Hit query(vec3 origin, vec3 dir, float t_max, bool any_hit) {
-#ifdef USE_BVH
-    return traverse(origin, dir, t_max, any_hit);
-#else
-    if (any_hit) {
-        Hit h;
-        h.t = t_max;
-        h.kind = occluded_brute(origin, dir, t_max) ? 1u : 0u;
-        h.index = 0u;
-        h.u = 0.0;
-        h.v = 0.0;
-        return h;
-    }
-    return closest_hit_brute(origin, dir);
-#endif
-}
-#endif

@@ -126,30 +126,42 @@ layout(std430, set = 0, binding = 4) readonly buffer Lights {
     Light lights[];
 } light_buf;
 
-// The BVH (common/src/scene/accel.rs), depth-first: an interior node's left child is the
-// next node and `left_or_first` its right child; a leaf (count > 0) holds
-// prims[left_or_first .. +count], each a triangle index or a sphere index with
-// the top bit set. Bound always; read only by the USE_BVH variant.
+// The BVH (common/src/scene/accel.rs): interior nodes, each holding both of
+// its children's boxes (one 64-byte read per step), node 0 the root. A child
+// is a reference: an interior node's index, or with the top bit set a leaf,
+// prims[first .. first + count] with first above bit 2 and count - 1 below.
+// Bound always; read only by the USE_BVH variant.
 struct BvhNode {
-    vec3 bmin;
-    uint left_or_first;
-    vec3 bmax;
-    uint count;
+    vec3 left_min;
+    uint left;
+    vec3 left_max;
+    uint pad0;
+    vec3 right_min;
+    uint right;
+    vec3 right_max;
+    uint pad1;
 };
 
 layout(std430, set = 0, binding = 6) readonly buffer BvhNodes {
     BvhNode nodes[];
 } bvh_buf;
 
-layout(std430, set = 0, binding = 7) readonly buffer BvhPrims {
-    uint prims[];
-} prim_buf;
+// The leaves' primitives in leaf order, each with only what its test reads
+// (a triangle's corners, or a sphere's centre and radius in b.x), so a leaf
+// is one contiguous read. `code` is a triangle index, or a sphere index with
+// the top bit set: the hit keeps it for shading.
+struct BvhPrim {
+    vec3 a;
+    uint code;
+    vec3 b;
+    uint pad0;
+    vec3 c;
+    uint pad1;
+};
 
-// Per node: the parent's index (low 30 bits) and the axis the node's children
-// were split on (top 2 bits). Read only by the BVH_STACKLESS traversal.
-layout(std430, set = 0, binding = 8) readonly buffer BvhLinks {
-    uint links[];
-} link_buf;
+layout(std430, set = 0, binding = 7) readonly buffer BvhPrims {
+    BvhPrim prims[];
+} prim_buf;
 
 const float T_MAX = 1.0e30;
 

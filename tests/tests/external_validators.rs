@@ -113,11 +113,9 @@ fn variants() -> Vec<(String, Variant)> {
             UniformCounts,
         ],
         vec![NoLoopBounding, UnpairedBvhStack, StorageCounts],
-        vec![StacklessBvh],
         vec![NoContraction],
         vec![Glslang],
         vec![FloatControls],
-        vec![OneQuery],
     ] {
         let label = experiments
             .iter()
@@ -129,11 +127,10 @@ fn variants() -> Vec<(String, Variant)> {
             chosen(d, Accel::Bvh, true, experiments),
         ));
     }
-    // The ray-counting variant (--count-rays) of brute force, the BVH and one-query.
+    // The ray-counting variant (--count-rays) of brute force and the BVH.
     for (label, accel, experiments) in [
         ("generic", Accel::None, vec![]),
         ("generic+bvh", Accel::Bvh, vec![]),
-        ("generic+bvh one-query", Accel::Bvh, vec![OneQuery]),
     ] {
         v.push((
             format!("{label} counting rays"),

@@ -79,35 +79,90 @@ pub struct GpuLight {
     pub pad1: f32,
 }
 
-/// `BvhNode` (std430 array element, binding 6). Depth-first layout: an interior
-/// node's left child is the next node and `left_or_first` is its right child;
-/// a leaf (`count > 0`) holds `prims[left_or_first .. left_or_first + count]`.
+/// `BvhNode` (std430 array element, binding 6): an interior node holding both
+/// of its children's boxes, so that one 64-byte read gives the traversal
+/// everything it needs to choose its next step (Aila and Laine 2009). With a
+/// box per node instead, every step read the node, then each child's box, the
+/// right child's only once its index had arrived. Node 0 is the root. A child
+/// is a `ChildRef`: an interior node's index, or a leaf's primitives.
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, Pod, Zeroable, PartialEq)]
 pub struct GpuBvhNode {
-    pub min: [f32; 3],
-    pub left_or_first: u32,
-    pub max: [f32; 3],
-    pub count: u32,
+    pub left_min: [f32; 3],
+    pub left: u32,
+    pub left_max: [f32; 3],
+    pub pad0: u32,
+    pub right_min: [f32; 3],
+    pub right: u32,
+    pub right_max: [f32; 3],
+    pub pad1: u32,
 }
 
+/// `BvhPrim` (std430 array element, binding 7): one primitive of a leaf, in
+/// leaf order, holding only what the intersection tests read, so that a
+/// leaf's primitives are one contiguous read (48 bytes each) instead of an
+/// index each and then a 96-byte triangle elsewhere. `code` is the primitive
+/// (`PRIM_SPHERE_BIT` for a sphere), which the hit keeps for shading.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, Pod, Zeroable, PartialEq)]
+pub struct GpuBvhPrim {
+    /// A triangle's p0, a sphere's centre.
+    pub a: [f32; 3],
+    pub code: u32,
+    /// A triangle's p1; a sphere's radius in x.
+    pub b: [f32; 3],
+    pub pad0: u32,
+    /// A triangle's p2; zero for a sphere.
+    pub c: [f32; 3],
+    pub pad1: u32,
+}
+
+/// A child box, as f32 corners rounded outwards.
+pub type Bounds = ([f32; 3], [f32; 3]);
+
 impl GpuBvhNode {
-    pub fn leaf((min, max): ([f32; 3], [f32; 3]), first: u32, count: u32) -> GpuBvhNode {
+    pub fn new(
+        (left_min, left_max): Bounds,
+        left: u32,
+        (right_min, right_max): Bounds,
+        right: u32,
+    ) -> GpuBvhNode {
         GpuBvhNode {
-            min,
-            left_or_first: first,
-            max,
-            count,
+            left_min,
+            left,
+            left_max,
+            right_min,
+            right,
+            right_max,
+            ..Default::default()
         }
     }
+}
 
-    pub fn interior((min, max): ([f32; 3], [f32; 3]), right: u32) -> GpuBvhNode {
-        GpuBvhNode {
-            min,
-            left_or_first: right,
-            max,
-            count: 0,
-        }
+/// A child reference in a `GpuBvhNode` and on the traversal stack: with
+/// `LEAF_BIT` clear, an interior node's index; with it set, a leaf, which holds
+/// `prims[first .. first + count]` with `first` above `LEAF_FIRST_SHIFT` and
+/// `count - 1` below it. The shader decodes it the same way (trace/bvh.glsl).
+pub mod child_ref {
+    pub const LEAF_BIT: u32 = 1 << 31;
+    pub const LEAF_FIRST_SHIFT: u32 = 2;
+    /// Primitives per leaf at most: what the count's two bits hold.
+    pub const MAX_LEAF_COUNT: usize = 1 << LEAF_FIRST_SHIFT;
+    /// Primitives a tree can hold: `first` has 29 bits.
+    pub const MAX_PRIMS: usize = 1 << (31 - LEAF_FIRST_SHIFT);
+
+    pub fn leaf(first: u32, count: u32) -> u32 {
+        debug_assert!((1..=MAX_LEAF_COUNT as u32).contains(&count) && (first as usize) < MAX_PRIMS);
+        LEAF_BIT | (first << LEAF_FIRST_SHIFT) | (count - 1)
+    }
+
+    /// `Some((first, count))` for a leaf, `None` for an interior node.
+    pub fn as_leaf(r: u32) -> Option<(usize, usize)> {
+        (r & LEAF_BIT != 0).then(|| {
+            let first = (r & !LEAF_BIT) >> LEAF_FIRST_SHIFT;
+            let count = (r & (MAX_LEAF_COUNT as u32 - 1)) + 1;
+            (first as usize, count as usize)
+        })
     }
 }
 
@@ -124,14 +179,8 @@ pub struct GpuRayCount {
     pub glass_refracted: u32,
 }
 
-/// In the BVH's primitive list (binding 7): set for a sphere index, clear for a triangle index.
+/// In a BVH primitive's code (`Bvh::prims`, `GpuBvhPrim::code`): set for a sphere index, clear for a triangle index.
 pub const PRIM_SPHERE_BIT: u32 = 1 << 31;
-
-/// Per BVH node (binding 8), for the stackless traversal: the parent's index
-/// in the low bits and, for an interior node, the axis its children were split
-/// on in the top two (the left child holds the lower side).
-pub const LINK_AXIS_SHIFT: u32 = 30;
-pub const LINK_PARENT_MASK: u32 = (1 << LINK_AXIS_SHIFT) - 1;
 
 /// Binding numbers, shared by the shader build (GLSL binding map) and both apps.
 pub mod binding {
@@ -145,7 +194,8 @@ pub mod binding {
     /// 5 is the compute path's output image.
     pub const BVH_NODES: u32 = 6;
     pub const BVH_PRIMS: u32 = 7;
-    pub const BVH_LINKS: u32 = 8;
+    // 8 held the parent links of a stackless traversal, measured and rejected
+    // (comparison/results/nvidia-h100/FINDINGS.md).
     /// The sphere, triangle and light counts, where the shader reads them at
     /// run time (`--experiment storage-counts`) instead of baking them in.
     pub const COUNTS: u32 = 9;
@@ -154,20 +204,20 @@ pub mod binding {
     pub const RAY_COUNTS: u32 = 10;
     pub const LAST: u32 = RAY_COUNTS;
     /// The storage buffers in binding order.
-    pub const STORAGE: [u32; 8] = [
-        SPHERES, TRIANGLES, MATERIALS, LIGHTS, BVH_NODES, BVH_PRIMS, BVH_LINKS, COUNTS,
+    pub const STORAGE: [u32; 7] = [
+        SPHERES, TRIANGLES, MATERIALS, LIGHTS, BVH_NODES, BVH_PRIMS, COUNTS,
     ];
 }
 
-/// A flattened BVH, ready to upload: the three arrays the shader walks
-/// (bindings 6, 7 and 8). `Bvh::build` (scene/accel.rs) makes one.
+/// A flattened BVH: the nodes the shader walks (binding 6) and the primitive
+/// codes in leaf order, from which the upload makes the leaves' `GpuBvhPrim`s
+/// (binding 7). `Bvh::build` (scene/accel.rs) makes one.
 #[derive(Debug, Clone, Default)]
 pub struct Bvh {
     pub nodes: Vec<GpuBvhNode>,
     /// Leaf contents: a sphere index with `PRIM_SPHERE_BIT` set, or a triangle index.
     pub prims: Vec<u32>,
-    /// Per node: parent index and split axis (`LINK_*`), for the stackless traversal.
-    pub links: Vec<u32>,
     pub build_ms: f64,
+    /// Levels of the tree, leaves included: a single leaf is depth 1.
     pub depth: u32,
 }

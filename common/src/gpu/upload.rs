@@ -3,7 +3,8 @@
 //! (`camera::local_origin`), and the checks of those buffers against a device's limits.
 
 use crate::gpu::layout::{
-    binding, Bvh, GpuBvhNode, GpuFrame, GpuLight, GpuMaterial, GpuSphere, GpuTriangle,
+    binding, Bvh, GpuBvhNode, GpuBvhPrim, GpuFrame, GpuLight, GpuMaterial, GpuSphere, GpuTriangle,
+    PRIM_SPHERE_BIT,
 };
 use crate::scene::camera::{in_local_frame, RayFrame};
 use crate::scene::{Camera, Scene};
@@ -19,8 +20,8 @@ pub struct GpuScene {
     pub lights: Vec<GpuLight>,
     /// Empty unless the scene traces through a BVH.
     pub bvh_nodes: Vec<GpuBvhNode>,
-    pub bvh_prims: Vec<u32>,
-    pub bvh_links: Vec<u32>,
+    /// The leaves' primitives, copied from `spheres` and `triangles`.
+    pub bvh_prims: Vec<GpuBvhPrim>,
     /// Spheres, triangles, lights, and a pad word.
     pub counts: [u32; 4],
 }
@@ -63,7 +64,7 @@ impl GpuScene {
         let scene = &*in_local_frame(world);
         let empty = Bvh::default();
         let bvh = world.bvh_tree().unwrap_or(&empty);
-        GpuScene {
+        let mut gpu = GpuScene {
             frame: GpuFrame::new(world, &world.camera, width, height),
             spheres: scene
                 .spheres
@@ -113,14 +114,38 @@ impl GpuScene {
                 })
                 .collect(),
             bvh_nodes: bvh.nodes.clone(),
-            bvh_prims: bvh.prims.clone(),
-            bvh_links: bvh.links.clone(),
+            bvh_prims: Vec::new(),
             counts: [
                 scene.spheres.len() as u32,
                 scene.triangles.len() as u32,
                 scene.lights.len() as u32,
                 0,
             ],
+        };
+        // Copied from the f32 buffers, so a leaf tests exactly the positions
+        // that the brute-force loops and the shading read.
+        gpu.bvh_prims = bvh.prims.iter().map(|&code| gpu.bvh_prim(code)).collect();
+        gpu
+    }
+
+    fn bvh_prim(&self, code: u32) -> GpuBvhPrim {
+        if code & PRIM_SPHERE_BIT != 0 {
+            let s = &self.spheres[(code & !PRIM_SPHERE_BIT) as usize];
+            GpuBvhPrim {
+                a: s.center,
+                code,
+                b: [s.radius, 0.0, 0.0],
+                ..Default::default()
+            }
+        } else {
+            let t = &self.triangles[code as usize];
+            GpuBvhPrim {
+                a: t.p0,
+                code,
+                b: t.p1,
+                c: t.p2,
+                ..Default::default()
+            }
         }
     }
 
@@ -149,7 +174,6 @@ impl GpuScene {
             binding::LIGHTS => bytes(&self.lights),
             binding::BVH_NODES => bytes(&self.bvh_nodes),
             binding::BVH_PRIMS => bytes(&self.bvh_prims),
-            binding::BVH_LINKS => bytes(&self.bvh_links),
             binding::COUNTS => bytes(&self.counts),
             _ => panic!("binding {binding} is not a storage buffer"),
         }
@@ -173,7 +197,6 @@ pub fn storage_name(binding: u32) -> &'static str {
         binding::LIGHTS => "lights",
         binding::BVH_NODES => "BVH node",
         binding::BVH_PRIMS => "BVH primitive",
-        binding::BVH_LINKS => "BVH link",
         binding::COUNTS => "counts",
         _ => "frame",
     }

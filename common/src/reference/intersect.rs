@@ -2,7 +2,7 @@
 //! choice, the BVH walk, and the closest hit and shadow queries built on them
 //! (trace.glsl's intersection and traversal, step by step).
 
-use crate::gpu::layout::{Bvh, PRIM_SPHERE_BIT};
+use crate::gpu::layout::{child_ref, Bvh, PRIM_SPHERE_BIT};
 use crate::scene::accel::MAX_LEAF;
 use crate::scene::numerics::{SphereTest, TriangleTest};
 use crate::scene::{Scene, Sphere, Triangle};
@@ -83,27 +83,28 @@ fn walk(
     mut t_max: f64,
     mut leaf: impl FnMut(&[u32], f64) -> Option<f64>,
 ) {
-    let mut stack = vec![(0usize, 0.0f64)];
-    while let Some((index, t_enter)) = stack.pop() {
+    if bvh.nodes.is_empty() {
+        return;
+    }
+    // (child reference, entry distance); the root is interior node 0.
+    let mut stack = vec![(0u32, 0.0f64)];
+    while let Some((child, t_enter)) = stack.pop() {
         // Equal distances must be visited: a tie may go to a later leaf.
         if t_enter > t_max {
             continue;
         }
-        let node = &bvh.nodes[index];
-        if node.count > 0 {
-            let first = node.left_or_first as usize;
-            match leaf(&bvh.prims[first..first + node.count as usize], t_max) {
+        if let Some((first, count)) = child_ref::as_leaf(child) {
+            match leaf(&bvh.prims[first..first + count], t_max) {
                 Some(t) => t_max = t,
                 None => return,
             }
             continue;
         }
-        let child = |c: usize| {
-            let n = &bvh.nodes[c];
-            enter_box(n.min, n.max, o, d, t_max).map(|t| (c, t))
-        };
+        let node = &bvh.nodes[child as usize];
+        let left = enter_box(node.left_min, node.left_max, o, d, t_max).map(|t| (node.left, t));
+        let right = enter_box(node.right_min, node.right_max, o, d, t_max).map(|t| (node.right, t));
         // Far child pushed first, so the near one is visited first.
-        match (child(index + 1), child(node.left_or_first as usize)) {
+        match (left, right) {
             (Some(a), Some(b)) if a.1 <= b.1 => stack.extend([b, a]),
             (Some(a), Some(b)) => stack.extend([a, b]),
             (Some(a), None) | (None, Some(a)) => stack.push(a),
@@ -287,10 +288,6 @@ pub(super) fn closest_hit(tracer: &Tracer, o: DVec3, d: DVec3) -> Option<(f64, H
         }
         return best.map(|h| (best_t, h));
     };
-    if bvh.nodes.is_empty() || enter_box(bvh.nodes[0].min, bvh.nodes[0].max, o, d, T_MAX).is_none()
-    {
-        return None;
-    }
     // (t, brute-force order, hit): the least t, and among equal t the least order.
     let mut best: Option<(f64, u64, Hit)> = None;
     walk(bvh, o, d, T_MAX, |prims, _| {
@@ -348,9 +345,6 @@ pub(super) fn occluded(tracer: &Tracer, o: DVec3, d: DVec3, dist: f64) -> bool {
                 .iter()
                 .any(|t| hit_triangle(n.triangle, &r, t, 0.0, dist).is_some());
     };
-    if bvh.nodes.is_empty() || enter_box(bvh.nodes[0].min, bvh.nodes[0].max, o, d, dist).is_none() {
-        return false;
-    }
     let mut hit = false;
     walk(bvh, o, d, dist, |prims, t_max| {
         if prims.iter().any(|&c| blocks(c)) {

@@ -4,7 +4,7 @@
 //! walks (`gpu::layout::Bvh`, mirrored in shaders/trace.glsl and layout-tested),
 //! plus the primitive list its leaves point into.
 
-use crate::gpu::layout::{Bvh, GpuBvhNode, LINK_AXIS_SHIFT, LINK_PARENT_MASK, PRIM_SPHERE_BIT};
+use crate::gpu::layout::{child_ref, Bounds, Bvh, GpuBvhNode, GpuBvhPrim, PRIM_SPHERE_BIT};
 use crate::scene::camera::in_local_frame;
 use crate::scene::{BvhCache, Scene};
 use glam::DVec3;
@@ -50,7 +50,7 @@ impl Scene {
 }
 
 /// Primitives per leaf at most; SAH may stop splitting earlier.
-pub const MAX_LEAF: usize = 4;
+pub const MAX_LEAF: usize = child_ref::MAX_LEAF_COUNT;
 const BINS: usize = 16;
 /// Relative cost of one node visit vs one primitive test, for SAH.
 const TRAVERSAL_COST: f64 = 1.0;
@@ -119,7 +119,14 @@ impl Bvh {
         if !refs.is_empty() {
             let n = refs.len();
             bvh.nodes.reserve(2 * n / MAX_LEAF + 1);
-            build_node(&mut bvh, &mut refs, 0, n, 1, 0);
+            let (bounds, root) = build_node(&mut bvh, &mut refs, 0, n, 1);
+            if child_ref::as_leaf(root).is_some() {
+                // Node 0 is always an interior node: a tree that is one leaf
+                // gets a root whose two children are that leaf. The second
+                // test of the same primitives finds nothing closer.
+                let b = bounds_f32(&bounds);
+                bvh.nodes.push(GpuBvhNode::new(b, root, b, root));
+            }
         }
         bvh.build_ms = start.elapsed().as_secs_f64() * 1e3;
         bvh
@@ -133,9 +140,10 @@ impl Bvh {
         self.depth.saturating_sub(1).max(1)
     }
 
-    /// Bytes on the GPU: nodes plus the leaf primitive list.
+    /// Bytes on the GPU: the nodes plus the leaves' primitives (`GpuBvhPrim`).
     pub fn bytes(&self) -> usize {
-        std::mem::size_of_val(self.nodes.as_slice()) + std::mem::size_of_val(self.prims.as_slice())
+        std::mem::size_of_val(self.nodes.as_slice())
+            + self.prims.len() * std::mem::size_of::<GpuBvhPrim>()
     }
 }
 
@@ -152,22 +160,18 @@ fn bounds_of(refs: &[PrimRef]) -> (Aabb, Aabb) {
     (b, c)
 }
 
-/// Builds the subtree over refs[lo..hi] at the next free node index; returns it.
-/// Depth-first order: an interior node's left child is the next node, its right
-/// child's index is stored in the node.
+/// Builds the subtree over refs[lo..hi] and returns its box and its child
+/// reference. Interior nodes go in depth-first order, so a subtree's nodes are
+/// contiguous and the root is node 0.
 fn build_node(
     bvh: &mut Bvh,
     refs: &mut [PrimRef],
     lo: usize,
     hi: usize,
     depth: u32,
-    parent: usize,
-) -> usize {
+) -> (Aabb, u32) {
     bvh.depth = bvh.depth.max(depth);
-    let index = bvh.nodes.len();
     let (bounds, centroids) = bounds_of(&refs[lo..hi]);
-    bvh.nodes.push(GpuBvhNode::default());
-    bvh.links.push(parent as u32 & LINK_PARENT_MASK);
     let count = hi - lo;
     let split = if count <= 1 {
         None
@@ -181,39 +185,33 @@ fn build_node(
         None if count > MAX_LEAF => Some((count / 2, None)),
         None => None,
     };
-    let node = match split {
-        None => {
-            let first = bvh.prims.len() as u32;
-            bvh.prims.extend(refs[lo..hi].iter().map(|r| r.code));
-            GpuBvhNode::leaf(bounds_f32(&bounds), first, count as u32)
-        }
-        Some((mid, plane)) => {
-            if let Some(plane) = plane {
-                // Partition with the same bin arithmetic that counted the sides.
-                let slice = &mut refs[lo..hi];
-                let mut i = 0;
-                for j in 0..slice.len() {
-                    if plane.left(&slice[j]) {
-                        slice.swap(i, j);
-                        i += 1;
-                    }
-                }
-                debug_assert_eq!(i, mid);
-            }
-            let mid = lo + mid;
-            // A median split has no axis; any order serves it.
-            let axis = plane.map_or(0, |p| p.axis as u32);
-            bvh.links[index] |= axis << LINK_AXIS_SHIFT;
-            build_node(bvh, refs, lo, mid, depth + 1, index);
-            let right = build_node(bvh, refs, mid, hi, depth + 1, index);
-            GpuBvhNode::interior(bounds_f32(&bounds), right as u32)
-        }
+    let Some((mid, plane)) = split else {
+        let first = bvh.prims.len() as u32;
+        bvh.prims.extend(refs[lo..hi].iter().map(|r| r.code));
+        return (bounds, child_ref::leaf(first, count as u32));
     };
-    bvh.nodes[index] = node;
-    index
+    if let Some(plane) = plane {
+        // Partition with the same bin arithmetic that counted the sides.
+        let slice = &mut refs[lo..hi];
+        let mut i = 0;
+        for j in 0..slice.len() {
+            if plane.left(&slice[j]) {
+                slice.swap(i, j);
+                i += 1;
+            }
+        }
+        debug_assert_eq!(i, mid);
+    }
+    let mid = lo + mid;
+    let index = bvh.nodes.len();
+    bvh.nodes.push(GpuBvhNode::default());
+    let (left_box, left) = build_node(bvh, refs, lo, mid, depth + 1);
+    let (right_box, right) = build_node(bvh, refs, mid, hi, depth + 1);
+    bvh.nodes[index] = GpuBvhNode::new(bounds_f32(&left_box), left, bounds_f32(&right_box), right);
+    (bounds, index as u32)
 }
 
-fn bounds_f32(b: &Aabb) -> ([f32; 3], [f32; 3]) {
+fn bounds_f32(b: &Aabb) -> Bounds {
     // Round outwards so f32 boxes still contain the f64 primitives.
     let lo = b.min.to_array().map(|v| next_down(v as f32, v));
     let hi = b.max.to_array().map(|v| next_up(v as f32, v));
@@ -335,14 +333,33 @@ mod tests {
         seen.dedup();
         assert_eq!(seen.len(), total, "every primitive is in exactly one leaf");
         assert_eq!(bvh.prims.len(), total);
-        // Every leaf's box holds its primitives; every child's box lies in its parent's.
-        for (i, n) in bvh.nodes.iter().enumerate() {
-            if n.count > 0 {
-                assert!(n.count as usize <= MAX_LEAF, "leaf {i} holds {}", n.count);
-                for &code in
-                    &bvh.prims[n.left_or_first as usize..(n.left_or_first + n.count) as usize]
-                {
-                    let (lo, hi) = if code & PRIM_SPHERE_BIT != 0 {
+        // Every leaf's box holds its primitives; every child's box lies in its
+        // parent's; every node is reached once.
+        let mut reached = vec![false; bvh.nodes.len()];
+        let mut todo = vec![(0usize, None::<Bounds>)];
+        while let Some((i, outer)) = todo.pop() {
+            assert!(!reached[i], "node {i} is reached twice");
+            reached[i] = true;
+            let n = &bvh.nodes[i];
+            for (lo, hi, child) in [
+                (n.left_min, n.left_max, n.left),
+                (n.right_min, n.right_max, n.right),
+            ] {
+                if let Some((outer_lo, outer_hi)) = outer {
+                    for a in 0..3 {
+                        assert!(
+                            lo[a] >= outer_lo[a] && hi[a] <= outer_hi[a],
+                            "a child of node {i} lies outside it"
+                        );
+                    }
+                }
+                let Some((first, count)) = child_ref::as_leaf(child) else {
+                    todo.push((child as usize, Some((lo, hi))));
+                    continue;
+                };
+                assert!(count <= MAX_LEAF, "a leaf of node {i} holds {count}");
+                for &code in &bvh.prims[first..first + count] {
+                    let (plo, phi) = if code & PRIM_SPHERE_BIT != 0 {
                         let s = &scene.spheres[(code & !PRIM_SPHERE_BIT) as usize];
                         (s.center - s.radius, s.center + s.radius)
                     } else {
@@ -354,23 +371,14 @@ mod tests {
                     };
                     for a in 0..3 {
                         assert!(
-                            n.min[a] as f64 <= lo[a] && n.max[a] as f64 >= hi[a],
-                            "leaf {i} box misses a primitive"
-                        );
-                    }
-                }
-            } else {
-                for child in [i + 1, n.left_or_first as usize] {
-                    let c = &bvh.nodes[child];
-                    for a in 0..3 {
-                        assert!(
-                            c.min[a] >= n.min[a] && c.max[a] <= n.max[a],
-                            "child {child} outside parent {i}"
+                            lo[a] as f64 <= plo[a] && hi[a] as f64 >= phi[a],
+                            "a leaf box of node {i} misses a primitive"
                         );
                     }
                 }
             }
         }
+        assert!(reached.iter().all(|&r| r), "every node is reached");
         bvh
     }
 
@@ -384,12 +392,19 @@ mod tests {
         // 1000 identical spheres: no SAH plane separates them, the median split must.
         let b = check(&many);
         assert!(b.depth < 64, "depth {}", b.depth);
+        // One primitive: the root's two children are its one leaf.
+        let one = Scene::load("spherelist", &[]).unwrap();
+        let mut one = one.clone();
+        one.spheres.truncate(1);
+        one.triangles.clear();
+        let b = check(&one);
+        assert_eq!((b.nodes.len(), b.depth, b.stack_entries()), (1, 1, 1));
     }
 
     #[test]
     fn teapot_tree_is_shallow_and_compact() {
         let b = Bvh::build(&Scene::load("teapot", &[]).unwrap());
         assert!(b.depth <= 32, "depth {}", b.depth);
-        assert!(b.nodes.len() < 2 * 19_201, "{} nodes", b.nodes.len());
+        assert!(b.nodes.len() < 19_200, "{} nodes", b.nodes.len());
     }
 }

@@ -150,13 +150,7 @@ impl Variant {
         v.experiments = args.experiment.clone();
         v.experiments.sort();
         v.experiments.dedup();
-        if v.experiments.contains(&Experiment::OneQuery) {
-            v.defines.insert("ONE_QUERY".into(), "1".into());
-        }
         if v.defines.contains_key("USE_BVH") {
-            if v.experiments.contains(&Experiment::StacklessBvh) {
-                v.defines.insert("BVH_STACKLESS".into(), "1".into());
-            }
             if v.experiments.contains(&Experiment::UnpairedBvhStack) {
                 v.defines.insert("BVH_STACK_UNPAIRED".into(), "1".into());
             }
