@@ -150,10 +150,10 @@ impl Variant {
         v.experiments = args.experiment.clone();
         v.experiments.sort();
         v.experiments.dedup();
-        if v.defines.contains_key("USE_BVH") {
-            if v.experiments.contains(&Experiment::UnpairedBvhStack) {
-                v.defines.insert("BVH_STACK_UNPAIRED".into(), "1".into());
-            }
+        if v.defines.contains_key("USE_BVH")
+            && v.experiments.contains(&Experiment::UnpairedBvhStack)
+        {
+            v.defines.insert("BVH_STACK_UNPAIRED".into(), "1".into());
         }
         if v.experiments.contains(&Experiment::UniformCounts)
             || v.experiments.contains(&Experiment::StorageCounts)
