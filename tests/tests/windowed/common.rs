@@ -40,6 +40,18 @@ pub fn assert_resized(app: App, err: &str, resizes: u32) {
     assert!(numbers[1] >= 1, "{app:?}: no minimize/restore: {line}");
 }
 
+/// xdotool's steps that wait for the app's window (its title starts with
+/// "twinray") and focus it, so that keys and the mouse reach it as `%1`.
+pub const FOCUS: [&str; 7] = [
+    "search",
+    "--sync",
+    "--name",
+    "^twinray",
+    "windowfocus",
+    "--sync",
+    "%1",
+];
+
 /// Under load (a fresh shader cache, other windows in parallel tests) the X
 /// server now and then refuses xdotool's connection outright ("Can't open
 /// display"): nothing has happened yet, so try again.

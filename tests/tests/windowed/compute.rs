@@ -3,7 +3,7 @@
 //! switches, and every screenshot and screen equal to the headless image of
 //! its path, under the validation layer's synchronisation validation.
 
-use crate::common::{assert_resized, clean_report, stderr, xdotool_retrying};
+use crate::common::{assert_resized, clean_report, stderr, xdotool_retrying, FOCUS};
 use std::path::Path;
 use twinray_common::cli::RenderPath;
 use twinray_common::value_name::ValueName;
@@ -240,17 +240,7 @@ fn c_key_switches_the_path_the_title_follows_and_the_screen_equals_headless() {
             "getwindowgeometry",
             "%1",
         ]));
-        step(&[
-            "search",
-            "--sync",
-            "--name",
-            "^twinray",
-            "windowfocus",
-            "--sync",
-            "%1",
-            "key",
-            "Escape",
-        ]);
+        step(&[&FOCUS[..], &["key", "Escape"]].concat());
         let o = child.wait_with_output().unwrap();
         assert!(o.status.success(), "{app:?}: {}", stderr(&o));
         assert!(

@@ -1,7 +1,7 @@
 //! Real mouse input (xdotool through XTEST): a drag orbits the camera, the
 //! wheel zooms, and R restores the initial view.
 
-use crate::common::{stderr, xdotool_retrying};
+use crate::common::{stderr, xdotool_retrying, FOCUS};
 use twinray_common::reference::metrics::compare;
 use twinray_tests::{render, scratch, App, Xvfb};
 
@@ -31,15 +31,7 @@ fn after_gesture(
         out.to_str().unwrap(),
     ];
     let mut child = x.spawn(&app.exe(), &args, &[], dir);
-    let mut cmd = vec![
-        "search",
-        "--sync",
-        "--name",
-        "^twinray",
-        "windowfocus",
-        "--sync",
-        "%1",
-    ];
+    let mut cmd = FOCUS.to_vec();
     // Pauses let frames render between the steps: the saved view is the last
     // one drawn, and Escape would otherwise land before the gesture is drawn.
     cmd.extend_from_slice(gesture);

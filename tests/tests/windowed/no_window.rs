@@ -7,15 +7,15 @@ use twinray_tests::{scratch, App};
 #[test]
 fn explain_prints_ordered_steps_on_stderr_only() {
     let dir = scratch("explain");
+    let args = [
+        "--explain",
+        "--headless",
+        "--scene",
+        "box",
+        "--size",
+        "64x64",
+    ];
     for app in App::BOTH {
-        let args = [
-            "--explain",
-            "--headless",
-            "--scene",
-            "box",
-            "--size",
-            "64x64",
-        ];
         let o = twinray_tests::run(&app.exe(), &args, &[]);
         assert!(o.status.success(), "{app:?}: {}", stderr(&o));
         assert!(
@@ -43,18 +43,7 @@ fn explain_prints_ordered_steps_on_stderr_only() {
         );
     }
     // The Vulkan steps name the objects in the order the walkthrough teaches them.
-    let o = twinray_tests::run(
-        &App::Vulkan.exe(),
-        &[
-            "--explain",
-            "--headless",
-            "--scene",
-            "box",
-            "--size",
-            "64x64",
-        ],
-        &[],
-    );
+    let o = twinray_tests::run(&App::Vulkan.exe(), &args, &[]);
     let err = stderr(&o);
     let order = [
         "VkInstance",
