@@ -25,21 +25,27 @@ fn bad_sizes() {
 
 #[test]
 fn too_many_primitives_for_the_storage_buffer_limit() {
-    // 5 million 32-byte spheres: 160 MB, above Mesa's 128 MiB limit (and most GPUs' 2^27..2^32).
-    expect_both(
-        &[
-            "--headless",
-            "--size",
-            "16x16",
-            "--scene",
-            "spherelist",
-            "--set",
-            "extra_spheres=5000000",
-        ],
-        &[],
-        2,
-        &["spheres", "limit"],
-    );
+    // 5 million spheres, above Mesa's 128 MiB limit (and most GPUs' 2^27..2^32)
+    // in either buffer that holds them: brute force's 32-byte spheres (160 MB)
+    // and the BVH's 48-byte leaf primitives (240 MB).
+    for (accel, buffer) in [("none", "spheres"), ("bvh", "BVH primitive")] {
+        expect_both(
+            &[
+                "--headless",
+                "--size",
+                "16x16",
+                "--scene",
+                "spherelist",
+                "--set",
+                "extra_spheres=5000000",
+                "--accel",
+                accel,
+            ],
+            &[],
+            2,
+            &[buffer, "limit"],
+        );
+    }
 }
 
 #[test]
