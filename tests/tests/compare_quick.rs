@@ -204,6 +204,7 @@ fn why_table_has_a_verdict_per_gap_and_experiment(report: &str, out: &std::path:
         "no-loop-bounding",
         "opengl-spirv",
         "unpaired-bvh-stack",
+        "shared-bvh-stack",
         "no-contraction",
         "float-controls",
         "quad",

@@ -206,8 +206,16 @@ pub fn storage_name(binding: u32) -> &'static str {
 pub fn check_storage_limit(gpu: &GpuScene, limit: u64, limit_name: &str) -> anyhow::Result<()> {
     let (b, n) = gpu.largest_storage();
     if n as u64 > limit {
+        // The BVH's buffers are the largest only when it is on, and brute
+        // force needs less for the same scene.
+        let remedy = match b {
+            binding::BVH_NODES | binding::BVH_PRIMS => {
+                "use fewer primitives, or trace without the BVH (--accel none)"
+            }
+            _ => "use fewer primitives",
+        };
         return Err(crate::error::bad_input(format!(
-            "the scene's {} buffer needs {n} bytes, more than this device's {limit_name} limit of {limit} bytes; use fewer primitives",
+            "the scene's {} buffer needs {n} bytes, more than this device's {limit_name} limit of {limit} bytes; {remedy}",
             storage_name(b)
         )));
     }
