@@ -267,3 +267,33 @@ fn every_builtin_variant_and_the_generic_one_compile_for_both_apis() {
         );
     }
 }
+
+/// The shader's own constants for what the BVH's words encode (trace/bvh.glsl)
+/// equal the Rust ones that write those words.
+#[test]
+fn the_bvh_encodings_match_rust() {
+    let mut variant = Variant::generic(Default::default());
+    variant.defines.insert("USE_BVH".into(), "1".into());
+    variant.defines.insert("BVH_STACK".into(), "4".into());
+    let module = parse(&fragment_source(), naga::ShaderStage::Fragment, &variant)
+        .unwrap()
+        .0;
+    let constant = |name: &str| -> u32 {
+        let (_, c) = module
+            .constants
+            .iter()
+            .find(|(_, c)| c.name.as_deref() == Some(name))
+            .unwrap_or_else(|| panic!("the shader has no constant {name}"));
+        match module.global_expressions[c.init] {
+            naga::Expression::Literal(naga::Literal::U32(v)) => v,
+            ref other => panic!("{name} is {other:?}, not a u32 literal"),
+        }
+    };
+    assert_eq!(constant("SPHERE_BIT"), PRIM_SPHERE_BIT);
+    assert_eq!(constant("LEAF_BIT"), child_ref::LEAF_BIT);
+    assert_eq!(constant("LEAF_FIRST_SHIFT"), child_ref::LEAF_FIRST_SHIFT);
+    // NO_CHILD decodes to a leaf past the most primitives a tree may hold.
+    let (first, _) =
+        child_ref::as_leaf(constant("NO_CHILD")).expect("NO_CHILD is a leaf reference");
+    assert!(first >= twinray_common::limits::MAX_BVH_PRIMITIVES);
+}

@@ -39,7 +39,11 @@ shared uvec2 bvh_stack[BVH_STACK * WG_X * WG_Y];
 #define BVH_POP(i) (((i) & 1u) == 0u ? stack[(i) >> 1u].xy : stack[(i) >> 1u].zw)
 #endif
 
+// A child reference (gpu::layout::child_ref, which a test holds these to):
+// an interior node's index, or with LEAF_BIT a leaf, its first primitive
+// above LEAF_FIRST_SHIFT and its count - 1 below.
 const uint LEAF_BIT = 0x80000000u;
+const uint LEAF_FIRST_SHIFT = 2u;
 // No child to visit: a leaf reference no tree has (its count bits say 4 and
 // its first primitive is past any limit).
 const uint NO_CHILD = 0xFFFFFFFFu;
@@ -144,8 +148,8 @@ Hit traverse(vec3 origin, vec3 dir, float t_max, bool any_hit) {
             }
         }
         if (child != NO_CHILD) {
-            uint first = (child & ~LEAF_BIT) >> 2u;
-            uint count = (child & 3u) + 1u;
+            uint first = (child & ~LEAF_BIT) >> LEAF_FIRST_SHIFT;
+            uint count = (child & ((1u << LEAF_FIRST_SHIFT) - 1u)) + 1u;
             if (hit_leaf(h, origin, dir, ray, first, count, any_hit)) {
                 return h;
             }

@@ -129,7 +129,7 @@ layout(std430, set = 0, binding = 4) readonly buffer Lights {
 // The BVH (common/src/scene/accel.rs): interior nodes, each holding both of
 // its children's boxes (one 64-byte read per step), node 0 the root. A child
 // is a reference: an interior node's index, or with the top bit set a leaf,
-// prims[first .. first + count] with first above bit 2 and count - 1 below.
+// prims[first .. first + count] (bvh.glsl decodes it).
 // Bound always; read only by the USE_BVH variant.
 struct BvhNode {
     vec3 left_min;
