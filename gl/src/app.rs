@@ -104,7 +104,8 @@ pub fn run(args: RenderArgs, knobs: &OpenGlKnobs, started: Instant) -> anyhow::R
                 }
                 gl.draw_arrays(glow::TRIANGLES, 0, pass.vertices() as i32);
             };
-            let (frames, setup_ms) = frame_loop(gl, &timer, args.frame_count(), started, &draw);
+            let (frames, setup_ms) =
+                frame_loop(gl, &timer, args.frame_count(), started, &|| {}, &draw);
             (frames, setup_ms, target.read())
         }
         // The same tracer as a compute shader: compute.rs owns its program and texture.
@@ -127,11 +128,16 @@ pub fn run(args: RenderArgs, knobs: &OpenGlKnobs, started: Instant) -> anyhow::R
             let _buffers = SceneBuffers::new(gl, &gpu_scene)?;
             let timer = Timer::new(gl, &info.device)?;
             log.check(gl, "after setup");
-            let dispatch = || {
-                compute.barrier_between_frames();
-                compute.dispatch();
-            };
-            let (frames, setup_ms) = frame_loop(gl, &timer, args.frame_count(), started, &dispatch);
+            // The barrier before the timer starts, as Vulkan records its
+            // barrier before the first timestamp: both time the dispatch alone.
+            let (frames, setup_ms) = frame_loop(
+                gl,
+                &timer,
+                args.frame_count(),
+                started,
+                &|| compute.barrier_between_frames(),
+                &|| compute.dispatch(),
+            );
             (frames, setup_ms, compute.read())
         }
     };
@@ -207,13 +213,15 @@ fn run_windowed(args: &RenderArgs, started: Instant) -> anyhow::Result<()> {
 }
 
 /// The same loop as Vulkan's: one iteration is submit + wait, timed on the
-/// wall clock around the GPU-timed `draw` (the draw call or the dispatch).
+/// wall clock around `before` (what Vulkan records ahead of its first
+/// timestamp) and the GPU-timed `draw` (the draw call or the dispatch).
 /// Returns the frames and `setup_ms`.
 fn frame_loop(
     gl: &glow::Context,
     timer: &Timer,
     count: u32,
     started: Instant,
+    before: &dyn Fn(),
     draw: &dyn Fn(),
 ) -> (Vec<FrameTime>, f64) {
     let mut frames = Vec::with_capacity(count as usize);
@@ -223,6 +231,7 @@ fn frame_loop(
         if i == 0 {
             setup_ms = ms(t0 - started);
         }
+        before();
         timer.begin();
         draw();
         timer.end();
