@@ -84,7 +84,7 @@ pub struct GpuLight {
 /// everything it needs to choose its next step (Aila and Laine 2009). With a
 /// box per node instead, every step read the node, then each child's box, the
 /// right child's only once its index had arrived. Node 0 is the root. A child
-/// is a `ChildRef`: an interior node's index, or a leaf's primitives.
+/// is a reference (`child_ref`): an interior node's index, or a leaf's primitives.
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, Pod, Zeroable, PartialEq)]
 pub struct GpuBvhNode {
