@@ -136,6 +136,13 @@ pub enum Experiment {
     /// in the command buffer (as OpenGL always has them) instead of baked
     /// into the pipeline.
     DynamicViewport,
+    /// OpenGL: naga's buffer and image declarations as naga writes them,
+    /// without the `restrict` (GLSL) or `Restrict` (SPIR-V) that tells the
+    /// driver no two of them alias, which Vulkan's SPIR-V assumes anyway.
+    NagaAliasing,
+    /// Both APIs: bounds-checked buffer access (Vulkan's robustBufferAccess
+    /// feature; OpenGL a robust-access context).
+    RobustAccess,
 }
 
 /// The tracer's entry point: the two ways one GLSL tracer reaches the GPU.
@@ -532,7 +539,9 @@ mod tests {
                 "load-clear",
                 "rgba8",
                 "compute-queue",
-                "dynamic-viewport"
+                "dynamic-viewport",
+                "naga-aliasing",
+                "robust-access"
             ]
         );
         assert_eq!(

@@ -69,7 +69,8 @@ impl FragmentPass {
 /// the pass's experiments need the headless fragment path, `compute-queue` the
 /// headless compute path; `dynamic-viewport` and `compute-queue` are Vulkan's
 /// alone (`vulkan` false: OpenGL, which has neither queues nor a viewport
-/// fixed in advance).
+/// fixed in advance); `naga-aliasing` is OpenGL's alone, and `robust-access`
+/// needs a headless run.
 pub fn check_experiments(args: &RenderArgs, vulkan: bool) -> anyhow::Result<()> {
     for e in &args.experiment {
         let name = e.name();
@@ -85,6 +86,16 @@ pub fn check_experiments(args: &RenderArgs, vulkan: bool) -> anyhow::Result<()> 
                 RenderPath::Compute,
                 Some("OpenGL has no queues to choose from"),
             ),
+            Experiment::NagaAliasing if vulkan => {
+                return Err(bad_input(format!(
+                    "--experiment {name} is OpenGL only: Vulkan's SPIR-V lets the driver assume that no two resources alias anyway"
+                )));
+            }
+            Experiment::RobustAccess if !args.headless => {
+                return Err(bad_input(format!(
+                    "--experiment {name} is a headless measurement; run it with --headless"
+                )));
+            }
             _ => continue,
         };
         if let (false, Some(why)) = (vulkan, not_in_opengl) {

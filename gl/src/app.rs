@@ -20,7 +20,7 @@ use twinray_common::fragment_pass::{check_experiments, FragmentPass};
 use twinray_common::gpu::upload::{check_storage_limit, GpuScene};
 use twinray_common::reference::image_io::FloatImage;
 use twinray_common::report::{dump_shaders, dump_statistics, FrameTime, RunReport};
-use twinray_common::shader::build::{build, build_compute};
+use twinray_common::shader::build::{build, build_compute, restricts_resources};
 use twinray_common::shader::variant::{CountingRun, Variant};
 
 /// `started` is taken first thing in main, so `setup_ms` includes process,
@@ -50,7 +50,8 @@ pub fn run(args: RenderArgs, knobs: &OpenGlKnobs, started: Instant) -> anyhow::R
     let (width, height) = (args.size.width, args.size.height);
     let gpu_scene = GpuScene::new(&scene, width, height);
 
-    let mut ctx = Gl::headless(args.validate, knobs)?;
+    let robust = args.experiment.contains(&Experiment::RobustAccess);
+    let mut ctx = Gl::headless(args.validate, robust, knobs)?;
     let log = DebugLog::install(&mut ctx.gl);
     let gl = &ctx.gl;
     let info = context::device_info(gl);
@@ -77,7 +78,10 @@ pub fn run(args: RenderArgs, knobs: &OpenGlKnobs, started: Instant) -> anyhow::R
                 || format!("variant {}", variant.label()),
             );
             let program = if args.gl_spirv {
-                let fs = twinray_common::shader::post::spirv_for_opengl(&shaders.fragment_spirv);
+                let fs = twinray_common::shader::post::spirv_for_opengl(
+                    &shaders.fragment_spirv,
+                    restricts_resources(&variant),
+                );
                 Program::from_spirv(
                     gl,
                     &|name| ctx.proc_address(name),
@@ -88,7 +92,13 @@ pub fn run(args: RenderArgs, knobs: &OpenGlKnobs, started: Instant) -> anyhow::R
                 Program::new(gl, &shaders.vertex_glsl, &shaders.fragment_glsl)?
             };
             if let Some(dir) = &args.dump_shaders {
-                shader_stats.push(program::dump_binary(gl, program.raw(), dir, "gl-program")?);
+                shader_stats.push(program::dump_binary(
+                    gl,
+                    program.raw(),
+                    args.gl_spirv,
+                    dir,
+                    "gl-program",
+                )?);
             }
             let _buffers = SceneBuffers::new(gl, &gpu_scene)?;
             let pass = FragmentPass::of(&args.experiment);
@@ -121,6 +131,7 @@ pub fn run(args: RenderArgs, knobs: &OpenGlKnobs, started: Instant) -> anyhow::R
                 shader_stats.push(program::dump_binary(
                     gl,
                     compute.program(),
+                    args.gl_spirv,
                     dir,
                     "gl-program",
                 )?);

@@ -17,7 +17,7 @@ use glow::HasContext;
 use twinray_common::cli::Workgroup;
 use twinray_common::error::bad_input;
 use twinray_common::gpu::layout::binding;
-use twinray_common::shader::build::ComputeShader;
+use twinray_common::shader::build::{restricts_resources, ComputeShader};
 use twinray_common::shader::post::spirv_for_opengl;
 
 /// The compute program, the storage texture and the dispatch grid.
@@ -54,7 +54,7 @@ impl<'gl> Compute<'gl> {
                 gl,
                 proc_address,
                 glow::COMPUTE_SHADER,
-                &spirv_for_opengl(&shader.spirv),
+                &spirv_for_opengl(&shader.spirv, restricts_resources(&shader.variant)),
                 "compute",
             )?,
             // SAFETY: the context is current (the caller made it so).

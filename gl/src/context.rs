@@ -5,7 +5,7 @@ use anyhow::Context as _;
 use glow::HasContext;
 use glutin::api::egl::{context::PossiblyCurrentContext, device::Device, display::Display};
 use glutin::config::{Api, ConfigSurfaceTypes, ConfigTemplateBuilder};
-use glutin::context::{ContextApi, ContextAttributesBuilder, GlProfile, Version};
+use glutin::context::{ContextApi, ContextAttributesBuilder, GlProfile, Robustness, Version};
 use glutin::prelude::*;
 use twinray_common::cli::OpenGlKnobs;
 use twinray_common::error::{bad_input, no_device};
@@ -33,8 +33,9 @@ impl Gl {
     }
 
     /// Creates the context on the preferred device (or `knobs`'s); `debug` asks
-    /// for a debug context so that KHR_debug reports everything the driver checks.
-    pub fn headless(debug: bool, knobs: &OpenGlKnobs) -> anyhow::Result<Gl> {
+    /// for a debug context so that KHR_debug reports everything the driver checks;
+    /// `robust` a robust-access one (`--experiment robust-access`).
+    pub fn headless(debug: bool, robust: bool, knobs: &OpenGlKnobs) -> anyhow::Result<Gl> {
         // No libEGL, or one without the device extensions, is a missing driver
         // for the user, not a bug: glutin's error alone would not say what to install.
         let devices: Vec<Device> = Device::query_devices()
@@ -60,7 +61,7 @@ impl Gl {
         });
         let mut failures = Vec::new();
         for (index, device) in candidates(&devices, knobs.device)? {
-            match create(index, device, debug) {
+            match create(index, device, debug, robust) {
                 Ok(gl) => {
                     // A run that fell back to another device must say so: its
                     // timings would otherwise pass for the skipped device's.
@@ -99,7 +100,7 @@ fn candidates(devices: &[Device], wanted: Option<usize>) -> anyhow::Result<Vec<(
     Ok(hard.into_iter().chain(soft).collect())
 }
 
-fn create(index: usize, device: &Device, debug: bool) -> anyhow::Result<Gl> {
+fn create(index: usize, device: &Device, debug: bool, robust: bool) -> anyhow::Result<Gl> {
     let what = format!(
         "EGL device {index} ({})",
         device.name().unwrap_or("unnamed")
@@ -117,8 +118,14 @@ fn create(index: usize, device: &Device, debug: bool) -> anyhow::Result<Gl> {
         .with_context(|| format!("listing EGL configs on {what}"))?
         .next()
         .with_context(|| format!("{what} has no OpenGL EGL config"))?;
+    let robustness = if robust {
+        Robustness::RobustNoResetNotification
+    } else {
+        Robustness::NotRobust
+    };
     let attributes = ContextAttributesBuilder::new()
         .with_debug(debug)
+        .with_robustness(robustness)
         .with_profile(GlProfile::Core)
         .with_context_api(ContextApi::OpenGl(Some(Version::new(4, 5))))
         .build(None);
@@ -131,8 +138,9 @@ fn create(index: usize, device: &Device, debug: bool) -> anyhow::Result<Gl> {
         "EGL display + config + context, made current without a surface",
         || {
             format!(
-                "{what}: OpenGL 4.5 core{}, surfaceless (renders into our own FBO)",
-                if debug { ", debug" } else { "" }
+                "{what}: OpenGL 4.5 core{}{}, surfaceless (renders into our own FBO)",
+                if debug { ", debug" } else { "" },
+                if robust { ", robust access" } else { "" }
             )
         },
     );

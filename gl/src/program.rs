@@ -174,15 +174,29 @@ pub(crate) unsafe fn link(
 /// binary holds the program as readable NV assembly (`!!NVfp5.0`,
 /// `!!NVcp5.0`), whose `TEMP lmem0[N]` is the local memory of one invocation
 /// in 16-byte slots. Other drivers' binaries are opaque: then only the size.
+/// `spirv`: the program was linked from SPIR-V (`--gl-spirv`), whose binary
+/// Mesa 22.3 cannot save (its glGetProgramBinary reads the GLSL source that
+/// such a program lacks, and crashes): on Mesa it is not asked for.
 pub fn dump_binary(
     gl: &glow::Context,
     program: glow::Program,
+    spirv: bool,
     dir: &std::path::Path,
     name: &str,
 ) -> anyhow::Result<twinray_common::report::ShaderStats> {
-    // SAFETY: a linked program of the current context.
-    let binary = unsafe { gl.get_program_binary(program) };
+    // SAFETY: a plain string query on the current context.
+    let mesa = unsafe { gl.get_parameter_string(glow::VERSION) }.contains("Mesa");
     let mut statistics = Vec::new();
+    let binary = if spirv && mesa {
+        statistics.push((
+            "program binary bytes".to_string(),
+            "0 (Mesa cannot save a SPIR-V program's binary)".to_string(),
+        ));
+        None
+    } else {
+        // SAFETY: a linked program of the current context.
+        unsafe { gl.get_program_binary(program) }
+    };
     if let Some(b) = binary.filter(|b| !b.buffer.is_empty()) {
         let path = dir.join(format!("{name}.bin"));
         std::fs::write(&path, &b.buffer)
@@ -195,7 +209,7 @@ pub fn dump_binary(
             statistics.push(("NV lmem0 slots (16 B each)".to_string(), slots.to_string()));
             statistics.push(("local memory bytes".to_string(), (slots * 16).to_string()));
         }
-    } else {
+    } else if statistics.is_empty() {
         statistics.push((
             "program binary bytes".to_string(),
             "0 (not offered)".to_string(),

@@ -97,7 +97,15 @@ fn render(
     let gpu_scene = GpuScene::new(scene, width, height);
     let instance = Instance::new(args.validate, knobs.validation, &[])?;
     let compute_only = args.experiment.contains(&Experiment::ComputeQueue);
-    let device = Device::new(&instance, None, knobs, compute_only, args.count_rays)?;
+    let robust_access = args.experiment.contains(&Experiment::RobustAccess);
+    let device = Device::new(
+        &instance,
+        None,
+        knobs,
+        compute_only,
+        args.count_rays,
+        robust_access,
+    )?;
     device.check_size(width, height)?;
     // --vk-wait idle waits for each frame with vkQueueWaitIdle +
     // vkDeviceWaitIdle, as the 2018 study did, instead of the frame's fence.

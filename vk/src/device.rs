@@ -62,7 +62,8 @@ impl Device {
     /// comes from a family without GRAPHICS (`--experiment compute-queue`).
     /// `count_rays` asks for fragmentStoresAndAtomics, which the ray-counting
     /// frame needs on the fragment path; the timed runs get the device they
-    /// always had.
+    /// always had. `robust_access` turns on robustBufferAccess, the bounds
+    /// checks of `--experiment robust-access`.
     // Long function: the walkthrough's device step read top to bottom (pick a GPU, a queue family, features, extensions, create); each block is one choice.
     pub fn new(
         instance: &Instance,
@@ -70,6 +71,7 @@ impl Device {
         knobs: &VulkanKnobs,
         compute_only: bool,
         count_rays: bool,
+        robust_access: bool,
     ) -> Result<Device> {
         let vk_instance = &instance.instance;
         // SAFETY: `instance` is alive for the whole call (borrowed) and is used from this thread
@@ -190,11 +192,12 @@ queue family {queue_family}: {flags:?}, timestampValidBits {timestamp_valid_bits
             vk::PhysicalDevicePipelineExecutablePropertiesFeaturesKHR::default()
                 .pipeline_executable_info(true);
         // SAFETY: a query on the chosen physical device of the live instance.
-        let fragment_stores = unsafe { vk_instance.get_physical_device_features(chosen.physical) }
-            .fragment_stores_and_atomics
-            == vk::TRUE;
+        let offered = unsafe { vk_instance.get_physical_device_features(chosen.physical) };
+        let fragment_stores = offered.fragment_stores_and_atomics == vk::TRUE;
+        // Every Vulkan 1.0 device offers robustBufferAccess.
         let features = vk::PhysicalDeviceFeatures::default()
-            .fragment_stores_and_atomics(fragment_stores && count_rays);
+            .fragment_stores_and_atomics(fragment_stores && count_rays)
+            .robust_buffer_access(robust_access && offered.robust_buffer_access == vk::TRUE);
         let mut info = vk::DeviceCreateInfo::default()
             .queue_create_infos(&queue_infos)
             .enabled_extension_names(&extensions)
@@ -219,10 +222,10 @@ queue family {queue_family}: {flags:?}, timestampValidBits {timestamp_valid_bits
                 } else {
                     "none"
                 };
-                let features = if fragment_stores && count_rays {
-                    "fragmentStoresAndAtomics (--count-rays)"
-                } else {
-                    "no optional features"
+                let features = match (fragment_stores && count_rays, robust_access) {
+                    (true, _) => "fragmentStoresAndAtomics (--count-rays)",
+                    (false, true) => "robustBufferAccess (--experiment robust-access)",
+                    (false, false) => "no optional features",
                 };
                 format!("1 queue from family {queue_family}, priority 1.0; device extensions: {ext}; {features}")
             },

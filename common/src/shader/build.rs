@@ -8,7 +8,7 @@
 use crate::cli::{Experiment, Workgroup};
 use crate::shader::post::{
     float_controls_spirv, no_contraction_spirv, precise_float_locals_glsl,
-    strip_local_array_zero_init_glsl, strip_local_array_zero_init_spirv,
+    restrict_resources_glsl, strip_local_array_zero_init_glsl, strip_local_array_zero_init_spirv,
 };
 use crate::shader::variant::{Variant, SPEC_CONSTANTS};
 use anyhow::{anyhow, Context};
@@ -300,6 +300,11 @@ pub fn to_glsl(
     } else {
         strip_local_array_zero_init_glsl(&out)
     };
+    let out = if restricts_resources(variant) {
+        restrict_resources_glsl(&out)
+    } else {
+        out
+    };
     Ok(
         if variant.experiments.contains(&Experiment::NoContraction) {
             precise_float_locals_glsl(&out)
@@ -307,6 +312,13 @@ pub fn to_glsl(
             out
         },
     )
+}
+
+/// Whether OpenGL's shader declares its buffers and image `restrict` (GLSL) or
+/// `Restrict` (SPIR-V), as Vulkan's SPIR-V implies: always, except with
+/// `--experiment naga-aliasing` (see `post::restrict_resources_glsl`).
+pub fn restricts_resources(variant: &Variant) -> bool {
+    !variant.experiments.contains(&Experiment::NagaAliasing)
 }
 
 /// The SPIR-V that Vulkan runs: naga's, or with `--experiment glslang` Khronos'
@@ -448,7 +460,7 @@ mod tests {
     #[test]
     fn spirv_for_opengl_drops_sets_and_flips_origin_only() {
         let s = build(&Variant::generic(Default::default())).unwrap();
-        let gl = spirv_for_opengl(&s.fragment_spirv);
+        let gl = spirv_for_opengl(&s.fragment_spirv, false);
         let count = |w: &[u32], op: u32, arg2: u32| {
             let mut i = 5;
             let mut n = 0;

@@ -147,22 +147,26 @@ pub fn no_contraction_spirv(words: &[u32]) -> Vec<u32> {
     const FLOAT_ARITHMETIC: [u32; 14] = [
         127, 129, 131, 133, 136, 140, 141, 142, 143, 144, 145, 146, 147, 148,
     ];
-    // Instructions that may precede the annotations; the decorations go
-    // right after the last of them (annotations come before any type).
-    const PREAMBLE: [u32; 19] = [
-        2, 3, 4, 5, 6, 7, 10, 11, 14, 15, 16, 17, 71, 72, 73, 74, 75, 330, 331,
-    ];
-    let instructions: Vec<&[u32]> = spirv_instructions(words).collect();
-    let decorations: Vec<u32> = instructions
-        .iter()
+    let decorations: Vec<u32> = spirv_instructions(words)
         .filter(|inst| FLOAT_ARITHMETIC.contains(&(inst[0] & 0xffff)) && inst.len() >= 3)
         .flat_map(|inst| [(3 << 16) | OP_DECORATE, inst[2], DECORATION_NO_CONTRACTION])
         .collect();
+    with_annotations(words, &decorations)
+}
+
+/// `words` with `annotations` (whole instructions) added after its last
+/// annotation, where SPIR-V's layout puts them: after the debug
+/// instructions and the existing decorations, before the first type.
+fn with_annotations(words: &[u32], annotations: &[u32]) -> Vec<u32> {
+    // The instructions that may precede the end of the annotations.
+    const PREAMBLE: [u32; 19] = [
+        2, 3, 4, 5, 6, 7, 10, 11, 14, 15, 16, 17, 71, 72, 73, 74, 75, 330, 331,
+    ];
     let mut out = words[..5.min(words.len())].to_vec();
     let mut inserted = false;
-    for inst in instructions {
+    for inst in spirv_instructions(words) {
         if !inserted && !PREAMBLE.contains(&(inst[0] & 0xffff)) {
-            out.extend_from_slice(&decorations);
+            out.extend_from_slice(annotations);
             inserted = true;
         }
         out.extend_from_slice(inst);
@@ -257,12 +261,86 @@ pub fn float_controls_spirv(words: &[u32]) -> Vec<u32> {
     out
 }
 
+// Vulkan's SPIR-V lets a driver assume that no two resources alias unless one
+// is decorated `Aliased`; OpenGL assumes the opposite: two buffer variables, or
+// a buffer and an image, may name the same memory unless declared `restrict`
+// (GLSL) or decorated `Restrict` (SPIR-V for GL_ARB_gl_spirv). naga writes
+// neither, so the same shader told Vulkan's compiler more than OpenGL's. The
+// apps bind every resource to a buffer or texture of its own, so `restrict` is
+// true of each, and with it OpenGL's compiler may treat the tracer's read-only
+// buffers as read-only for the whole dispatch, as Vulkan's already does.
+
+/// Declares every buffer block and image of naga's GLSL `restrict`:
+/// `layout(...) readonly buffer B {` becomes `layout(...) restrict readonly
+/// buffer B {`, and likewise for `uniform image2D`.
+pub fn restrict_resources_glsl(glsl: &str) -> String {
+    let mut out = String::with_capacity(glsl.len() + 256);
+    for line in glsl.split_inclusive('\n') {
+        let resource = line.starts_with("layout(")
+            && (line.contains(" buffer ") || line.contains(" uniform image"));
+        match line.find(") ").filter(|_| resource) {
+            Some(close) => {
+                out.push_str(&line[..close + 2]);
+                out.push_str("restrict ");
+                out.push_str(&line[close + 2..]);
+            }
+            None => out.push_str(line),
+        }
+    }
+    out
+}
+
+/// Decorates every storage buffer and image variable `Restrict`: the SPIR-V
+/// form of [`restrict_resources_glsl`], for OpenGL's SPIR-V path.
+pub fn restrict_resources_spirv(words: &[u32]) -> Vec<u32> {
+    const OP_TYPE_IMAGE: u32 = 25;
+    const OP_TYPE_POINTER: u32 = 32;
+    const OP_VARIABLE: u32 = 59;
+    const OP_DECORATE: u32 = 71;
+    const DECORATION_RESTRICT: u32 = 19;
+    const UNIFORM_CONSTANT: u32 = 0;
+    const STORAGE_BUFFER: u32 = 12;
+    // naga's storage buffers are `Uniform` variables of a `BufferBlock`
+    // struct in SPIR-V 1.0 and `StorageBuffer` ones after; both count, and so
+    // does a `Uniform` block, where `Restrict` is true and changes nothing.
+    const UNIFORM: u32 = 2;
+    let instructions: Vec<&[u32]> = spirv_instructions(words).collect();
+    let images: std::collections::HashSet<u32> = instructions
+        .iter()
+        .filter(|i| i[0] & 0xffff == OP_TYPE_IMAGE && i.len() >= 2)
+        .map(|i| i[1])
+        .collect();
+    let resource_pointers: std::collections::HashSet<u32> = instructions
+        .iter()
+        .filter(|i| i[0] & 0xffff == OP_TYPE_POINTER && i.len() >= 4)
+        .filter(|i| {
+            matches!(i[2], STORAGE_BUFFER | UNIFORM)
+                || (i[2] == UNIFORM_CONSTANT && images.contains(&i[3]))
+        })
+        .map(|i| i[1])
+        .collect();
+    let decorations: Vec<u32> = instructions
+        .iter()
+        .filter(|i| i[0] & 0xffff == OP_VARIABLE && i.len() >= 4)
+        .filter(|i| resource_pointers.contains(&i[1]))
+        .flat_map(|i| [(3 << 16) | OP_DECORATE, i[2], DECORATION_RESTRICT])
+        .collect();
+    with_annotations(words, &decorations)
+}
+
 /// naga's Vulkan SPIR-V made loadable by OpenGL (GL_ARB_gl_spirv), so both APIs
 /// can run the very same binary: GL has no descriptor sets, so the
 /// `DescriptorSet` decorations go, and GL's window origin is the lower left, so
 /// `OriginUpperLeft` becomes `OriginLowerLeft` (with glReadPixels' bottom-up rows
-/// this gives the same upright image as the GLSL path). Nothing else changes.
-pub fn spirv_for_opengl(words: &[u32]) -> Vec<u32> {
+/// this gives the same upright image as the GLSL path). With `restrict`, every
+/// resource is also decorated `Restrict` ([`restrict_resources_spirv`]), as
+/// the GLSL path declares them. Nothing else changes.
+pub fn spirv_for_opengl(words: &[u32], restrict: bool) -> Vec<u32> {
+    let words = if restrict {
+        &restrict_resources_spirv(words)
+    } else {
+        words
+    };
     const OP_EXECUTION_MODE: u32 = 16;
     const OP_DECORATE: u32 = 71;
     const DECORATION_DESCRIPTOR_SET: u32 = 34;
