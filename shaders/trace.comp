@@ -21,7 +21,26 @@ layout(local_size_x = WG_X, local_size_y = WG_Y, local_size_z = 1) in;
 
 layout(rgba32f, set = 0, binding = 5) uniform writeonly image2D out_image;
 
+#ifdef SHARED_PAD_KIB
+// --shared-pad (a measurement): workgroup memory the tracer does not need. A
+// driver splits each multiprocessor's memory between shared memory and L1
+// cache by what its shaders declare, and fits fewer workgroups once shared
+// memory runs out; this shows what either does to the time. Each invocation
+// writes one word, spread across the whole array, and reads it back through an
+// index the compiler cannot prove equal (frame.pad is always 0), so no
+// compiler can drop the array, and no invocation reads another's word.
+shared uint shared_pad[SHARED_PAD_KIB * 256];
+#endif
+
 void main() {
+#ifdef SHARED_PAD_KIB
+    uint group = uint(WG_X * WG_Y);
+    uint stride = uint(SHARED_PAD_KIB * 256) / group;
+    shared_pad[gl_LocalInvocationIndex * stride] = gl_LocalInvocationIndex;
+    if (shared_pad[((gl_LocalInvocationIndex + frame.pad) % group) * stride] == 0xffffffffu) {
+        return;
+    }
+#endif
     uvec2 p = gl_GlobalInvocationID.xy;
     if (p.x >= frame.width || p.y >= frame.height) {
         return;

@@ -74,6 +74,12 @@ pub struct RenderArgs {
     /// Compute path only: the workgroup size WxH (e.g. 8x8, 16x8, 16x16) [default: 16x8].
     #[arg(long, value_name = "WxH", value_parser = parse_workgroup)]
     pub workgroup: Option<Workgroup>,
+    /// Measurement only, compute path: declare this many KiB of workgroup
+    /// memory that the tracer does not need (each invocation writes and reads
+    /// one word of it), to see how the driver's split of each multiprocessor's
+    /// memory between shared memory and L1 cache, and its occupancy, move the time.
+    #[arg(long, value_name = "KIB", value_parser = clap::value_parser!(u32).range(1..=32))]
+    pub shared_pad: Option<u32>,
     /// For experiments only (repeatable): put back a cost the shader build
     /// removes, or move the compute path's BVH stack, to measure its effect.
     #[arg(long, value_enum, value_name = "NAME")]
@@ -282,6 +288,7 @@ impl RenderArgs {
             explain: false,
             path: RenderPath::Fragment,
             workgroup: None,
+            shared_pad: None,
             experiment: Vec::new(),
             dump_shaders: None,
         }
@@ -292,6 +299,9 @@ impl RenderArgs {
     pub fn compute_workgroup(&self) -> anyhow::Result<Workgroup> {
         if self.path == RenderPath::Fragment && self.workgroup.is_some() {
             return Err(bad_input("--workgroup applies to --path compute only"));
+        }
+        if self.path == RenderPath::Fragment && self.shared_pad.is_some() {
+            return Err(bad_input("--shared-pad applies to --path compute only"));
         }
         Ok(self.workgroup.unwrap_or(Workgroup::DEFAULT))
     }

@@ -105,6 +105,7 @@ pub fn app_args(args: &RenderArgs) -> Vec<String> {
         explain,
         path,
         workgroup,
+        shared_pad,
         experiment,
         dump_shaders,
     } = args;
@@ -144,6 +145,9 @@ pub fn app_args(args: &RenderArgs) -> Vec<String> {
     v.extend(["--path".into(), path.name()]);
     if let Some(wg) = workgroup {
         v.extend(["--workgroup".into(), wg.to_string()]);
+    }
+    if let Some(kib) = shared_pad {
+        v.extend(["--shared-pad".into(), kib.to_string()]);
     }
     for e in experiment {
         v.extend(["--experiment".into(), e.name()]);
@@ -352,6 +356,7 @@ mod tests {
             explain: true,
             path: RenderPath::Compute,
             workgroup: Some(Workgroup { x: 8, y: 4 }),
+            shared_pad: Some(24),
             experiment: vec![Experiment::NagaZeroInit, Experiment::UnpairedBvhStack],
             dump_shaders: Some(PathBuf::from("dump")),
         }
@@ -419,6 +424,7 @@ mod tests {
             "out" => "a.png",
             "set" => "max_depth=3",
             "workgroup" => "8x4",
+            "shared-pad" => "24",
             "dump-shaders" => "dump",
             other => panic!("--{other} needs a sample value in this test"),
         };

@@ -231,9 +231,14 @@ pub fn to_spirv(
     } else {
         !variant.defines.contains_key("USE_BVH")
     };
+    // Workgroup memory (the shared BVH stack and --shared-pad, both compute
+    // experiments) is written before it is read, and the GLSL writer is told
+    // not to zero it (`to_glsl`): naga's default polyfill would zero it at the
+    // start of every workgroup in Vulkan alone, a cost only one API would pay.
     let options = spv::Options {
         flags: spv::WriterFlags::LABEL_VARYINGS,
         force_loop_bounding: loop_bounding,
+        zero_initialize_workgroup_memory: spv::ZeroInitializeWorkgroupMemoryMode::None,
         ..Default::default()
     };
     let pipeline = spv::PipelineOptions {

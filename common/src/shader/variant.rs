@@ -168,6 +168,9 @@ impl Variant {
         if v.experiments.contains(&Experiment::Quad) {
             v.defines.insert(QUAD_DEFINE.into(), "1".into());
         }
+        if let Some(kib) = args.shared_pad {
+            v.defines.insert("SHARED_PAD_KIB".into(), kib.to_string());
+        }
         v
     }
 
