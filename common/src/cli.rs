@@ -149,6 +149,11 @@ pub enum Experiment {
     /// Both APIs: bounds-checked buffer access (Vulkan's robustBufferAccess
     /// feature; OpenGL a robust-access context).
     RobustAccess,
+    /// OpenGL, compute path, NVIDIA: record the highest warp slot in use on
+    /// each multiprocessor (GL_NV_shader_thread_group's gl_WarpIDNV), the
+    /// occupancy that OpenGL's driver does not report; Vulkan's follows from
+    /// its pipeline statistics' register count.
+    WarpProbe,
 }
 
 /// The tracer's entry point: the two ways one GLSL tracer reaches the GPU.
@@ -551,7 +556,8 @@ mod tests {
                 "compute-queue",
                 "dynamic-viewport",
                 "naga-aliasing",
-                "robust-access"
+                "robust-access",
+                "warp-probe"
             ]
         );
         assert_eq!(

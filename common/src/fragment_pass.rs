@@ -69,8 +69,8 @@ impl FragmentPass {
 /// the pass's experiments need the headless fragment path, `compute-queue` the
 /// headless compute path; `dynamic-viewport` and `compute-queue` are Vulkan's
 /// alone (`vulkan` false: OpenGL, which has neither queues nor a viewport
-/// fixed in advance); `naga-aliasing` is OpenGL's alone, and `robust-access`
-/// needs a headless run.
+/// fixed in advance); `naga-aliasing` and `warp-probe` (headless compute)
+/// are OpenGL's alone, and `robust-access` needs a headless run.
 pub fn check_experiments(args: &RenderArgs, vulkan: bool) -> anyhow::Result<()> {
     for e in &args.experiment {
         let name = e.name();
@@ -86,6 +86,12 @@ pub fn check_experiments(args: &RenderArgs, vulkan: bool) -> anyhow::Result<()> 
                 RenderPath::Compute,
                 Some("OpenGL has no queues to choose from"),
             ),
+            Experiment::WarpProbe if vulkan => {
+                return Err(bad_input(format!(
+                    "--experiment {name} is OpenGL only: Vulkan reports the register count that fixes its occupancy (--dump-shaders)"
+                )));
+            }
+            Experiment::WarpProbe => (RenderPath::Compute, None),
             Experiment::NagaAliasing if vulkan => {
                 return Err(bad_input(format!(
                     "--experiment {name} is OpenGL only: Vulkan's SPIR-V lets the driver assume that no two resources alias anyway"

@@ -6,6 +6,7 @@ use crate::buffers::SceneBuffers;
 use crate::compute::Compute;
 use crate::context::{self, Gl};
 use crate::debug::DebugLog;
+use crate::probe::WarpProbe;
 use crate::program::{self, EmptyVertexArray, Program};
 use crate::rays::count_rays;
 use crate::target::{self, Target};
@@ -38,6 +39,11 @@ pub fn run(args: RenderArgs, knobs: &OpenGlKnobs, started: Instant) -> anyhow::R
             ));
         }
         return run_windowed(&args, started);
+    }
+    if args.gl_spirv && args.experiment.contains(&Experiment::WarpProbe) {
+        return Err(bad_input(
+            "--gl-spirv with --experiment warp-probe: the probe is added to naga's GLSL, which --gl-spirv does not load; drop one of them",
+        ));
     }
     if args.gl_spirv && args.experiment.contains(&Experiment::Glslang) {
         return Err(bad_input(
@@ -121,6 +127,12 @@ pub fn run(args: RenderArgs, knobs: &OpenGlKnobs, started: Instant) -> anyhow::R
         // The same tracer as a compute shader: compute.rs owns its program and texture.
         RenderPath::Compute => {
             let shader = build_compute(&variant, workgroup)?;
+            // Before the compile, so that a driver without the extension gets a clear refusal.
+            let probe = if args.experiment.contains(&Experiment::WarpProbe) {
+                Some(WarpProbe::new(gl)?)
+            } else {
+                None
+            };
             let proc_address = |name: &std::ffi::CStr| ctx.proc_address(name);
             let spirv = args
                 .gl_spirv
@@ -149,6 +161,9 @@ pub fn run(args: RenderArgs, knobs: &OpenGlKnobs, started: Instant) -> anyhow::R
                 &|| compute.barrier_between_frames(),
                 &|| compute.dispatch(),
             );
+            if let Some(probe) = &probe {
+                eprintln!("twinray-gl: {}", probe.summary()?);
+            }
             (frames, setup_ms, compute.read())
         }
     };

@@ -1,6 +1,6 @@
 //! twinray-gl: the OpenGL twin of twinray-vk. Modules in the order a reader
 //! meets the setup: context, debug output, program, buffers, target, timer,
-//! the compute path (compute.rs), the headless run that strings them together,
+//! the compute path (compute.rs) and its warp probe (probe.rs), the headless run that strings them together,
 //! and the windowed run.
 
 pub mod app;
@@ -8,6 +8,7 @@ pub mod buffers;
 pub mod compute;
 pub mod context;
 pub mod debug;
+pub mod probe;
 pub mod program;
 pub mod rays;
 pub mod target;

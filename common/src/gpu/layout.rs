@@ -203,6 +203,9 @@ pub mod binding {
     /// only by the untimed counting frame; no other variant declares it.
     pub const RAY_COUNTS: u32 = 10;
     pub const LAST: u32 = RAY_COUNTS;
+    /// OpenGL's `--experiment warp-probe` buffer (one word per multiprocessor),
+    /// which only that experiment's GLSL declares (`shader::post::warp_probe_glsl`).
+    pub const WARP_PROBE: u32 = 11;
     /// The storage buffers in binding order.
     pub const STORAGE: [u32; 7] = [
         SPHERES, TRIANGLES, MATERIALS, LIGHTS, BVH_NODES, BVH_PRIMS, COUNTS,

@@ -9,6 +9,7 @@ use crate::cli::{Experiment, Workgroup};
 use crate::shader::post::{
     float_controls_spirv, no_contraction_spirv, precise_float_locals_glsl,
     restrict_resources_glsl, strip_local_array_zero_init_glsl, strip_local_array_zero_init_spirv,
+    warp_probe_glsl,
 };
 use crate::shader::variant::{Variant, SPEC_CONSTANTS};
 use anyhow::{anyhow, Context};
@@ -307,6 +308,13 @@ pub fn to_glsl(
     };
     let out = if restricts_resources(variant) {
         restrict_resources_glsl(&out)
+    } else {
+        out
+    };
+    let out = if stage == ShaderStage::Compute
+        && variant.experiments.contains(&Experiment::WarpProbe)
+    {
+        warp_probe_glsl(&out, crate::gpu::layout::binding::WARP_PROBE)?
     } else {
         out
     };

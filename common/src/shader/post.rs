@@ -328,6 +328,30 @@ pub fn restrict_resources_spirv(words: &[u32]) -> Vec<u32> {
     with_annotations(words, &decorations)
 }
 
+/// `--experiment warp-probe`: OpenGL's compute GLSL with, first thing in
+/// `main`, each invocation raising its multiprocessor's word of a buffer at
+/// `binding` to its warp's slot + 1 (GL_NV_shader_thread_group), so the
+/// buffer ends up holding each multiprocessor's highest resident warp slot.
+pub fn warp_probe_glsl(glsl: &str, binding: u32) -> anyhow::Result<String> {
+    let version_end = glsl
+        .find('\n')
+        .filter(|_| glsl.starts_with("#version"))
+        .ok_or_else(|| anyhow::anyhow!("warp probe: the GLSL does not start with #version"))?;
+    let main = glsl
+        .find("void main() {\n")
+        .ok_or_else(|| anyhow::anyhow!("warp probe: the GLSL has no `void main() {{`"))?;
+    let body = main + "void main() {\n".len();
+    Ok(format!(
+        "{}\n#extension GL_NV_shader_thread_group : require\n{}\
+         layout(std430, binding = {binding}) buffer WarpProbe {{ uint slots[]; }} warp_probe;\n\n\
+         {}    atomicMax(warp_probe.slots[uint(gl_SMIDNV)], uint(gl_WarpIDNV) + 1u);\n{}",
+        &glsl[..version_end],
+        &glsl[version_end + 1..main],
+        &glsl[main..body],
+        &glsl[body..]
+    ))
+}
+
 /// naga's Vulkan SPIR-V made loadable by OpenGL (GL_ARB_gl_spirv), so both APIs
 /// can run the very same binary: GL has no descriptor sets, so the
 /// `DescriptorSet` decorations go, and GL's window origin is the lower left, so
@@ -368,4 +392,32 @@ pub fn spirv_for_opengl(words: &[u32], restrict: bool) -> Vec<u32> {
         i += count;
     }
     out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn warp_probe_goes_after_version_and_first_in_main() {
+        let glsl = "#version 450 core\n#extension GL_ARB_shader_storage_buffer_object : require\nlayout(local_size_x = 16) in;\nvoid main() {\n    uint x = 1u;\n}\n";
+        let out = warp_probe_glsl(glsl, 11).unwrap();
+        let lines: Vec<&str> = out.lines().collect();
+        assert_eq!(lines[0], "#version 450 core");
+        assert_eq!(lines[1], "#extension GL_NV_shader_thread_group : require");
+        let main = lines.iter().position(|l| *l == "void main() {").unwrap();
+        assert!(lines[main + 1].contains("atomicMax(warp_probe.slots[uint(gl_SMIDNV)], uint(gl_WarpIDNV) + 1u)"));
+        assert!(out.contains("layout(std430, binding = 11) buffer WarpProbe"));
+        assert!(warp_probe_glsl("void main() {\n}\n", 11).is_err());
+    }
+
+    #[test]
+    fn restrict_marks_every_buffer_and_image_and_nothing_else() {
+        let glsl = "layout(std140, binding = 0) uniform Frame_block { Frame f; };\nlayout(std430, binding = 1) readonly buffer Spheres_block {\nlayout(binding = 5,rgba32f) writeonly uniform image2D img;\n    uint buffer_count = 0u;\n";
+        let out = restrict_resources_glsl(glsl);
+        assert_eq!(
+            out,
+            "layout(std140, binding = 0) uniform Frame_block { Frame f; };\nlayout(std430, binding = 1) restrict readonly buffer Spheres_block {\nlayout(binding = 5,rgba32f) restrict writeonly uniform image2D img;\n    uint buffer_count = 0u;\n"
+        );
+    }
 }
