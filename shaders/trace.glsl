@@ -427,6 +427,11 @@ shared uvec2 bvh_stack[BVH_STACK * WG_X * WG_Y];
 #define BVH_PUSH(i, e) if (((i) & 1u) == 0u) { stack[(i) >> 1u].xy = (e); } else { stack[(i) >> 1u].zw = (e); }
 #define BVH_POP(i) (((i) & 1u) == 0u ? stack[(i) >> 1u].xy : stack[(i) >> 1u].zw)
 #endif
+#if defined(BVH_STACK_GLOBAL) && !defined(BVH_STACK_SHARED)
+// One stack for both walks, at module scope: per invocation like a local, but
+// a compiler that inlines each call of `traverse` cannot give each copy its own.
+BVH_STACK_DECLARE;
+#endif
 
 // A child reference (gpu::layout::child_ref, which a test holds these to):
 // an interior node's index, or with LEAF_BIT a leaf, its first primitive
@@ -503,7 +508,7 @@ Hit traverse(vec3 origin, vec3 dir, float t_max, bool any_hit) {
     h.v = 0.0;
     vec3 inv_dir = inverse_dir(dir);
     TriRay ray = tri_ray(origin, dir);
-#ifndef BVH_STACK_SHARED
+#if !defined(BVH_STACK_SHARED) && !defined(BVH_STACK_GLOBAL)
     BVH_STACK_DECLARE;
 #endif
     uint sp = 0u;

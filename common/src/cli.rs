@@ -108,6 +108,9 @@ pub enum Experiment {
     SharedBvhStack,
     /// One BVH stack entry per array element (uvec2) instead of two per uvec4.
     UnpairedBvhStack,
+    /// One BVH stack at module scope that the closest-hit and any-hit walks
+    /// share, instead of a local array in each inlined walk.
+    GlobalBvhStack,
     /// Read the primitive and light counts from a storage buffer instead of
     /// baking them into the shader.
     StorageCounts,
@@ -545,6 +548,7 @@ mod tests {
                 "no-loop-bounding",
                 "shared-bvh-stack",
                 "unpaired-bvh-stack",
+                "global-bvh-stack",
                 "storage-counts",
                 "uniform-counts",
                 "no-contraction",

@@ -1,4 +1,5 @@
-//! What the shader build hands the drivers: no function-local array keeps
+//! What the shader build hands the drivers: no per-invocation array
+//! (function-local, or private at module scope) keeps
 //! naga's zero initialiser (it costs every pixel a store per element, and on
 //! NVIDIA's OpenGL a trip to local memory), in any variant, for either API,
 //! on either path; and trace.glsl itself gives no array an initialiser, so the
@@ -20,6 +21,10 @@ fn variants() -> Vec<Variant> {
             v.push(Variant::for_scene(&scene));
             v.push(Variant::specialized(&scene));
         }
+        // The BVH stack at module scope: a private array, not a local one.
+        let mut global = Variant::for_scene(&scene);
+        global.defines.insert("BVH_STACK_GLOBAL".into(), "1".into());
+        v.push(global);
     }
     for offset in Offset::ALL {
         for triangle in TriangleTest::ALL {
@@ -35,7 +40,8 @@ fn variants() -> Vec<Variant> {
     v
 }
 
-/// Function-storage OpVariables with an initialiser whose type is an array.
+/// Function- or Private-storage OpVariables (per invocation) with an
+/// initialiser whose type is an array.
 fn initialised_local_arrays(words: &[u32]) -> usize {
     let mut arrays = std::collections::HashSet::new();
     let mut array_pointers = std::collections::HashSet::new();
@@ -48,10 +54,12 @@ fn initialised_local_arrays(words: &[u32]) -> usize {
             28 => {
                 arrays.insert(inst[1]);
             }
-            32 if inst[2] == 7 && arrays.contains(&inst[3]) => {
+            32 if matches!(inst[2], 6 | 7) && arrays.contains(&inst[3]) => {
                 array_pointers.insert(inst[1]);
             }
-            59 if inst[3] == 7 && count == 5 && array_pointers.contains(&inst[1]) => found += 1,
+            59 if matches!(inst[3], 6 | 7) && count == 5 && array_pointers.contains(&inst[1]) => {
+                found += 1
+            }
             _ => {}
         }
         i += count;
@@ -59,10 +67,11 @@ fn initialised_local_arrays(words: &[u32]) -> usize {
     found
 }
 
-/// GLSL lines that declare a local array with an initialiser.
+/// GLSL lines that declare a local or module-scope array with an
+/// initialiser (a `const` array's first word is no type: not one of these).
 fn initialised_glsl_arrays(glsl: &str) -> Vec<String> {
     glsl.lines()
-        .filter(|l| l.starts_with("    ") && l.contains("] = ") && l.trim_end().ends_with(");"))
+        .filter(|l| !l.starts_with("const ") && l.contains("] = ") && l.trim_end().ends_with(");"))
         .filter(|l| {
             // A declaration is `T name[N]`; an element store is `name[i]`.
             let decl = l.split(" = ").next().unwrap_or("").trim();
@@ -111,6 +120,16 @@ fn the_experiment_puts_the_initialisers_back() {
     let s = build::build(&v).unwrap();
     assert!(initialised_local_arrays(&s.fragment_spirv) > 0);
     assert!(!initialised_glsl_arrays(&s.fragment_glsl).is_empty());
+    // The module-scope stack alone: the checks see a private array too.
+    v.defines.insert("BVH_STACK_GLOBAL".into(), "1".into());
+    v.defines.insert("STACK_SIZE".into(), "1".into());
+    let s = build::build(&v).unwrap();
+    let module_scope: Vec<String> = initialised_glsl_arrays(&s.fragment_glsl)
+        .into_iter()
+        .filter(|l| !l.starts_with(' '))
+        .collect();
+    assert_eq!(module_scope.len(), 1, "{module_scope:?}");
+    assert!(initialised_local_arrays(&s.fragment_spirv) > 0);
 }
 
 #[test]

@@ -10,18 +10,22 @@
 // traversal (128 stores into NVIDIA's local memory per traversal, 1.2-1.85x the
 // BVH time on an H100). trace.glsl only reads stack entries below the stack
 // pointer, each written by a push first, so the zeros are never read: both
-// passes remove the initialisers of function-local arrays, and only those.
+// passes remove the initialisers of per-invocation arrays (function-local, or
+// private at module scope), and only those.
 // trace.glsl gives no array an explicit initialiser (a test holds it to that),
 // so every initialiser removed here is naga's.
 
-/// Removes the `OpConstantNull` initialiser of every `Function`-storage
-/// `OpVariable` whose type is an array.
+/// Removes the `OpConstantNull` initialiser of every `Function`- or
+/// `Private`-storage `OpVariable` whose type is an array (a private array is
+/// per invocation too: `--experiment global-bvh-stack`'s stack).
 pub fn strip_local_array_zero_init_spirv(words: &[u32]) -> Vec<u32> {
     const OP_TYPE_ARRAY: u32 = 28;
     const OP_TYPE_POINTER: u32 = 32;
     const OP_CONSTANT_NULL: u32 = 46;
     const OP_VARIABLE: u32 = 59;
+    const STORAGE_PRIVATE: u32 = 6;
     const STORAGE_FUNCTION: u32 = 7;
+    let per_invocation = |class: u32| class == STORAGE_FUNCTION || class == STORAGE_PRIVATE;
     let instructions = || spirv_instructions(words);
     let arrays: std::collections::HashSet<u32> = instructions()
         .filter(|i| i[0] & 0xffff == OP_TYPE_ARRAY && i.len() >= 2)
@@ -35,7 +39,7 @@ pub fn strip_local_array_zero_init_spirv(words: &[u32]) -> Vec<u32> {
         .filter(|i| {
             i[0] & 0xffff == OP_TYPE_POINTER
                 && i.len() >= 4
-                && i[2] == STORAGE_FUNCTION
+                && per_invocation(i[2])
                 && arrays.contains(&i[3])
         })
         .map(|i| i[1])
@@ -44,7 +48,7 @@ pub fn strip_local_array_zero_init_spirv(words: &[u32]) -> Vec<u32> {
     for i in instructions() {
         let strip = i[0] & 0xffff == OP_VARIABLE
             && i.len() == 5
-            && i[3] == STORAGE_FUNCTION
+            && per_invocation(i[3])
             && array_pointers.contains(&i[1])
             && nulls.contains(&i[4]);
         if strip {
@@ -77,9 +81,10 @@ fn spirv_instructions(words: &[u32]) -> impl Iterator<Item = &[u32]> {
     })
 }
 
-/// Removes naga's zero initialiser from every function-local array declaration
-/// (`    T name[N] = T[N](zeros);` becomes `    T name[N];`). Only initialisers
-/// made of zero literals and constructors are touched.
+/// Removes naga's zero initialiser from every function-local or module-scope
+/// array declaration (`    T name[N] = T[N](zeros);` becomes `    T name[N];`).
+/// Only initialisers made of zero literals and constructors are touched, so a
+/// `const` array, whose first word is no type, stays as it is.
 pub fn strip_local_array_zero_init_glsl(glsl: &str) -> String {
     let mut out = String::with_capacity(glsl.len());
     for line in glsl.split_inclusive('\n') {
@@ -94,11 +99,11 @@ pub fn strip_local_array_zero_init_glsl(glsl: &str) -> String {
     out
 }
 
-/// For an indented `T name[N] = T[N](...);` line whose initialiser holds only
-/// zeros, the declaration part `    T name[N]`.
+/// For a `T name[N] = T[N](...);` line whose initialiser holds only zeros,
+/// the declaration part `    T name[N]`.
 fn local_array_zero_init(line: &str) -> Option<&str> {
     let body = line.trim_end();
-    if !line.starts_with(' ') || !body.ends_with(");") {
+    if !body.ends_with(");") {
         return None;
     }
     let (decl, init) = body.split_once(" = ")?;

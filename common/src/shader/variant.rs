@@ -155,6 +155,11 @@ impl Variant {
         {
             v.defines.insert("BVH_STACK_UNPAIRED".into(), "1".into());
         }
+        if v.defines.contains_key("USE_BVH")
+            && v.experiments.contains(&Experiment::GlobalBvhStack)
+        {
+            v.defines.insert("BVH_STACK_GLOBAL".into(), "1".into());
+        }
         if v.experiments.contains(&Experiment::UniformCounts)
             || v.experiments.contains(&Experiment::StorageCounts)
         {
