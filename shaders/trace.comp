@@ -11,10 +11,10 @@
 // so invocations past the right and bottom edges return at once.
 
 #ifndef WG_X
-#define WG_X 16
+#define WG_X 8
 #endif
 #ifndef WG_Y
-#define WG_Y 8
+#define WG_Y 4
 #endif
 
 layout(local_size_x = WG_X, local_size_y = WG_Y, local_size_z = 1) in;

@@ -403,9 +403,9 @@ const uint SPHERE_BIT = 0x80000000u;
 // the current path, so no push is ever dropped and no slot is wasted.
 //
 // Experiments (--experiment, common/src/cli.rs): BVH_STACK_UNPAIRED keeps
-// one uvec2 per element; BVH_STACK_SHARED (compute only, where it fits)
-// keeps the stack in shared memory, entry-major so that a warp's pushes hit
-// distinct banks.
+// one uvec2 per element; BVH_STACK_LOCAL gives each walk a local stack of its
+// own; BVH_STACK_SHARED (compute only, where it fits) keeps the stack in
+// shared memory, entry-major so that a warp's pushes hit distinct banks.
 #ifndef BVH_STACK
 // Only a source compiled without the build's defines (an external compiler
 // checking trace.glsl on its own) gets here: the apps always size the stack
@@ -427,9 +427,11 @@ shared uvec2 bvh_stack[BVH_STACK * WG_X * WG_Y];
 #define BVH_PUSH(i, e) if (((i) & 1u) == 0u) { stack[(i) >> 1u].xy = (e); } else { stack[(i) >> 1u].zw = (e); }
 #define BVH_POP(i) (((i) & 1u) == 0u ? stack[(i) >> 1u].xy : stack[(i) >> 1u].zw)
 #endif
-#if defined(BVH_STACK_GLOBAL) && !defined(BVH_STACK_SHARED)
-// One stack for both walks, at module scope: per invocation like a local, but
-// a compiler that inlines each call of `traverse` cannot give each copy its own.
+#if !defined(BVH_STACK_SHARED) && !defined(BVH_STACK_LOCAL)
+// One stack for both walks (closest hit and any hit), at module scope: per
+// invocation like a local array, but a compiler that inlines each call of
+// `traverse` cannot give each copy a stack of its own, as NVIDIA's OpenGL
+// compiler did (21 slots of local memory instead of 12 for the teapot).
 BVH_STACK_DECLARE;
 #endif
 
@@ -508,7 +510,7 @@ Hit traverse(vec3 origin, vec3 dir, float t_max, bool any_hit) {
     h.v = 0.0;
     vec3 inv_dir = inverse_dir(dir);
     TriRay ray = tri_ray(origin, dir);
-#if !defined(BVH_STACK_SHARED) && !defined(BVH_STACK_GLOBAL)
+#ifdef BVH_STACK_LOCAL
     BVH_STACK_DECLARE;
 #endif
     uint sp = 0u;
@@ -768,11 +770,27 @@ float fresnel(float cos_i, float cos_t, float eta) {
 // The CPU reference (common/src/reference/) follows these files step by step
 // in f64; change both together.
 
+// The ray stack: each entry is two vec4s, (origin, weight) and (direction,
+// depth). NVIDIA's OpenGL compiler gives every element of a local array a
+// 16-byte slot of its own, so an entry kept as a vec3, a vec3, a float and a
+// uint took four slots where these take two; and NVIDIA's OpenGL runs a
+// compute shader on fewer multiprocessors the more local memory each
+// invocation needs (comparison/results/nvidia-h100/FINDINGS.md, "Local memory
+// and OpenGL's multiprocessors"). RAY_STACK_SPLIT (--experiment
+// split-ray-stack) puts back the four arrays. The depth is a small integer,
+// exact as a float.
+#ifdef RAY_STACK_SPLIT
+#define RAY_STACK_DECLARE vec3 st_origin[STACK_SIZE]; vec3 st_dir[STACK_SIZE]; float st_weight[STACK_SIZE]; uint st_depth[STACK_SIZE]
+#define RAY_PUSH(i, o, d, w, depth) st_origin[i] = (o); st_dir[i] = (d); st_weight[i] = (w); st_depth[i] = (depth)
+#define RAY_POP(i) o = st_origin[i]; d = st_dir[i]; w = st_weight[i]; depth = st_depth[i]
+#else
+#define RAY_STACK_DECLARE vec4 st_origin_weight[STACK_SIZE]; vec4 st_dir_depth[STACK_SIZE]
+#define RAY_PUSH(i, o, d, w, depth) st_origin_weight[i] = vec4((o), (w)); st_dir_depth[i] = vec4((d), float(depth))
+#define RAY_POP(i) o = st_origin_weight[i].xyz; w = st_origin_weight[i].w; d = st_dir_depth[i].xyz; depth = uint(st_dir_depth[i].w)
+#endif
+
 vec3 trace(vec3 origin, vec3 dir) {
-    vec3 st_origin[STACK_SIZE];
-    vec3 st_dir[STACK_SIZE];
-    float st_weight[STACK_SIZE];
-    uint st_depth[STACK_SIZE];
+    RAY_STACK_DECLARE;
 #ifdef HAS_GLASS
     // Glass pushes two rays per hit: the stack's size bounds the depth.
     uint max_depth = min(frame.max_depth, uint(STACK_SIZE - 1));
@@ -783,18 +801,16 @@ vec3 trace(vec3 origin, vec3 dir) {
 
     vec3 color = vec3(0.0);
     int sp = 0;
-    st_origin[0] = origin;
-    st_dir[0] = dir;
-    st_weight[0] = 1.0;
-    st_depth[0] = 0u;
+    RAY_PUSH(0, origin, dir, 1.0, 0u);
     sp = 1;
 
     while (sp > 0) {
         sp -= 1;
-        vec3 o = st_origin[sp];
-        vec3 d = st_dir[sp];
-        float w = st_weight[sp];
-        uint depth = st_depth[sp];
+        vec3 o;
+        vec3 d;
+        float w;
+        uint depth;
+        RAY_POP(sp);
 
         // The shading stays written out here rather than in functions: naga's
         // output for a struct returned by value and `out` parameters cost both
@@ -891,10 +907,7 @@ vec3 trace(vec3 origin, vec3 dir) {
                     float wt = w * kt * (1.0 - f);
                     if (wt >= frame.min_weight && sp < STACK_SIZE) {
                         vec3 t_dir = normalize(eta * d + (eta * cos_i - cos_t) * ns);
-                        st_origin[sp] = spawn_point(p, -ng, t_dir, scale);
-                        st_dir[sp] = t_dir;
-                        st_weight[sp] = wt;
-                        st_depth[sp] = depth + 1u;
+                        RAY_PUSH(sp, spawn_point(p, -ng, t_dir, scale), t_dir, wt, depth + 1u);
                         sp += 1;
 #ifdef COUNT_RAYS
                         rays_traced.glass_refracted += 1u;
@@ -906,10 +919,7 @@ vec3 trace(vec3 origin, vec3 dir) {
             float wr = w * kr;
             if (wr >= frame.min_weight && sp < STACK_SIZE) {
                 vec3 r_dir = reflect(d, ns);
-                st_origin[sp] = spawn_point(p, ng, r_dir, scale);
-                st_dir[sp] = r_dir;
-                st_weight[sp] = wr;
-                st_depth[sp] = depth + 1u;
+                RAY_PUSH(sp, spawn_point(p, ng, r_dir, scale), r_dir, wr, depth + 1u);
                 sp += 1;
 #ifdef COUNT_RAYS
                 if (m.transparency > 0.0) {

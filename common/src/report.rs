@@ -31,7 +31,7 @@ pub struct RunReport {
     /// before the compute path: those were fragment runs).
     #[serde(default)]
     pub path: RenderPath,
-    /// The compute workgroup as "16x8"; None for the fragment path.
+    /// The compute workgroup as "8x4"; None for the fragment path.
     #[serde(default)]
     pub workgroup: Option<String>,
     pub frames: Vec<FrameTime>,

@@ -21,10 +21,11 @@ fn variants() -> Vec<Variant> {
             v.push(Variant::for_scene(&scene));
             v.push(Variant::specialized(&scene));
         }
-        // The BVH stack at module scope: a private array, not a local one.
-        let mut global = Variant::for_scene(&scene);
-        global.defines.insert("BVH_STACK_GLOBAL".into(), "1".into());
-        v.push(global);
+        // The BVH stacks local to each walk, and the ray stack as four arrays.
+        let mut local = Variant::for_scene(&scene);
+        local.defines.insert("BVH_STACK_LOCAL".into(), "1".into());
+        local.defines.insert("RAY_STACK_SPLIT".into(), "1".into());
+        v.push(local);
     }
     for offset in Offset::ALL {
         for triangle in TriangleTest::ALL {
@@ -120,8 +121,7 @@ fn the_experiment_puts_the_initialisers_back() {
     let s = build::build(&v).unwrap();
     assert!(initialised_local_arrays(&s.fragment_spirv) > 0);
     assert!(!initialised_glsl_arrays(&s.fragment_glsl).is_empty());
-    // The module-scope stack alone: the checks see a private array too.
-    v.defines.insert("BVH_STACK_GLOBAL".into(), "1".into());
+    // The module-scope BVH stack alone: the checks see a private array too.
     v.defines.insert("STACK_SIZE".into(), "1".into());
     let s = build::build(&v).unwrap();
     let module_scope: Vec<String> = initialised_glsl_arrays(&s.fragment_glsl)

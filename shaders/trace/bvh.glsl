@@ -14,9 +14,9 @@ const uint SPHERE_BIT = 0x80000000u;
 // the current path, so no push is ever dropped and no slot is wasted.
 //
 // Experiments (--experiment, common/src/cli.rs): BVH_STACK_UNPAIRED keeps
-// one uvec2 per element; BVH_STACK_SHARED (compute only, where it fits)
-// keeps the stack in shared memory, entry-major so that a warp's pushes hit
-// distinct banks.
+// one uvec2 per element; BVH_STACK_LOCAL gives each walk a local stack of its
+// own; BVH_STACK_SHARED (compute only, where it fits) keeps the stack in
+// shared memory, entry-major so that a warp's pushes hit distinct banks.
 #ifndef BVH_STACK
 // Only a source compiled without the build's defines (an external compiler
 // checking trace.glsl on its own) gets here: the apps always size the stack
@@ -38,9 +38,11 @@ shared uvec2 bvh_stack[BVH_STACK * WG_X * WG_Y];
 #define BVH_PUSH(i, e) if (((i) & 1u) == 0u) { stack[(i) >> 1u].xy = (e); } else { stack[(i) >> 1u].zw = (e); }
 #define BVH_POP(i) (((i) & 1u) == 0u ? stack[(i) >> 1u].xy : stack[(i) >> 1u].zw)
 #endif
-#if defined(BVH_STACK_GLOBAL) && !defined(BVH_STACK_SHARED)
-// One stack for both walks, at module scope: per invocation like a local, but
-// a compiler that inlines each call of `traverse` cannot give each copy its own.
+#if !defined(BVH_STACK_SHARED) && !defined(BVH_STACK_LOCAL)
+// One stack for both walks (closest hit and any hit), at module scope: per
+// invocation like a local array, but a compiler that inlines each call of
+// `traverse` cannot give each copy a stack of its own, as NVIDIA's OpenGL
+// compiler did (21 slots of local memory instead of 12 for the teapot).
 BVH_STACK_DECLARE;
 #endif
 
@@ -119,7 +121,7 @@ Hit traverse(vec3 origin, vec3 dir, float t_max, bool any_hit) {
     h.v = 0.0;
     vec3 inv_dir = inverse_dir(dir);
     TriRay ray = tri_ray(origin, dir);
-#if !defined(BVH_STACK_SHARED) && !defined(BVH_STACK_GLOBAL)
+#ifdef BVH_STACK_LOCAL
     BVH_STACK_DECLARE;
 #endif
     uint sp = 0u;

@@ -33,11 +33,27 @@
 // The CPU reference (common/src/reference/) follows these files step by step
 // in f64; change both together.
 
+// The ray stack: each entry is two vec4s, (origin, weight) and (direction,
+// depth). NVIDIA's OpenGL compiler gives every element of a local array a
+// 16-byte slot of its own, so an entry kept as a vec3, a vec3, a float and a
+// uint took four slots where these take two; and NVIDIA's OpenGL runs a
+// compute shader on fewer multiprocessors the more local memory each
+// invocation needs (comparison/results/nvidia-h100/FINDINGS.md, "Local memory
+// and OpenGL's multiprocessors"). RAY_STACK_SPLIT (--experiment
+// split-ray-stack) puts back the four arrays. The depth is a small integer,
+// exact as a float.
+#ifdef RAY_STACK_SPLIT
+#define RAY_STACK_DECLARE vec3 st_origin[STACK_SIZE]; vec3 st_dir[STACK_SIZE]; float st_weight[STACK_SIZE]; uint st_depth[STACK_SIZE]
+#define RAY_PUSH(i, o, d, w, depth) st_origin[i] = (o); st_dir[i] = (d); st_weight[i] = (w); st_depth[i] = (depth)
+#define RAY_POP(i) o = st_origin[i]; d = st_dir[i]; w = st_weight[i]; depth = st_depth[i]
+#else
+#define RAY_STACK_DECLARE vec4 st_origin_weight[STACK_SIZE]; vec4 st_dir_depth[STACK_SIZE]
+#define RAY_PUSH(i, o, d, w, depth) st_origin_weight[i] = vec4((o), (w)); st_dir_depth[i] = vec4((d), float(depth))
+#define RAY_POP(i) o = st_origin_weight[i].xyz; w = st_origin_weight[i].w; d = st_dir_depth[i].xyz; depth = uint(st_dir_depth[i].w)
+#endif
+
 vec3 trace(vec3 origin, vec3 dir) {
-    vec3 st_origin[STACK_SIZE];
-    vec3 st_dir[STACK_SIZE];
-    float st_weight[STACK_SIZE];
-    uint st_depth[STACK_SIZE];
+    RAY_STACK_DECLARE;
 #ifdef HAS_GLASS
     // Glass pushes two rays per hit: the stack's size bounds the depth.
     uint max_depth = min(frame.max_depth, uint(STACK_SIZE - 1));
@@ -48,18 +64,16 @@ vec3 trace(vec3 origin, vec3 dir) {
 
     vec3 color = vec3(0.0);
     int sp = 0;
-    st_origin[0] = origin;
-    st_dir[0] = dir;
-    st_weight[0] = 1.0;
-    st_depth[0] = 0u;
+    RAY_PUSH(0, origin, dir, 1.0, 0u);
     sp = 1;
 
     while (sp > 0) {
         sp -= 1;
-        vec3 o = st_origin[sp];
-        vec3 d = st_dir[sp];
-        float w = st_weight[sp];
-        uint depth = st_depth[sp];
+        vec3 o;
+        vec3 d;
+        float w;
+        uint depth;
+        RAY_POP(sp);
 
         // The shading stays written out here rather than in functions: naga's
         // output for a struct returned by value and `out` parameters cost both
@@ -156,10 +170,7 @@ vec3 trace(vec3 origin, vec3 dir) {
                     float wt = w * kt * (1.0 - f);
                     if (wt >= frame.min_weight && sp < STACK_SIZE) {
                         vec3 t_dir = normalize(eta * d + (eta * cos_i - cos_t) * ns);
-                        st_origin[sp] = spawn_point(p, -ng, t_dir, scale);
-                        st_dir[sp] = t_dir;
-                        st_weight[sp] = wt;
-                        st_depth[sp] = depth + 1u;
+                        RAY_PUSH(sp, spawn_point(p, -ng, t_dir, scale), t_dir, wt, depth + 1u);
                         sp += 1;
 #ifdef COUNT_RAYS
                         rays_traced.glass_refracted += 1u;
@@ -171,10 +182,7 @@ vec3 trace(vec3 origin, vec3 dir) {
             float wr = w * kr;
             if (wr >= frame.min_weight && sp < STACK_SIZE) {
                 vec3 r_dir = reflect(d, ns);
-                st_origin[sp] = spawn_point(p, ng, r_dir, scale);
-                st_dir[sp] = r_dir;
-                st_weight[sp] = wr;
-                st_depth[sp] = depth + 1u;
+                RAY_PUSH(sp, spawn_point(p, ng, r_dir, scale), r_dir, wr, depth + 1u);
                 sp += 1;
 #ifdef COUNT_RAYS
                 if (m.transparency > 0.0) {

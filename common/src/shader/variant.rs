@@ -155,10 +155,12 @@ impl Variant {
         {
             v.defines.insert("BVH_STACK_UNPAIRED".into(), "1".into());
         }
-        if v.defines.contains_key("USE_BVH")
-            && v.experiments.contains(&Experiment::GlobalBvhStack)
+        if v.defines.contains_key("USE_BVH") && v.experiments.contains(&Experiment::LocalBvhStack)
         {
-            v.defines.insert("BVH_STACK_GLOBAL".into(), "1".into());
+            v.defines.insert("BVH_STACK_LOCAL".into(), "1".into());
+        }
+        if v.experiments.contains(&Experiment::SplitRayStack) {
+            v.defines.insert("RAY_STACK_SPLIT".into(), "1".into());
         }
         if v.experiments.contains(&Experiment::UniformCounts)
             || v.experiments.contains(&Experiment::StorageCounts)
