@@ -79,6 +79,11 @@ const fn both(gap: &'static Gap, e: &'static [Experiment]) -> Case {
     case(gap, e, e, Api::Opengl)
 }
 
+/// OpenGL alone runs the experiment; Vulkan as shipped.
+const fn opengl(gap: &'static Gap, e: &'static [Experiment]) -> Case {
+    case(gap, &[], e, Api::Opengl)
+}
+
 /// OpenGL runs naga's SPIR-V (`--gl-spirv`), the very binary Vulkan runs.
 const fn gl_spirv(gap: &'static Gap) -> Case {
     case(gap, &[], &[], Api::OpenglSpirv)
@@ -95,11 +100,15 @@ pub const CASES: &[Case] = &[
     vulkan(&BOX_FRAGMENT, &[Experiment::DynamicViewport]),
     vulkan(&BOX_COMPUTE, &[Experiment::ComputeQueue]),
     gl_spirv(&BOX_COMPUTE),
+    both(&BOX_COMPUTE, &[Experiment::SplitRayStack]),
     vulkan(&TEAPOT_FRAGMENT, &[Experiment::Glslang]),
     vulkan(&TEAPOT_FRAGMENT, &[Experiment::NoLoopBounding]),
     gl_spirv(&TEAPOT_FRAGMENT),
     both(&TEAPOT_BVH_COMPUTE, &[Experiment::UnpairedBvhStack]),
     both(&TEAPOT_BVH_COMPUTE, &[Experiment::SharedBvhStack]),
+    both(&TEAPOT_BVH_COMPUTE, &[Experiment::LocalBvhStack]),
+    opengl(&TEAPOT_BVH_COMPUTE, &[Experiment::NagaAliasing]),
+    both(&TEAPOT_BVH_COMPUTE, &[Experiment::RobustAccess]),
     gl_spirv(&TEAPOT_BVH_COMPUTE),
     both(&BOX_IMAGES, &[Experiment::NoContraction]),
     vulkan(&BOX_IMAGES, &[Experiment::NoContraction]),

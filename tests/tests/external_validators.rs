@@ -113,6 +113,7 @@ fn variants() -> Vec<(String, Variant)> {
             UniformCounts,
         ],
         vec![NoLoopBounding, UnpairedBvhStack, StorageCounts],
+        vec![NagaAliasing, LocalBvhStack, SplitRayStack],
         vec![NoContraction],
         vec![Glslang],
         vec![FloatControls],
