@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # The compute path's workgroup size in both APIs at every point of the
-# traversal issue and the study's brute-force points (two rounds in
+# traversal issue, the teapot at 1920x1080 (the rays-per-second point) and the
+# study's brute-force points (two rounds in
 # alternating API order; the brute-force teapot one round of 4 frames), then
 # OpenGL's occupancy at the teapot's BVH with each workgroup and shared-memory
 # pad (--experiment warp-probe; its sentence lands in probe.log after a label
@@ -15,6 +16,7 @@ errors="$out/workgroups.log"
 # shellcheck source=comparison/gpu-lib.sh
 source "$(dirname "$0")/gpu-lib.sh"
 points=(
+    "--scene teapot --size 1920x1080 --accel bvh --frames 60"
     "--scene box --size 1000x1000 --accel none --frames 60"
     "--scene spherelist --size 300x300 --set extra_spheres=10000 --accel none --frames 20"
     "--scene teapot --size 1000x1000 --accel bvh --frames 60"
