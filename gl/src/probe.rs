@@ -38,7 +38,11 @@ impl<'gl> WarpProbe<'gl> {
                 .context("glCreateBuffer (warp probe)")?;
             gl.bind_buffer(glow::SHADER_STORAGE_BUFFER, Some(buffer));
             gl.buffer_data_u8_slice(glow::SHADER_STORAGE_BUFFER, &zeros, glow::DYNAMIC_READ);
-            gl.bind_buffer_base(glow::SHADER_STORAGE_BUFFER, binding::WARP_PROBE, Some(buffer));
+            gl.bind_buffer_base(
+                glow::SHADER_STORAGE_BUFFER,
+                binding::WARP_PROBE,
+                Some(buffer),
+            );
             Ok(WarpProbe { gl, buffer })
         }
     }

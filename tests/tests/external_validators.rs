@@ -237,7 +237,10 @@ fn glslang_and_spirv_val_accept_every_variant() {
             }
             let gl = write(
                 &dir.join(format!("v{i}-{stage}.gl.spv")),
-                &words_to_bytes(&spirv_for_opengl(&spirv, build::restricts_resources(variant))),
+                &words_to_bytes(&spirv_for_opengl(
+                    &spirv,
+                    build::restricts_resources(variant),
+                )),
             );
             jobs.push(Job {
                 what: format!("{what}: naga SPIR-V as OpenGL loads it"),

@@ -105,7 +105,14 @@ pub fn run(
         surface::required_extensions(&window)?,
     )?;
     let surface = Surface::new(&instance, &window)?;
-    let device = Device::new(&instance, Some(&surface), knobs, false, args.count_rays, false)?;
+    let device = Device::new(
+        &instance,
+        Some(&surface),
+        knobs,
+        false,
+        args.count_rays,
+        false,
+    )?;
     let loader = khr::swapchain::Device::new(&instance.instance, &device.device);
     let format = swapchain::choose_format(&device, &surface)?;
     let present_mode = swapchain::choose_present_mode(&device, &surface, args.vsync)?;

@@ -7,9 +7,8 @@
 
 use crate::cli::{Experiment, Workgroup};
 use crate::shader::post::{
-    float_controls_spirv, no_contraction_spirv, precise_float_locals_glsl,
-    restrict_resources_glsl, strip_local_array_zero_init_glsl, strip_local_array_zero_init_spirv,
-    warp_probe_glsl,
+    float_controls_spirv, no_contraction_spirv, precise_float_locals_glsl, restrict_resources_glsl,
+    strip_local_array_zero_init_glsl, strip_local_array_zero_init_spirv, warp_probe_glsl,
 };
 use crate::shader::variant::{Variant, SPEC_CONSTANTS};
 use anyhow::{anyhow, Context};
@@ -311,13 +310,12 @@ pub fn to_glsl(
     } else {
         out
     };
-    let out = if stage == ShaderStage::Compute
-        && variant.experiments.contains(&Experiment::WarpProbe)
-    {
-        warp_probe_glsl(&out, crate::gpu::layout::binding::WARP_PROBE)?
-    } else {
-        out
-    };
+    let out =
+        if stage == ShaderStage::Compute && variant.experiments.contains(&Experiment::WarpProbe) {
+            warp_probe_glsl(&out, crate::gpu::layout::binding::WARP_PROBE)?
+        } else {
+            out
+        };
     Ok(
         if variant.experiments.contains(&Experiment::NoContraction) {
             precise_float_locals_glsl(&out)

@@ -411,7 +411,8 @@ mod tests {
         assert_eq!(lines[0], "#version 450 core");
         assert_eq!(lines[1], "#extension GL_NV_shader_thread_group : require");
         let main = lines.iter().position(|l| *l == "void main() {").unwrap();
-        assert!(lines[main + 1].contains("atomicMax(warp_probe.slots[uint(gl_SMIDNV)], uint(gl_WarpIDNV) + 1u)"));
+        assert!(lines[main + 1]
+            .contains("atomicMax(warp_probe.slots[uint(gl_SMIDNV)], uint(gl_WarpIDNV) + 1u)"));
         assert!(out.contains("layout(std430, binding = 11) buffer WarpProbe"));
         assert!(warp_probe_glsl("void main() {\n}\n", 11).is_err());
     }

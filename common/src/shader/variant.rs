@@ -155,8 +155,7 @@ impl Variant {
         {
             v.defines.insert("BVH_STACK_UNPAIRED".into(), "1".into());
         }
-        if v.defines.contains_key("USE_BVH") && v.experiments.contains(&Experiment::LocalBvhStack)
-        {
+        if v.defines.contains_key("USE_BVH") && v.experiments.contains(&Experiment::LocalBvhStack) {
             v.defines.insert("BVH_STACK_LOCAL".into(), "1".into());
         }
         if v.experiments.contains(&Experiment::SplitRayStack) {
