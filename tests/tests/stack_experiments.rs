@@ -1,0 +1,206 @@
+//! The measurements that came with OpenGL's compute path reaching all of an
+//! H100's multiprocessors (comparison/results/nvidia-h100/FINDINGS.md, "Local
+//! memory and OpenGL's multiprocessors") change only where the tracer keeps
+//! what it stores, or what the driver is told: on lavapipe and llvmpipe each
+//! renders the default image bit for bit, with the validation layer / GL debug
+//! context silent. `local-bvh-stack` and `split-ray-stack` put back the old
+//! stacks, `naga-aliasing` naga's declarations without `restrict`,
+//! `robust-access` bounds-checked buffers, `--shared-pad` unused workgroup
+//! memory, and `--gl-spirv` loads the SPIR-V that `Restrict` now decorates.
+//! Every run that cannot honour one exits 2 with one sentence saying why, and
+//! `--dump-shaders` with `--gl-spirv` no longer crashes Mesa.
+
+use twinray_tests::{fail, render, run, scratch, App};
+
+/// One measurement: what it adds to the command line, what the run it is
+/// compared with adds (nothing: the default), and whether it exists on the
+/// compute path only.
+struct Variant {
+    args: &'static [&'static str],
+    base: &'static [&'static str],
+    compute_only: bool,
+}
+
+/// Each of `variants` against its base, for one scene, both APIs, both paths.
+fn same_image(scene: &str, size: &str, extra: &[&str], variants: &[Variant]) {
+    let dir = scratch(&format!("stack-experiments-{scene}"));
+    for app in App::BOTH {
+        for path in ["fragment", "compute"] {
+            for v in variants {
+                let opengl_only = [v.args, v.base]
+                    .concat()
+                    .iter()
+                    .any(|a| *a == "naga-aliasing" || *a == "--gl-spirv");
+                if (v.compute_only && path == "fragment")
+                    || (opengl_only && matches!(app, App::Vulkan))
+                {
+                    continue;
+                }
+                let base_args = [extra, &["--path", path], v.base].concat();
+                let (_, base) = render(app, scene, size, &base_args, &dir.join("base.png"));
+                let args = [extra, &["--path", path], v.args].concat();
+                let (report, img) = render(app, scene, size, &args, &dir.join("variant.png"));
+                assert_eq!(
+                    report.validation_messages, 0,
+                    "{scene} {app:?} {path} {:?}: validation messages",
+                    v.args
+                );
+                let differing = img
+                    .pixels()
+                    .zip(base.pixels())
+                    .filter(|(a, b)| a != b)
+                    .count();
+                assert_eq!(
+                    differing, 0,
+                    "{scene} {app:?} {path} {:?} against {:?}: {differing} pixels differ",
+                    v.args, v.base
+                );
+            }
+        }
+    }
+    std::fs::remove_dir_all(dir).ok();
+}
+
+const fn everywhere(args: &'static [&'static str]) -> Variant {
+    Variant {
+        args,
+        base: &[],
+        compute_only: false,
+    }
+}
+
+const VARIANTS: &[Variant] = &[
+    everywhere(&[
+        "--experiment",
+        "local-bvh-stack",
+        "--experiment",
+        "split-ray-stack",
+    ]),
+    everywhere(&["--experiment", "naga-aliasing"]),
+    everywhere(&["--experiment", "robust-access"]),
+    // Mesa's GLSL and SPIR-V compilers may round a pixel differently (they
+    // did on the box before `Restrict` existed), so the SPIR-V with `Restrict`
+    // is held to the SPIR-V without it.
+    Variant {
+        args: &["--gl-spirv"],
+        base: &["--gl-spirv", "--experiment", "naga-aliasing"],
+        compute_only: false,
+    },
+    Variant {
+        args: &["--shared-pad", "8"],
+        base: &[],
+        compute_only: true,
+    },
+    Variant {
+        args: &["--workgroup", "16x16", "--shared-pad", "1"],
+        base: &["--workgroup", "16x16"],
+        compute_only: true,
+    },
+];
+
+/// The box has glass, so its ray stack holds several rays; odd sizes, so the
+/// compute path's edge workgroups are partial.
+#[test]
+fn box_bvh_renders_the_default_image_with_each_stack_and_declaration() {
+    same_image("box", "97x61", &["--accel", "bvh"], VARIANTS);
+}
+
+#[test]
+fn teapot_bvh_renders_the_default_image_with_each_stack_and_declaration() {
+    same_image("teapot", "65x49", &["--accel", "bvh"], VARIANTS);
+}
+
+/// Exit 2 and a stderr that contains `sentence`.
+fn refused(app: App, args: &[&str], sentence: &str) {
+    let (code, stderr) = fail(&app.exe(), args, &[]);
+    assert_eq!(code, 2, "{app:?} {args:?}: exit code (stderr: {stderr})");
+    assert!(
+        stderr.contains(sentence),
+        "{app:?} {args:?}: stderr must say '{sentence}', got: {stderr}"
+    );
+}
+
+#[test]
+fn runs_that_cannot_honour_a_measurement_refuse_it() {
+    let compute = ["--headless", "--size", "32x24", "--path", "compute"];
+    let with = |extra: &[&'static str]| [&compute[..], extra].concat();
+    refused(
+        App::Vulkan,
+        &with(&["--experiment", "naga-aliasing"]),
+        "--experiment naga-aliasing is OpenGL only",
+    );
+    refused(
+        App::Vulkan,
+        &with(&["--experiment", "warp-probe"]),
+        "--experiment warp-probe is OpenGL only",
+    );
+    // Mesa has no GL_NV_shader_thread_group: refused before the compile.
+    refused(
+        App::OpenGl,
+        &with(&["--experiment", "warp-probe"]),
+        "--experiment warp-probe needs GL_NV_shader_thread_group",
+    );
+    refused(
+        App::OpenGl,
+        &with(&["--experiment", "warp-probe", "--gl-spirv"]),
+        "--gl-spirv with --experiment warp-probe",
+    );
+    refused(
+        App::OpenGl,
+        &["--headless", "--experiment", "warp-probe"],
+        "--experiment warp-probe applies to --path compute only",
+    );
+    for app in App::BOTH {
+        refused(
+            app,
+            &["--headless", "--shared-pad", "8"],
+            "--shared-pad applies to --path compute only",
+        );
+        for kib in ["0", "33", "eight"] {
+            refused(app, &with(&["--shared-pad", kib]), "--shared-pad");
+        }
+        // Refused before any window opens: no display is needed to see it.
+        refused(
+            app,
+            &["--experiment", "robust-access"],
+            "--experiment robust-access is a headless measurement; run it with --headless",
+        );
+    }
+}
+
+/// Mesa 22.3's glGetProgramBinary crashed on a program linked from SPIR-V; the
+/// app no longer asks it for one, and says so in the statistics.
+#[test]
+fn dumping_a_spirv_program_on_mesa_says_what_it_cannot_save() {
+    let dir = scratch("stack-experiments-dump");
+    for path in ["fragment", "compute"] {
+        let dump = dir.join(path);
+        let dump_s = dump.to_str().unwrap();
+        let o = run(
+            &App::OpenGl.exe(),
+            &[
+                "--headless",
+                "--size",
+                "32x24",
+                "--gl-spirv",
+                "--path",
+                path,
+                "--dump-shaders",
+                dump_s,
+            ],
+            &[],
+        );
+        assert!(
+            o.status.success(),
+            "{path}: {} {}",
+            o.status,
+            String::from_utf8_lossy(&o.stderr)
+        );
+        let stats = std::fs::read_to_string(dump.join("statistics.json")).unwrap();
+        assert!(
+            stats.contains("Mesa cannot save a SPIR-V program's binary"),
+            "{path}: {stats}"
+        );
+    }
+    std::fs::remove_dir_all(dir).ok();
+}
