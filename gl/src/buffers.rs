@@ -1,5 +1,7 @@
 //! The scene on the GPU: the `Frame` uniform buffer and the four storage
-//! buffers, uploaded once from the bytes `common` builds for both APIs.
+//! buffers, uploaded once from the bytes `common` builds for both APIs; and
+//! the storage buffers a shader writes for the app to read back once (the ray
+//! counts, the warp probe).
 
 use anyhow::{anyhow, Context as _};
 use glow::HasContext;
@@ -81,5 +83,59 @@ impl Drop for SceneBuffers<'_> {
             // GL keeps it alive for draws already issued.
             unsafe { self.gl.delete_buffer(b) }
         }
+    }
+}
+
+/// A zeroed storage buffer bound at one binding, which a shader writes and the
+/// app reads back once; deleted on drop.
+pub struct ReadbackBuffer<'gl> {
+    gl: &'gl glow::Context,
+    buffer: glow::Buffer,
+    bytes: usize,
+}
+
+impl<'gl> ReadbackBuffer<'gl> {
+    /// `what` names it in errors (`glCreateBuffer (what)`).
+    pub fn new(
+        gl: &'gl glow::Context,
+        index: u32,
+        bytes: usize,
+        what: &str,
+    ) -> anyhow::Result<ReadbackBuffer<'gl>> {
+        let zeros = vec![0u8; bytes];
+        // SAFETY: a fresh buffer on the current context; `zeros` is copied by the driver.
+        unsafe {
+            let buffer = gl
+                .create_buffer()
+                .map_err(|e| anyhow!(e))
+                .with_context(|| format!("glCreateBuffer ({what})"))?;
+            gl.bind_buffer(glow::SHADER_STORAGE_BUFFER, Some(buffer));
+            // Written by the GPU, read back once.
+            gl.buffer_data_u8_slice(glow::SHADER_STORAGE_BUFFER, &zeros, glow::DYNAMIC_READ);
+            gl.bind_buffer_base(glow::SHADER_STORAGE_BUFFER, index, Some(buffer));
+            Ok(ReadbackBuffer { gl, buffer, bytes })
+        }
+    }
+
+    /// The contents as the shader left them.
+    pub fn read(&self) -> Vec<u8> {
+        let mut bytes = vec![0u8; self.bytes];
+        // SAFETY: the buffer holds exactly `self.bytes`; the barrier orders the
+        // shader's writes before the read.
+        unsafe {
+            self.gl.memory_barrier(glow::BUFFER_UPDATE_BARRIER_BIT);
+            self.gl
+                .bind_buffer(glow::SHADER_STORAGE_BUFFER, Some(self.buffer));
+            self.gl
+                .get_buffer_sub_data(glow::SHADER_STORAGE_BUFFER, 0, &mut bytes);
+        }
+        bytes
+    }
+}
+
+impl Drop for ReadbackBuffer<'_> {
+    fn drop(&mut self) {
+        // SAFETY: created on this context, which outlives it.
+        unsafe { self.gl.delete_buffer(self.buffer) }
     }
 }

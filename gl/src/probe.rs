@@ -5,7 +5,8 @@
 //! reports no register count, so this is how its occupancy is seen; Vulkan's
 //! follows from the register count in its pipeline statistics.
 
-use anyhow::{anyhow, bail, Context as _};
+use crate::buffers::ReadbackBuffer;
+use anyhow::bail;
 use glow::HasContext;
 use twinray_common::gpu::layout::binding;
 
@@ -13,8 +14,7 @@ use twinray_common::gpu::layout::binding;
 const SLOTS: usize = 4096;
 
 pub struct WarpProbe<'gl> {
-    gl: &'gl glow::Context,
-    buffer: glow::Buffer,
+    buffer: ReadbackBuffer<'gl>,
 }
 
 impl<'gl> WarpProbe<'gl> {
@@ -29,37 +29,13 @@ impl<'gl> WarpProbe<'gl> {
                 "--experiment warp-probe needs GL_NV_shader_thread_group (NVIDIA's OpenGL driver), which this driver lacks",
             ));
         }
-        let zeros = vec![0u8; SLOTS * 4];
-        // SAFETY: a fresh buffer on the current context; `zeros` is copied by the driver.
-        unsafe {
-            let buffer = gl
-                .create_buffer()
-                .map_err(|e| anyhow!(e))
-                .context("glCreateBuffer (warp probe)")?;
-            gl.bind_buffer(glow::SHADER_STORAGE_BUFFER, Some(buffer));
-            gl.buffer_data_u8_slice(glow::SHADER_STORAGE_BUFFER, &zeros, glow::DYNAMIC_READ);
-            gl.bind_buffer_base(
-                glow::SHADER_STORAGE_BUFFER,
-                binding::WARP_PROBE,
-                Some(buffer),
-            );
-            Ok(WarpProbe { gl, buffer })
-        }
+        let buffer = ReadbackBuffer::new(gl, binding::WARP_PROBE, SLOTS * 4, "warp probe")?;
+        Ok(WarpProbe { buffer })
     }
 
     /// One sentence: the multiprocessors seen and their highest warp slots.
     pub fn summary(&self) -> anyhow::Result<String> {
-        let mut bytes = vec![0u8; SLOTS * 4];
-        // SAFETY: the buffer holds SLOTS words; the barrier orders the
-        // shader's atomics before the read.
-        unsafe {
-            self.gl.memory_barrier(glow::BUFFER_UPDATE_BARRIER_BIT);
-            self.gl
-                .bind_buffer(glow::SHADER_STORAGE_BUFFER, Some(self.buffer));
-            self.gl
-                .get_buffer_sub_data(glow::SHADER_STORAGE_BUFFER, 0, &mut bytes);
-        }
-        let words: Vec<u32> = bytemuck::pod_collect_to_vec(&bytes);
+        let words: Vec<u32> = bytemuck::pod_collect_to_vec(&self.buffer.read());
         let mut seen: Vec<u32> = words.into_iter().filter(|&w| w > 0).collect();
         if seen.is_empty() {
             bail!("--experiment warp-probe: no invocation wrote the probe buffer");
@@ -72,12 +48,5 @@ impl<'gl> WarpProbe<'gl> {
             seen[seen.len() / 2],
             seen[seen.len() - 1]
         ))
-    }
-}
-
-impl Drop for WarpProbe<'_> {
-    fn drop(&mut self) {
-        // SAFETY: created on this context, which outlives it.
-        unsafe { self.gl.delete_buffer(self.buffer) }
     }
 }

@@ -155,6 +155,17 @@ pub fn fail(program: &Path, args: &[&str], env: &[(&str, &str)]) -> (i32, String
     (o.status.code().unwrap_or(-1), stderr)
 }
 
+/// Runs `app` with `args` and expects a refusal: exit 2 and a stderr that
+/// contains `sentence`.
+pub fn refused(app: App, args: &[&str], sentence: &str) {
+    let (code, stderr) = fail(&app.exe(), args, &[]);
+    assert_eq!(code, 2, "{app:?} {args:?}: exit code (stderr: {stderr})");
+    assert!(
+        stderr.contains(sentence),
+        "{app:?} {args:?}: stderr must say '{sentence}', got: {stderr}"
+    );
+}
+
 /// A private X server for one windowed test (Debian's `xvfb`; tests/run.sh
 /// installs it). `-displayfd` lets Xvfb pick a free display number itself, so
 /// tests running in parallel never collide. `-fbdir` keeps the screen in a

@@ -8,7 +8,7 @@
 //! `compute-queue`) exits 2 with one sentence saying why.
 
 use twinray_common::reference::metrics::compare;
-use twinray_tests::{fail, render, scratch, App};
+use twinray_tests::{refused, render, scratch, App};
 
 /// Odd sizes, so that the quad's diagonal crosses pixel centres unevenly and
 /// no row or column is a multiple of anything.
@@ -67,16 +67,6 @@ fn same_image(scene: &str, size: &str, extra: &[&str]) {
 #[test]
 fn box_renders_the_default_image_with_each_experiment() {
     same_image("box", "161x121", &[]);
-}
-
-/// Exit 2 and a stderr that contains `sentence`.
-fn refused(app: App, args: &[&str], sentence: &str) {
-    let (code, stderr) = fail(&app.exe(), args, &[]);
-    assert_eq!(code, 2, "{app:?} {args:?}: exit code (stderr: {stderr})");
-    assert!(
-        stderr.contains(sentence),
-        "{app:?} {args:?}: stderr must say '{sentence}', got: {stderr}"
-    );
 }
 
 #[test]

@@ -10,7 +10,7 @@
 //! Every run that cannot honour one exits 2 with one sentence saying why, and
 //! `--dump-shaders` with `--gl-spirv` no longer crashes Mesa.
 
-use twinray_tests::{fail, render, run, scratch, App};
+use twinray_tests::{refused, render, run, scratch, App};
 
 /// One measurement: what it adds to the command line, what the run it is
 /// compared with adds (nothing: the default), and whether it exists on the
@@ -108,16 +108,6 @@ fn box_bvh_renders_the_default_image_with_each_stack_and_declaration() {
 #[test]
 fn teapot_bvh_renders_the_default_image_with_each_stack_and_declaration() {
     same_image("teapot", "65x49", &["--accel", "bvh"], VARIANTS);
-}
-
-/// Exit 2 and a stderr that contains `sentence`.
-fn refused(app: App, args: &[&str], sentence: &str) {
-    let (code, stderr) = fail(&app.exe(), args, &[]);
-    assert_eq!(code, 2, "{app:?} {args:?}: exit code (stderr: {stderr})");
-    assert!(
-        stderr.contains(sentence),
-        "{app:?} {args:?}: stderr must say '{sentence}', got: {stderr}"
-    );
 }
 
 #[test]
