@@ -469,6 +469,27 @@ mod tests {
     }
 
     #[test]
+    fn opengl_spirv_marks_every_resource_restrict() {
+        let s = build(&Variant::generic(Default::default())).unwrap();
+        let decorations = |w: &[u32], decoration: u32| {
+            crate::shader::post::spirv_instructions(w)
+                .filter(|i| i[0] & 0xffff == 71 && i.len() >= 3 && i[2] == decoration)
+                .count()
+        };
+        // Each of the five set-0 resources, and nothing else, is decorated Restrict.
+        let gl = spirv_for_opengl(&s.fragment_spirv, true);
+        assert_eq!(
+            decorations(&s.fragment_spirv, 19),
+            0,
+            "Vulkan's SPIR-V is naga's"
+        );
+        assert_eq!(decorations(&gl, 19), decorations(&s.fragment_spirv, 34));
+        assert_eq!(decorations(&gl, 19), 5);
+        let plain = spirv_for_opengl(&s.fragment_spirv, false);
+        assert_eq!(decorations(&plain, 19), 0);
+    }
+
+    #[test]
     fn spirv_for_opengl_drops_sets_and_flips_origin_only() {
         let s = build(&Variant::generic(Default::default())).unwrap();
         let gl = spirv_for_opengl(&s.fragment_spirv, false);

@@ -63,7 +63,7 @@ pub fn strip_local_array_zero_init_spirv(words: &[u32]) -> Vec<u32> {
 
 /// The instructions of a SPIR-V module after its 5-word header; a malformed
 /// tail is returned as one last slice so nothing is lost.
-fn spirv_instructions(words: &[u32]) -> impl Iterator<Item = &[u32]> {
+pub(crate) fn spirv_instructions(words: &[u32]) -> impl Iterator<Item = &[u32]> {
     let mut i = 5.min(words.len());
     std::iter::from_fn(move || {
         if i >= words.len() {
