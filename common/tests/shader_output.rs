@@ -153,21 +153,39 @@ fn trace_glsl_initialises_no_array_itself() {
     }
 }
 
-/// shaders/trace.glsl is the single tracer external compilers take, and the
-/// parts are what people edit: the two must say the same.
+/// The apps compile what is on disk: every file of shaders/trace/ is a part,
+/// and the tracer the build embeds is those files, read now, in their order.
 #[test]
-fn trace_glsl_is_its_parts_assembled() {
-    let expected = build::assemble_tracer();
-    if build::TRACE_GLSL == expected {
-        return;
+fn the_tracer_is_the_parts_on_disk() {
+    let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../shaders/trace");
+    let mut on_disk: Vec<String> = std::fs::read_dir(&dir)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .filter(|n| n.ends_with(".glsl"))
+        .collect();
+    on_disk.sort();
+    let mut listed: Vec<String> = build::TRACE_PARTS
+        .iter()
+        .map(|(n, _)| n.to_string())
+        .collect();
+    listed.sort();
+    assert_eq!(
+        on_disk, listed,
+        "every part in shaders/trace/ is in TRACE_PARTS"
+    );
+    let mut expected = String::new();
+    for (name, embedded) in build::TRACE_PARTS {
+        let text = std::fs::read_to_string(dir.join(name)).unwrap();
+        assert_eq!(
+            embedded, text,
+            "{name}: TRACE_PARTS holds the file as it is"
+        );
+        expected.push_str(&text);
     }
-    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../shaders/trace.glsl");
-    if std::env::var("TWINRAY_UPDATE_DOCS").is_ok_and(|v| v == "1") {
-        std::fs::write(&path, &expected).unwrap();
-        return;
-    }
-    panic!(
-        "shaders/trace.glsl differs from shaders/trace/*.glsl put together; run\n  TWINRAY_UPDATE_DOCS=1 cargo test --release -p twinray-common --test shader_output"
+    let body = build::TRACE_GLSL.split_once('\n').unwrap().1;
+    assert_eq!(
+        body, expected,
+        "TRACE_GLSL concatenates the parts in TRACE_PARTS's order"
     );
 }
 

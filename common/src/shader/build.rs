@@ -17,8 +17,8 @@ use naga::valid::{Capabilities, ModuleInfo, ValidationFlags, Validator};
 use naga::{Module, ShaderStage};
 
 /// The tracer's parts, in reading order (shaders/trace/loop.glsl lists what
-/// each holds). naga has no `#include`, so [`assemble_tracer`] puts them
-/// together, here and nowhere else.
+/// each holds). naga has no `#include`, so the build puts them together here,
+/// at compile time: editing a part and rebuilding changes what the apps run.
 pub const TRACE_PARTS: [(&str, &str); 6] = [
     (
         "inputs.glsl",
@@ -40,23 +40,20 @@ pub const TRACE_PARTS: [(&str, &str); 6] = [
     ),
 ];
 
-/// The first line of shaders/trace.glsl, which says where it comes from.
-pub const ASSEMBLED_HEADER: &str =
-    "// trace.glsl — the one Whitted-style tracer, assembled from shaders/trace/*.glsl \
-(edit those; a test regenerates this file with TWINRAY_UPDATE_DOCS=1).\n";
-
-/// shaders/trace.glsl as the parts make it: the header line, then each part.
-pub fn assemble_tracer() -> String {
-    let mut s = String::from(ASSEMBLED_HEADER);
-    for (_, part) in TRACE_PARTS {
-        s.push_str(part);
-    }
-    s
-}
-
-/// The single tracer every variant, both APIs and both paths start from, and
-/// the file an external compiler can take as it is (with an entry point).
-pub const TRACE_GLSL: &str = include_str!("../../../shaders/trace.glsl");
+/// The single tracer every variant, both APIs and both paths start from: the
+/// parts of [`TRACE_PARTS`] concatenated by the compiler (`concat!` of the same
+/// files), so there is no checked-in copy to fall out of step. `--dump-shaders`
+/// writes it, with a run's defines and entry point, as one file an external
+/// compiler takes (`shader_source`).
+pub const TRACE_GLSL: &str = concat!(
+    "// The one Whitted-style tracer, put together from shaders/trace/*.glsl by common/src/shader/build.rs.\n",
+    include_str!("../../../shaders/trace/inputs.glsl"),
+    include_str!("../../../shaders/trace/intersect.glsl"),
+    include_str!("../../../shaders/trace/bvh.glsl"),
+    include_str!("../../../shaders/trace/hit.glsl"),
+    include_str!("../../../shaders/trace/secondary.glsl"),
+    include_str!("../../../shaders/trace/loop.glsl"),
+);
 pub const TRACE_FRAG: &str = include_str!("../../../shaders/trace.frag");
 pub const FULLSCREEN_VERT: &str = include_str!("../../../shaders/fullscreen.vert");
 pub const TRACE_COMP: &str = include_str!("../../../shaders/trace.comp");
