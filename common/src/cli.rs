@@ -5,6 +5,7 @@
 //! can set them for every run). Everything is parsed once, in `main`.
 
 use crate::error::bad_input;
+use crate::lab::experiment::Experiment;
 use crate::scene::accel::Accel;
 use crate::value_name::ValueName;
 use clap::builder::{PossibleValue, TypedValueParser};
@@ -43,21 +44,21 @@ pub struct RenderArgs {
     /// Vulkan: require validation layers and fail on any message. OpenGL: debug context, fail on any error.
     #[arg(long)]
     pub validate: bool,
-    /// Render with the all-features shader instead of the scene's own variant.
-    #[arg(long)]
+    /// Laboratory (docs/experiments.md): the all-features shader instead of the scene's own variant.
+    #[arg(long, hide = true)]
     pub generic: bool,
     /// Render with one shader for every scene whose feature switches are
     /// specialization constants set to this scene's features (fixed by naga's
     /// process_overrides), instead of the scene's own variant of defines.
-    #[arg(long, conflicts_with = "generic")]
+    #[arg(long, conflicts_with = "generic", hide = true)]
     pub specialize: bool,
     /// Acceleration structure: auto (a BVH for scenes with many primitives), none (test
     /// every primitive, as the 2018 study did) or bvh.
     #[arg(long, value_enum, default_value_t = Accel::Auto)]
     pub accel: Accel,
-    /// OpenGL only: load naga's SPIR-V through GL_ARB_gl_spirv instead of naga's GLSL,
+    /// Laboratory, OpenGL only: load naga's SPIR-V through GL_ARB_gl_spirv instead of naga's GLSL,
     /// so that both APIs run the very same shader binary (isolates the compiler path).
-    #[arg(long)]
+    #[arg(long, hide = true)]
     pub gl_spirv: bool,
     /// Windowed: wait for the display's refresh (Vulkan FIFO, OpenGL swap interval 1).
     /// Without it the frame rate is uncapped (MAILBOX or IMMEDIATE, swap interval 0).
@@ -78,90 +79,22 @@ pub struct RenderArgs {
     /// memory that the tracer does not need (each invocation writes and reads
     /// one word of it), to see how the driver's split of each multiprocessor's
     /// memory between shared memory and L1 cache, and its occupancy, move the time.
-    #[arg(long, value_name = "KIB", value_parser = clap::value_parser!(u32).range(1..=32))]
+    #[arg(long, value_name = "KIB", value_parser = clap::value_parser!(u32).range(1..=32), hide = true)]
     pub shared_pad: Option<u32>,
-    /// For experiments only (repeatable): put back a cost the shader build
-    /// removes, or move the compute path's BVH stack, to measure its effect.
-    #[arg(long, value_enum, value_name = "NAME")]
+    /// Laboratory (repeatable): one experiment of docs/experiments.md, which
+    /// puts back a cost the build removes (or moves one) to measure its effect.
+    #[arg(long, value_enum, value_name = "NAME", hide = true)]
     pub experiment: Vec<Experiment>,
+    /// Print the laboratory's page (its experiments and measurement options,
+    /// docs/experiments.md) and exit.
+    #[arg(long)]
+    pub experiments: bool,
     /// Write the shaders this run compiles (naga's SPIR-V and GLSL) and what
     /// the driver reports of them (OpenGL's program binary, Vulkan's pipeline
     /// executable statistics where offered) into this folder.
     #[arg(long, value_name = "DIR")]
     pub dump_shaders: Option<PathBuf>,
 }
-/// Knobs that put back what the build normally removes, so that each removal's
-/// effect can be measured in both APIs (`--experiment`, for the comparison's
-/// investigation; never needed to render correctly).
-#[derive(
-    Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Hash, clap::ValueEnum, serde::Serialize,
-)]
-#[serde(rename_all = "kebab-case")]
-pub enum Experiment {
-    /// Keep naga's zero initialisers on function-local arrays.
-    NagaZeroInit,
-    /// Keep naga's loop bounding (a 64-bit counter in every SPIR-V loop) on the BVH variants too.
-    NagaLoopBounding,
-    /// Drop naga's loop bounding from the brute-force variants too.
-    NoLoopBounding,
-    /// Compute path: put the BVH stack in shared memory wherever it fits (the default keeps it local).
-    SharedBvhStack,
-    /// One BVH stack entry per array element (uvec2) instead of two per uvec4.
-    UnpairedBvhStack,
-    /// A BVH stack local to each walk (closest hit, any hit) instead of one
-    /// at module scope that both share.
-    LocalBvhStack,
-    /// The ray stack as four arrays (origin, direction, weight, depth)
-    /// instead of two of vec4 pairs.
-    SplitRayStack,
-    /// Read the primitive and light counts from a storage buffer instead of
-    /// baking them into the shader.
-    StorageCounts,
-    /// Read the primitive and light counts from the Frame uniform instead of
-    /// baking them into the shader (what made lavapipe grow per frame).
-    UniformCounts,
-    /// Forbid the driver to fuse or reassociate float arithmetic: a
-    /// `NoContraction` decoration on every float operation of the SPIR-V and
-    /// `precise` on every float local of the GLSL.
-    NoContraction,
-    /// SPIR-V only: ask for IEEE behaviour the driver may otherwise relax
-    /// (SPV_KHR_float_controls: denormals preserved, signed zero, Inf and NaN
-    /// preserved), to see whether Vulkan's defaults explain its pixels.
-    FloatControls,
-    /// The SPIR-V (what Vulkan runs) from Khronos' reference compiler,
-    /// glslangValidator (on PATH; Debian's glslang-tools), given the same
-    /// GLSL and defines, instead of from naga.
-    Glslang,
-    /// Fragment path: the fullscreen pass as two triangles (6 vertices)
-    /// instead of one oversized triangle.
-    Quad,
-    /// Fragment path: clear the colour target at the start of the pass
-    /// (Vulkan: load op CLEAR instead of DONT_CARE; OpenGL: glClear before the draw).
-    LoadClear,
-    /// Fragment path: an RGBA8 UNORM render target instead of RGBA32F (the
-    /// GPU rounds to 8 bits; the PNG stays within 1/255).
-    Rgba8,
-    /// Vulkan, compute path: dispatch on a queue family with COMPUTE but not
-    /// GRAPHICS (refused where the device has none, and by OpenGL).
-    ComputeQueue,
-    /// Vulkan, fragment path: the viewport and scissor as dynamic state set
-    /// in the command buffer (as OpenGL always has them) instead of baked
-    /// into the pipeline.
-    DynamicViewport,
-    /// OpenGL: naga's buffer and image declarations as naga writes them,
-    /// without the `restrict` (GLSL) or `Restrict` (SPIR-V) that tells the
-    /// driver no two of them alias, which Vulkan's SPIR-V assumes anyway.
-    NagaAliasing,
-    /// Both APIs: bounds-checked buffer access (Vulkan's robustBufferAccess
-    /// feature; OpenGL a robust-access context).
-    RobustAccess,
-    /// OpenGL, compute path, NVIDIA: record the highest warp slot in use on
-    /// each multiprocessor (GL_NV_shader_thread_group's gl_WarpIDNV), the
-    /// occupancy that OpenGL's driver does not report; Vulkan's follows from
-    /// its pipeline statistics' register count.
-    WarpProbe,
-}
-
 /// The tracer's entry point: the two ways one GLSL tracer reaches the GPU.
 #[derive(
     Debug,
@@ -304,6 +237,7 @@ impl RenderArgs {
             workgroup: None,
             shared_pad: None,
             experiment: Vec::new(),
+            experiments: false,
             dump_shaders: None,
         }
     }
@@ -342,16 +276,6 @@ impl RenderArgs {
             crate::reference::image_io::check_output_file("--out", out)?;
         }
         Ok(())
-    }
-
-    /// Loads the scene named by `--scene` with the `--set` overrides applied.
-    /// Every run (headless, windowed, reference) loads its scene before any GPU
-    /// work, so the output paths are checked here too.
-    pub fn load_scene(&self) -> anyhow::Result<crate::scene::Scene> {
-        self.check_outputs()?;
-        let mut scene = crate::scene::Scene::load(&self.scene, &self.overrides()?)?;
-        scene.set_accel(self.accel);
-        Ok(scene)
     }
 }
 
@@ -407,7 +331,8 @@ pub struct VulkanKnobs {
         env = "TWINRAY_VK_MEMORY",
         value_enum,
         value_parser = named_in_env(clap::builder::EnumValueParser::<SceneMemory>::new()),
-        default_value_t = SceneMemory::Device
+        default_value_t = SceneMemory::Device,
+        hide = true
     )]
     pub memory: SceneMemory,
     /// Turn the validation layer on without failing on its messages (with a
@@ -425,7 +350,8 @@ pub struct VulkanKnobs {
         env = "TWINRAY_VK_WAIT",
         value_enum,
         value_parser = named_in_env(clap::builder::EnumValueParser::<FrameWait>::new()),
-        default_value_t = FrameWait::Fence
+        default_value_t = FrameWait::Fence,
+        hide = true
     )]
     pub wait: FrameWait,
 }
@@ -533,6 +459,7 @@ impl<P: TypedValueParser> TypedValueParser for NamedInEnv<P> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::lab::experiment::Experiment;
     use crate::scene::numerics::{Offset, SphereTest, TriangleTest};
     use crate::scene::OriginMode;
 

@@ -20,9 +20,10 @@
 pub mod cli;
 pub mod error;
 pub mod explain;
-pub mod fragment_pass;
 pub mod gpu;
+pub mod lab;
 pub mod limits;
+pub mod plan;
 pub mod rays;
 pub mod reference;
 pub mod report;

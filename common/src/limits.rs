@@ -173,3 +173,19 @@ mod tests {
         assert!(check_storage_bytes("t", MAX_TRIANGLES + 1, size_of::<GpuTriangle>()).is_err());
     }
 }
+
+/// The largest storage buffer a run may bind, and the name of the limit that
+/// sets it: the device's own once there is one, twinray's otherwise.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct StorageLimit {
+    pub bytes: u64,
+    pub name: &'static str,
+}
+
+impl StorageLimit {
+    /// No device: only twinray's own limit (the f64 reference, the tests).
+    pub const ANY: StorageLimit = StorageLimit {
+        bytes: MAX_STORAGE_BUFFER_BYTES,
+        name: "twinray's storage-buffer limit",
+    };
+}

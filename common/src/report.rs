@@ -4,6 +4,7 @@
 use crate::cli::{RenderPath, Workgroup};
 use crate::rays::{grays_per_s, RateClock, RayCounts, RayKinds};
 use crate::scene::SceneStats;
+use crate::shader::build::Stage;
 use crate::stats::{summarize, Summary};
 use serde::{Deserialize, Serialize};
 
@@ -58,6 +59,10 @@ pub struct RunReport {
     pub grays_per_s: Option<f64>,
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub grays_clock: Option<RateClock>,
+    /// Where the run traced through a BVH: how long building it took, a step
+    /// of the setup of its own (absent without a BVH).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub bvh_ms: Option<f64>,
 }
 
 /// One compiled stage and the figures its driver gives for it, as the driver
@@ -119,6 +124,7 @@ impl RunReport {
                 rays: None,
                 grays_per_s: None,
                 grays_clock: None,
+                bvh_ms: None,
             },
         }
     }
@@ -195,6 +201,12 @@ impl RunReportBuilder {
         self
     }
 
+    /// The BVH's build time, where the run built one.
+    pub fn bvh_ms(mut self, ms: Option<f64>) -> Self {
+        self.report.bvh_ms = ms;
+        self
+    }
+
     /// The report, with its summaries filled from the frames.
     pub fn build(mut self) -> RunReport {
         self.report.summarise();
@@ -204,21 +216,63 @@ impl RunReportBuilder {
 
 /// Writes what `--dump-shaders DIR` promises of naga's output: the SPIR-V and
 /// the GLSL of each stage this run compiled, named `<stage>.spv` and
-/// `<stage>.glsl` (the apps add what their driver reports).
-pub fn dump_shaders(dir: &std::path::Path, stages: &[(&str, &[u32], &str)]) -> anyhow::Result<()> {
+/// `<stage>.glsl`, and the source of each as one file an external compiler
+/// takes (`<stage>.source.glsl`: the variant's defines, then the tracer's parts
+/// put together). The apps add what their driver reports.
+pub fn dump_shaders(dir: &std::path::Path, stages: &[&Stage]) -> anyhow::Result<()> {
     use anyhow::Context;
     std::fs::create_dir_all(dir)
         .with_context(|| format!("--dump-shaders: cannot create '{}'", dir.display()))?;
-    for (stage, spirv, glsl) in stages {
+    for stage in stages {
         let write = |name: String, bytes: &[u8]| {
             let path = dir.join(name);
             std::fs::write(&path, bytes)
                 .with_context(|| format!("--dump-shaders: cannot write '{}'", path.display()))
         };
-        write(format!("{stage}.spv"), bytemuck::cast_slice(spirv))?;
-        write(format!("{stage}.glsl"), glsl.as_bytes())?;
+        write(
+            format!("{}.spv", stage.name),
+            bytemuck::cast_slice(&stage.spirv),
+        )?;
+        write(format!("{}.glsl", stage.name), stage.glsl.as_bytes())?;
+        write(
+            format!("{}.source.glsl", stage.name),
+            stage.source.as_bytes(),
+        )?;
     }
     Ok(())
+}
+
+/// The timed loop both apps run, one iteration = submit + wait, as the 2018
+/// study measured: `frame` submits and waits, the wall clock runs around it,
+/// then `gpu_ms` reads the GPU's own time of that frame. `setup_ms` runs from
+/// `started` (first thing in main) to the first frame. The first frame is an
+/// `--explain` step titled `title`.
+pub fn timed_frames(
+    count: u32,
+    started: std::time::Instant,
+    title: &str,
+    mut frame: impl FnMut() -> anyhow::Result<()>,
+    mut gpu_ms: impl FnMut() -> anyhow::Result<Option<f64>>,
+) -> anyhow::Result<(Vec<FrameTime>, f64)> {
+    let mut frames = Vec::with_capacity(count as usize);
+    let mut setup_ms = 0.0;
+    for i in 0..count {
+        let t0 = std::time::Instant::now();
+        if i == 0 {
+            setup_ms = (t0 - started).as_secs_f64() * 1e3;
+        }
+        frame()?;
+        let wall_ms = t0.elapsed().as_secs_f64() * 1e3;
+        let gpu_ms = gpu_ms()?;
+        frames.push(FrameTime { gpu_ms, wall_ms });
+        if i == 0 {
+            crate::explain::step(title, || {
+                let gpu = gpu_ms.map_or("no GPU time".into(), |g| format!("GPU {g:.3} ms"));
+                format!("wall {wall_ms:.3} ms, {gpu}; later frames repeat the same work")
+            });
+        }
+    }
+    Ok((frames, setup_ms))
 }
 
 /// Writes the driver's figures beside the dumped shaders as `statistics.json`.

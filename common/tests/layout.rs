@@ -243,24 +243,25 @@ fn every_builtin_variant_and_the_generic_one_compile_for_both_apis() {
             }
         }
     }
-    let mut bvh = twinray_common::scene::Scene::load("box", &[]).unwrap();
-    bvh.bvh = true;
-    variants.push(Variant::for_scene(&bvh));
+    let scene = twinray_common::scene::Scene::load("box", &[]).unwrap();
+    let bvh = twinray_common::plan::build_bvh(&scene);
+    variants.push(Variant::for_scene(&scene, Some(&bvh)));
     for (name, _) in twinray_common::scene::load::BUILTIN_SCENES {
         let scene = twinray_common::scene::Scene::load(name, &[]).unwrap();
-        variants.push(Variant::for_scene(&scene));
+        variants.push(Variant::for_scene(&scene, None));
     }
     for v in variants {
         let s = twinray_common::shader::build::build(&v)
             .unwrap_or_else(|e| panic!("{}: {e:#}", v.label()));
-        assert_eq!(s.fragment_spirv[0], 0x0723_0203, "SPIR-V magic");
+        assert_eq!(s.fragment.spirv[0], 0x0723_0203, "SPIR-V magic");
         assert!(
-            s.fragment_glsl.starts_with("#version 450 core"),
+            s.fragment.glsl.starts_with("#version 450 core"),
             "{}",
-            &s.fragment_glsl[..40]
+            &s.fragment.glsl[..40]
         );
         assert!(
-            s.fragment_glsl
+            s.fragment
+                .glsl
                 .contains("layout(std140, binding = 0) uniform"),
             "{}: UBO bound by number",
             v.label()
@@ -273,8 +274,7 @@ fn every_builtin_variant_and_the_generic_one_compile_for_both_apis() {
 #[test]
 fn the_bvh_encodings_match_rust() {
     let mut variant = Variant::generic(Default::default());
-    variant.defines.insert("USE_BVH".into(), "1".into());
-    variant.defines.insert("BVH_STACK".into(), "4".into());
+    variant.bvh_stack = Some(4);
     let module = parse(&fragment_source(), naga::ShaderStage::Fragment, &variant)
         .unwrap()
         .0;

@@ -5,7 +5,8 @@
 //! on either path; and trace.glsl itself gives no array an initialiser, so the
 //! post-passes only ever remove naga's.
 
-use twinray_common::cli::{Experiment, Workgroup};
+use twinray_common::cli::Workgroup;
+use twinray_common::plan::build_bvh;
 use twinray_common::scene::load::BUILTIN_SCENES;
 use twinray_common::scene::numerics::{Numerics, Offset, SphereTest, TriangleTest};
 use twinray_common::scene::Scene;
@@ -15,16 +16,16 @@ use twinray_common::shader::variant::Variant;
 fn variants() -> Vec<Variant> {
     let mut v = Vec::new();
     for (name, _) in BUILTIN_SCENES {
-        let mut scene = Scene::load(name, &[]).unwrap();
-        for bvh in [false, true] {
-            scene.bvh = bvh;
-            v.push(Variant::for_scene(&scene));
-            v.push(Variant::specialized(&scene));
+        let scene = Scene::load(name, &[]).unwrap();
+        let tree = build_bvh(&scene);
+        for bvh in [None, Some(&tree)] {
+            v.push(Variant::for_scene(&scene, bvh));
+            v.push(Variant::specialized(&scene, bvh));
         }
         // The BVH stacks local to each walk, and the ray stack as four arrays.
-        let mut local = Variant::for_scene(&scene);
-        local.defines.insert("BVH_STACK_LOCAL".into(), "1".into());
-        local.defines.insert("RAY_STACK_SPLIT".into(), "1".into());
+        let mut local = Variant::for_scene(&scene, Some(&tree));
+        local.knobs.local_bvh_stack = true;
+        local.knobs.split_ray_stack = true;
         v.push(local);
     }
     for offset in Offset::ALL {
@@ -91,8 +92,8 @@ fn no_local_array_keeps_an_initialiser() {
         let s = build::build(v).unwrap_or_else(|e| panic!("{}: {e:#}", v.label()));
         let c = build::build_compute(v, Workgroup::DEFAULT).unwrap();
         for (what, words, glsl) in [
-            ("fragment", &s.fragment_spirv, &s.fragment_glsl),
-            ("compute", &c.spirv, &c.glsl),
+            ("fragment", &s.fragment.spirv, &s.fragment.glsl),
+            ("compute", &c.stage.spirv, &c.stage.glsl),
         ] {
             assert_eq!(
                 initialised_local_arrays(words),
@@ -114,22 +115,21 @@ fn no_local_array_keeps_an_initialiser() {
 #[test]
 fn the_experiment_puts_the_initialisers_back() {
     // Proves the checks above can fail: naga's own output has them.
-    let mut scene = Scene::load("teapot", &[]).unwrap();
-    scene.bvh = true;
-    let mut v = Variant::for_scene(&scene);
-    v.experiments = vec![Experiment::NagaZeroInit];
+    let scene = Scene::load("teapot", &[]).unwrap();
+    let mut v = Variant::for_scene(&scene, Some(&build_bvh(&scene)));
+    v.passes.strip_zero_init = false;
     let s = build::build(&v).unwrap();
-    assert!(initialised_local_arrays(&s.fragment_spirv) > 0);
-    assert!(!initialised_glsl_arrays(&s.fragment_glsl).is_empty());
+    assert!(initialised_local_arrays(&s.fragment.spirv) > 0);
+    assert!(!initialised_glsl_arrays(&s.fragment.glsl).is_empty());
     // The module-scope BVH stack alone: the checks see a private array too.
-    v.defines.insert("STACK_SIZE".into(), "1".into());
+    v.ray_stack = 1;
     let s = build::build(&v).unwrap();
-    let module_scope: Vec<String> = initialised_glsl_arrays(&s.fragment_glsl)
+    let module_scope: Vec<String> = initialised_glsl_arrays(&s.fragment.glsl)
         .into_iter()
         .filter(|l| !l.starts_with(' '))
         .collect();
     assert_eq!(module_scope.len(), 1, "{module_scope:?}");
-    assert!(initialised_local_arrays(&s.fragment_spirv) > 0);
+    assert!(initialised_local_arrays(&s.fragment.spirv) > 0);
 }
 
 #[test]

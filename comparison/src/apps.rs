@@ -10,6 +10,7 @@ use twinray_common::cli::RenderArgs;
 use twinray_common::error::{bad_input, Failure, FailureKind};
 use twinray_common::report::{DeviceInfo, FrameTime, RunReport};
 use twinray_common::scene::accel::Accel;
+use twinray_common::scene::Scene;
 use twinray_common::value_name::ValueName;
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
@@ -107,6 +108,7 @@ pub fn app_args(args: &RenderArgs) -> Vec<String> {
         workgroup,
         shared_pad,
         experiment,
+        experiments: _,
         dump_shaders,
     } = args;
     let mut v = vec![
@@ -239,7 +241,8 @@ pub fn render_reference(args: &RenderArgs) -> anyhow::Result<()> {
     }
     // The reference takes the apps' options; one that cannot apply is refused as they refuse it.
     args.compute_workgroup()?;
-    let scene = args.load_scene()?;
+    args.check_outputs()?;
+    let scene = Scene::load(&args.scene, &args.overrides()?)?;
     let (w, h) = (args.size.width, args.size.height);
     let t = Instant::now();
     // --accel none: brute force, a reference independent of the BVH code.
@@ -327,7 +330,8 @@ mod tests {
     use super::app_args;
     use clap::Parser;
     use std::path::PathBuf;
-    use twinray_common::cli::{Experiment, RenderArgs, RenderPath, Size, VulkanCli, Workgroup};
+    use twinray_common::cli::{RenderArgs, RenderPath, Size, VulkanCli, Workgroup};
+    use twinray_common::lab::experiment::Experiment;
     use twinray_common::scene::accel::Accel;
 
     /// Every option away from its default, so that one the argv builder drops
@@ -358,6 +362,7 @@ mod tests {
             workgroup: Some(Workgroup { x: 8, y: 4 }),
             shared_pad: Some(24),
             experiment: vec![Experiment::NagaZeroInit, Experiment::UnpairedBvhStack],
+            experiments: false,
             dump_shaders: Some(PathBuf::from("dump")),
         }
     }

@@ -6,7 +6,8 @@
 //! reads them, so neither imports the other.
 
 use crate::apps::Api;
-use twinray_common::cli::{Experiment, RenderPath, Size};
+use twinray_common::cli::{RenderPath, Size};
+use twinray_common::lab::experiment::Experiment;
 use twinray_common::reference::metrics::Metrics;
 use twinray_common::report::RunReport;
 use twinray_common::scene::accel::Accel;

@@ -1,6 +1,13 @@
-//! One headless run, in the order of the Vulkan twin: scene and shader from
-//! `common`, context, limits, program, buffers, target, frame loop, readback,
-//! PNG and JSON.
+//! The run, top to bottom, with the same functions in the same order as the
+//! Vulkan twin (vk/src/app.rs): the options checked once (`Planner`), the
+//! context (OpenGL's instance and device in one), then the run plan from
+//! twinray-common (scene, BVH, shader variant, buffer bytes, checked against
+//! the context's limits), then every GL object the path needs, the timed frame
+//! loop, the readback, and the report.
+//!
+//! GL objects are deleted before the context they live in. Here each one is a
+//! local that deletes itself in `Drop`, and Rust drops locals in reverse order
+//! of creation, so on success and on every error path they go first.
 
 use crate::buffers::SceneBuffers;
 use crate::compute::Compute;
@@ -11,224 +18,57 @@ use crate::program::{self, EmptyVertexArray, Program};
 use crate::rays::count_rays;
 use crate::target::{self, Target};
 use crate::timer::Timer;
-use anyhow::anyhow;
+use anyhow::{anyhow, Result};
 use glow::HasContext;
 use std::time::Instant;
-use twinray_common::cli::{Experiment, OpenGlKnobs, RenderArgs, RenderPath};
-use twinray_common::error::bad_input;
+use twinray_common::cli::{OpenGlKnobs, RenderArgs, Workgroup};
 use twinray_common::explain;
-use twinray_common::fragment_pass::{check_experiments, FragmentPass};
-use twinray_common::gpu::upload::{check_storage_limit, GpuScene};
+use twinray_common::lab;
+use twinray_common::limits::StorageLimit;
+use twinray_common::plan::requests::Api;
+use twinray_common::plan::{Planner, RunPlan};
 use twinray_common::reference::image_io::FloatImage;
-use twinray_common::report::{dump_shaders, dump_statistics, FrameTime, RunReport};
-use twinray_common::shader::build::{build, build_compute, restricts_resources};
-use twinray_common::shader::variant::{CountingRun, Variant};
+use twinray_common::report::{
+    dump_shaders, dump_statistics, timed_frames, DeviceInfo, FrameTime, RunReport, ShaderStats,
+};
+use twinray_common::shader::build::{ComputeShader, PathShaders, Shaders};
+use twinray_common::shader::post::spirv_for_opengl;
 
 /// `started` is taken first thing in main, so `setup_ms` includes process,
 /// driver and shader start-up, as in the Vulkan app.
-// Long function: the OpenGL twin of vk's headless run, one block per step in the same order as vk/src/app.rs, so the two read side by side.
-pub fn run(args: RenderArgs, knobs: &OpenGlKnobs, started: Instant) -> anyhow::Result<()> {
+pub fn run(args: RenderArgs, knobs: &OpenGlKnobs, started: Instant) -> Result<()> {
+    if lab::print_page_if_asked(&args) {
+        return Ok(());
+    }
     if args.explain {
         explain::enable("twinray-gl", "OpenGL");
     }
-    check_experiments(&args, false)?;
+    let planner = Planner::new(&args, Api::OpenGl)?;
     if !args.headless {
-        if args.gl_spirv {
-            return Err(bad_input(
-                "--gl-spirv is a headless measurement option; run it with --headless",
-            ));
-        }
-        return run_windowed(&args, started);
+        return run_windowed(&planner, started);
     }
-    if args.gl_spirv && args.experiment.contains(&Experiment::WarpProbe) {
-        return Err(bad_input(
-            "--gl-spirv with --experiment warp-probe: the probe is added to naga's GLSL, which --gl-spirv does not load; drop one of them",
-        ));
-    }
-    if args.gl_spirv && args.experiment.contains(&Experiment::Glslang) {
-        return Err(bad_input(
-            "--gl-spirv with --experiment glslang: glslang's SPIR-V is 1.3 for Vulkan 1.1, and OpenGL loads SPIR-V 1.0 only; drop one of them",
-        ));
-    }
-    let scene = args.load_scene()?;
-    let variant = Variant::chosen(&scene, &args);
-    let workgroup = args.compute_workgroup()?;
-    let (width, height) = (args.size.width, args.size.height);
-    let gpu_scene = GpuScene::new(&scene, width, height);
-
-    let robust = args.experiment.contains(&Experiment::RobustAccess);
-    let mut ctx = Gl::headless(args.validate, robust, knobs)?;
-    let log = DebugLog::install(&mut ctx.gl);
-    let gl = &ctx.gl;
-    let info = context::device_info(gl);
-    target::check_size(gl, width, height)?;
-    // SAFETY: plain query; 64-bit because the limit may exceed 2 GiB.
-    let max_ssbo = unsafe { gl.get_parameter_i64(glow::MAX_SHADER_STORAGE_BLOCK_SIZE) };
-    check_storage_limit(
-        &gpu_scene,
-        max_ssbo.max(0) as u64,
-        "GL_MAX_SHADER_STORAGE_BLOCK_SIZE",
-    )?;
-
-    // Declaration order is creation order; Rust drops locals in reverse, so GL
-    // objects are deleted in reverse order on success and on every error path.
-    let mut shader_stats = Vec::new();
-    let (frames, setup_ms, pixels) = match args.path {
-        RenderPath::Fragment => {
-            let shaders = build(&variant)?;
-            if let Some(dir) = &args.dump_shaders {
-                dump_shaders(dir, &shaders.stages())?;
-            }
-            explain::step(
-                "Shaders: GLSL -> naga module -> GLSL 450 core (twinray-common)",
-                || format!("variant {}", variant.label()),
-            );
-            let program = if args.gl_spirv {
-                let fs = twinray_common::shader::post::spirv_for_opengl(
-                    &shaders.fragment_spirv,
-                    restricts_resources(&variant),
-                );
-                Program::from_spirv(
-                    gl,
-                    &|name| ctx.proc_address(name),
-                    &shaders.vertex_glsl,
-                    &fs,
-                )?
-            } else {
-                Program::new(gl, &shaders.vertex_glsl, &shaders.fragment_glsl)?
-            };
-            if let Some(dir) = &args.dump_shaders {
-                shader_stats.push(program::dump_binary(
-                    gl,
-                    program.raw(),
-                    args.gl_spirv,
-                    dir,
-                    "gl-program",
-                )?);
-            }
-            let _buffers = SceneBuffers::new(gl, &gpu_scene)?;
-            let pass = FragmentPass::of(&args.experiment);
-            let target = Target::new(gl, width, height, &pass)?;
-            let vao = EmptyVertexArray::new(gl)?;
-            let timer = Timer::new(gl, &info.device)?;
-            program.bind(&vao);
-            log.check(gl, "after setup");
-            // SAFETY: program, VAO, buffers and FBO are bound and alive.
-            let draw = || unsafe {
-                if pass.clear {
-                    gl.clear(glow::COLOR_BUFFER_BIT);
-                }
-                gl.draw_arrays(glow::TRIANGLES, 0, pass.vertices() as i32);
-            };
-            let (frames, setup_ms) =
-                frame_loop(gl, &timer, args.frame_count(), started, &|| {}, &draw);
-            (frames, setup_ms, target.read())
-        }
-        // The same tracer as a compute shader: compute.rs owns its program and texture.
-        RenderPath::Compute => {
-            let shader = build_compute(&variant, workgroup)?;
-            // Before the compile, so that a driver without the extension gets a clear refusal.
-            let probe = if args.experiment.contains(&Experiment::WarpProbe) {
-                Some(WarpProbe::new(gl)?)
-            } else {
-                None
-            };
-            let proc_address = |name: &std::ffi::CStr| ctx.proc_address(name);
-            let spirv = args
-                .gl_spirv
-                .then_some(&proc_address as &dyn Fn(&std::ffi::CStr) -> *const std::ffi::c_void);
-            let compute = Compute::new(gl, &shader, spirv, width, height)?;
-            if let Some(dir) = &args.dump_shaders {
-                dump_shaders(dir, &[("compute", &shader.spirv, &shader.glsl)])?;
-                shader_stats.push(program::dump_binary(
-                    gl,
-                    compute.program(),
-                    args.gl_spirv,
-                    dir,
-                    "gl-program",
-                )?);
-            }
-            let _buffers = SceneBuffers::new(gl, &gpu_scene)?;
-            let timer = Timer::new(gl, &info.device)?;
-            log.check(gl, "after setup");
-            // The barrier before the timer starts, as Vulkan records its
-            // barrier before the first timestamp: both time the dispatch alone.
-            let (frames, setup_ms) = frame_loop(
-                gl,
-                &timer,
-                args.frame_count(),
-                started,
-                &|| compute.barrier_between_frames(),
-                &|| compute.dispatch(),
-            );
-            if let Some(probe) = &probe {
-                eprintln!("twinray-gl: {}", probe.summary()?);
-            }
-            (frames, setup_ms, compute.read())
-        }
-    };
-    if let Some(dir) = &args.dump_shaders {
-        dump_statistics(dir, &shader_stats)?;
-    }
-    explain::step("Frames: the draw or dispatch + glFinish each", || {
-        format!(
-            "{} frame(s); first wall {:.3} ms",
-            frames.len(),
-            frames.first().map_or(0.0, |f| f.wall_ms)
-        )
-    });
-    let image = FloatImage::from_rgba(width, height, &pixels);
-    explain::step("Readback", || {
-        format!("{width}x{height} RGBA32F, top row first")
-    });
-    let rays = if args.count_rays {
-        let counting = CountingRun {
-            scene: &gpu_scene,
-            variant: &variant,
-            path: args.path,
-            workgroup,
-            width,
-            height,
-        };
-        Some(count_rays(gl, &counting)?)
-    } else {
-        None
-    };
-    log.check(gl, "after the frame loop");
+    let (report, image) = render(&planner, knobs, started)?;
 
     if let Some(out) = &args.out {
         image.save_png_for("--out", out)?;
     }
-    let errors = log.errors();
     if args.json {
-        let label = if args.gl_spirv {
-            format!("{} (SPIR-V)", variant.label())
-        } else {
-            variant.label()
-        };
-        let mut report = RunReport::builder("opengl", info, scene.stats(), label)
-            .size(width, height)
-            .path(args.path, workgroup)
-            .frames(frames, setup_ms)
-            .nonfinite_pixels(image.nonfinite_pixels())
-            .validation_messages(errors)
-            .shader_stats(shader_stats)
-            .build();
-        if let Some(kinds) = rays {
-            report.add_rays(kinds);
-        }
         report.print_json()?;
     }
-    if args.validate && errors > 0 {
-        return Err(anyhow!("{errors} GL debug errors (see above)"));
+    if args.validate && report.validation_messages > 0 {
+        return Err(anyhow!(
+            "{} GL debug errors (see above)",
+            report.validation_messages
+        ));
     }
     Ok(())
 }
 
 /// The window: `window::run` owns the loop; the report has the headless shape
 /// (wall time = frame to frame; no NaN count, nothing is read back).
-fn run_windowed(args: &RenderArgs, started: Instant) -> anyhow::Result<()> {
-    let (run, info, errors) = crate::window::run(args, started)?;
+fn run_windowed(planner: &Planner, started: Instant) -> Result<()> {
+    let args = planner.args();
+    let (run, info, errors) = crate::window::run(planner, started)?;
     if args.json {
         run.report("opengl", info, errors).print_json()?;
     }
@@ -238,41 +78,235 @@ fn run_windowed(args: &RenderArgs, started: Instant) -> anyhow::Result<()> {
     Ok(())
 }
 
-/// The same loop as Vulkan's: one iteration is submit + wait, timed on the
-/// wall clock around `before` (what Vulkan records ahead of its first
-/// timestamp) and the GPU-timed `draw` (the draw call or the dispatch).
-/// Returns the frames and `setup_ms`.
-fn frame_loop(
-    gl: &glow::Context,
-    timer: &Timer,
-    count: u32,
+/// Everything OpenGL, from the context to the readback, one named step per
+/// line. Returns the report (with the debug-error count) and the last frame.
+fn render(
+    planner: &Planner,
+    knobs: &OpenGlKnobs,
     started: Instant,
-    before: &dyn Fn(),
-    draw: &dyn Fn(),
-) -> (Vec<FrameTime>, f64) {
-    let mut frames = Vec::with_capacity(count as usize);
-    let mut setup_ms = 0.0;
-    for i in 0..count {
-        let t0 = Instant::now();
-        if i == 0 {
-            setup_ms = ms(t0 - started);
-        }
-        before();
-        timer.begin();
-        draw();
-        timer.end();
-        // glFinish, not a fence: the wait is part of what the study timed.
-        // SAFETY: no arguments; the context is current.
-        unsafe { gl.finish() };
-        let wall_ms = ms(t0.elapsed());
-        frames.push(FrameTime {
-            gpu_ms: timer.result_ms(),
-            wall_ms,
-        });
+) -> Result<(RunReport, FloatImage)> {
+    let args = planner.args();
+    let (width, height) = (args.size.width, args.size.height);
+    let mut ctx = Gl::headless(args.validate, planner.device().robust_access, knobs)?;
+    let log = DebugLog::install(&mut ctx.gl);
+    let ctx = &ctx;
+    let gl = &ctx.gl;
+    let info = context::device_info(gl);
+    target::check_size(gl, width, height)?;
+    // The plan comes after the context, whose storage limit it is checked
+    // against before any buffer exists.
+    let plan = planner.prepare(&storage_limit(gl), width, height)?;
+    if let Some(dir) = &args.dump_shaders {
+        dump_shaders(dir, &plan.shaders.stages())?;
     }
-    (frames, setup_ms)
+    let run = HeadlessRun {
+        args,
+        ctx,
+        log: &log,
+        info: &info,
+        plan: &plan,
+        planner,
+        started,
+    };
+    let (rendered, shader_stats) = match &plan.shaders {
+        PathShaders::Fragment(shaders) => render_fragment(&run, shaders)?,
+        PathShaders::Compute(shader) => render_compute(&run, shader)?,
+    };
+    log.check(gl, "after the frame loop");
+    let label = variant_label(&plan, args.gl_spirv);
+    let (mut report, image) = report(
+        args,
+        &plan,
+        &info,
+        (label, planner.workgroup()),
+        rendered,
+        shader_stats,
+    )?;
+    if args.count_rays {
+        let counting = plan.counting(&plan.gpu, planner.pass(), width, height);
+        report.add_rays(count_rays(gl, &counting)?);
+        log.check(gl, "after the ray count");
+    }
+    report.validation_messages = log.errors();
+    Ok((report, image))
+    // Every GL object is deleted here, newest first, then the context.
 }
 
-fn ms(d: std::time::Duration) -> f64 {
-    d.as_secs_f64() * 1e3
+/// The largest storage block the context binds: what every run plan is checked against.
+pub fn storage_limit(gl: &glow::Context) -> StorageLimit {
+    // SAFETY: plain query; 64-bit because the limit may exceed 2 GiB.
+    let bytes = unsafe { gl.get_parameter_i64(glow::MAX_SHADER_STORAGE_BLOCK_SIZE) };
+    StorageLimit {
+        bytes: bytes.max(0) as u64,
+        name: "GL_MAX_SHADER_STORAGE_BLOCK_SIZE",
+    }
+}
+
+/// What both paths render from.
+struct HeadlessRun<'a> {
+    args: &'a RenderArgs,
+    ctx: &'a Gl,
+    log: &'a DebugLog,
+    info: &'a DeviceInfo,
+    plan: &'a RunPlan,
+    planner: &'a Planner,
+    /// `setup_ms` runs from here to the first frame.
+    started: Instant,
+}
+
+impl HeadlessRun<'_> {
+    /// The timed loop, the same for both paths: one iteration = `before`
+    /// (what Vulkan records ahead of its first timestamp), the GPU-timed
+    /// `draw` (the draw call or the dispatch), then glFinish, not a fence: the
+    /// wait is part of what the study timed.
+    fn frames(
+        &self,
+        timer: &Timer,
+        before: &dyn Fn(),
+        draw: &dyn Fn(),
+    ) -> Result<(Vec<FrameTime>, f64)> {
+        let gl = &self.ctx.gl;
+        self.log.check(gl, "after setup");
+        timed_frames(
+            self.args.frame_count(),
+            self.started,
+            "Frame 1: the draw or dispatch between timer queries, then glFinish",
+            || {
+                before();
+                timer.begin();
+                draw();
+                timer.end();
+                // SAFETY: no arguments; the context is current.
+                unsafe { gl.finish() };
+                Ok(())
+            },
+            || Ok(timer.result_ms()),
+        )
+    }
+
+    /// `--dump-shaders`: what the driver made of `program`.
+    fn dump_binary(&self, program: glow::Program) -> Result<Vec<ShaderStats>> {
+        match &self.args.dump_shaders {
+            Some(dir) => Ok(vec![program::dump_binary(
+                &self.ctx.gl,
+                program,
+                self.args.gl_spirv,
+                dir,
+                "gl-program",
+            )?]),
+            None => Ok(Vec::new()),
+        }
+    }
+}
+
+/// The frames and the setup time the loop measured, and the last frame's pixels.
+type Rendered = (Vec<FrameTime>, f64, Vec<f32>);
+
+/// The fragment path, in the Vulkan twin's steps: the program (GL's pipeline),
+/// the scene buffers, the colour target, the timer, the frames, the readback.
+fn render_fragment(run: &HeadlessRun, shaders: &Shaders) -> Result<(Rendered, Vec<ShaderStats>)> {
+    let (ctx, gl) = (run.ctx, &run.ctx.gl);
+    let (width, height) = (run.args.size.width, run.args.size.height);
+    let program = if run.args.gl_spirv {
+        let fs = spirv_for_opengl(&shaders.fragment.spirv, shaders.variant.passes.restrict);
+        Program::from_spirv(
+            gl,
+            &|name| ctx.proc_address(name),
+            &shaders.vertex.glsl,
+            &fs,
+        )?
+    } else {
+        Program::new(gl, &shaders.vertex.glsl, &shaders.fragment.glsl)?
+    };
+    let stats = run.dump_binary(program.raw())?;
+    let _buffers = SceneBuffers::new(gl, &run.plan.gpu)?;
+    let pass = run.planner.pass();
+    let target = Target::new(gl, width, height, &pass)?;
+    let vao = EmptyVertexArray::new(gl)?;
+    let timer = Timer::new(gl, &run.info.device)?;
+    program.bind(&vao);
+    // SAFETY: program, VAO, buffers and FBO are bound and alive.
+    let draw = || unsafe {
+        if pass.clear {
+            gl.clear(glow::COLOR_BUFFER_BIT);
+        }
+        gl.draw_arrays(glow::TRIANGLES, 0, pass.vertices() as i32);
+    };
+    let (frames, setup_ms) = run.frames(&timer, &|| {}, &draw)?;
+    let pixels = target.read();
+    explain::step("Readback", || {
+        format!("{width}x{height} {}, top row first", pass.format_name())
+    });
+    Ok(((frames, setup_ms, pixels), stats))
+}
+
+/// The same tracer as a compute shader: compute.rs owns its program and texture.
+fn render_compute(
+    run: &HeadlessRun,
+    shader: &ComputeShader,
+) -> Result<(Rendered, Vec<ShaderStats>)> {
+    let (ctx, gl) = (run.ctx, &run.ctx.gl);
+    let size = &run.args.size;
+    // Before the compile, so that a driver without the extension gets a clear refusal.
+    let probe = if shader.variant.passes.warp_probe {
+        Some(WarpProbe::new(gl)?)
+    } else {
+        None
+    };
+    let proc_address = |name: &std::ffi::CStr| ctx.proc_address(name);
+    let spirv = run
+        .args
+        .gl_spirv
+        .then_some(&proc_address as &dyn Fn(&std::ffi::CStr) -> *const std::ffi::c_void);
+    let compute = Compute::new(gl, shader, spirv, size.width, size.height)?;
+    let stats = run.dump_binary(compute.program())?;
+    let _buffers = SceneBuffers::new(gl, &run.plan.gpu)?;
+    let timer = Timer::new(gl, &run.info.device)?;
+    // The barrier before the timer starts, as Vulkan records its barrier
+    // before the first timestamp: both time the dispatch alone.
+    let (frames, setup_ms) = run.frames(&timer, &|| compute.barrier_between_frames(), &|| {
+        compute.dispatch()
+    })?;
+    if let Some(probe) = &probe {
+        eprintln!("twinray-gl: {}", probe.summary()?);
+    }
+    let pixels = compute.read();
+    explain::step("Readback", || {
+        format!("{}x{} RGBA32F, top row first", size.width, size.height)
+    });
+    Ok(((frames, setup_ms, pixels), stats))
+}
+
+/// The variant as the report names it, and how the driver was handed it.
+fn variant_label(plan: &RunPlan, gl_spirv: bool) -> String {
+    if gl_spirv {
+        format!("{} (SPIR-V)", plan.variant.label())
+    } else {
+        plan.variant.label()
+    }
+}
+
+/// The run's report (device, variant, size, frames, and what the driver said
+/// of the compiled shaders), with the last frame.
+fn report(
+    args: &RenderArgs,
+    plan: &RunPlan,
+    info: &DeviceInfo,
+    (variant_label, workgroup): (String, Workgroup),
+    (frames, setup_ms, pixels): Rendered,
+    shader_stats: Vec<ShaderStats>,
+) -> Result<(RunReport, FloatImage)> {
+    if let Some(dir) = &args.dump_shaders {
+        dump_statistics(dir, &shader_stats)?;
+    }
+    let image = FloatImage::from_rgba(args.size.width, args.size.height, &pixels);
+    let report = RunReport::builder("opengl", info.clone(), plan.scene.stats(), variant_label)
+        .size(args.size.width, args.size.height)
+        .path(args.path, workgroup)
+        .frames(frames, setup_ms)
+        .nonfinite_pixels(image.nonfinite_pixels())
+        .shader_stats(shader_stats)
+        .bvh_ms(plan.bvh_ms)
+        .build();
+    Ok((report, image))
 }

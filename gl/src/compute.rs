@@ -17,7 +17,8 @@ use glow::HasContext;
 use twinray_common::cli::Workgroup;
 use twinray_common::error::bad_input;
 use twinray_common::gpu::layout::binding;
-use twinray_common::shader::build::{restricts_resources, ComputeShader};
+use twinray_common::plan::requests::ComputeLimits;
+use twinray_common::shader::build::ComputeShader;
 use twinray_common::shader::post::spirv_for_opengl;
 
 /// The compute program, the storage texture and the dispatch grid.
@@ -54,12 +55,12 @@ impl<'gl> Compute<'gl> {
                 gl,
                 proc_address,
                 glow::COMPUTE_SHADER,
-                &spirv_for_opengl(&shader.spirv, restricts_resources(&shader.variant)),
+                &spirv_for_opengl(&shader.stage.spirv, shader.variant.passes.restrict),
                 "compute",
             )?,
             // SAFETY: the context is current (the caller made it so).
             None => unsafe {
-                crate::program::compile(gl, glow::COMPUTE_SHADER, &shader.glsl, "compute")
+                crate::program::compile(gl, glow::COMPUTE_SHADER, &shader.stage.glsl, "compute")
             }?,
         };
         let program = link(gl, compiled)?;
@@ -267,7 +268,8 @@ impl Drop for Compute<'_> {
 }
 
 /// The workgroup and the grid against this driver's limits (bad input: the
-/// user chose the size and workgroup). Returns the group counts.
+/// user chose the size and workgroup), and the image against the largest
+/// texture. Returns the group counts.
 fn check_limits(
     gl: &glow::Context,
     wg: Workgroup,
@@ -275,7 +277,7 @@ fn check_limits(
     height: u32,
 ) -> anyhow::Result<(u32, u32)> {
     // SAFETY: plain queries on the current context.
-    let (size, invocations, count, texture) = unsafe {
+    let (group_size, invocations, group_count, texture) = unsafe {
         (
             [0, 1].map(|i| {
                 gl.get_parameter_indexed_i32(glow::MAX_COMPUTE_WORK_GROUP_SIZE, i)
@@ -290,23 +292,22 @@ fn check_limits(
             gl.get_parameter_i32(glow::MAX_TEXTURE_SIZE).max(0) as u32,
         )
     };
-    if wg.x > size[0] || wg.y > size[1] || wg.x * wg.y > invocations {
-        return Err(bad_input(format!(
-            "--workgroup {wg} exceeds this device's limits (GL_MAX_COMPUTE_WORK_GROUP_SIZE {}x{}, GL_MAX_COMPUTE_WORK_GROUP_INVOCATIONS {invocations})",
-            size[0], size[1]
-        )));
-    }
+    let limits = ComputeLimits {
+        group_size,
+        invocations,
+        group_count,
+        names: [
+            "GL_MAX_COMPUTE_WORK_GROUP_SIZE",
+            "GL_MAX_COMPUTE_WORK_GROUP_INVOCATIONS",
+            "GL_MAX_COMPUTE_WORK_GROUP_COUNT",
+        ],
+    };
     if width > texture || height > texture {
+        // The workgroup is checked first, as in Vulkan.
+        limits.dispatch(wg, 1, 1)?;
         return Err(bad_input(format!("--size {width}x{height} exceeds this device's limit of {texture} (GL_MAX_TEXTURE_SIZE)")));
     }
-    let groups = (width.div_ceil(wg.x), height.div_ceil(wg.y));
-    if groups.0 > count[0] || groups.1 > count[1] {
-        return Err(bad_input(format!(
-            "--size {width}x{height} with --workgroup {wg} needs {}x{} workgroups, more than this device's GL_MAX_COMPUTE_WORK_GROUP_COUNT {}x{}",
-            groups.0, groups.1, count[0], count[1]
-        )));
-    }
-    Ok(groups)
+    limits.dispatch(wg, width, height)
 }
 
 /// The compute program, linked from one compiled shader, which goes either way.

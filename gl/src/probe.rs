@@ -1,4 +1,4 @@
-//! `--experiment warp-probe` (OpenGL, compute path, NVIDIA): the buffer in
+//! The warp probe (OpenGL, compute path, NVIDIA; docs/experiments.md): the buffer in
 //! which each invocation of the probed tracer raises its multiprocessor's word
 //! to its warp slot + 1 (`shader::post::warp_probe_glsl`), and what is read
 //! off it: how many warps each multiprocessor held at once at most. OpenGL
@@ -26,7 +26,7 @@ impl<'gl> WarpProbe<'gl> {
             .contains("GL_NV_shader_thread_group")
         {
             return Err(twinray_common::error::bad_input(
-                "--experiment warp-probe needs GL_NV_shader_thread_group (NVIDIA's OpenGL driver), which this driver lacks",
+                "the warp probe needs GL_NV_shader_thread_group (NVIDIA's OpenGL driver), which this driver lacks",
             ));
         }
         let buffer = ReadbackBuffer::new(gl, binding::WARP_PROBE, SLOTS * 4, "warp probe")?;
@@ -38,7 +38,7 @@ impl<'gl> WarpProbe<'gl> {
         let words: Vec<u32> = bytemuck::pod_collect_to_vec(&self.buffer.read());
         let mut seen: Vec<u32> = words.into_iter().filter(|&w| w > 0).collect();
         if seen.is_empty() {
-            bail!("--experiment warp-probe: no invocation wrote the probe buffer");
+            bail!("the warp probe: no invocation wrote the probe buffer");
         }
         seen.sort_unstable();
         Ok(format!(

@@ -9,43 +9,38 @@ use crate::compute::Compute;
 use crate::program::{EmptyVertexArray, Program};
 use crate::target::Target;
 use glow::HasContext;
-use twinray_common::cli::RenderPath;
 use twinray_common::explain;
-use twinray_common::fragment_pass::FragmentPass;
 use twinray_common::gpu::layout::{binding, GpuRayCount};
 use twinray_common::limits::pixel_count;
+use twinray_common::plan::CountingRun;
 use twinray_common::rays::RayKinds;
-use twinray_common::shader::build::{build, build_compute};
-use twinray_common::shader::variant::CountingRun;
+use twinray_common::shader::build::PathShaders;
 
 /// Renders the counting frame of `run` and returns its rays by kind. Always
 /// naga's GLSL (also under `--gl-spirv`): the rays do not depend on how the
 /// driver was handed the shader.
 pub fn count_rays(gl: &glow::Context, run: &CountingRun) -> anyhow::Result<RayKinds> {
     let (width, height) = (run.width, run.height);
-    let counting = run.variant.counting();
     // Declared first, so deleted last: after the programs that use them.
-    let _scene = SceneBuffers::new(gl, run.scene)?;
+    let _scene = SceneBuffers::new(gl, run.gpu)?;
     let counts = ReadbackBuffer::new(
         gl,
         binding::RAY_COUNTS,
         pixel_count(width, height) * size_of::<GpuRayCount>(),
         "ray counts",
     )?;
-    match run.path {
-        RenderPath::Fragment => {
-            let shaders = build(&counting)?;
-            let program = Program::new(gl, &shaders.vertex_glsl, &shaders.fragment_glsl)?;
-            // The run's own fragment pass (`--experiment quad` draws two triangles).
-            let pass = FragmentPass::of(&run.variant.experiments);
+    match PathShaders::build(&run.variant)? {
+        PathShaders::Fragment(shaders) => {
+            let program = Program::new(gl, &shaders.vertex.glsl, &shaders.fragment.glsl)?;
+            // The run's own fragment pass (it may draw two triangles).
+            let pass = run.pass;
             let _target = Target::new(gl, width, height, &pass)?;
             let vao = EmptyVertexArray::new(gl)?;
             program.bind(&vao);
             // SAFETY: program, VAO, buffers and FBO are bound and alive.
             unsafe { gl.draw_arrays(glow::TRIANGLES, 0, pass.vertices() as i32) };
         }
-        RenderPath::Compute => {
-            let shader = build_compute(&counting, run.workgroup)?;
+        PathShaders::Compute(shader) => {
             let compute = Compute::new(gl, &shader, None, width, height)?;
             compute.dispatch();
         }

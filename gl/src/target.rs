@@ -1,12 +1,12 @@
 //! The offscreen render target: an FBO with one RGBA32F colour renderbuffer
 //! (float, so the PNG is quantised exactly as for Vulkan and the reference;
-//! RGBA8 with `--experiment rgba8`), the device's size limits, and the readback.
+//! RGBA8 where the pass asks for it), the device's size limits, and the readback.
 
 use anyhow::{anyhow, bail, Context as _};
 use glow::HasContext;
 use twinray_common::error::bad_input;
 use twinray_common::explain;
-use twinray_common::fragment_pass::FragmentPass;
+use twinray_common::plan::requests::FragmentPass;
 
 pub struct Target<'gl> {
     gl: &'gl glow::Context,

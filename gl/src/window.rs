@@ -40,17 +40,19 @@ use glutin_winit::{ApiPreference, DisplayBuilder, GlWindow as _};
 use raw_window_handle::HasWindowHandle;
 use std::num::NonZeroU32;
 use std::time::Instant;
-use twinray_common::cli::RenderArgs;
 use twinray_common::error::no_device;
 use twinray_common::explain;
-use twinray_common::fragment_pass::FragmentPass;
 use twinray_common::gpu::layout::GpuFrame;
 use twinray_common::gpu::upload::GpuScene;
+use twinray_common::limits::StorageLimit;
+use twinray_common::plan::requests::FragmentPass;
+use twinray_common::plan::{CountingRun, Planner};
 use twinray_common::rays::RayKinds;
 use twinray_common::reference::image_io::FloatImage;
 use twinray_common::report::DeviceInfo;
-use twinray_common::shader::variant::{CountingRun, Variant};
-use twinray_common::window::{self, Drawn, PathShaders, Renderer, WindowedRun};
+use twinray_common::shader::build::PathShaders;
+use twinray_common::window::title::window_title;
+use twinray_common::window::{self, Drawn, Renderer, WindowedRun};
 use winit::window::Window;
 
 /// Timer queries in a ring, so that reading one never waits for the GPU: a
@@ -60,17 +62,10 @@ const TIMERS: usize = 3;
 /// Opens the window and runs until it is closed. Returns the run, the device
 /// description and the number of GL errors seen.
 // Long function: the OpenGL twin of vk's windowed run, kept in the same block order as vk/src/window.rs so the two read side by side.
-pub fn run(args: &RenderArgs, started: Instant) -> Result<(WindowedRun, DeviceInfo, u64)> {
-    let scene = args.load_scene()?;
-    let variant = Variant::chosen(&scene, args);
-    let shaders = window::first_shaders(args, &scene)?;
-    explain::step(
-        "Shaders: GLSL -> naga module -> GLSL 450 core (twinray-common)",
-        || format!("variant {}, {} path", variant.label(), args.path),
-    );
-
+pub fn run(planner: &Planner, started: Instant) -> Result<(WindowedRun, DeviceInfo, u64)> {
+    let args = planner.args();
     let event_loop = window::event_loop()?;
-    let attributes = window::window_attributes(args, &scene.name, "OpenGL");
+    let attributes = window::window_attributes(args, &args.scene, "OpenGL");
     let template = ConfigTemplateBuilder::new()
         .with_api(Api::OPENGL)
         .with_transparency(false);
@@ -158,11 +153,23 @@ pub fn run(args: &RenderArgs, started: Instant) -> Result<(WindowedRun, DeviceIn
     let gl = &gl;
 
     let size = window.inner_size();
-    let gpu = GpuScene::new(&scene, size.width.max(1), size.height.max(1));
+    // The plan comes after the context, whose storage limit it is checked against.
+    let plan = planner.prepare(
+        &crate::app::storage_limit(gl),
+        size.width.max(1),
+        size.height.max(1),
+    )?;
+    window.set_title(&window_title(
+        &plan.scene.name,
+        "OpenGL",
+        args.path,
+        None,
+        None,
+    ));
     // Declaration order is creation order, so the struct's fields (newest
     // first) and these locals go in reverse on every path.
-    let drawing = path_program(gl, &shaders, (size.width, size.height))?;
-    let buffers = SceneBuffers::new(gl, &gpu)?;
+    let drawing = path_program(gl, &plan.shaders, (size.width, size.height))?;
+    let buffers = SceneBuffers::new(gl, &plan.gpu)?;
     let vao = EmptyVertexArray::new(gl)?;
     let timers = (0..TIMERS)
         .map(|_| Timer::new(gl, &info.device))
@@ -190,15 +197,7 @@ pub fn run(args: &RenderArgs, started: Instant) -> Result<(WindowedRun, DeviceIn
         "per frame: glBufferSubData (camera), glDrawArrays (fragment) or glDispatchCompute + glMemoryBarrier\n\
          + glBlitFramebuffer (compute), SwapBuffers: the driver queues, syncs and presents; C switches the path".into()
     });
-    let run = window::session::run(
-        "twinray-gl",
-        event_loop,
-        renderer,
-        args,
-        scene,
-        variant,
-        started,
-    )?;
+    let run = window::session::run("twinray-gl", event_loop, renderer, planner, plan, started)?;
     Ok((run, info, log.errors()))
 }
 
@@ -249,8 +248,8 @@ fn path_program<'gl>(
     Ok(match shaders {
         PathShaders::Fragment(s) => PathProgram::Fragment(Program::new(
             gl,
-            &s.vertex_glsl,
-            &upper_left_origin(&s.fragment_glsl),
+            &s.vertex.glsl,
+            &upper_left_origin(&s.fragment.glsl),
         )?),
         PathShaders::Compute(s) => {
             let mut c = Compute::new(gl, s, None, size.0.max(1), size.1.max(1))?;
@@ -290,13 +289,17 @@ impl Renderer for GlWindow<'_> {
     /// framebuffer of its own, so the window's are made and bound again after it.
     fn count_rays(&mut self, run: &CountingRun, shaders: &PathShaders) -> Result<RayKinds> {
         let kinds = crate::rays::count_rays(self.gl, run)?;
-        self.load_scene(run.scene, shaders)?;
+        self.load_scene(run.gpu, shaders)?;
         // SAFETY: plain state on the current context.
         unsafe {
             self.gl
                 .viewport(0, 0, self.size.0 as i32, self.size.1 as i32)
         };
         Ok(kinds)
+    }
+
+    fn storage_limit(&self) -> StorageLimit {
+        crate::app::storage_limit(self.gl)
     }
 
     fn api(&self) -> &'static str {

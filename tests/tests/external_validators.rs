@@ -11,14 +11,17 @@
 use std::path::{Path, PathBuf};
 use std::process::Command;
 use std::sync::Mutex;
-use twinray_common::cli::{Experiment, RenderArgs, Size, Workgroup};
-use twinray_common::fragment_pass::QUAD_DEFINE;
+use twinray_common::cli::{RenderArgs, RenderPath, Size, Workgroup};
+use twinray_common::lab::experiment::Experiment;
+use twinray_common::plan::build_bvh;
+use twinray_common::plan::requests::Api;
+use twinray_common::plan::Planner;
 use twinray_common::scene::accel::Accel;
 use twinray_common::scene::numerics::{Numerics, Offset, SphereTest, TriangleTest};
 use twinray_common::scene::{Features, Scene};
 use twinray_common::shader::build::{self, build_compute, compute_source, fragment_source};
 use twinray_common::shader::post::spirv_for_opengl;
-use twinray_common::shader::variant::Variant;
+use twinray_common::shader::variant::{SpirvCompiler, Variant, QUAD_DEFINE};
 use twinray_common::value_name::ValueName;
 use twinray_tests::scratch;
 
@@ -39,7 +42,7 @@ fn words_to_bytes(words: &[u32]) -> Vec<u8> {
     words.iter().flat_map(|w| w.to_le_bytes()).collect()
 }
 
-/// The variants the apps build (`Variant::chosen`) for the box scene — every
+/// The variants the apps build (`Planner::variant`) for the box scene — every
 /// numerical choice with the generic shader (`--generic`) and the BVH, and
 /// with specialization constants (`--specialize`) — plus the generic shader
 /// with the counts read from the uniform (`Variant::generic`) for every
@@ -54,8 +57,8 @@ fn variants() -> Vec<(String, Variant)> {
             .filter_map(|kv| kv.split_once('='))
             .map(|(k, v)| (k.to_string(), v.to_string()))
             .collect();
-        let mut scene = Scene::load("box", &set).unwrap();
-        scene.set_accel(accel);
+        let scene = Scene::load("box", &set).unwrap();
+        let bvh = accel.wants_bvh(&scene).then(|| build_bvh(&scene));
         let args = RenderArgs {
             generic,
             specialize: !generic,
@@ -68,7 +71,9 @@ fn variants() -> Vec<(String, Variant)> {
                 },
             )
         };
-        Variant::chosen(&scene, &args)
+        // OpenGL's planner: it takes every experiment listed below.
+        let planner = Planner::new(&args, Api::OpenGl).unwrap();
+        planner.variant(&scene, bvh.as_ref(), RenderPath::Fragment)
     };
     for offset in Offset::ALL {
         for triangle in TriangleTest::ALL {
@@ -194,16 +199,21 @@ fn glslang_and_spirv_val_accept_every_variant() {
                 fragment_sources += 1;
                 (
                     fragment_source(),
-                    variant.defines.clone(),
-                    s.fragment_spirv,
-                    s.fragment_glsl,
+                    variant.defines(),
+                    s.fragment.spirv,
+                    s.fragment.glsl,
                 )
             } else {
                 let s = build_compute(variant, Workgroup::DEFAULT)
                     .unwrap_or_else(|e| panic!("{label} compute: {e:#}"));
                 compute_sources += 1;
                 // The compute variant adds WG_X, WG_Y (and BVH_STACK_SHARED).
-                (compute_source(), s.variant.defines, s.spirv, s.glsl)
+                (
+                    compute_source(),
+                    s.variant.defines(),
+                    s.stage.spirv,
+                    s.stage.glsl,
+                )
             };
             let what = format!("{label} ({stage})");
             let base = dir.join(format!("v{i}"));
@@ -222,7 +232,7 @@ fn glslang_and_spirv_val_accept_every_variant() {
             );
             // glslang's SPIR-V targets Vulkan 1.1 (SPIR-V 1.3), which OpenGL
             // cannot load (the GL app refuses --gl-spirv with it).
-            let glslang = variant.experiments.contains(&Experiment::Glslang);
+            let glslang = variant.passes.compiler == SpirvCompiler::Glslang;
             jobs.push(Job {
                 what: format!("{what}: SPIR-V for Vulkan"),
                 program: "spirv-val",
@@ -237,10 +247,7 @@ fn glslang_and_spirv_val_accept_every_variant() {
             }
             let gl = write(
                 &dir.join(format!("v{i}-{stage}.gl.spv")),
-                &words_to_bytes(&spirv_for_opengl(
-                    &spirv,
-                    build::restricts_resources(variant),
-                )),
+                &words_to_bytes(&spirv_for_opengl(&spirv, variant.passes.restrict)),
             );
             jobs.push(Job {
                 what: format!("{what}: naga SPIR-V as OpenGL loads it"),

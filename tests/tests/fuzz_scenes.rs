@@ -15,6 +15,8 @@ use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
 use twinray_common::error::exit_code_of;
 use twinray_common::gpu::upload::GpuScene;
+use twinray_common::plan::build_bvh;
+use twinray_common::scene::accel::Accel;
 use twinray_common::scene::load::BUILTIN_SCENES;
 use twinray_common::scene::Scene;
 
@@ -378,7 +380,9 @@ fn mutated_scenes_and_meshes_never_panic() {
             let scene = Scene::from_toml(&name, &scene_text, &dir, &overrides);
             if let Ok(s) = &scene {
                 check_accepted(s, &scene_text);
-                GpuScene::new(s, 8, 8);
+                // As a run with --accel auto prepares it: the BVH where it pays.
+                let bvh = Accel::Auto.wants_bvh(s).then(|| build_bvh(s));
+                GpuScene::new(s, bvh.as_ref(), 8, 8);
             }
             scene.map(|_| ())
         });

@@ -128,7 +128,7 @@ fn runs_that_cannot_honour_a_measurement_refuse_it() {
     refused(
         App::OpenGl,
         &with(&["--experiment", "warp-probe"]),
-        "--experiment warp-probe needs GL_NV_shader_thread_group",
+        "the warp probe needs GL_NV_shader_thread_group",
     );
     refused(
         App::OpenGl,

@@ -1,6 +1,8 @@
-//! The run, top to bottom: the shared setup from twinray-common (scene, shader
-//! variant, buffer bytes), then every Vulkan object in the order the reader met
-//! them, the timed frame loop, the readback, and the report.
+//! The run, top to bottom, in the walkthrough's order: the options checked
+//! once (`Planner`), the instance and the device, then the run plan from
+//! twinray-common (scene, BVH, shader variant, buffer bytes, checked against
+//! the device's limits), then every Vulkan object the path needs, the timed
+//! frame loop, the readback, and the report.
 //!
 //! Vulkan objects must be destroyed before the objects they were made from
 //! (buffers before the device, the device before the instance). Here each one is
@@ -9,46 +11,39 @@
 
 use crate::commands::Commands;
 use crate::compute::Compute;
+use crate::descriptors::Descriptors;
 use crate::device::Device;
 use crate::instance::{Instance, VALIDATION_MESSAGES};
-use crate::pipeline::RenderPass;
+use crate::pipeline::{Pipeline, RenderPass};
 use crate::rays::count_rays;
-use crate::scene::SceneResources;
+use crate::scene::scene_buffers;
 use crate::target::Target;
 use crate::timestamps::Timestamps;
 use crate::window;
 use anyhow::{bail, Result};
 use std::sync::atomic::Ordering;
 use std::time::Instant;
-use twinray_common::cli::{
-    Experiment, FrameWait, RenderArgs, RenderPath, SceneMemory, VulkanKnobs, Workgroup,
-};
-use twinray_common::error::bad_input;
+use twinray_common::cli::{FrameWait, RenderArgs, SceneMemory, VulkanKnobs, Workgroup};
 use twinray_common::explain;
-use twinray_common::fragment_pass::{check_experiments, FragmentPass};
-use twinray_common::gpu::upload::GpuScene;
+use twinray_common::lab;
+use twinray_common::plan::requests::Api;
+use twinray_common::plan::{Planner, RunPlan};
 use twinray_common::reference::image_io::FloatImage;
-use twinray_common::report::{dump_shaders, dump_statistics, FrameTime, RunReport};
-use twinray_common::scene::Scene;
-use twinray_common::shader::build::{build, build_compute, ComputeShader, Shaders};
-use twinray_common::shader::variant::{CountingRun, Variant};
+use twinray_common::report::{dump_shaders, dump_statistics, timed_frames, FrameTime, RunReport};
+use twinray_common::shader::build::{ComputeShader, PathShaders, Shaders};
 
 pub fn run(args: RenderArgs, knobs: &VulkanKnobs, process_start: Instant) -> Result<()> {
+    if lab::print_page_if_asked(&args) {
+        return Ok(());
+    }
     if args.explain {
         explain::enable("twinray-vk", "Vulkan");
     }
-    if args.gl_spirv {
-        return Err(bad_input(
-            "--gl-spirv is an OpenGL option: Vulkan always runs naga's SPIR-V",
-        ));
-    }
-    check_experiments(&args, true)?;
+    let planner = Planner::new(&args, Api::Vulkan)?;
     if !args.headless {
-        return run_windowed(&args, knobs, process_start);
+        return run_windowed(&planner, knobs, process_start);
     }
-    let scene = args.load_scene()?;
-    let variant = Variant::chosen(&scene, &args);
-    let (mut report, image) = render(&args, knobs, &scene, &variant, process_start)?;
+    let (mut report, image) = render(&planner, knobs, process_start)?;
 
     // Counted only now that every Vulkan object is gone, so teardown mistakes count too.
     report.validation_messages = VALIDATION_MESSAGES.load(Ordering::SeqCst);
@@ -69,8 +64,9 @@ pub fn run(args: RenderArgs, knobs: &VulkanKnobs, process_start: Instant) -> Res
 
 /// The window: `window::run` owns the loop; the report is the same shape as
 /// headless (wall time = frame to frame; no NaN count, nothing is read back).
-fn run_windowed(args: &RenderArgs, knobs: &VulkanKnobs, process_start: Instant) -> Result<()> {
-    let (run, info) = window::run(args, knobs, process_start)?;
+fn run_windowed(planner: &Planner, knobs: &VulkanKnobs, process_start: Instant) -> Result<()> {
+    let args = planner.args();
+    let (run, info) = window::run(planner, knobs, process_start)?;
     // Every Vulkan object is gone by now, so teardown mistakes count too.
     let messages = VALIDATION_MESSAGES.load(Ordering::SeqCst);
     if args.json {
@@ -85,60 +81,41 @@ fn run_windowed(args: &RenderArgs, knobs: &VulkanKnobs, process_start: Instant) 
 /// Everything Vulkan, from the instance to the readback, one named step per
 /// line. Returns the report (without the validation count) and the last frame.
 fn render(
-    args: &RenderArgs,
+    planner: &Planner,
     knobs: &VulkanKnobs,
-    scene: &Scene,
-    variant: &Variant,
     process_start: Instant,
 ) -> Result<(RunReport, FloatImage)> {
+    let args = planner.args();
     let (width, height) = (args.size.width, args.size.height);
-    let workgroup = args.compute_workgroup()?;
-    let shaders = build_shaders(args, variant)?;
-    let gpu_scene = GpuScene::new(scene, width, height);
     let instance = Instance::new(args.validate, knobs.validation, &[])?;
-    let compute_only = args.experiment.contains(&Experiment::ComputeQueue);
-    let robust_access = args.experiment.contains(&Experiment::RobustAccess);
-    let device = Device::new(
-        &instance,
-        None,
-        knobs,
-        compute_only,
-        args.count_rays,
-        robust_access,
-    )?;
+    let device = Device::new(&instance, None, knobs, &planner.device())?;
     device.check_size(width, height)?;
-    // --vk-wait idle waits for each frame with vkQueueWaitIdle +
-    // vkDeviceWaitIdle, as the 2018 study did, instead of the frame's fence.
-    let idle_wait = knobs.wait == FrameWait::Idle;
-    let host_memory = device.scene_memory == SceneMemory::Host;
-    let timestamps = Timestamps::new(&device)?;
-    let frame_loop = FrameLoop {
-        timestamps: timestamps.as_ref(),
-        count: args.frame_count(),
-        idle_wait,
-        process_start,
-    };
+    // The plan comes after the device, whose storage limit it is checked
+    // against before any buffer exists.
+    let plan = planner.prepare(&device.storage_limit(), width, height)?;
+    if let Some(dir) = &args.dump_shaders {
+        // The driver keeps its statistics only for pipelines made from now on.
+        crate::statistics::enable();
+        dump_shaders(dir, &plan.shaders.stages())?;
+    }
     let run = HeadlessRun {
         args,
         device: &device,
-        gpu_scene: &gpu_scene,
-        frame_loop,
+        plan: &plan,
+        planner,
+        idle_wait: knobs.wait == FrameWait::Idle,
+        process_start,
     };
-    let rendered = match args.path {
-        RenderPath::Fragment => render_fragment(&run, &shaders)?,
-        RenderPath::Compute => render_compute(&run, &build_compute(variant, workgroup)?)?,
+    let rendered = match &plan.shaders {
+        PathShaders::Fragment(shaders) => render_fragment(&run, shaders)?,
+        PathShaders::Compute(shader) => render_compute(&run, shader)?,
     };
-    let label = variant_label(variant, host_memory, idle_wait);
-    let (mut report, image) = report(args, scene, &device, label, workgroup, rendered)?;
+    let host_memory = device.scene_memory == SceneMemory::Host;
+    let label = variant_label(&plan, host_memory, run.idle_wait);
+    let workgroup = planner.workgroup();
+    let (mut report, image) = report(args, &plan, &device, (label, workgroup), rendered)?;
     if args.count_rays {
-        let counting = CountingRun {
-            scene: &gpu_scene,
-            variant,
-            path: args.path,
-            workgroup,
-            width,
-            height,
-        };
+        let counting = plan.counting(&plan.gpu, planner.pass(), width, height);
         report.add_rays(count_rays(&device, &counting)?);
     }
     Ok((report, image))
@@ -149,63 +126,69 @@ fn render(
 struct HeadlessRun<'a> {
     args: &'a RenderArgs,
     device: &'a Device,
-    gpu_scene: &'a GpuScene,
-    frame_loop: FrameLoop<'a>,
+    plan: &'a RunPlan,
+    planner: &'a Planner,
+    /// vkQueueWaitIdle + vkDeviceWaitIdle after each frame, as the 2018 study
+    /// did, instead of the frame's fence (`--vk-wait idle`).
+    idle_wait: bool,
+    /// `setup_ms` runs from here to the first submit.
+    process_start: Instant,
 }
 
 impl HeadlessRun<'_> {
-    /// `--dump-shaders`: the stages this run compiles.
-    fn dump_shaders(&self, stages: &[(&str, &[u32], &str)]) -> Result<()> {
-        match &self.args.dump_shaders {
-            Some(dir) => dump_shaders(dir, stages),
-            None => Ok(()),
-        }
+    /// The timed loop, the same for both paths: one iteration = submit + wait.
+    fn frames(
+        &self,
+        commands: &Commands,
+        timestamps: Option<&Timestamps>,
+    ) -> Result<(Vec<FrameTime>, f64)> {
+        timed_frames(
+            self.args.frame_count(),
+            self.process_start,
+            "Frame 1: vkQueueSubmit + vkWaitForFences, timestamps read, vkResetFences",
+            || {
+                commands.submit()?;
+                commands.wait(self.idle_wait)
+            },
+            || {
+                let gpu_ms = timestamps.map(Timestamps::read_ms).transpose()?;
+                commands.reset_fence()?;
+                Ok(gpu_ms)
+            },
+        )
     }
 }
 
-/// The frames and the setup time `frame_loop` measured, and the last frame.
+/// The frames and the setup time the loop measured, and the last frame.
 type Rendered = (Vec<FrameTime>, f64, FloatImage);
 
-/// naga's vertex and fragment shaders for the scene's variant; `--dump-shaders`
-/// turns on the driver's statistics before any pipeline is made.
-fn build_shaders(args: &RenderArgs, variant: &Variant) -> Result<Shaders> {
-    let shaders = build(variant)?;
-    if args.dump_shaders.is_some() {
-        crate::statistics::enable();
-    }
-    explain::step(
-        "Shaders: GLSL -> naga module -> SPIR-V (twinray-common)",
-        || format!("variant {}", variant.label()),
-    );
-    Ok(shaders)
-}
-
-/// The fragment path: render pass, scene buffers, descriptor set and pipeline,
-/// the colour target, the recorded commands, the frames, the readback. Its
-/// objects drop at the end, newest first, before the device.
+/// The fragment path, in the walkthrough's steps: scene buffers, descriptor
+/// set, render pass, pipeline, the colour target, timestamps, the recorded
+/// commands, the frames, the readback. Its objects drop at the end, newest
+/// first, before the device.
 fn render_fragment(run: &HeadlessRun, shaders: &Shaders) -> Result<Rendered> {
-    let (device, frame_loop) = (run.device, &run.frame_loop);
+    let device = run.device;
     let (width, height) = (run.args.size.width, run.args.size.height);
-    run.dump_shaders(&shaders.stages())?;
-    let pass = FragmentPass::of(&run.args.experiment);
+    let pass = run.planner.pass();
+    let (frame, storage) = scene_buffers(device, &run.plan.gpu)?;
+    let descriptors = Descriptors::new(device, &frame, &storage)?;
     let render_pass = RenderPass::offscreen(device, &pass)?;
     let rp = render_pass.render_pass;
     // None: a pipeline whose viewport and scissor are set while recording.
     let fixed_size = (!pass.dynamic_viewport).then_some((width, height));
-    let resources = SceneResources::new(device, run.gpu_scene, shaders, rp, fixed_size)?;
-    let (pipeline, descriptors) = (&resources.pipeline, &resources.descriptors);
+    let pipeline = Pipeline::new(device, descriptors.set_layout, shaders, rp, fixed_size)?;
     let target = Target::new(device, rp, width, height, &pass)?;
-    let timestamps = frame_loop.timestamps;
+    let timestamps = Timestamps::new(device)?;
     let commands = Commands::record(
         device,
         rp,
-        pipeline,
-        descriptors,
+        &pipeline,
+        &descriptors,
         &target,
-        timestamps,
+        timestamps.as_ref(),
         &pass,
     )?;
-    let (frames, setup_ms) = frame_loop.run(&commands)?;
+    let (frames, setup_ms) = run.frames(&commands, timestamps.as_ref())?;
     let image = target.read_back(device)?;
     explain::step(
         "Readback: vkCmdCopyImageToBuffer + HOST barrier, then map",
@@ -214,13 +197,12 @@ fn render_fragment(run: &HeadlessRun, shaders: &Shaders) -> Result<Rendered> {
     Ok((frames, setup_ms, image))
 }
 
-/// The same tracer as a compute shader: compute.rs owns its pipeline and
-/// storage image.
+/// The same tracer as a compute shader: the scene buffers, timestamps, then
+/// compute.rs's pipeline, storage image and commands.
 fn render_compute(run: &HeadlessRun, shader: &ComputeShader) -> Result<Rendered> {
     let size = &run.args.size;
-    run.dump_shaders(&[("compute", &shader.spirv, &shader.glsl)])?;
-    let (frame, storage) = crate::scene::scene_buffers(run.device, run.gpu_scene)?;
-    let timestamps = run.frame_loop.timestamps;
+    let (frame, storage) = scene_buffers(run.device, &run.plan.gpu)?;
+    let timestamps = Timestamps::new(run.device)?;
     let compute = Compute::new(
         run.device,
         &frame,
@@ -228,17 +210,17 @@ fn render_compute(run: &HeadlessRun, shader: &ComputeShader) -> Result<Rendered>
         shader,
         size.width,
         size.height,
-        timestamps,
+        timestamps.as_ref(),
     )?;
-    let (frames, setup_ms) = run.frame_loop.run(&compute.commands)?;
+    let (frames, setup_ms) = run.frames(&compute.commands, timestamps.as_ref())?;
     Ok((frames, setup_ms, compute.read_back(run.device)?))
 }
 
 /// The variant as the report names it, with the naive choices it was asked for.
-fn variant_label(variant: &Variant, host_memory: bool, idle_wait: bool) -> String {
+fn variant_label(plan: &RunPlan, host_memory: bool, idle_wait: bool) -> String {
     format!(
         "{}{}{}",
-        variant.label(),
+        plan.variant.label(),
         if host_memory {
             " (host-visible buffers)"
         } else {
@@ -252,70 +234,22 @@ fn variant_label(variant: &Variant, host_memory: bool, idle_wait: bool) -> Strin
 /// of the compiled shaders), with the last frame.
 fn report(
     args: &RenderArgs,
-    scene: &Scene,
+    plan: &RunPlan,
     device: &Device,
-    variant_label: String,
-    workgroup: Workgroup,
+    (variant_label, workgroup): (String, Workgroup),
     (frames, setup_ms, image): Rendered,
 ) -> Result<(RunReport, FloatImage)> {
     let shader_stats = crate::statistics::captured();
     if let Some(dir) = &args.dump_shaders {
         dump_statistics(dir, &shader_stats)?;
     }
-    let report = RunReport::builder("vulkan", device.info(), scene.stats(), variant_label)
+    let report = RunReport::builder("vulkan", device.info(), plan.scene.stats(), variant_label)
         .size(args.size.width, args.size.height)
         .path(args.path, workgroup)
         .frames(frames, setup_ms)
         .nonfinite_pixels(image.nonfinite_pixels())
         .shader_stats(shader_stats)
+        .bvh_ms(plan.bvh_ms)
         .build();
     Ok((report, image))
-}
-
-/// The timed loop, the same for both paths: one iteration = submit + wait,
-/// as the original study measured.
-struct FrameLoop<'a> {
-    timestamps: Option<&'a Timestamps>,
-    count: u32,
-    idle_wait: bool,
-    /// `setup_ms` runs from here to the first submit.
-    process_start: Instant,
-}
-
-impl FrameLoop<'_> {
-    /// Runs `commands` `count` times. Returns the frames and `setup_ms`.
-    fn run(&self, commands: &Commands) -> Result<(Vec<FrameTime>, f64)> {
-        let FrameLoop {
-            timestamps,
-            count,
-            idle_wait,
-            process_start,
-        } = *self;
-        let mut frames = Vec::new();
-        let mut setup_ms = 0.0;
-        for i in 0..count {
-            let start = Instant::now();
-            if i == 0 {
-                setup_ms = (start - process_start).as_secs_f64() * 1e3;
-            }
-            commands.submit()?;
-            commands.wait(idle_wait)?;
-            let wall_ms = start.elapsed().as_secs_f64() * 1e3;
-            let gpu_ms = timestamps.map(Timestamps::read_ms).transpose()?;
-            commands.reset_fence()?;
-            frames.push(FrameTime { gpu_ms, wall_ms });
-            if i == 0 {
-                explain::step(
-                    "Frame 1: vkQueueSubmit + vkWaitForFences + vkResetFences",
-                    || {
-                        let gpu = gpu_ms.map_or("no timestamps on this queue".into(), |g| {
-                            format!("GPU {g:.3} ms")
-                        });
-                        format!("wall {wall_ms:.3} ms, {gpu}; later frames resubmit the same command buffer")
-                    },
-                );
-            }
-        }
-        Ok((frames, setup_ms))
-    }
 }

@@ -18,7 +18,7 @@ use crate::timestamps::Timestamps;
 use anyhow::{Context, Result};
 use ash::vk;
 use twinray_common::explain;
-use twinray_common::fragment_pass::FragmentPass;
+use twinray_common::plan::requests::FragmentPass;
 
 pub struct Commands {
     device: ash::Device,
@@ -40,7 +40,7 @@ impl Commands {
         timestamps: Option<&Timestamps>,
         pass: &FragmentPass,
     ) -> Result<Commands> {
-        // Read only by a pass whose load op is CLEAR (`--experiment load-clear`).
+        // Read only by a pass whose load op is CLEAR (the pass asks for a clear).
         let clear = [vk::ClearValue::default()];
         let extent = vk::Extent2D {
             width: target.width,
@@ -60,7 +60,7 @@ impl Commands {
             // SAFETY: every handle is alive and `cmd` is recording.
             unsafe {
                 d.cmd_begin_render_pass(cmd, &begin, vk::SubpassContents::INLINE);
-                // `--experiment dynamic-viewport`: the pipeline left them dynamic.
+                // A pass with a dynamic viewport: the pipeline left them dynamic.
                 if pass.dynamic_viewport {
                     d.cmd_set_viewport(cmd, 0, &[viewport]);
                     d.cmd_set_scissor(cmd, 0, &[scissor]);
@@ -75,7 +75,7 @@ impl Commands {
                     &[],
                 );
                 // No vertex buffer: the vertex shader makes the fullscreen
-                // triangle (or `--experiment quad`'s two) from the vertex index.
+                // triangle (or a quad pass's two) from the vertex index.
                 d.cmd_draw(cmd, pass.vertices(), 1, 0, 0);
                 d.cmd_end_render_pass(cmd);
             }

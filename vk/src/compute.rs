@@ -35,8 +35,6 @@ use crate::target::{create_image_with_view, read_image, readback_buffer, record_
 use crate::timestamps::Timestamps;
 use anyhow::{Context, Result};
 use ash::vk;
-use twinray_common::cli::Workgroup;
-use twinray_common::error::bad_input;
 use twinray_common::explain;
 use twinray_common::gpu::upload::GpuScene;
 use twinray_common::reference::image_io::FloatImage;
@@ -71,7 +69,9 @@ impl Compute {
         height: u32,
         timestamps: Option<&Timestamps>,
     ) -> Result<Compute> {
-        let groups = check_limits(device, shader.workgroup, width, height)?;
+        let groups = device
+            .compute_limits()
+            .dispatch(shader.workgroup, width, height)?;
         let readback = readback_buffer(device, width, height)?;
         let image = StorageImage::new(device, width, height)?;
         let descriptors = Descriptors::for_stage(
@@ -81,7 +81,7 @@ impl Compute {
             vk::ShaderStageFlags::COMPUTE,
             Some(image.view),
         )?;
-        let pipeline = ComputePipeline::new(device, descriptors.set_layout, &shader.spirv)?;
+        let pipeline = ComputePipeline::new(device, descriptors.set_layout, &shader.stage.spirv)?;
         let commands = Commands::record_with(device, |d, cmd| {
             if let Some(t) = timestamps {
                 t.record_reset(cmd);
@@ -197,7 +197,10 @@ impl WindowCompute {
         swapchain_format: vk::Format,
         extent: vk::Extent2D,
     ) -> Result<WindowCompute> {
-        let groups = check_limits(device, shader.workgroup, extent.width, extent.height)?;
+        let groups =
+            device
+                .compute_limits()
+                .dispatch(shader.workgroup, extent.width, extent.height)?;
         let (frame, storage) = scene_buffers(device, scene)?;
         let image = StorageImage::new(device, extent.width, extent.height)?;
         let descriptors = Descriptors::for_stage(
@@ -207,7 +210,7 @@ impl WindowCompute {
             vk::ShaderStageFlags::COMPUTE,
             Some(image.view),
         )?;
-        let pipeline = ComputePipeline::new(device, descriptors.set_layout, &shader.spirv)?;
+        let pipeline = ComputePipeline::new(device, descriptors.set_layout, &shader.stage.spirv)?;
         explain::step(
             "Compute path in the window: VkPipeline (compute) + storage VkImage sized to the swapchain",
             || {
@@ -235,7 +238,10 @@ impl WindowCompute {
     /// A new storage image for a new swapchain size, and the set pointed at it.
     /// The caller waits for the GPU first: the old image may still be in use.
     pub fn resize(&mut self, device: &Device, extent: vk::Extent2D) -> Result<()> {
-        self.groups = check_limits(device, self.shader.workgroup, extent.width, extent.height)?;
+        self.groups =
+            device
+                .compute_limits()
+                .dispatch(self.shader.workgroup, extent.width, extent.height)?;
         let image = StorageImage::new(device, extent.width, extent.height)?;
         self.descriptors.write_image(image.view);
         self.image = image; // the old one is destroyed here, no longer referenced
@@ -383,30 +389,6 @@ pub fn window_blocker(
     Some(format!(
         "{why}, which the compute path needs to show its image in a window; use --path fragment, or --headless"
     ))
-}
-
-/// The workgroup against the device's limits (bad input: the user chose it), and
-/// the dispatch size, which has limits of its own. Returns the group counts.
-fn check_limits(device: &Device, wg: Workgroup, width: u32, height: u32) -> Result<(u32, u32)> {
-    let l = &device.properties.limits;
-    if wg.x > l.max_compute_work_group_size[0]
-        || wg.y > l.max_compute_work_group_size[1]
-        || wg.x * wg.y > l.max_compute_work_group_invocations
-    {
-        return Err(bad_input(format!(
-            "--workgroup {wg} exceeds this device's limits (maxComputeWorkGroupSize {}x{}, maxComputeWorkGroupInvocations {})",
-            l.max_compute_work_group_size[0], l.max_compute_work_group_size[1], l.max_compute_work_group_invocations
-        )));
-    }
-    let groups = (width.div_ceil(wg.x), height.div_ceil(wg.y));
-    if groups.0 > l.max_compute_work_group_count[0] || groups.1 > l.max_compute_work_group_count[1]
-    {
-        return Err(bad_input(format!(
-            "--size {width}x{height} with --workgroup {wg} needs {}x{} workgroups, more than this device's maxComputeWorkGroupCount {}x{}",
-            groups.0, groups.1, l.max_compute_work_group_count[0], l.max_compute_work_group_count[1]
-        )));
-    }
-    Ok(groups)
 }
 
 /// The compute pipeline: one stage and the layout it reads its descriptors through.

@@ -15,6 +15,8 @@ use ash::{khr, vk};
 use twinray_common::cli::{SceneMemory, VulkanKnobs};
 use twinray_common::error::{bad_input, no_device};
 use twinray_common::explain;
+use twinray_common::limits::StorageLimit;
+use twinray_common::plan::requests::{ComputeLimits, DeviceRequest};
 use twinray_common::report::DeviceInfo;
 
 pub struct Device {
@@ -25,8 +27,8 @@ pub struct Device {
     /// "driverName driverInfo" where Vulkan 1.2 can tell us, else the raw driverVersion.
     pub driver: String,
     pub queue_family: u32,
-    /// What the queue family can do: without GRAPHICS (`--experiment
-    /// compute-queue`) no barrier may name a graphics stage.
+    /// What the queue family can do: without GRAPHICS (a compute-only queue)
+    /// no barrier may name a graphics stage.
     pub queue_flags: vk::QueueFlags,
     /// The queue family's timestampValidBits: 0 means no timestamps on this queue.
     pub timestamp_valid_bits: u32,
@@ -51,28 +53,30 @@ struct Candidate {
     /// its timestampValidBits and flags.
     graphics_family: Option<(u32, u32, vk::QueueFlags)>,
     /// The first family that dispatches but cannot draw, likewise
-    /// (`--experiment compute-queue`).
+    /// (a run that asks for a compute-only queue).
     compute_family: Option<(u32, u32, vk::QueueFlags)>,
 }
 
 impl Device {
     /// `surface` is the window's, in windowed mode: the queue must also present
     /// to it, and the device must offer VK_KHR_swapchain. `knobs` may name the
-    /// device and say where scene buffers go. `compute_only`: the one queue
-    /// comes from a family without GRAPHICS (`--experiment compute-queue`).
-    /// `count_rays` asks for fragmentStoresAndAtomics, which the ray-counting
-    /// frame needs on the fragment path; the timed runs get the device they
-    /// always had. `robust_access` turns on robustBufferAccess, the bounds
-    /// checks of `--experiment robust-access`.
+    /// device and say where scene buffers go. `request` is what the run plan
+    /// asks of the device: a queue from a family without GRAPHICS
+    /// (`compute_only_queue`); fragmentStoresAndAtomics, which the ray-counting
+    /// frame needs on the fragment path (`count_rays`; the timed runs get the
+    /// device they always had); robustBufferAccess's bounds checks (`robust_access`).
     // Long function: the walkthrough's device step read top to bottom (pick a GPU, a queue family, features, extensions, create); each block is one choice.
     pub fn new(
         instance: &Instance,
         surface: Option<&Surface>,
         knobs: &VulkanKnobs,
-        compute_only: bool,
-        count_rays: bool,
-        robust_access: bool,
+        request: &DeviceRequest,
     ) -> Result<Device> {
+        let DeviceRequest {
+            compute_only_queue,
+            count_rays,
+            robust_access,
+        } = *request;
         let vk_instance = &instance.instance;
         // SAFETY: `instance` is alive for the whole call (borrowed) and is used from this thread
         // only.
@@ -123,10 +127,10 @@ impl Device {
             .collect();
         let chosen = choose(&candidates, knobs.device())?;
         let graphics = chosen.graphics_family.expect("choose() checks this");
-        let (queue_family, timestamp_valid_bits, flags) = if compute_only {
+        let (queue_family, timestamp_valid_bits, flags) = if compute_only_queue {
             chosen.compute_family.ok_or_else(|| {
                 bad_input(format!(
-                    "--experiment compute-queue: the Vulkan device '{}' has no compute-only queue family (one with COMPUTE but not GRAPHICS)",
+                    "the run asks for a compute-only queue, but the Vulkan device '{}' has no compute-only queue family (one with COMPUTE but not GRAPHICS)",
                     chosen.name
                 ))
             })?
@@ -224,7 +228,7 @@ queue family {queue_family}: {flags:?}, timestampValidBits {timestamp_valid_bits
                 };
                 let features = match (fragment_stores && count_rays, robust_access) {
                     (true, _) => "fragmentStoresAndAtomics (--count-rays)",
-                    (false, true) => "robustBufferAccess (--experiment robust-access)",
+                    (false, true) => "robustBufferAccess (bounds checks)",
                     (false, false) => "no optional features",
                 };
                 format!("1 queue from family {queue_family}, priority 1.0; device extensions: {ext}; {features}")
@@ -250,6 +254,35 @@ queue family {queue_family}: {flags:?}, timestampValidBits {timestamp_valid_bits
             fragment_stores: fragment_stores && count_rays,
             scene_memory: knobs.memory,
         })
+    }
+
+    /// The largest storage buffer this device binds: what every run plan is checked against.
+    pub fn storage_limit(&self) -> StorageLimit {
+        StorageLimit {
+            bytes: self.properties.limits.max_storage_buffer_range as u64,
+            name: "maxStorageBufferRange",
+        }
+    }
+
+    /// The compute limits under Vulkan's names.
+    pub fn compute_limits(&self) -> ComputeLimits {
+        let l = &self.properties.limits;
+        ComputeLimits {
+            group_size: [
+                l.max_compute_work_group_size[0],
+                l.max_compute_work_group_size[1],
+            ],
+            invocations: l.max_compute_work_group_invocations,
+            group_count: [
+                l.max_compute_work_group_count[0],
+                l.max_compute_work_group_count[1],
+            ],
+            names: [
+                "maxComputeWorkGroupSize",
+                "maxComputeWorkGroupInvocations",
+                "maxComputeWorkGroupCount",
+            ],
+        }
     }
 
     /// What the `--json` report says about this device.

@@ -267,7 +267,7 @@ impl<'a> Uploads<'a> {
                 )
             })
             .collect();
-        // A compute-only queue (`--experiment compute-queue`) runs no fragment stage to wait for.
+        // A compute-only queue runs no fragment stage to wait for.
         let shaders = if self.device.queue_flags.contains(vk::QueueFlags::GRAPHICS) {
             vk::PipelineStageFlags::FRAGMENT_SHADER | vk::PipelineStageFlags::COMPUTE_SHADER
         } else {

@@ -20,14 +20,14 @@ use crate::device::Device;
 use anyhow::{Context, Result};
 use ash::vk;
 use twinray_common::explain;
-use twinray_common::fragment_pass::FragmentPass;
+use twinray_common::plan::requests::FragmentPass;
 use twinray_common::shader::build::Shaders;
 
 /// Float output, so the NaN count and the 8-bit rounding happen on the CPU,
 /// identically for both APIs. Every Vulkan device can render to it.
 pub const COLOR_FORMAT: vk::Format = vk::Format::R32G32B32A32_SFLOAT;
 
-/// The headless target's format: COLOR_FORMAT, or with `--experiment rgba8`
+/// The headless target's format: COLOR_FORMAT, or where the pass asks for it
 /// 8-bit UNORM (also mandatory as a colour attachment and copy source).
 pub fn target_format(pass: &FragmentPass) -> vk::Format {
     if pass.rgba8 {
@@ -69,7 +69,7 @@ impl RenderPass {
     ) -> Result<RenderPass> {
         let d = &device.device;
         // The fullscreen triangle writes every pixel, so the old contents are not
-        // loaded (DONT_CARE) unless `--experiment load-clear` measures a CLEAR.
+        // loaded (DONT_CARE) unless the pass asks for a CLEAR.
         let attachment = vk::AttachmentDescription::default()
             .format(format)
             .samples(vk::SampleCountFlags::TYPE_1)
@@ -200,13 +200,13 @@ impl Pipeline {
             "1 descriptor set layout (set 0), no push constants".into()
         });
 
-        let vertex = module(d, &shaders.vertex_spirv, "vertex")?;
-        let fragment = module(d, &shaders.fragment_spirv, "fragment")?;
+        let vertex = module(d, &shaders.vertex.spirv, "vertex")?;
+        let fragment = module(d, &shaders.fragment.spirv, "fragment")?;
         explain::step("VkShaderModule x2 (naga SPIR-V)", || {
             format!(
                 "vertex {} words, fragment {} words; variant {}",
-                shaders.vertex_spirv.len(),
-                shaders.fragment_spirv.len(),
+                shaders.vertex.spirv.len(),
+                shaders.fragment.spirv.len(),
                 shaders.variant.label()
             )
         });

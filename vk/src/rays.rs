@@ -14,22 +14,19 @@ use crate::scene::scene_buffers;
 use crate::target::Target;
 use anyhow::Result;
 use ash::vk;
-use twinray_common::cli::RenderPath;
 use twinray_common::error::no_device;
 use twinray_common::explain;
-use twinray_common::fragment_pass::FragmentPass;
 use twinray_common::gpu::layout::{binding, GpuRayCount};
 use twinray_common::limits::pixel_count;
+use twinray_common::plan::CountingRun;
 use twinray_common::rays::RayKinds;
-use twinray_common::shader::build::{build, build_compute};
-use twinray_common::shader::variant::CountingRun;
+use twinray_common::shader::build::PathShaders;
 
 /// Renders the counting frame of `run` and returns its rays by kind.
 pub fn count_rays(device: &Device, run: &CountingRun) -> Result<RayKinds> {
     let (width, height) = (run.width, run.height);
-    let counting = run.variant.counting();
     // Declared first, so dropped last: after the pipelines that use them.
-    let (frame, mut storage) = scene_buffers(device, run.scene)?;
+    let (frame, mut storage) = scene_buffers(device, run.gpu)?;
     let bytes = pixel_count(width, height) * size_of::<GpuRayCount>();
     let counts = Buffer::host_visible_with(
         device,
@@ -39,17 +36,16 @@ pub fn count_rays(device: &Device, run: &CountingRun) -> Result<RayKinds> {
     )?;
     let counts_handle = counts.buffer;
     storage.push((binding::RAY_COUNTS, counts));
-    match run.path {
-        RenderPath::Fragment => {
+    match PathShaders::build(&run.variant)? {
+        PathShaders::Fragment(shaders) => {
             if !device.fragment_stores {
                 return Err(no_device(format!(
                         "--count-rays on the fragment path needs fragmentStoresAndAtomics, which '{}' does not offer; count with --path compute",
                         device.name
                     )));
             }
-            let shaders = build(&counting)?;
-            // The run's own fragment pass (`--experiment quad` draws two triangles).
-            let pass = FragmentPass::of(&run.variant.experiments);
+            // The run's own fragment pass (it may draw two triangles).
+            let pass = run.pass;
             let render_pass = RenderPass::offscreen(device, &pass)?;
             let rp = render_pass.render_pass;
             let descriptors = Descriptors::new(device, &frame, &storage)?;
@@ -61,8 +57,7 @@ pub fn count_rays(device: &Device, run: &CountingRun) -> Result<RayKinds> {
             commands.submit()?;
             commands.wait(false)?;
         }
-        RenderPath::Compute => {
-            let shader = build_compute(&counting, run.workgroup)?;
+        PathShaders::Compute(shader) => {
             let compute = Compute::new(device, &frame, &storage, &shader, width, height, None)?;
             compute.commands.submit()?;
             compute.commands.wait(false)?;

@@ -12,7 +12,7 @@ use anyhow::Result;
 use ash::vk;
 use twinray_common::cli::SceneMemory;
 use twinray_common::gpu::layout::binding;
-use twinray_common::gpu::upload::{check_storage_limit, storage_name, GpuScene};
+use twinray_common::gpu::upload::{storage_name, GpuScene};
 use twinray_common::shader::build::Shaders;
 
 /// Fields in reverse creation order, so that they drop in the order Vulkan needs:
@@ -60,8 +60,7 @@ impl SceneResources {
 /// choice. `--vk-memory host` keeps the scene in host-visible memory instead,
 /// so the comparison can show what a naive placement costs.
 pub fn scene_buffers(device: &Device, scene: &GpuScene) -> Result<(Buffer, Vec<(u32, Buffer)>)> {
-    let limit = device.properties.limits.max_storage_buffer_range as u64;
-    check_storage_limit(scene, limit, "maxStorageBufferRange")?;
+    // The run plan checked every buffer against `Device::storage_limit`.
     let host = device.scene_memory == SceneMemory::Host;
     // The uniform block first, then the storage buffers in binding order.
     let frame = (

@@ -17,7 +17,7 @@ use anyhow::{Context, Result};
 use ash::vk;
 use ash::vk::MemoryPropertyFlags as Flags;
 use twinray_common::explain;
-use twinray_common::fragment_pass::FragmentPass;
+use twinray_common::plan::requests::FragmentPass;
 use twinray_common::reference::image_io::FloatImage;
 
 pub struct Target {
@@ -29,7 +29,7 @@ pub struct Target {
     pub width: u32,
     pub height: u32,
     readback: Buffer,
-    /// `--experiment rgba8`: the image and the readback hold 8-bit UNORM texels.
+    /// An RGBA8 pass: the image and the readback hold 8-bit UNORM texels.
     rgba8: bool,
 }
 

@@ -29,18 +29,20 @@ use crate::target::Target;
 use anyhow::{Context, Result};
 use ash::{khr, vk};
 use std::time::Instant;
-use twinray_common::cli::{RenderArgs, VulkanKnobs};
+use twinray_common::cli::VulkanKnobs;
 use twinray_common::error::no_device;
 use twinray_common::explain;
-use twinray_common::fragment_pass::FragmentPass;
 use twinray_common::gpu::layout::GpuFrame;
 use twinray_common::gpu::upload::GpuScene;
+use twinray_common::limits::StorageLimit;
+use twinray_common::plan::requests::FragmentPass;
+use twinray_common::plan::{CountingRun, Planner};
 use twinray_common::rays::RayKinds;
 use twinray_common::reference::image_io::FloatImage;
 use twinray_common::report::DeviceInfo;
+use twinray_common::shader::build::PathShaders;
 use twinray_common::shader::build::Shaders;
-use twinray_common::shader::variant::{CountingRun, Variant};
-use twinray_common::window::{self, Drawn, PathShaders, Renderer, WindowedRun};
+use twinray_common::window::{self, Drawn, Renderer, WindowedRun};
 use winit::window::Window;
 
 /// The current path's per-scene objects, and the shaders they were built
@@ -75,25 +77,18 @@ pub struct VkWindow {
 
 /// Opens the window and runs until it is closed; returns what `--json` reports.
 pub fn run(
-    args: &RenderArgs,
+    planner: &Planner,
     knobs: &VulkanKnobs,
     started: Instant,
 ) -> Result<(WindowedRun, DeviceInfo)> {
-    let scene = args.load_scene()?;
-    let variant = Variant::chosen(&scene, args);
-    let shaders = window::first_shaders(args, &scene)?;
-    explain::step(
-        "Shaders: GLSL -> naga module -> SPIR-V (twinray-common)",
-        || format!("variant {}, {} path", variant.label(), args.path),
-    );
-
+    let args = planner.args();
     let event_loop = window::event_loop()?;
     // winit 0.30 prefers windows made inside `resumed` (for Android's and the
     // web's life cycles). On desktops a window made before the loop starts
     // works the same, and lets setup run top to bottom like the headless path.
     #[allow(deprecated)]
     let window = event_loop
-        .create_window(window::window_attributes(args, &scene.name, "Vulkan"))
+        .create_window(window::window_attributes(args, &args.scene, "Vulkan"))
         .context("creating the window")?;
     explain::step("Window (winit)", || {
         let s = window.inner_size();
@@ -105,14 +100,7 @@ pub fn run(
         surface::required_extensions(&window)?,
     )?;
     let surface = Surface::new(&instance, &window)?;
-    let device = Device::new(
-        &instance,
-        Some(&surface),
-        knobs,
-        false,
-        args.count_rays,
-        false,
-    )?;
+    let device = Device::new(&instance, Some(&surface), knobs, &planner.device())?;
     let loader = khr::swapchain::Device::new(&instance.instance, &device.device);
     let format = swapchain::choose_format(&device, &surface)?;
     let present_mode = swapchain::choose_present_mode(&device, &surface, args.vsync)?;
@@ -122,9 +110,21 @@ pub fn run(
         swapchain::accepts_transfer_writes(&device, &surface)?,
         format.format,
     );
-    let render_pass = RenderPass::for_swapchain(&device, format.format)?;
     let size = window.inner_size();
-    let gpu = GpuScene::new(&scene, size.width.max(1), size.height.max(1));
+    // The plan comes after the device, whose storage limit it is checked against.
+    let plan = planner.prepare(
+        &device.storage_limit(),
+        size.width.max(1),
+        size.height.max(1),
+    )?;
+    window.set_title(&twinray_common::window::title::window_title(
+        &plan.scene.name,
+        "Vulkan",
+        args.path,
+        None,
+        None,
+    ));
+    let render_pass = RenderPass::for_swapchain(&device, format.format)?;
     let size = (size.width, size.height);
     let chain = Swapchain::new(
         &device,
@@ -145,8 +145,8 @@ pub fn run(
     );
     let drawing = path_resources(
         &device,
-        &gpu,
-        &shaders,
+        &plan.gpu,
+        &plan.shaders,
         render_pass.render_pass,
         format.format,
         extent,
@@ -174,15 +174,7 @@ pub fn run(
         "per frame: wait fence, acquire image, re-record (fragment: render pass; compute: dispatch + blit),\n\
          submit (wait image-available, signal render-finished), present; C switches the path".into()
     });
-    let run = window::session::run(
-        "twinray-vk",
-        event_loop,
-        renderer,
-        args,
-        scene,
-        variant,
-        started,
-    )?;
+    let run = window::session::run("twinray-vk", event_loop, renderer, planner, plan, started)?;
     Ok((run, info))
 }
 
@@ -247,6 +239,10 @@ impl Renderer for VkWindow {
 
     fn api(&self) -> &'static str {
         "Vulkan"
+    }
+
+    fn storage_limit(&self) -> StorageLimit {
+        self.device.storage_limit()
     }
 
     fn window(&self) -> &Window {

@@ -57,13 +57,13 @@ impl GpuFrame {
 
 impl GpuScene {
     /// The buffers of `scene` in its local frame: positions have the local origin
-    /// subtracted in f64 before they become f32, and the BVH (`Scene::bvh_tree`)
-    /// is built over those translated primitives, so its boxes are rounded in
-    /// the same frame.
-    pub fn new(world: &Scene, width: u32, height: u32) -> GpuScene {
+    /// subtracted in f64 before they become f32, and `bvh` (where the run
+    /// traces through one) was built over those translated primitives, so its
+    /// boxes are rounded in the same frame.
+    pub fn new(world: &Scene, bvh: Option<&Bvh>, width: u32, height: u32) -> GpuScene {
         let scene = &*in_local_frame(world);
         let empty = Bvh::default();
-        let bvh = world.bvh_tree().unwrap_or(&empty);
+        let bvh = bvh.unwrap_or(&empty);
         let mut gpu = GpuScene {
             frame: GpuFrame::new(world, &world.camera, width, height),
             spheres: scene
@@ -252,7 +252,7 @@ mod tests {
             assert_eq!(o / grid, (o / grid).round(), "{}", case.name);
             // What the GPU holds lies within a few view distances of zero, and
             // `origin=world` gives the world coordinates back.
-            let g = GpuScene::new(&s, 8, 8);
+            let g = GpuScene::new(&s, None, 8, 8);
             let far = g
                 .spheres
                 .iter()
@@ -266,7 +266,7 @@ mod tests {
             world.origin = OriginMode::World;
             assert_eq!(local_origin(&world), DVec3::ZERO);
             assert_eq!(
-                GpuScene::new(&world, 8, 8).frame.eye,
+                GpuScene::new(&world, None, 8, 8).frame.eye,
                 s.camera.eye.as_vec3().to_array()
             );
         }

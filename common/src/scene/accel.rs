@@ -5,8 +5,7 @@
 //! plus the primitive list its leaves point into.
 
 use crate::gpu::layout::{child_ref, Bounds, Bvh, GpuBvhNode, GpuBvhPrim, PRIM_SPHERE_BIT};
-use crate::scene::camera::in_local_frame;
-use crate::scene::{BvhCache, Scene};
+use crate::scene::Scene;
 use glam::DVec3;
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
@@ -21,31 +20,15 @@ pub enum Accel {
 /// report's acceleration section for the measurements behind the number.
 pub const AUTO_BVH_MIN_PRIMITIVES: usize = 64;
 
-impl Scene {
-    /// The scene's BVH where it traces through one (built on first use, then
-    /// kept). Primitives changed after that call would not be seen: scenes are
-    /// not edited once loaded, except for `--accel` and the ray depth.
-    pub fn bvh_tree(&self) -> Option<&Bvh> {
-        self.bvh.then(|| {
-            &**self
-                .bvh_cache
-                .0
-                // Over the primitives as the GPU holds them: relative to the local origin.
-                .get_or_init(|| {
-                    let local = in_local_frame(self);
-                    std::sync::Arc::new(Bvh::build(&local))
-                })
-        })
-    }
-
-    /// Applies `--accel` (none: brute force; bvh: a BVH; auto: a BVH from the threshold on).
-    pub fn set_accel(&mut self, accel: Accel) {
-        self.bvh_cache = BvhCache::default();
-        self.bvh = match accel {
+impl Accel {
+    /// Whether a run with this `--accel` traces `scene` through a BVH (none:
+    /// brute force; bvh: a BVH; auto: a BVH from the threshold on).
+    pub fn wants_bvh(self, scene: &Scene) -> bool {
+        match self {
             Accel::None => false,
-            Accel::Bvh => self.primitive_count() > 0,
-            Accel::Auto => self.primitive_count() >= AUTO_BVH_MIN_PRIMITIVES,
-        };
+            Accel::Bvh => scene.primitive_count() > 0,
+            Accel::Auto => scene.primitive_count() >= AUTO_BVH_MIN_PRIMITIVES,
+        }
     }
 }
 

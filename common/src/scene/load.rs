@@ -91,6 +91,30 @@ impl Scene {
         )
     }
 
+    /// Splits `--set` overrides into those that apply to the built-in scene
+    /// `name` and those that cannot (each with the reason), so that a window's
+    /// scene switch keeps what it can instead of refusing the switch. Only the
+    /// overrides are tried, on the parsed file: nothing is tessellated here.
+    pub fn applicable_overrides(
+        name: &str,
+        overrides: &[(String, String)],
+    ) -> (Vec<(String, String)>, Vec<String>) {
+        let Some((_, text)) = BUILTIN_SCENES.iter().find(|(n, _)| *n == name) else {
+            return (overrides.to_vec(), Vec::new());
+        };
+        let Ok(def) = toml::from_str::<SceneFile>(text) else {
+            return (overrides.to_vec(), Vec::new());
+        };
+        let (mut kept, mut dropped) = (Vec::new(), Vec::new());
+        for o in overrides {
+            match apply_overrides(&mut def.clone(), std::slice::from_ref(o)) {
+                Ok(_) => kept.push(o.clone()),
+                Err(e) => dropped.push(format!("{e:#}")),
+            }
+        }
+        (kept, dropped)
+    }
+
     fn parse(
         name: &str,
         text: &str,

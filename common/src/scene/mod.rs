@@ -23,7 +23,6 @@ mod resolve;
 pub mod teapot;
 
 use crate::error::bad_input;
-use crate::gpu::layout::Bvh;
 use crate::value_name::ValueName;
 use glam::DVec3;
 use numerics::Numerics;
@@ -88,37 +87,8 @@ pub struct Scene {
     pub lights: Vec<Light>,
     pub spheres: Vec<Sphere>,
     pub triangles: Vec<Triangle>,
-    /// Trace through a BVH (scene/accel.rs) instead of testing every primitive.
-    /// `--accel` decides; `auto` (the default) uses one from `AUTO_BVH_MIN_PRIMITIVES` on.
-    pub bvh: bool,
-    /// The BVH once built (`bvh_tree`): both the shader variant (its stack
-    /// depth) and the GPU buffers need it, and building it twice costs seconds
-    /// for a million triangles.
-    pub(crate) bvh_cache: BvhCache,
 }
 
-/// A built BVH carried with its scene. Derived data, not part of the scene's
-/// identity: two scenes compare equal whether or not either was built.
-#[derive(Clone, Default)]
-pub(crate) struct BvhCache(pub(crate) std::sync::OnceLock<std::sync::Arc<Bvh>>);
-
-impl PartialEq for BvhCache {
-    fn eq(&self, _: &BvhCache) -> bool {
-        true
-    }
-}
-
-impl std::fmt::Debug for BvhCache {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        f.write_str(if self.0.get().is_some() {
-            "built"
-        } else {
-            "not built"
-        })
-    }
-}
-
-/// What a scene contains, which decides its shader variant.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize)]
 pub struct Features {
     pub spheres: bool,
@@ -192,7 +162,6 @@ impl Scene {
         let r = |x: f64| x as f32 as f64;
         let v = |x: DVec3| x.as_vec3().as_dvec3();
         let mut s = self.clone();
-        s.bvh_cache = BvhCache::default();
         s.background = v(s.background);
         s.min_weight = r(s.min_weight);
         s.epsilon = r(s.epsilon);

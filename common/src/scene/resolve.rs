@@ -5,7 +5,6 @@
 
 use crate::error::bad_input;
 use crate::limits;
-use crate::scene::accel::AUTO_BVH_MIN_PRIMITIVES;
 use crate::scene::check::{
     colour3, coord3, coord_ok, count, finite, flat_normal, positive, unit_normal, within,
 };
@@ -14,7 +13,7 @@ use crate::scene::format::{
 };
 use crate::scene::mesh::{load_bpt, load_obj, FileSource};
 use crate::scene::numerics::Numerics;
-use crate::scene::{BvhCache, Camera, Light, Material, OriginMode, Scene, Sphere, Triangle};
+use crate::scene::{Camera, Light, Material, OriginMode, Scene, Sphere, Triangle};
 use glam::{DMat3, DVec3};
 use std::collections::{HashMap, HashSet};
 
@@ -106,8 +105,6 @@ pub(super) fn resolve(
         origin: render.origin,
         materials,
         lights,
-        bvh: primitives >= AUTO_BVH_MIN_PRIMITIVES,
-        bvh_cache: BvhCache::default(),
         spheres,
         triangles,
     })

@@ -1,16 +1,18 @@
-//! The naga build: concatenates shaders/ (naga has no #include), compiles a
-//! `Variant` through defines (or, for comparison, through specialization
+//! The naga build: puts shaders/ together (naga has no #include), compiles a
+//! `Variant` through its defines (or, for comparison, through specialization
 //! constants that naga's process_overrides fixes), validates the naga module
 //! once, and writes SPIR-V for Vulkan and GLSL 450 core for OpenGL from that
-//! same module — then takes out two costs naga adds on its own (see
-//! `post::strip_local_array_zero_init_*` and `spv::Options::force_loop_bounding`).
+//! same module — then finishes both as the variant's `Passes` say (by default
+//! taking out two costs naga adds on its own: `post::strip_local_array_zero_init_*`
+//! and `spv::Options::force_loop_bounding`). Each entry point compiles only
+//! what it runs.
 
-use crate::cli::{Experiment, Workgroup};
+use crate::cli::{RenderPath, Workgroup};
 use crate::shader::post::{
     float_controls_spirv, no_contraction_spirv, precise_float_locals_glsl, restrict_resources_glsl,
     strip_local_array_zero_init_glsl, strip_local_array_zero_init_spirv, warp_probe_glsl,
 };
-use crate::shader::variant::{Variant, SPEC_CONSTANTS};
+use crate::shader::variant::{Entry, SpirvCompiler, Variant, SPEC_CONSTANTS};
 use anyhow::{anyhow, Context};
 use naga::back::{glsl, spv};
 use naga::valid::{Capabilities, ModuleInfo, ValidationFlags, Validator};
@@ -68,6 +70,19 @@ pub fn compute_source() -> String {
     format!("#version 450\n{TRACE_GLSL}\n{TRACE_COMP}")
 }
 
+/// One stage of `variant` as a single self-contained file that an external
+/// compiler (glslangValidator) takes as it is: the version, the variant's
+/// defines, then the source naga parses. `--dump-shaders` writes it.
+pub fn standalone_source(source: &str, variant: &Variant) -> String {
+    let body = source.strip_prefix("#version 450\n").unwrap_or(source);
+    let mut s = String::from("#version 450\n");
+    for (k, v) in variant.defines() {
+        s.push_str(&format!("#define {k} {v}\n"));
+    }
+    s.push_str(body);
+    s
+}
+
 /// Parses and validates one stage.
 pub fn parse(
     source: &str,
@@ -75,9 +90,7 @@ pub fn parse(
     variant: &Variant,
 ) -> anyhow::Result<(Module, ModuleInfo)> {
     let mut options = naga::front::glsl::Options::from(stage);
-    for (k, v) in &variant.defines {
-        options.defines.insert(k.clone(), v.clone());
-    }
+    options.defines.extend(variant.defines());
     let module = naga::front::glsl::Frontend::default()
         .parse(&options, source)
         .map_err(|e| {
@@ -100,8 +113,9 @@ pub fn parse(
     // Neither writer takes overrides: fix them now, as a Vulkan driver would
     // at pipeline creation (ids as decimal keys, booleans as 0 or 1).
     let mut constants = naga::back::PipelineConstants::default();
+    let values = variant.constants();
     for (name, id) in SPEC_CONSTANTS {
-        if let Some(&on) = variant.constants.get(name) {
+        if let Some(&on) = values.get(name) {
             constants.insert(id.to_string(), if on { 1.0 } else { 0.0 });
         }
     }
@@ -117,41 +131,38 @@ pub fn parse(
     Ok((m.into_owned(), i.into_owned()))
 }
 
-/// One variant, compiled for both APIs.
+/// One compiled stage: what each API loads, and the source it came from.
+#[derive(Debug, Clone)]
+pub struct Stage {
+    /// "vertex", "fragment" or "compute": the file names `--dump-shaders` writes.
+    pub name: &'static str,
+    pub spirv: Vec<u32>,
+    pub glsl: String,
+    /// The stage as one file an external compiler takes (`standalone_source`).
+    pub source: String,
+}
+
+fn compile(
+    name: &'static str,
+    source: &str,
+    stage: ShaderStage,
+    variant: &Variant,
+) -> anyhow::Result<Stage> {
+    let (m, i) = parse(source, stage, variant)?;
+    Ok(Stage {
+        name,
+        spirv: spirv_for_vulkan(source, (&m, &i), stage, variant)?,
+        glsl: to_glsl(&m, &i, stage, variant)?,
+        source: standalone_source(source, variant),
+    })
+}
+
+/// The fragment path's pair, for both APIs.
 #[derive(Debug, Clone)]
 pub struct Shaders {
     pub variant: Variant,
-    pub vertex_spirv: Vec<u32>,
-    pub fragment_spirv: Vec<u32>,
-    pub vertex_glsl: String,
-    pub fragment_glsl: String,
-}
-
-impl Shaders {
-    /// Both stages as `--dump-shaders` writes them: (name, SPIR-V, GLSL).
-    pub fn stages(&self) -> [(&str, &[u32], &str); 2] {
-        [
-            ("vertex", &self.vertex_spirv, &self.vertex_glsl),
-            ("fragment", &self.fragment_spirv, &self.fragment_glsl),
-        ]
-    }
-}
-
-pub fn build(variant: &Variant) -> anyhow::Result<Shaders> {
-    let (vm, vi) = parse(FULLSCREEN_VERT, ShaderStage::Vertex, variant)?;
-    let (fm, fi) = parse(&fragment_source(), ShaderStage::Fragment, variant)?;
-    Ok(Shaders {
-        variant: variant.clone(),
-        vertex_spirv: spirv_for_vulkan(FULLSCREEN_VERT, (&vm, &vi), ShaderStage::Vertex, variant)?,
-        fragment_spirv: spirv_for_vulkan(
-            &fragment_source(),
-            (&fm, &fi),
-            ShaderStage::Fragment,
-            variant,
-        )?,
-        vertex_glsl: to_glsl(&vm, &vi, ShaderStage::Vertex, variant)?,
-        fragment_glsl: to_glsl(&fm, &fi, ShaderStage::Fragment, variant)?,
-    })
+    pub vertex: Stage,
+    pub fragment: Stage,
 }
 
 /// The tracer as a compute shader, for both APIs.
@@ -159,46 +170,90 @@ pub fn build(variant: &Variant) -> anyhow::Result<Shaders> {
 pub struct ComputeShader {
     pub variant: Variant,
     pub workgroup: Workgroup,
-    pub spirv: Vec<u32>,
-    pub glsl: String,
+    pub stage: Stage,
 }
 
-/// The scene's variant plus the workgroup size, which reaches the shader as the
-/// WG_X/WG_Y defines: `local_size` must be a constant, and a define keeps it out
-/// of the specialisation-constant path naga's writers handle poorly.
-pub fn build_compute(variant: &Variant, workgroup: Workgroup) -> anyhow::Result<ComputeShader> {
-    let mut v = variant.clone();
-    v.defines.insert("WG_X".into(), workgroup.x.to_string());
-    v.defines.insert("WG_Y".into(), workgroup.y.to_string());
-    if bvh_stack_in_shared_memory(variant, workgroup) {
-        v.defines.insert("BVH_STACK_SHARED".into(), "1".into());
+/// The shaders of one entry point: the fullscreen pair, or the compute
+/// shader with its workgroup. Each path compiles only what it runs.
+#[derive(Debug, Clone)]
+pub enum PathShaders {
+    Fragment(Shaders),
+    Compute(ComputeShader),
+}
+
+impl PathShaders {
+    /// Compiles `variant` for its entry point.
+    pub fn build(variant: &Variant) -> anyhow::Result<PathShaders> {
+        Ok(match variant.entry {
+            Entry::Fragment => PathShaders::Fragment(build(variant)?),
+            Entry::Compute(workgroup) => PathShaders::Compute(build_compute(variant, workgroup)?),
+        })
     }
-    let (m, i) = parse(&compute_source(), ShaderStage::Compute, &v)?;
-    Ok(ComputeShader {
-        variant: v.clone(),
-        workgroup,
-        spirv: spirv_for_vulkan(&compute_source(), (&m, &i), ShaderStage::Compute, &v)?,
-        glsl: to_glsl(&m, &i, ShaderStage::Compute, &v)?,
+
+    pub fn path(&self) -> RenderPath {
+        match self {
+            PathShaders::Fragment(_) => RenderPath::Fragment,
+            PathShaders::Compute(_) => RenderPath::Compute,
+        }
+    }
+
+    pub fn variant(&self) -> &Variant {
+        match self {
+            PathShaders::Fragment(s) => &s.variant,
+            PathShaders::Compute(c) => &c.variant,
+        }
+    }
+
+    /// The stages, as `--dump-shaders` writes them.
+    pub fn stages(&self) -> Vec<&Stage> {
+        match self {
+            PathShaders::Fragment(s) => vec![&s.vertex, &s.fragment],
+            PathShaders::Compute(c) => vec![&c.stage],
+        }
+    }
+}
+
+/// The fullscreen pair of `variant` (whatever its entry point says).
+pub fn build(variant: &Variant) -> anyhow::Result<Shaders> {
+    let variant = variant.on(Entry::Fragment);
+    Ok(Shaders {
+        vertex: compile("vertex", FULLSCREEN_VERT, ShaderStage::Vertex, &variant)?,
+        fragment: compile(
+            "fragment",
+            &fragment_source(),
+            ShaderStage::Fragment,
+            &variant,
+        )?,
+        variant,
     })
 }
 
-/// The most shared memory the compute path's BVH stack may take: OpenGL
-/// guarantees a workgroup 32 KiB (Vulkan only 16 KiB, but lavapipe, llvmpipe
-/// and NVIDIA offer 32 KiB or more). Only `--experiment shared-bvh-stack` uses it.
-pub const SHARED_BVH_STACK_BUDGET: usize = 32 * 1024;
+/// The compute shader of `variant` with `workgroup`.
+pub fn build_compute(variant: &Variant, workgroup: Workgroup) -> anyhow::Result<ComputeShader> {
+    let variant = variant.on(Entry::Compute(workgroup));
+    Ok(ComputeShader {
+        stage: compile("compute", &compute_source(), ShaderStage::Compute, &variant)?,
+        workgroup,
+        variant,
+    })
+}
 
-/// Whether the compute tracer keeps its BVH stack in shared memory: only with
-/// `--experiment shared-bvh-stack`, and only where the stack fits in the budget.
-pub fn bvh_stack_in_shared_memory(variant: &Variant, workgroup: Workgroup) -> bool {
-    let Some(entries) = variant
-        .defines
-        .get("BVH_STACK")
-        .and_then(|n| n.parse::<usize>().ok())
-    else {
-        return false;
-    };
-    let bytes = entries * (workgroup.x * workgroup.y) as usize * 8;
-    variant.experiments.contains(&Experiment::SharedBvhStack) && bytes <= SHARED_BVH_STACK_BUDGET
+/// Whether naga bounds every loop of the SPIR-V with a 64-bit counter that
+/// breaks out after 2^64 iterations, so that a driver cannot assume an
+/// infinite loop away; the GLSL writer adds none, so it is a cost only Vulkan
+/// pays. Every loop of the tracer ends (the stacks shrink, the primitive loops
+/// count up to a constant), so it is never needed for correctness. On NVIDIA
+/// it costs the BVH variants time in Vulkan, but without it NVIDIA's Vulkan
+/// compiler, given the constant trip count of the brute-force sphere loop,
+/// made the 10,000-sphere list slower
+/// (comparison/results/nvidia-h100/FINDINGS.md, "Loop bounding"). So the BVH
+/// variants go without it and the brute-force ones keep it, unless the
+/// laboratory says otherwise.
+pub fn loop_bounding(variant: &Variant) -> bool {
+    variant
+        .passes
+        .loop_bounding
+        .unwrap_or(variant.bvh_stack.is_none())
 }
 
 pub fn to_spirv(
@@ -210,31 +265,13 @@ pub fn to_spirv(
     // No ADJUST_COORDINATE_SPACE (y stays as written, see trace.frag) and no DEBUG,
     // so debug and release builds emit identical SPIR-V.
     //
-    // naga's loop bounding gives every loop a 64-bit counter that breaks out
-    // after 2^64 iterations, so that a driver cannot assume an infinite loop
-    // away; the GLSL writer adds none, so it is a cost only Vulkan pays. Every
-    // loop of trace.glsl ends (the stacks shrink, the primitive loops count up
-    // to a constant), so it is never needed for correctness. Measured on an
-    // H100 (comparison/results/nvidia-h100/FINDINGS.md), it costs the BVH
-    // variants 4-17 % in Vulkan and the box 7 %, but without it NVIDIA's
-    // Vulkan compiler, given the constant trip count of the brute-force sphere
-    // loop, made the 10,000-sphere list 1.7x slower (227 ms against 135). So the
-    // BVH variants go without it and the brute-force ones keep it, until the
-    // counts reach the shader in a way no driver specialises on.
-    let loop_bounding = if variant.experiments.contains(&Experiment::NagaLoopBounding) {
-        true
-    } else if variant.experiments.contains(&Experiment::NoLoopBounding) {
-        false
-    } else {
-        !variant.defines.contains_key("USE_BVH")
-    };
     // Workgroup memory (the shared BVH stack and --shared-pad, both compute
     // experiments) is written before it is read, and the GLSL writer is told
     // not to zero it (`to_glsl`): naga's default polyfill would zero it at the
     // start of every workgroup in Vulkan alone, a cost only one API would pay.
     let options = spv::Options {
         flags: spv::WriterFlags::LABEL_VARYINGS,
-        force_loop_bounding: loop_bounding,
+        force_loop_bounding: loop_bounding(variant),
         zero_initialize_workgroup_memory: spv::ZeroInitializeWorkgroupMemoryMode::None,
         ..Default::default()
     };
@@ -244,10 +281,10 @@ pub fn to_spirv(
     };
     let words = spv::write_vec(module, info, &options, Some(&pipeline))
         .with_context(|| format!("writing {stage:?} SPIR-V"))?;
-    Ok(if variant.experiments.contains(&Experiment::NagaZeroInit) {
-        words
-    } else {
+    Ok(if variant.passes.strip_zero_init {
         strip_local_array_zero_init_spirv(&words)
+    } else {
+        words
     })
 }
 
@@ -297,64 +334,41 @@ pub fn to_glsl(
     writer
         .write()
         .with_context(|| format!("writing {stage:?} GLSL"))?;
-    let out = if variant.experiments.contains(&Experiment::NagaZeroInit) {
-        out
-    } else {
-        strip_local_array_zero_init_glsl(&out)
-    };
-    let out = if restricts_resources(variant) {
-        restrict_resources_glsl(&out)
-    } else {
-        out
-    };
-    let out =
-        if stage == ShaderStage::Compute && variant.experiments.contains(&Experiment::WarpProbe) {
-            warp_probe_glsl(&out, crate::gpu::layout::binding::WARP_PROBE)?
-        } else {
-            out
-        };
-    Ok(
-        if variant.experiments.contains(&Experiment::NoContraction) {
-            precise_float_locals_glsl(&out)
-        } else {
-            out
-        },
-    )
+    let passes = variant.passes;
+    if passes.strip_zero_init {
+        out = strip_local_array_zero_init_glsl(&out);
+    }
+    if passes.restrict {
+        out = restrict_resources_glsl(&out);
+    }
+    if stage == ShaderStage::Compute && passes.warp_probe {
+        out = warp_probe_glsl(&out, crate::gpu::layout::binding::WARP_PROBE)?;
+    }
+    if passes.no_contraction {
+        out = precise_float_locals_glsl(&out);
+    }
+    Ok(out)
 }
 
-/// Whether OpenGL's shader declares its buffers and image `restrict` (GLSL) or
-/// `Restrict` (SPIR-V), as Vulkan's SPIR-V implies: always, except with
-/// `--experiment naga-aliasing` (see `post::restrict_resources_glsl`).
-pub fn restricts_resources(variant: &Variant) -> bool {
-    !variant.experiments.contains(&Experiment::NagaAliasing)
-}
-
-/// The SPIR-V that Vulkan runs: naga's, or with `--experiment glslang` Khronos'
-/// glslangValidator's from the same source and defines; with `--experiment
-/// no-contraction`, decorated so that the driver may not fuse float arithmetic.
+/// The SPIR-V that Vulkan runs: naga's, or glslangValidator's from the same
+/// source and defines; finished as the variant's passes say.
 fn spirv_for_vulkan(
     source: &str,
     (module, info): (&Module, &ModuleInfo),
     stage: ShaderStage,
     variant: &Variant,
 ) -> anyhow::Result<Vec<u32>> {
-    let words = if variant.experiments.contains(&Experiment::Glslang) {
-        glslang_spirv(source, stage, variant)?
-    } else {
-        to_spirv(module, info, stage, variant)?
+    let mut words = match variant.passes.compiler {
+        SpirvCompiler::Glslang => glslang_spirv(source, stage, variant)?,
+        SpirvCompiler::Naga => to_spirv(module, info, stage, variant)?,
     };
-    let words = if variant.experiments.contains(&Experiment::NoContraction) {
-        no_contraction_spirv(&words)
-    } else {
-        words
-    };
-    Ok(
-        if variant.experiments.contains(&Experiment::FloatControls) {
-            float_controls_spirv(&words)
-        } else {
-            words
-        },
-    )
+    if variant.passes.no_contraction {
+        words = no_contraction_spirv(&words);
+    }
+    if variant.passes.float_controls {
+        words = float_controls_spirv(&words);
+    }
+    Ok(words)
 }
 
 /// `--experiment glslang`: compiles `source` with glslangValidator, to measure
@@ -376,7 +390,7 @@ fn glslang_spirv(source: &str, stage: ShaderStage, variant: &Variant) -> anyhow:
         .with_context(|| format!("--experiment glslang: writing {}", input.display()))?;
     let mut command = std::process::Command::new("glslangValidator");
     command.args(["-V", "--target-env", "vulkan1.1"]);
-    command.args(variant.defines.iter().map(|(k, v)| format!("-D{k}={v}")));
+    command.args(variant.defines().iter().map(|(k, v)| format!("-D{k}={v}")));
     command.arg("-o").arg(&output).arg(&input);
     let result = command.output().map_err(|e| {
         anyhow!("--experiment glslang needs glslangValidator on PATH (Debian: glslang-tools): {e}")
@@ -427,9 +441,9 @@ mod tests {
     #[test]
     fn specialized_variant_leaves_no_override_for_the_writers() {
         let scene = Scene::load("spherelist", &[]).unwrap();
-        let v = Variant::specialized(&scene);
-        assert_eq!(v.constants.get("SPEC_GLASS"), Some(&false));
-        assert_eq!(v.constants.get("SPEC_MIRROR"), Some(&true));
+        let v = Variant::specialized(&scene, None);
+        assert_eq!(v.constants().get("SPEC_GLASS"), Some(&false));
+        assert_eq!(v.constants().get("SPEC_MIRROR"), Some(&true));
         let (m, _) = parse(&fragment_source(), ShaderStage::Fragment, &v).unwrap();
         // process_overrides keeps the arena but replaces every use by a constant.
         let uses = m
@@ -444,13 +458,14 @@ mod tests {
         assert!(!m.overrides.is_empty(), "the shader declares the switches");
         assert_eq!(uses, 0, "no override left for the writers");
         let s = build(&v).unwrap();
-        assert!(!s.fragment_spirv.is_empty() && s.fragment_glsl.contains("void main"));
+        assert!(!s.fragment.spirv.is_empty() && s.fragment.glsl.contains("void main"));
     }
 
     #[test]
     fn compute_shader_builds_with_each_measured_workgroup() {
         for wg in Workgroup::MEASURED {
             let c = build_compute(&Variant::generic(Default::default()), wg).unwrap();
+            let c = &c.stage;
             assert_eq!(c.spirv[0], 0x0723_0203, "SPIR-V magic");
             let local = format!(
                 "layout(local_size_x = {}, local_size_y = {}, local_size_z = 1) in;",
@@ -474,22 +489,22 @@ mod tests {
                 .count()
         };
         // Each of the five set-0 resources, and nothing else, is decorated Restrict.
-        let gl = spirv_for_opengl(&s.fragment_spirv, true);
+        let gl = spirv_for_opengl(&s.fragment.spirv, true);
         assert_eq!(
-            decorations(&s.fragment_spirv, 19),
+            decorations(&s.fragment.spirv, 19),
             0,
             "Vulkan's SPIR-V is naga's"
         );
-        assert_eq!(decorations(&gl, 19), decorations(&s.fragment_spirv, 34));
+        assert_eq!(decorations(&gl, 19), decorations(&s.fragment.spirv, 34));
         assert_eq!(decorations(&gl, 19), 5);
-        let plain = spirv_for_opengl(&s.fragment_spirv, false);
+        let plain = spirv_for_opengl(&s.fragment.spirv, false);
         assert_eq!(decorations(&plain, 19), 0);
     }
 
     #[test]
     fn spirv_for_opengl_drops_sets_and_flips_origin_only() {
         let s = build(&Variant::generic(Default::default())).unwrap();
-        let gl = spirv_for_opengl(&s.fragment_spirv, false);
+        let gl = spirv_for_opengl(&s.fragment.spirv, false);
         let count = |w: &[u32], op: u32, arg2: u32| {
             let mut i = 5;
             let mut n = 0;
@@ -503,16 +518,16 @@ mod tests {
             n
         };
         assert_eq!(
-            count(&s.fragment_spirv, 71, 34),
+            count(&s.fragment.spirv, 71, 34),
             5,
             "five resources in set 0"
         );
         assert_eq!(count(&gl, 71, 34), 0);
-        assert_eq!(count(&s.fragment_spirv, 16, 7), 1);
+        assert_eq!(count(&s.fragment.spirv, 16, 7), 1);
         assert_eq!(count(&gl, 16, 8), 1);
         assert_eq!(
             gl.len(),
-            s.fragment_spirv.len() - 5 * 4,
+            s.fragment.spirv.len() - 5 * 4,
             "only the five 4-word decorations go"
         );
     }

@@ -1,41 +1,155 @@
-//! The one place a scene's shader variant is decided: `Variant::chosen`, from
-//! the scene and the run's options, which both apps (headless and windowed) and
-//! the comparison call. A variant is the map of defines (and, for
-//! `--specialize`, specialization constants) that selects what trace.glsl
-//! compiles: only the features the scene uses, its counts and BVH stack, its
-//! numerical choices, and any `--experiment`.
+//! What one compiled tracer is: a typed `Variant` that holds every choice the
+//! shader's bytes depend on — the scene's features, the ray stack, the counts,
+//! the BVH stack, the numerical choices, the form (the scene's own, generic or
+//! specialised), the entry point with its workgroup, and the laboratory's
+//! shader knobs and passes over naga's output. It renders its defines only at
+//! the end (`defines`), for naga. The run plan (`plan`) decides a variant; the
+//! build (`build`) compiles it; nothing parses a decision back out of a define.
 
-use crate::cli::{Experiment, RenderArgs, RenderPath, Workgroup};
-use crate::fragment_pass::QUAD_DEFINE;
-use crate::gpu::upload::GpuScene;
+use crate::cli::{RenderPath, Workgroup};
+use crate::gpu::layout::Bvh;
 use crate::limits::MAX_DEPTH;
 use crate::scene::numerics::Numerics;
 use crate::scene::{Features, Scene};
-use crate::value_name::ValueName;
 use std::collections::BTreeMap;
 
-/// The defines that select a shader variant. Same map → same module → same code
-/// in both APIs. `numerics` is what its numerical defines encode, kept so that
-/// the reference can be asked to take the same choices. `constants` are the
-/// specialization constants of `Variant::specialized` (empty otherwise).
-/// `experiments` undo the build's own optimisations, to measure them.
-#[derive(Debug, Clone, PartialEq, Eq, serde::Serialize)]
+/// One tracer, fully decided. Same variant → same module → same code in both APIs.
+#[derive(Debug, Clone, PartialEq, Eq)]
 pub struct Variant {
-    pub defines: BTreeMap<String, String>,
+    /// The primitives and materials compiled in.
+    pub features: Features,
+    pub form: Form,
+    /// Pending rays the depth-first ray stack holds.
+    pub ray_stack: u32,
+    /// Where the shader's loops find the primitive and light counts.
+    pub counts: Counts,
+    /// The BVH traversal stack's entries, where the variant traces through a BVH.
+    pub bvh_stack: Option<u32>,
+    /// Offset, triangle and sphere tests; the reference can take the same.
     pub numerics: Numerics,
-    pub constants: BTreeMap<String, bool>,
-    pub experiments: Vec<Experiment>,
+    /// The entry point: the fullscreen pair, or compute with its workgroup.
+    pub entry: Entry,
+    /// COUNT_RAYS: the untimed frame that counts rays by kind.
+    pub count_rays: bool,
+    /// What the laboratory changed in the shader source (all off in the product).
+    pub knobs: ShaderKnobs,
+    /// How naga's output is finished (the product's passes unless the laboratory says otherwise).
+    pub passes: Passes,
+    /// The experiments' names, in registry order, for the label.
+    pub tags: Vec<String>,
 }
 
-/// What the untimed ray-counting frame renders (`--count-rays`), in either
-/// app: the run's scene at its size, on its path, with `variant.counting()`.
-pub struct CountingRun<'a> {
-    pub scene: &'a GpuScene,
-    pub variant: &'a Variant,
-    pub path: RenderPath,
-    pub workgroup: Workgroup,
-    pub width: u32,
-    pub height: u32,
+/// Which source the variant compiles.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Form {
+    /// Only the scene's features, as defines (the default).
+    Scene,
+    /// Every feature and the deepest stack (`--generic`).
+    Generic,
+    /// One source for every scene whose feature switches are specialization
+    /// constants fixed by naga's process_overrides (`--specialize`).
+    Specialized,
+}
+
+/// The loops' bounds.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Counts {
+    /// Baked in as constants (a bound read at run time made lavapipe compile
+    /// and keep a new shader at every draw).
+    Baked {
+        spheres: u32,
+        triangles: u32,
+        lights: u32,
+    },
+    /// Read from the `Frame` uniform.
+    Uniform,
+    /// Read from a storage buffer.
+    Storage,
+}
+
+/// The tracer's entry point.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Entry {
+    /// shaders/fullscreen.vert + shaders/trace.frag.
+    Fragment,
+    /// shaders/trace.comp with this workgroup.
+    Compute(Workgroup),
+}
+
+impl Entry {
+    pub fn new(path: RenderPath, workgroup: Workgroup) -> Entry {
+        match path {
+            RenderPath::Fragment => Entry::Fragment,
+            RenderPath::Compute => Entry::Compute(workgroup),
+        }
+    }
+
+    pub fn path(&self) -> RenderPath {
+        match self {
+            Entry::Fragment => RenderPath::Fragment,
+            Entry::Compute(_) => RenderPath::Compute,
+        }
+    }
+}
+
+/// Changes to the shader source that only the laboratory asks for.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub struct ShaderKnobs {
+    /// One BVH stack entry per array element instead of two per uvec4.
+    pub unpaired_bvh_stack: bool,
+    /// A BVH stack per walk instead of one at module scope.
+    pub local_bvh_stack: bool,
+    /// Compute: the BVH stack in shared memory where it fits.
+    pub shared_bvh_stack: bool,
+    /// The ray stack as four arrays instead of two of vec4 pairs.
+    pub split_ray_stack: bool,
+    /// The fullscreen pass as two triangles.
+    pub quad: bool,
+    /// Compute: KiB of workgroup memory the tracer does not need.
+    pub shared_pad_kib: Option<u32>,
+}
+
+/// The SPIR-V compiler Vulkan's shader comes from.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum SpirvCompiler {
+    #[default]
+    Naga,
+    /// Khronos' glslangValidator, from the same source and defines.
+    Glslang,
+}
+
+/// How naga's output is finished before a driver sees it.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Passes {
+    pub compiler: SpirvCompiler,
+    /// naga's zero initialisers on function-local arrays are taken out.
+    pub strip_zero_init: bool,
+    /// naga's loop bounding, where the laboratory forces it on or off
+    /// (`None`: the build decides, see `build::loop_bounding`).
+    pub loop_bounding: Option<bool>,
+    /// `NoContraction` / `precise` on every float operation.
+    pub no_contraction: bool,
+    /// SPV_KHR_float_controls' strict IEEE modes.
+    pub float_controls: bool,
+    /// OpenGL's resources declared `restrict` / `Restrict`, as Vulkan's SPIR-V implies.
+    pub restrict: bool,
+    /// OpenGL compute: record each multiprocessor's highest warp slot.
+    pub warp_probe: bool,
+}
+
+impl Default for Passes {
+    /// The product's passes.
+    fn default() -> Passes {
+        Passes {
+            compiler: SpirvCompiler::Naga,
+            strip_zero_init: true,
+            loop_bounding: None,
+            no_contraction: false,
+            float_controls: false,
+            restrict: true,
+            warp_probe: false,
+        }
+    }
 }
 
 /// The feature switches trace.glsl declares with `layout(constant_id = N)`
@@ -48,216 +162,253 @@ pub const SPEC_CONSTANTS: [(&str, u16); 4] = [
     ("SPEC_GLASS", 3),
 ];
 
+/// The define under which shaders/fullscreen.vert emits two triangles.
+pub const QUAD_DEFINE: &str = "FULLSCREEN_QUAD";
+
+/// The most shared memory the compute path's BVH stack may take: OpenGL
+/// guarantees a workgroup 32 KiB (Vulkan only 16 KiB, but lavapipe, llvmpipe
+/// and NVIDIA offer 32 KiB or more).
+pub const SHARED_BVH_STACK_BUDGET: usize = 32 * 1024;
+
+const ALL_FEATURES: Features = Features {
+    spheres: true,
+    triangles: true,
+    mirror: true,
+    glass: true,
+};
+
 impl Variant {
-    /// Only what the scene needs: no triangle loop without triangles, no
-    /// refraction code without glass, a ray stack sized to the scene's depth;
-    /// and the scene's numerical choices (offset, triangle and sphere tests).
-    pub fn for_scene(scene: &Scene) -> Variant {
-        let mut v = Variant::from_features(scene.features(), scene.max_depth, scene.numerics);
-        v.add_scene_data(scene);
+    /// Only what the features need: no triangle loop without triangles, no
+    /// refraction code without glass, a ray stack sized to the depth. The
+    /// counts are read from the uniform until `with_scene_data` bakes them.
+    pub fn from_features(features: Features, max_depth: u32, numerics: Numerics) -> Variant {
+        // Only glass makes the ray tree branch (reflected and refracted rays):
+        // then the depth-first stack holds one pending ray per level. Without
+        // glass a hit pushes at most one ray after popping one, so one slot
+        // serves every max depth, and every max depth compiles to one shader.
+        let ray_stack = if features.glass {
+            max_depth.max(1) + 1
+        } else {
+            1
+        };
+        Variant {
+            features,
+            form: Form::Scene,
+            ray_stack,
+            counts: Counts::Uniform,
+            bvh_stack: None,
+            numerics,
+            entry: Entry::Fragment,
+            count_rays: false,
+            knobs: ShaderKnobs::default(),
+            passes: Passes::default(),
+            tags: Vec::new(),
+        }
+    }
+
+    /// The scene's own variant, tracing through `bvh` where it has one.
+    pub fn for_scene(scene: &Scene, bvh: Option<&Bvh>) -> Variant {
+        Variant::from_features(scene.features(), scene.max_depth, scene.numerics)
+            .with_scene_data(scene, bvh)
+    }
+
+    /// Every feature on, the deepest stack, the counts read from the `Frame`
+    /// uniform: renders any scene (with the given numerics).
+    pub fn generic(numerics: Numerics) -> Variant {
+        let mut v = Variant::from_features(ALL_FEATURES, MAX_DEPTH, numerics);
+        v.form = Form::Generic;
+        v
+    }
+
+    /// The generic source with the scene's features as specialization
+    /// constants. An array size cannot be an override, so the ray stack stays
+    /// the deepest.
+    pub fn specialized(scene: &Scene, bvh: Option<&Bvh>) -> Variant {
+        let mut v = Variant::generic(scene.numerics).with_scene_data(scene, bvh);
+        v.form = Form::Specialized;
+        v.features = scene.features();
         v
     }
 
     /// What every variant built for one scene bakes in: the primitive and light
-    /// counts that bound the shader's loops (a bound read from a uniform made
-    /// lavapipe compile and keep a new shader at every draw), and, with a BVH,
-    /// a traversal stack exactly as deep as the built tree needs.
-    fn add_scene_data(&mut self, scene: &Scene) {
-        let mut set = |k: &str, v: String| self.defines.insert(k.to_string(), v);
-        set("SPHERE_COUNT", format!("{}u", scene.spheres.len()));
-        set("TRIANGLE_COUNT", format!("{}u", scene.triangles.len()));
-        set("LIGHT_COUNT", format!("{}u", scene.lights.len()));
-        if let Some(bvh) = scene.bvh_tree() {
-            set("USE_BVH", "1".into());
-            set("BVH_STACK", bvh.stack_entries().to_string());
+    /// counts that bound the shader's loops, and, with a BVH, a traversal stack
+    /// exactly as deep as the built tree needs.
+    pub fn with_scene_data(mut self, scene: &Scene, bvh: Option<&Bvh>) -> Variant {
+        self.counts = Counts::Baked {
+            spheres: scene.spheres.len() as u32,
+            triangles: scene.triangles.len() as u32,
+            lights: scene.lights.len() as u32,
+        };
+        self.bvh_stack = bvh.map(Bvh::stack_entries);
+        self
+    }
+
+    /// This variant with the ray counters compiled in: the shader of the one
+    /// untimed frame that counts rays. Everything else is the timed variant's,
+    /// so both trace the same rays.
+    pub fn counting(&self) -> Variant {
+        Variant {
+            count_rays: true,
+            ..self.clone()
         }
     }
 
-    pub fn from_features(f: Features, max_depth: u32, numerics: Numerics) -> Variant {
-        let mut defines = BTreeMap::new();
+    /// This variant on another entry point.
+    pub fn on(&self, entry: Entry) -> Variant {
+        Variant {
+            entry,
+            ..self.clone()
+        }
+    }
+
+    /// Whether the compute tracer keeps its BVH stack in shared memory: only
+    /// with the laboratory's shared stack, and only where it fits the budget.
+    pub fn bvh_stack_in_shared_memory(&self) -> bool {
+        let (Some(entries), Entry::Compute(wg)) = (self.bvh_stack, self.entry) else {
+            return false;
+        };
+        let bytes = entries as usize * (wg.x * wg.y) as usize * 8;
+        self.knobs.shared_bvh_stack && bytes <= SHARED_BVH_STACK_BUDGET
+    }
+
+    /// The specialization constants (`Form::Specialized` only).
+    pub fn constants(&self) -> BTreeMap<String, bool> {
+        if self.form != Form::Specialized {
+            return BTreeMap::new();
+        }
+        let f = self.features;
+        SPEC_CONSTANTS
+            .iter()
+            .zip([f.spheres, f.triangles, f.mirror, f.glass])
+            .map(|((name, _), on)| (name.to_string(), on))
+            .collect()
+    }
+
+    /// The defines naga compiles the variant with: rendered here, at the end,
+    /// from the typed choices.
+    pub fn defines(&self) -> BTreeMap<String, String> {
+        let mut d = BTreeMap::new();
         let mut flag = |on: bool, name: &str| {
             if on {
-                defines.insert(name.to_string(), "1".to_string());
+                d.insert(name.to_string(), "1".to_string());
             }
+        };
+        // The generic form compiles every feature; the specialised one's
+        // switches are constants (trace.glsl defines every HAS_* under SPECIALIZE).
+        let f = match self.form {
+            Form::Scene => self.features,
+            Form::Generic => ALL_FEATURES,
+            Form::Specialized => Features {
+                spheres: false,
+                triangles: false,
+                mirror: false,
+                glass: false,
+            },
         };
         flag(f.spheres, "HAS_SPHERES");
         flag(f.triangles, "HAS_TRIANGLES");
         flag(f.mirror, "HAS_MIRROR");
         flag(f.glass, "HAS_GLASS");
-        // Only glass makes the ray tree branch (reflected and refracted rays):
-        // then the depth-first stack holds one pending ray per level. Without
-        // glass a hit pushes at most one ray after popping one, so one slot
-        // serves every max depth, and every max depth compiles to one shader.
-        let stack = if f.glass { max_depth.max(1) + 1 } else { 1 };
-        defines.insert("STACK_SIZE".into(), stack.to_string());
-        for d in numerics.defines() {
-            defines.insert(d.to_string(), "1".to_string());
+        flag(self.form == Form::Specialized, "SPECIALIZE");
+        let k = self.knobs;
+        let bvh = self.bvh_stack.is_some();
+        flag(bvh, "USE_BVH");
+        flag(bvh && k.unpaired_bvh_stack, "BVH_STACK_UNPAIRED");
+        flag(bvh && k.local_bvh_stack, "BVH_STACK_LOCAL");
+        flag(k.split_ray_stack, "RAY_STACK_SPLIT");
+        flag(self.counts == Counts::Storage, "COUNTS_FROM_STORAGE");
+        flag(k.quad, QUAD_DEFINE);
+        flag(self.count_rays, "COUNT_RAYS");
+        flag(self.bvh_stack_in_shared_memory(), "BVH_STACK_SHARED");
+        for n in self.numerics.defines() {
+            flag(true, n);
         }
-        Variant {
-            defines,
-            numerics,
-            constants: BTreeMap::new(),
-            experiments: Vec::new(),
+        d.insert("STACK_SIZE".into(), self.ray_stack.to_string());
+        if let Some(n) = self.bvh_stack {
+            d.insert("BVH_STACK".into(), n.to_string());
         }
-    }
-
-    /// The specialization-constant alternative to `for_scene`, for comparison
-    /// (`--specialize`): one source for every scene, with every feature and the
-    /// deepest stack compiled in, whose feature switches are `constant_id`
-    /// overrides set to the scene's features. naga's SPIR-V and GLSL writers
-    /// take no overrides, so `parse` fixes them with process_overrides: the
-    /// driver then sees constant branches where `for_scene` leaves no code. An
-    /// array size cannot be an override, so the ray stack stays the deepest.
-    pub fn specialized(scene: &Scene) -> Variant {
-        let mut v = Variant::generic(scene.numerics);
-        // trace.glsl defines every HAS_* itself under SPECIALIZE.
-        v.defines.retain(|k, _| !k.starts_with("HAS_"));
-        v.defines.insert("SPECIALIZE".into(), "1".into());
-        v.add_scene_data(scene);
-        let f = scene.features();
-        for ((name, _), on) in
-            SPEC_CONSTANTS
-                .iter()
-                .zip([f.spheres, f.triangles, f.mirror, f.glass])
+        if let Counts::Baked {
+            spheres,
+            triangles,
+            lights,
+        } = self.counts
         {
-            v.constants.insert(name.to_string(), on);
+            d.insert("SPHERE_COUNT".into(), format!("{spheres}u"));
+            d.insert("TRIANGLE_COUNT".into(), format!("{triangles}u"));
+            d.insert("LIGHT_COUNT".into(), format!("{lights}u"));
         }
-        v
-    }
-
-    /// This variant with the ray counters compiled in (COUNT_RAYS): the shader
-    /// of the one untimed frame that counts rays. Every other define is the
-    /// timed variant's, so both trace the same rays.
-    pub fn counting(&self) -> Variant {
-        let mut v = self.clone();
-        v.defines.insert("COUNT_RAYS".into(), "1".into());
-        v
-    }
-
-    /// The variant the apps render: `--generic`, `--specialize` or the scene's
-    /// own; each traces through the BVH when the scene has one. The one place
-    /// both apps (and the windowed ones) choose what to compile.
-    pub fn chosen(scene: &Scene, args: &RenderArgs) -> Variant {
-        let mut v = if args.generic {
-            let mut v = Variant::generic(scene.numerics);
-            v.add_scene_data(scene);
-            v
-        } else if args.specialize {
-            Variant::specialized(scene)
-        } else {
-            Variant::for_scene(scene)
-        };
-        v.experiments = args.experiment.clone();
-        v.experiments.sort();
-        v.experiments.dedup();
-        if v.defines.contains_key("USE_BVH")
-            && v.experiments.contains(&Experiment::UnpairedBvhStack)
-        {
-            v.defines.insert("BVH_STACK_UNPAIRED".into(), "1".into());
+        if let Some(kib) = k.shared_pad_kib {
+            d.insert("SHARED_PAD_KIB".into(), kib.to_string());
         }
-        if v.defines.contains_key("USE_BVH") && v.experiments.contains(&Experiment::LocalBvhStack) {
-            v.defines.insert("BVH_STACK_LOCAL".into(), "1".into());
+        // `local_size` must be a constant; a define keeps it out of the
+        // specialisation-constant path naga's writers handle poorly.
+        if let Entry::Compute(wg) = self.entry {
+            d.insert("WG_X".into(), wg.x.to_string());
+            d.insert("WG_Y".into(), wg.y.to_string());
         }
-        if v.experiments.contains(&Experiment::SplitRayStack) {
-            v.defines.insert("RAY_STACK_SPLIT".into(), "1".into());
-        }
-        if v.experiments.contains(&Experiment::UniformCounts)
-            || v.experiments.contains(&Experiment::StorageCounts)
-        {
-            for k in ["SPHERE_COUNT", "TRIANGLE_COUNT", "LIGHT_COUNT"] {
-                v.defines.remove(k);
-            }
-        }
-        if v.experiments.contains(&Experiment::StorageCounts) {
-            v.defines.insert("COUNTS_FROM_STORAGE".into(), "1".into());
-        }
-        if v.experiments.contains(&Experiment::Quad) {
-            v.defines.insert(QUAD_DEFINE.into(), "1".into());
-        }
-        if let Some(kib) = args.shared_pad {
-            v.defines.insert("SHARED_PAD_KIB".into(), kib.to_string());
-        }
-        v
-    }
-
-    /// Every feature on, the deepest stack, the counts read from the `Frame`
-    /// uniform: renders any scene (with the given numerics). The apps never run
-    /// it as it is: `chosen` bakes the scene's counts into every variant.
-    pub fn generic(numerics: Numerics) -> Variant {
-        let all = Features {
-            spheres: true,
-            triangles: true,
-            mirror: true,
-            glass: true,
-        };
-        Variant::from_features(all, MAX_DEPTH, numerics)
+        d
     }
 
     /// Whether this variant can draw everything `needed` can: every feature of
-    /// `needed` compiled in, and a ray stack at least as deep. A windowed app keeps
-    /// its pipeline when `+`/`-` change the depth to one the current variant covers.
+    /// `needed` compiled in, and a ray stack at least as deep, with every other
+    /// choice the same. A windowed app keeps its pipeline when `+`/`-` change
+    /// the depth to one the current variant covers.
     pub fn covers(&self, needed: &Variant) -> bool {
-        let stack = |v: &Variant| {
-            v.defines
-                .get("STACK_SIZE")
-                .and_then(|s| s.parse::<u32>().ok())
-                .unwrap_or(0)
+        let compiled = |v: &Variant| match v.form {
+            Form::Generic => ALL_FEATURES,
+            _ => v.features,
         };
-        needed
-            .defines
-            .keys()
-            .filter(|k| k.starts_with("HAS_"))
-            .all(|k| self.defines.contains_key(k))
-            && stack(self) >= stack(needed)
-            && self.constants == needed.constants
-            && self.experiments == needed.experiments
-            && [
-                "SPHERE_COUNT",
-                "TRIANGLE_COUNT",
-                "LIGHT_COUNT",
-                "USE_BVH",
-                "BVH_STACK",
-            ]
-            .iter()
-            .all(|k| self.defines.get(*k) == needed.defines.get(*k))
+        let (a, b) = (compiled(self), compiled(needed));
+        let features = if self.form == Form::Specialized || needed.form == Form::Specialized {
+            self.form == needed.form && a == b
+        } else {
+            (a.spheres || !b.spheres)
+                && (a.triangles || !b.triangles)
+                && (a.mirror || !b.mirror)
+                && (a.glass || !b.glass)
+        };
+        features
+            && self.ray_stack >= needed.ray_stack
+            && Variant {
+                features: needed.features,
+                form: needed.form,
+                ray_stack: needed.ray_stack,
+                ..self.clone()
+            } == *needed
     }
 
     /// A short label such as `spheres+triangles+mirror+glass/stack6/normal-scaled/watertight/stable`
-    /// (with `/bvhN` at the end when the variant traces through a BVH with an
-    /// N-entry stack, then any `--experiment`).
+    /// (with `/bvhN` when the variant traces through a BVH with an N-entry
+    /// stack, `/spec` when specialised, then any experiment's name).
     pub fn label(&self) -> String {
-        let mut parts: Vec<String> = ["SPHERES", "TRIANGLES", "MIRROR", "GLASS"]
-            .iter()
-            .filter(|d| {
-                self.defines.contains_key(&format!("HAS_{d}"))
-                    || self.constants.get(&format!("SPEC_{d}")) == Some(&true)
-            })
-            .map(|d| d.to_lowercase())
-            .collect();
+        let f = match self.form {
+            Form::Generic => ALL_FEATURES,
+            _ => self.features,
+        };
+        let mut parts: Vec<&str> = [
+            (f.spheres, "spheres"),
+            (f.triangles, "triangles"),
+            (f.mirror, "mirror"),
+            (f.glass, "glass"),
+        ]
+        .iter()
+        .filter(|(on, _)| *on)
+        .map(|(_, n)| *n)
+        .collect();
         if parts.is_empty() {
-            parts.push("background".into());
+            parts.push("background");
         }
-        let bvh = match self.defines.get("BVH_STACK") {
-            Some(n) => format!("/bvh{n}"),
-            None => String::new(),
-        };
-        let spec = if self.constants.is_empty() {
-            ""
-        } else {
+        let bvh = self.bvh_stack.map_or(String::new(), |n| format!("/bvh{n}"));
+        let spec = if self.form == Form::Specialized {
             "/spec"
+        } else {
+            ""
         };
-        let experiments: String = self
-            .experiments
-            .iter()
-            .map(|e| format!("/{}", e.name()))
-            .collect();
+        let tags: String = self.tags.iter().map(|t| format!("/{t}")).collect();
         format!(
-            "{}/stack{}/{}{bvh}{spec}{experiments}",
+            "{}/stack{}/{}{bvh}{spec}{tags}",
             parts.join("+"),
-            self.defines
-                .get("STACK_SIZE")
-                .map(String::as_str)
-                .unwrap_or("?"),
+            self.ray_stack,
             self.numerics.label()
         )
     }
@@ -270,34 +421,42 @@ mod tests {
     #[test]
     fn depth_changes_rebuild_only_when_the_variant_cannot_cover_them() {
         let scene = Scene::load("box", &[]).unwrap();
-        let deep = Variant::for_scene(&scene);
+        let deep = Variant::for_scene(&scene, None);
         let mut shallow_scene = scene.clone();
         shallow_scene.max_depth = 2;
-        let shallow = Variant::for_scene(&shallow_scene);
+        let shallow = Variant::for_scene(&shallow_scene, None);
         assert!(
             deep.covers(&shallow),
             "a deeper stack draws shallower scenes"
         );
         assert!(!shallow.covers(&deep), "a stack too small for the depth");
         shallow_scene.max_depth = 1;
-        let flat = Variant::for_scene(&shallow_scene);
+        let flat = Variant::for_scene(&shallow_scene, None);
         assert!(
             !flat.covers(&shallow),
             "depth 1 compiles mirror and glass out"
         );
-        let mut generic = RenderArgs::headless(
-            "box",
-            crate::cli::Size {
-                width: 8,
-                height: 8,
-            },
-        );
-        generic.generic = true;
-        assert!(Variant::chosen(&scene, &generic).covers(&deep));
+        let generic = Variant::generic(scene.numerics).with_scene_data(&scene, None);
+        assert!(generic.covers(&deep));
         let teapot = Scene::load("teapot", &[]).unwrap();
+        let generic_teapot = Variant::generic(teapot.numerics).with_scene_data(&teapot, None);
         assert!(
-            !Variant::chosen(&teapot, &generic).covers(&deep),
+            !generic_teapot.covers(&deep),
             "the counts are baked in: another scene's shader cannot draw this one"
         );
+    }
+
+    #[test]
+    fn defines_render_the_typed_choices() {
+        let scene = Scene::load("box", &[]).unwrap();
+        let v = Variant::for_scene(&scene, None);
+        let d = v.defines();
+        assert_eq!(d.get("SPHERE_COUNT").map(String::as_str), Some("2u"));
+        assert!(d.contains_key("HAS_GLASS") && !d.contains_key("USE_BVH"));
+        let c = v.on(Entry::Compute(Workgroup { x: 8, y: 4 })).defines();
+        assert_eq!(c.get("WG_X").map(String::as_str), Some("8"));
+        let s = Variant::specialized(&scene, None);
+        assert!(s.defines().contains_key("SPECIALIZE") && !s.defines().contains_key("HAS_GLASS"));
+        assert_eq!(s.constants().get("SPEC_GLASS"), Some(&true));
     }
 }

@@ -18,12 +18,14 @@ use crate::cli::{RenderArgs, RenderPath, Workgroup};
 use crate::error::{no_device, without_source_location};
 use crate::gpu::layout::GpuFrame;
 use crate::gpu::upload::GpuScene;
+use crate::limits::StorageLimit;
+use crate::plan::CountingRun;
 use crate::rays::RayKinds;
 use crate::reference::image_io::FloatImage;
 use crate::report::{DeviceInfo, FrameTime, RunReport};
 use crate::scene::Scene;
-use crate::shader::build::{build, build_compute, ComputeShader, Shaders};
-use crate::shader::variant::{CountingRun, Variant};
+use crate::shader::build::PathShaders;
+use crate::shader::variant::Variant;
 use crate::window::title::window_title;
 use winit::dpi::PhysicalSize;
 use winit::event_loop::EventLoop;
@@ -34,6 +36,9 @@ pub trait Renderer {
     /// "Vulkan" or "OpenGL", for the title.
     fn api(&self) -> &'static str;
     fn window(&self) -> &Window;
+    /// The largest storage buffer the device binds: every plan a window
+    /// prepares (its start and each scene switch) is checked against it.
+    fn storage_limit(&self) -> StorageLimit;
     /// The window's drawable area changed; 0 in either dimension means minimized.
     fn resize(&mut self, width: u32, height: u32) -> anyhow::Result<()>;
     /// Draws and presents one frame with this uniform block. `Ok(None)` when no
@@ -60,34 +65,6 @@ pub struct Drawn {
     pub gpu_ms: Option<f64>,
 }
 
-/// The shaders of the path a window draws with: the fullscreen pair, or the
-/// compute entry point with its workgroup.
-#[derive(Clone)]
-pub enum PathShaders {
-    Fragment(Shaders),
-    Compute(ComputeShader),
-}
-
-impl PathShaders {
-    pub fn build(
-        variant: &Variant,
-        path: RenderPath,
-        workgroup: Workgroup,
-    ) -> anyhow::Result<PathShaders> {
-        Ok(match path {
-            RenderPath::Fragment => PathShaders::Fragment(build(variant)?),
-            RenderPath::Compute => PathShaders::Compute(build_compute(variant, workgroup)?),
-        })
-    }
-
-    pub fn path(&self) -> RenderPath {
-        match self {
-            PathShaders::Fragment(_) => RenderPath::Fragment,
-            PathShaders::Compute(_) => RenderPath::Compute,
-        }
-    }
-}
-
 /// The event loop, or a clear exit-3 error where there is no display.
 pub fn event_loop() -> anyhow::Result<EventLoop<()>> {
     EventLoop::new().map_err(|e| {
@@ -106,15 +83,6 @@ pub fn window_attributes(args: &RenderArgs, scene: &str, api: &str) -> WindowAtt
         .with_inner_size(PhysicalSize::new(args.size.width, args.size.height))
 }
 
-/// The shaders a window starts with: `--path`'s, for the scene's variant.
-pub fn first_shaders(args: &RenderArgs, scene: &Scene) -> anyhow::Result<PathShaders> {
-    PathShaders::build(
-        &Variant::chosen(scene, args),
-        args.path,
-        args.compute_workgroup()?,
-    )
-}
-
 /// What the run did, for `--json`.
 pub struct WindowedRun {
     pub frames: Vec<FrameTime>,
@@ -127,6 +95,8 @@ pub struct WindowedRun {
     pub height: u32,
     /// Milliseconds from `started` to the end of the first frame.
     pub setup_ms: f64,
+    /// The first scene's BVH build, where it had one.
+    pub bvh_ms: Option<f64>,
 }
 
 impl WindowedRun {
@@ -138,6 +108,7 @@ impl WindowedRun {
             .path(self.path, self.workgroup)
             .frames(self.frames, self.setup_ms)
             .validation_messages(validation_messages)
+            .bvh_ms(self.bvh_ms)
             .build()
     }
 }

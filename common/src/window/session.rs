@@ -1,18 +1,19 @@
 //! The event loop of a window: input to actions, redraws, resizes and
 //! minimizes, scene / depth / path switches, screenshots, `--frames` and `--out`.
 
-use crate::cli::{RenderArgs, RenderPath, Workgroup};
+use crate::cli::RenderPath;
 use crate::error::bad_input;
 use crate::gpu::layout::GpuFrame;
 use crate::gpu::upload::GpuScene;
 use crate::limits::MAX_DEPTH;
+use crate::plan::{Planner, RunPlan};
 use crate::report::FrameTime;
 use crate::scene::camera::Orbit;
-use crate::scene::Scene;
-use crate::shader::variant::{CountingRun, Variant};
+use crate::shader::build::PathShaders;
+use crate::shader::variant::Entry;
 use crate::window::keys::{action_for_key, Action};
 use crate::window::title::{window_title, TitleClock};
-use crate::window::{hooks, PathShaders, Renderer, WindowedRun};
+use crate::window::{hooks, Renderer, WindowedRun};
 use anyhow::Context;
 use std::path::PathBuf;
 use std::time::Instant;
@@ -23,28 +24,27 @@ use winit::event_loop::{ActiveEventLoop, ControlFlow, EventLoop};
 use winit::window::WindowId;
 
 /// Runs the window until Esc, the close button or `--frames`, then saves `--out`.
-/// The renderer is dropped (every API object destroyed) before this returns.
+/// `plan` is what the renderer was made with; `planner` makes the plans of
+/// the scenes the window switches to. The renderer is dropped (every API
+/// object destroyed) before this returns.
 pub fn run<R: Renderer>(
     program: &'static str,
     event_loop: EventLoop<()>,
     renderer: R,
-    args: &RenderArgs,
-    scene: Scene,
-    variant: Variant,
+    planner: &Planner,
+    plan: RunPlan,
     started: Instant,
 ) -> anyhow::Result<WindowedRun> {
     let size = renderer.window().inner_size();
     let now = Instant::now();
-    let workgroup = args.compute_workgroup()?;
+    let bvh_ms = plan.bvh_ms;
+    let args = planner.args();
     let mut session = Session {
         program,
-        orbit: Orbit::new(&scene.camera),
+        orbit: Orbit::new(&plan.scene.camera),
         renderer: Some(renderer),
-        args: args.clone(),
-        scene,
-        variant,
-        path: args.path,
-        workgroup,
+        planner: planner.clone(),
+        plan,
         size,
         clock: TitleClock::new(now),
         frames: Vec::new(),
@@ -76,15 +76,17 @@ pub fn run<R: Renderer>(
             t.handled, t.minimizes
         );
     }
+    let path = session.path();
     Ok(WindowedRun {
         frames: session.frames,
-        scene: session.scene,
-        variant: session.variant,
-        path: session.path,
-        workgroup: session.workgroup,
+        path,
+        workgroup: session.planner.workgroup(),
+        scene: session.plan.scene,
+        variant: session.plan.variant,
         width: session.size.width,
         height: session.size.height,
         setup_ms: session.setup_ms,
+        bvh_ms,
     })
 }
 
@@ -93,12 +95,10 @@ struct Session<R: Renderer> {
     /// `None` once the run has finished: dropping it destroys every API object
     /// while the event loop (and so the window system connection) is still alive.
     renderer: Option<R>,
-    args: RenderArgs,
-    scene: Scene,
-    variant: Variant,
-    path: RenderPath,
-    /// The compute path's, also kept while the fragment path draws.
-    workgroup: Workgroup,
+    planner: Planner,
+    /// The scene on screen, its BVH, variant (whose entry is the path
+    /// drawing) and shaders.
+    plan: RunPlan,
     orbit: Orbit,
     size: PhysicalSize<u32>,
     clock: TitleClock,
@@ -132,13 +132,17 @@ struct ResizeTest {
 }
 
 impl<R: Renderer> Session<R> {
+    fn path(&self) -> RenderPath {
+        self.plan.variant.entry.path()
+    }
+
     fn minimized(&self) -> bool {
         self.size.width == 0 || self.size.height == 0
     }
 
     fn frame_uniform(&self) -> GpuFrame {
         GpuFrame::new(
-            &self.scene,
+            &self.plan.scene,
             &self.orbit.camera(),
             self.size.width.max(1),
             self.size.height.max(1),
@@ -149,7 +153,7 @@ impl<R: Renderer> Session<R> {
     fn finish(&mut self, event_loop: &ActiveEventLoop, result: anyhow::Result<()>) {
         if let Err(e) = result {
             self.error.get_or_insert(e);
-        } else if let Some(out) = self.args.out.clone() {
+        } else if let Some(out) = self.planner.args().out.clone() {
             if let Err(e) = self.save(&out) {
                 self.error.get_or_insert(e);
             }
@@ -214,7 +218,7 @@ impl<R: Renderer> Session<R> {
                 };
                 let path = PathBuf::from(format!(
                     "twinray-{api}-{}-{}.png",
-                    self.scene.name, self.screenshots
+                    self.plan.scene.name, self.screenshots
                 ));
                 match self.save(&path) {
                     Ok(()) => {}
@@ -223,43 +227,61 @@ impl<R: Renderer> Session<R> {
                 }
             }
             Action::Scene(name) => {
-                let scene = match self.args.overrides().and_then(|o| Scene::load(name, &o)) {
-                    Ok(s) => s,
+                let Some(r) = self.renderer.as_ref() else {
+                    return Ok(());
+                };
+                let (w, h) = (self.size.width.max(1), self.size.height.max(1));
+                let switched =
+                    self.planner
+                        .prepare_switch(name, self.path(), &r.storage_limit(), w, h);
+                let (plan, dropped) = match switched {
+                    Ok(p) => p,
                     Err(e) => {
                         eprintln!("{}: cannot switch to '{name}': {e:#}", self.program);
                         return Ok(());
                     }
                 };
-                self.orbit = Orbit::new(&scene.camera);
-                self.variant = Variant::chosen(&scene, &self.args);
-                self.scene = scene;
-                self.rebuild()?;
+                for why in dropped {
+                    eprintln!("{}: '{name}' without it: {why}", self.program);
+                }
+                self.orbit = Orbit::new(&plan.scene.camera);
+                self.plan = plan;
+                if let Some(r) = self.renderer.as_mut() {
+                    r.load_scene(&self.plan.gpu, &self.plan.shaders)?;
+                }
                 self.restart_title();
             }
             Action::SwitchPath => {
-                self.path = match self.path {
+                let path = match self.path() {
                     RenderPath::Fragment => RenderPath::Compute,
                     RenderPath::Compute => RenderPath::Fragment,
                 };
+                self.plan.variant = self
+                    .plan
+                    .variant
+                    .on(Entry::new(path, self.planner.workgroup()));
                 self.rebuild()?;
                 self.restart_title();
-                eprintln!("{}: path {}", self.program, self.path);
+                eprintln!("{}: path {path}", self.program);
             }
             Action::DepthUp | Action::DepthDown => {
-                let d = self.scene.max_depth;
+                let d = self.plan.scene.max_depth;
                 let d = if action == Action::DepthUp {
                     (d + 1).min(MAX_DEPTH)
                 } else {
                     d.saturating_sub(1).max(1)
                 };
-                self.scene.max_depth = d;
+                self.plan.scene.max_depth = d;
                 self.rays_stale = true;
                 // The uniform block carries the depth; only a deeper stack or a
                 // feature the current shader compiled out needs a new variant.
-                let needed = Variant::chosen(&self.scene, &self.args);
-                let rebuilt = !self.variant.covers(&needed);
+                let plan = &self.plan;
+                let needed = self
+                    .planner
+                    .variant(&plan.scene, plan.bvh.as_ref(), self.path());
+                let rebuilt = !plan.variant.covers(&needed);
                 if rebuilt {
-                    self.variant = needed;
+                    self.plan.variant = needed;
                     self.rebuild()?;
                 }
                 let how = if rebuilt {
@@ -270,18 +292,21 @@ impl<R: Renderer> Session<R> {
                 eprintln!(
                     "{}: max depth {d} ({how}: {})",
                     self.program,
-                    self.variant.label()
+                    self.plan.variant.label()
                 );
             }
         }
         Ok(())
     }
 
+    /// The plan's variant changed (path or depth): its shaders and buffers anew.
     fn rebuild(&mut self) -> anyhow::Result<()> {
-        let shaders = PathShaders::build(&self.variant, self.path, self.workgroup)?;
-        let gpu = GpuScene::new(&self.scene, self.size.width.max(1), self.size.height.max(1));
+        let plan = &mut self.plan;
+        plan.shaders = PathShaders::build(&plan.variant)?;
+        let (w, h) = (self.size.width.max(1), self.size.height.max(1));
+        plan.gpu = GpuScene::new(&plan.scene, plan.bvh.as_ref(), w, h);
         if let Some(r) = self.renderer.as_mut() {
-            r.load_scene(&gpu, &shaders)?;
+            r.load_scene(&plan.gpu, &plan.shaders)?;
         }
         Ok(())
     }
@@ -290,24 +315,18 @@ impl<R: Renderer> Session<R> {
     /// of a drag, a zoom) its rays are counted again, between two frames and
     /// outside both of them: the next frame's wall time starts after the count.
     fn recount_rays(&mut self) -> anyhow::Result<()> {
-        if !(self.args.count_rays && self.rays_stale) || self.dragging || self.minimized() {
+        if !(self.planner.args().count_rays && self.rays_stale) || self.dragging || self.minimized()
+        {
             return Ok(());
         }
         self.rays_stale = false;
         let (width, height) = (self.size.width, self.size.height);
-        let mut gpu = GpuScene::new(&self.scene, width, height);
+        let plan = &self.plan;
+        let mut gpu = GpuScene::new(&plan.scene, plan.bvh.as_ref(), width, height);
         gpu.frame = self.frame_uniform();
-        let shaders = PathShaders::build(&self.variant, self.path, self.workgroup)?;
-        let run = CountingRun {
-            scene: &gpu,
-            variant: &self.variant,
-            path: self.path,
-            workgroup: self.workgroup,
-            width,
-            height,
-        };
+        let run = plan.counting(&gpu, self.planner.pass(), width, height);
         if let Some(r) = self.renderer.as_mut() {
-            self.rays = Some(r.count_rays(&run, &shaders)?.total());
+            self.rays = Some(r.count_rays(&run, &plan.shaders)?.total());
         }
         self.last_frame_end = Instant::now();
         self.clock = TitleClock::new(self.last_frame_end);
@@ -316,7 +335,13 @@ impl<R: Renderer> Session<R> {
 
     fn set_title(&self, fps_gpu: Option<(f64, Option<f64>)>) {
         if let Some(r) = &self.renderer {
-            let title = window_title(&self.scene.name, r.api(), self.path, fps_gpu, self.rays);
+            let title = window_title(
+                &self.plan.scene.name,
+                r.api(),
+                self.path(),
+                fps_gpu,
+                self.rays,
+            );
             r.window().set_title(&title);
         }
     }
@@ -353,7 +378,7 @@ impl<R: Renderer> Session<R> {
                 if let Some(a) = self.test_keys.pop() {
                     self.act(event_loop, a)?;
                 }
-                if self.args.frames.is_some_and(|n| self.drawn >= n) {
+                if self.planner.args().frames.is_some_and(|n| self.drawn >= n) {
                     self.finish(event_loop, Ok(()));
                     return Ok(());
                 }

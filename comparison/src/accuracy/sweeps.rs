@@ -6,8 +6,12 @@
 use crate::apps::{run_json, Api};
 use crate::runs::{api_name, overrides};
 use std::path::Path;
+use twinray_common::cli::RenderPath;
 use twinray_common::cli::{RenderArgs, Size};
 use twinray_common::limits::MAX_DEPTH;
+use twinray_common::plan::build_bvh;
+use twinray_common::plan::requests::Api as AppApi;
+use twinray_common::plan::Planner;
 use twinray_common::reference;
 use twinray_common::reference::metrics;
 use twinray_common::scene::hard;
@@ -222,8 +226,10 @@ pub fn program_of(scene: &str, set: &[String]) -> anyhow::Result<String> {
             height: 1,
         },
     );
-    let v = twinray_common::shader::variant::Variant::chosen(&scene, &args);
-    Ok(v.defines
+    let planner = Planner::new(&args, AppApi::Vulkan)?;
+    let bvh = args.accel.wants_bvh(&scene).then(|| build_bvh(&scene));
+    let v = planner.variant(&scene, bvh.as_ref(), RenderPath::Fragment);
+    Ok(v.defines()
         .iter()
         .map(|(k, v)| format!("{k}={v}"))
         .collect::<Vec<_>>()

@@ -1,0 +1,320 @@
+//! The laboratory: every experiment as one entry of one registry — its name,
+//! the API, path and mode it applies to, and what it does to the run plan
+//! (shader knobs, passes over naga's output, the loops' counts, device or
+//! pass requests) — plus the measurement options that only the laboratory
+//! uses. One check (`check`) refuses what a run cannot do; one function
+//! (`changes`) says what the chosen experiments change; `page` writes
+//! docs/experiments.md from the registry. The apps never read the list of
+//! experiments: they consume the plan these changes shaped.
+
+pub mod experiment;
+
+use crate::cli::{RenderArgs, RenderPath};
+use crate::error::bad_input;
+use crate::plan::requests::{Api, DeviceRequest, FragmentPass};
+use crate::shader::variant::{Counts, Passes, ShaderKnobs, SpirvCompiler};
+use crate::value_name::ValueName;
+use experiment::Experiment;
+
+/// What a run's experiments change, gathered from the registry.
+#[derive(Debug, Clone, PartialEq, Eq, Default)]
+pub struct Changes {
+    pub knobs: ShaderKnobs,
+    pub passes: Passes,
+    /// Where the loops' counts come from, if not baked in.
+    pub counts: Option<Counts>,
+    pub pass: FragmentPass,
+    pub device: DeviceRequest,
+    /// The experiments' names in registry order, for the variant's label.
+    pub tags: Vec<String>,
+}
+
+/// One experiment: where it applies and what it does.
+pub struct Entry {
+    pub experiment: Experiment,
+    /// The API it is confined to, with the reason the other cannot take it.
+    pub only: Option<(Api, &'static str)>,
+    /// The path it is confined to.
+    pub path: Option<RenderPath>,
+    /// Headless runs only (a measurement, not a way to look at the scene).
+    pub headless: bool,
+    /// What it does, for the page.
+    pub what: &'static str,
+    pub apply: fn(&mut Changes),
+}
+
+const fn entry(experiment: Experiment, what: &'static str, apply: fn(&mut Changes)) -> Entry {
+    Entry {
+        experiment,
+        only: None,
+        path: None,
+        headless: false,
+        what,
+        apply,
+    }
+}
+
+const fn pass_entry(experiment: Experiment, what: &'static str, apply: fn(&mut Changes)) -> Entry {
+    Entry {
+        path: Some(RenderPath::Fragment),
+        headless: true,
+        ..entry(experiment, what, apply)
+    }
+}
+
+const OPENGL_VIEWPORT: &str = "OpenGL's viewport is always state set before the draw";
+const OPENGL_QUEUES: &str = "OpenGL has no queues to choose from";
+const VULKAN_OCCUPANCY: &str =
+    "Vulkan reports the register count that fixes its occupancy (--dump-shaders)";
+const VULKAN_ALIASING: &str =
+    "Vulkan's SPIR-V lets the driver assume that no two resources alias anyway";
+
+/// Every experiment, in the order of `Experiment` (which is the order of the
+/// label's tags). A test holds the two to the same list.
+pub const REGISTRY: &[Entry] = &[
+    entry(Experiment::NagaZeroInit, "Keep naga's zero initialisers on function-local arrays.", |c| {
+        c.passes.strip_zero_init = false
+    }),
+    entry(Experiment::NagaLoopBounding, "Keep naga's loop bounding (a 64-bit counter in every SPIR-V loop) on the BVH variants too.", |c| {
+        c.passes.loop_bounding = Some(true)
+    }),
+    entry(Experiment::NoLoopBounding, "Drop naga's loop bounding from the brute-force variants too (naga-loop-bounding wins if both are given).", |c| {
+        c.passes.loop_bounding.get_or_insert(false);
+    }),
+    entry(Experiment::SharedBvhStack, "Compute path: put the BVH stack in shared memory wherever it fits in 32 KiB per workgroup (the default keeps it local).", |c| {
+        c.knobs.shared_bvh_stack = true
+    }),
+    entry(Experiment::UnpairedBvhStack, "One BVH stack entry per array element (uvec2) instead of two per uvec4.", |c| {
+        c.knobs.unpaired_bvh_stack = true
+    }),
+    entry(Experiment::LocalBvhStack, "A BVH stack local to each walk (closest hit, any hit) instead of one at module scope that both share.", |c| {
+        c.knobs.local_bvh_stack = true
+    }),
+    entry(Experiment::SplitRayStack, "The ray stack as four arrays (origin, direction, weight, depth) instead of two of vec4 pairs.", |c| {
+        c.knobs.split_ray_stack = true
+    }),
+    entry(Experiment::StorageCounts, "Read the primitive and light counts from a storage buffer instead of baking them into the shader.", |c| {
+        c.counts = Some(Counts::Storage)
+    }),
+    entry(Experiment::UniformCounts, "Read the primitive and light counts from the Frame uniform instead of baking them into the shader (what made lavapipe grow per frame); storage-counts wins if both are given.", |c| {
+        c.counts.get_or_insert(Counts::Uniform);
+    }),
+    entry(Experiment::NoContraction, "Forbid the driver to fuse or reassociate float arithmetic: a NoContraction decoration on every float operation of the SPIR-V and `precise` on every float local of the GLSL.", |c| {
+        c.passes.no_contraction = true
+    }),
+    entry(Experiment::FloatControls, "SPIR-V only: ask for the IEEE behaviour the driver may otherwise relax (SPV_KHR_float_controls: denormals preserved, signed zero, Inf and NaN preserved).", |c| {
+        c.passes.float_controls = true
+    }),
+    entry(Experiment::Glslang, "The SPIR-V (what Vulkan runs) from Khronos' reference compiler, glslangValidator (on PATH; Debian's glslang-tools), given the same GLSL and defines, instead of from naga.", |c| {
+        c.passes.compiler = SpirvCompiler::Glslang
+    }),
+    pass_entry(Experiment::Quad, "The fullscreen pass as two triangles (6 vertices) instead of one oversized triangle.", |c| {
+        c.knobs.quad = true;
+        c.pass.quad = true;
+    }),
+    pass_entry(Experiment::LoadClear, "Clear the colour target at the start of the pass (Vulkan: load op CLEAR instead of DONT_CARE; OpenGL: glClear before the draw).", |c| {
+        c.pass.clear = true
+    }),
+    pass_entry(Experiment::Rgba8, "An RGBA8 UNORM render target instead of RGBA32F (the GPU rounds to 8 bits; the PNG stays within 1/255).", |c| {
+        c.pass.rgba8 = true
+    }),
+    Entry {
+        only: Some((Api::Vulkan, OPENGL_QUEUES)),
+        path: Some(RenderPath::Compute),
+        headless: true,
+        ..entry(Experiment::ComputeQueue, "Dispatch on a queue family with COMPUTE but not GRAPHICS (refused where the device has none).", |c| {
+            c.device.compute_only_queue = true
+        })
+    },
+    Entry {
+        only: Some((Api::Vulkan, OPENGL_VIEWPORT)),
+        ..pass_entry(Experiment::DynamicViewport, "The viewport and scissor as dynamic state set in the command buffer (as OpenGL always has them) instead of baked into the pipeline.", |c| {
+            c.pass.dynamic_viewport = true
+        })
+    },
+    Entry {
+        only: Some((Api::OpenGl, VULKAN_ALIASING)),
+        ..entry(Experiment::NagaAliasing, "naga's buffer and image declarations as naga writes them, without the `restrict` (GLSL) or `Restrict` (SPIR-V) that tells the driver no two of them alias, which Vulkan's SPIR-V assumes anyway.", |c| {
+            c.passes.restrict = false
+        })
+    },
+    Entry {
+        headless: true,
+        ..entry(Experiment::RobustAccess, "Bounds-checked buffer access (Vulkan's robustBufferAccess feature; OpenGL a robust-access context).", |c| {
+            c.device.robust_access = true
+        })
+    },
+    Entry {
+        only: Some((Api::OpenGl, VULKAN_OCCUPANCY)),
+        path: Some(RenderPath::Compute),
+        headless: true,
+        ..entry(Experiment::WarpProbe, "NVIDIA only: record the highest warp slot in use on each multiprocessor (GL_NV_shader_thread_group's gl_WarpIDNV), the occupancy that OpenGL's driver does not report.", |c| {
+            c.passes.warp_probe = true
+        })
+    },
+];
+
+/// The registry's entry for `e`.
+pub fn entry_of(e: Experiment) -> &'static Entry {
+    REGISTRY
+        .iter()
+        .find(|r| r.experiment == e)
+        .expect("every experiment has an entry (a test checks)")
+}
+
+/// Refuses, in one sentence (exit 2), what this run cannot do: an experiment
+/// outside its API, path or mode, and the measurement options where they do
+/// not apply.
+pub fn check(args: &RenderArgs, api: Api) -> anyhow::Result<()> {
+    if args.gl_spirv && api == Api::Vulkan {
+        return Err(bad_input(
+            "--gl-spirv is an OpenGL option: Vulkan always runs naga's SPIR-V",
+        ));
+    }
+    for e in &args.experiment {
+        let (r, name) = (entry_of(*e), e.name());
+        if let Some((only, why)) = r.only {
+            if only != api {
+                return Err(bad_input(format!(
+                    "--experiment {name} is {} only: {why}",
+                    only.name()
+                )));
+            }
+        }
+        if let Some(path) = r.path {
+            if args.path != path {
+                return Err(bad_input(format!(
+                    "--experiment {name} applies to --path {path} only"
+                )));
+            }
+        }
+        if r.headless && !args.headless {
+            return Err(bad_input(format!(
+                "--experiment {name} is a headless measurement; run it with --headless"
+            )));
+        }
+    }
+    if api == Api::OpenGl && args.gl_spirv {
+        if !args.headless {
+            return Err(bad_input(
+                "--gl-spirv is a headless measurement option; run it with --headless",
+            ));
+        }
+        if args.experiment.contains(&Experiment::WarpProbe) {
+            return Err(bad_input(
+                "--gl-spirv with --experiment warp-probe: the probe is added to naga's GLSL, which --gl-spirv does not load; drop one of them",
+            ));
+        }
+        if args.experiment.contains(&Experiment::Glslang) {
+            return Err(bad_input(
+                "--gl-spirv with --experiment glslang: glslang's SPIR-V is 1.3 for Vulkan 1.1, and OpenGL loads SPIR-V 1.0 only; drop one of them",
+            ));
+        }
+    }
+    if args.path == RenderPath::Fragment && args.shared_pad.is_some() {
+        return Err(bad_input("--shared-pad applies to --path compute only"));
+    }
+    Ok(())
+}
+
+/// What the run's experiments and measurement options change, each applied
+/// once, in registry order.
+pub fn changes(args: &RenderArgs) -> Changes {
+    let mut c = Changes::default();
+    for r in REGISTRY {
+        if args.experiment.contains(&r.experiment) {
+            (r.apply)(&mut c);
+            c.tags.push(r.experiment.name());
+        }
+    }
+    c.knobs.shared_pad_kib = args.shared_pad;
+    c
+}
+
+/// The measurement options: laboratory switches that are options of their own
+/// (hidden from the default `--help`). (name, what it does.)
+pub const MEASUREMENT_OPTIONS: &[(&str, &str)] = &[
+    ("--experiment NAME", "Repeatable: one of the experiments below."),
+    ("--generic", "Render with the all-features shader instead of the scene's own variant."),
+    ("--specialize", "Render with one shader for every scene whose feature switches are specialization constants set to this scene's features (fixed by naga's process_overrides), instead of the scene's own variant of defines."),
+    ("--gl-spirv", "OpenGL, headless: load naga's SPIR-V through GL_ARB_gl_spirv instead of naga's GLSL, so that both APIs run the very same shader binary."),
+    ("--shared-pad KIB", "Compute path: declare 1-32 KiB of workgroup memory the tracer does not need (each invocation writes and reads one word of it), to see how the driver's split between shared memory and L1, and its occupancy, move the time."),
+    ("--vk-memory host", "Vulkan (also TWINRAY_VK_MEMORY): the scene's buffers in host-visible memory the GPU reads across the bus, instead of device-local memory filled through a staging buffer."),
+    ("--vk-wait idle", "Vulkan, headless (also TWINRAY_VK_WAIT): wait for each frame with vkQueueWaitIdle + vkDeviceWaitIdle, as the 2018 study did, instead of the frame's fence."),
+];
+
+/// `--experiments`: prints the laboratory's page; true when it did (the app then exits).
+pub fn print_page_if_asked(args: &RenderArgs) -> bool {
+    if args.experiments {
+        print!("{}", page());
+    }
+    args.experiments
+}
+
+/// docs/experiments.md, generated from the registry (a test keeps the file equal).
+pub fn page() -> String {
+    let mut s = String::from(
+        "# The laboratory: experiments and measurement options\n\n\
+         <!-- Generated from common/src/lab/mod.rs; TWINRAY_UPDATE_DOCS=1 cargo test -p twinray-common lab rewrites it. -->\n\n\
+         twinray's product is the tracer and its two apps. Each gap the comparison found between Vulkan and OpenGL \
+         has an experiment that puts a cost back, or takes one away, so that its effect can be measured in both APIs. \
+         None is needed to render correctly, and none appears in `--help`; `twinray-vk --experiments` prints this page. \
+         The comparison's why step (`twinray compare`) runs them, and the findings under `comparison/results/` \
+         report what each one measured.\n\n\
+         ## Measurement options\n\n| option | what it does |\n|---|---|\n",
+    );
+    for (name, what) in MEASUREMENT_OPTIONS {
+        s.push_str(&format!("| `{name}` | {what} |\n"));
+    }
+    s.push_str("\n## Experiments (`--experiment NAME`)\n\n| name | applies to | what it does |\n|---|---|---|\n");
+    for r in REGISTRY {
+        let mut scope = Vec::new();
+        scope.push(match r.only {
+            Some((api, _)) => format!("{} only", api.name()),
+            None => "both APIs".to_string(),
+        });
+        if let Some(p) = r.path {
+            scope.push(format!("{p} path"));
+        }
+        if r.headless {
+            scope.push("headless".to_string());
+        }
+        s.push_str(&format!(
+            "| `{}` | {} | {} |\n",
+            r.experiment.name(),
+            scope.join(", "),
+            r.what
+        ));
+    }
+    s
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use clap::ValueEnum;
+
+    #[test]
+    fn the_registry_has_every_experiment_once_in_order() {
+        let listed: Vec<Experiment> = REGISTRY.iter().map(|r| r.experiment).collect();
+        assert_eq!(listed, Experiment::value_variants());
+    }
+
+    /// docs/experiments.md is the registry's page; TWINRAY_UPDATE_DOCS=1 rewrites it.
+    #[test]
+    fn the_experiments_page_is_the_registry() {
+        let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../docs/experiments.md");
+        let expected = page();
+        if std::env::var("TWINRAY_UPDATE_DOCS").is_ok_and(|v| v == "1") {
+            std::fs::write(&path, &expected).unwrap();
+        }
+        let found = std::fs::read_to_string(&path).unwrap_or_default();
+        assert!(
+            found == expected,
+            "docs/experiments.md is not the registry's page; run\n  TWINRAY_UPDATE_DOCS=1 cargo test --release -p twinray-common lab"
+        );
+        for e in Experiment::value_variants() {
+            assert!(found.contains(&format!("| `{}` |", e.name())), "{e:?}");
+        }
+    }
+}

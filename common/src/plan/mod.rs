@@ -1,0 +1,233 @@
+//! One plan per run. `Planner::new` reads the options once — the laboratory's
+//! check and changes, the workgroup, the outputs — and says what the run asks
+//! of the device and of the fragment pass, before a device exists. Then
+//! `prepare` gives everything the GPU receives: the scene, its BVH (built once,
+//! timed as a step of its own), the typed shader variant, the buffers' bytes
+//! (checked against the device's storage limit) and the compiled shaders of
+//! the one path that runs. The headless run, the window's start, each of its
+//! scene switches and the counting frame all come from here, so they cannot
+//! disagree about what a run is.
+
+pub mod requests;
+
+use crate::cli::{RenderArgs, RenderPath, Workgroup};
+use crate::explain;
+use crate::gpu::layout::Bvh;
+use crate::gpu::upload::{check_storage_limit, GpuScene};
+use crate::lab::{self, Changes};
+use crate::limits::StorageLimit;
+use crate::scene::camera::in_local_frame;
+use crate::scene::Scene;
+use crate::shader::build::PathShaders;
+use crate::shader::variant::{Entry, Variant};
+use requests::{Api, DeviceRequest, FragmentPass};
+use std::time::Instant;
+
+/// The run's options, checked and turned into choices; makes the plans.
+#[derive(Debug, Clone)]
+pub struct Planner {
+    args: RenderArgs,
+    api: Api,
+    changes: Changes,
+    workgroup: Workgroup,
+}
+
+/// Everything one scene needs on the GPU, decided and prepared.
+pub struct RunPlan {
+    pub scene: Scene,
+    /// The BVH the variant traces through, built over the primitives as the
+    /// GPU holds them (relative to the local origin).
+    pub bvh: Option<Bvh>,
+    /// How long the build took.
+    pub bvh_ms: Option<f64>,
+    pub variant: Variant,
+    /// The buffers' bytes, at the size the plan was prepared for.
+    pub gpu: GpuScene,
+    /// The shaders of the variant's path, compiled.
+    pub shaders: PathShaders,
+}
+
+/// What the untimed ray-counting frame renders (`--count-rays`), in either
+/// app: the plan's scene at a size, with the counting variant of its shader.
+pub struct CountingRun<'a> {
+    pub gpu: &'a GpuScene,
+    /// The counting variant, on the path that is drawing.
+    pub variant: Variant,
+    pub pass: FragmentPass,
+    pub width: u32,
+    pub height: u32,
+}
+
+impl Planner {
+    /// Checks the options (one sentence and exit 2 for what this run cannot
+    /// do) and decides everything that needs no scene.
+    pub fn new(args: &RenderArgs, api: Api) -> anyhow::Result<Planner> {
+        lab::check(args, api)?;
+        let workgroup = args.compute_workgroup()?;
+        args.check_outputs()?;
+        let mut changes = lab::changes(args);
+        changes.device.count_rays = args.count_rays;
+        Ok(Planner {
+            args: args.clone(),
+            api,
+            changes,
+            workgroup,
+        })
+    }
+
+    pub fn args(&self) -> &RenderArgs {
+        &self.args
+    }
+
+    /// What the device must offer.
+    pub fn device(&self) -> DeviceRequest {
+        self.changes.device
+    }
+
+    /// The fragment path's pass.
+    pub fn pass(&self) -> FragmentPass {
+        self.changes.pass
+    }
+
+    /// The compute path's workgroup (also kept while the fragment path draws).
+    pub fn workgroup(&self) -> Workgroup {
+        self.workgroup
+    }
+
+    /// The plan for `--scene` with every `--set`, at `width`×`height`.
+    pub fn prepare(
+        &self,
+        limit: &StorageLimit,
+        width: u32,
+        height: u32,
+    ) -> anyhow::Result<RunPlan> {
+        let args = &self.args;
+        self.prepare_scene(
+            &args.scene,
+            &args.overrides()?,
+            args.path,
+            limit,
+            (width, height),
+        )
+    }
+
+    /// A window's switch to the built-in scene `name`: every `--set` that
+    /// applies to it is kept, and each one that cannot is dropped with the
+    /// reason (which the window prints), instead of refusing the switch.
+    pub fn prepare_switch(
+        &self,
+        name: &str,
+        path: RenderPath,
+        limit: &StorageLimit,
+        width: u32,
+        height: u32,
+    ) -> anyhow::Result<(RunPlan, Vec<String>)> {
+        let (kept, dropped) = Scene::applicable_overrides(name, &self.args.overrides()?);
+        let plan = self.prepare_scene(name, &kept, path, limit, (width, height))?;
+        Ok((plan, dropped))
+    }
+
+    fn prepare_scene(
+        &self,
+        name: &str,
+        overrides: &[(String, String)],
+        path: RenderPath,
+        limit: &StorageLimit,
+        (width, height): (u32, u32),
+    ) -> anyhow::Result<RunPlan> {
+        let scene = Scene::load(name, overrides)?;
+        explain::step("Scene (twinray-common)", || {
+            format!(
+                "{}: {} spheres, {} triangles, {} lights",
+                scene.name,
+                scene.spheres.len(),
+                scene.triangles.len(),
+                scene.lights.len()
+            )
+        });
+        let (bvh, bvh_ms) = if self.args.accel.wants_bvh(&scene) {
+            let t0 = Instant::now();
+            let bvh = build_bvh(&scene);
+            let ms = t0.elapsed().as_secs_f64() * 1e3;
+            explain::step("BVH (twinray-common)", || {
+                format!(
+                    "{} nodes over {} primitives, {} deep; built in {ms:.1} ms",
+                    bvh.nodes.len(),
+                    scene.primitive_count(),
+                    bvh.depth
+                )
+            });
+            (Some(bvh), Some(ms))
+        } else {
+            (None, None)
+        };
+        let variant = self.variant(&scene, bvh.as_ref(), path);
+        let gpu = GpuScene::new(&scene, bvh.as_ref(), width, height);
+        check_storage_limit(&gpu, limit.bytes, limit.name)?;
+        let shaders = PathShaders::build(&variant)?;
+        let target = match self.api {
+            Api::Vulkan => "SPIR-V",
+            Api::OpenGl => "GLSL 450 core",
+        };
+        explain::step(
+            &format!("Shaders: GLSL -> naga module -> {target} (twinray-common)"),
+            || format!("variant {}, {} path", variant.label(), variant.entry.path()),
+        );
+        Ok(RunPlan {
+            scene,
+            bvh,
+            bvh_ms,
+            variant,
+            gpu,
+            shaders,
+        })
+    }
+
+    /// The variant the apps render for `scene` on `path`: `--generic`,
+    /// `--specialize` or the scene's own, tracing through `bvh` where there is
+    /// one, with the laboratory's changes.
+    pub fn variant(&self, scene: &Scene, bvh: Option<&Bvh>, path: RenderPath) -> Variant {
+        let mut v = if self.args.generic {
+            Variant::generic(scene.numerics).with_scene_data(scene, bvh)
+        } else if self.args.specialize {
+            Variant::specialized(scene, bvh)
+        } else {
+            Variant::for_scene(scene, bvh)
+        };
+        let c = &self.changes;
+        v.knobs = c.knobs;
+        v.passes = c.passes;
+        if let Some(counts) = c.counts {
+            v.counts = counts;
+        }
+        v.tags = c.tags.clone();
+        v.entry = Entry::new(path, self.workgroup);
+        v
+    }
+}
+
+/// The BVH a run traces `scene` through: built over the primitives as the GPU
+/// holds them, relative to the local origin, so its boxes round in that frame.
+pub fn build_bvh(scene: &Scene) -> Bvh {
+    Bvh::build(&in_local_frame(scene))
+}
+
+impl RunPlan {
+    /// The counting frame of this plan on its own path, at `width`×`height`
+    /// (the window's size may differ from the plan's), with `gpu` as its buffers.
+    pub fn counting<'a>(
+        &self,
+        gpu: &'a GpuScene,
+        pass: FragmentPass,
+        width: u32,
+        height: u32,
+    ) -> CountingRun<'a> {
+        CountingRun {
+            gpu,
+            variant: self.variant.counting(),
+            pass,
+            width,
+            height,
+        }
+    }
+}

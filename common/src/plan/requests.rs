@@ -1,0 +1,116 @@
+//! What a run asks of the API outside the shader: of the device (a queue, a
+//! feature, a counter) and of the fragment path's pass (its vertices, clear and
+//! target format). The laboratory fills these in; both apps read them, so
+//! Vulkan and OpenGL draw, clear and read back alike.
+
+/// What the device must offer. All off in the product, except `count_rays`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub struct DeviceRequest {
+    /// Vulkan: dispatch on a queue family with COMPUTE but not GRAPHICS.
+    pub compute_only_queue: bool,
+    /// The atomics the counting frame needs (`--count-rays`).
+    pub count_rays: bool,
+    /// Bounds-checked buffer access (Vulkan's robustBufferAccess; an OpenGL
+    /// robust-access context).
+    pub robust_access: bool,
+}
+
+/// What the fragment path's draw looks like outside the shaders.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub struct FragmentPass {
+    /// Two triangles covering the viewport exactly, instead of one oversized
+    /// triangle clipped to it.
+    pub quad: bool,
+    /// The colour target cleared at the start of every frame's pass, instead
+    /// of its old contents left undefined (every pixel is written anyway).
+    pub clear: bool,
+    /// An RGBA8 UNORM target (the GPU rounds to 8 bits) instead of RGBA32F.
+    pub rgba8: bool,
+    /// Vulkan: the viewport and scissor set while recording instead of fixed
+    /// in the pipeline (OpenGL has no other kind).
+    pub dynamic_viewport: bool,
+}
+
+impl FragmentPass {
+    /// The vertices of the draw, which the vertex shader makes from their index.
+    pub fn vertices(&self) -> u32 {
+        if self.quad {
+            6
+        } else {
+            3
+        }
+    }
+
+    /// The render target's bytes per pixel.
+    pub fn texel_bytes(&self) -> u64 {
+        if self.rgba8 {
+            4
+        } else {
+            16
+        }
+    }
+
+    /// The render target's format as `--explain` and errors name it.
+    pub fn format_name(&self) -> &'static str {
+        if self.rgba8 {
+            "RGBA8"
+        } else {
+            "RGBA32F"
+        }
+    }
+}
+
+/// Which app is running: the one place a run's rules differ by API.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Api {
+    Vulkan,
+    OpenGl,
+}
+
+impl Api {
+    pub fn name(&self) -> &'static str {
+        match self {
+            Api::Vulkan => "Vulkan",
+            Api::OpenGl => "OpenGL",
+        }
+    }
+}
+
+/// A device's compute limits, under the names its API gives them.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct ComputeLimits {
+    pub group_size: [u32; 2],
+    pub invocations: u32,
+    pub group_count: [u32; 2],
+    /// The API's names for the three limits, for the error.
+    pub names: [&'static str; 3],
+}
+
+impl ComputeLimits {
+    /// The workgroup against the limits (bad input: the user chose it), and
+    /// the dispatch that covers `width`×`height`, which has limits of its own.
+    /// Returns the group counts.
+    pub fn dispatch(
+        &self,
+        wg: crate::cli::Workgroup,
+        width: u32,
+        height: u32,
+    ) -> anyhow::Result<(u32, u32)> {
+        let [size, invocations, count] = self.names;
+        let l = self;
+        if wg.x > l.group_size[0] || wg.y > l.group_size[1] || wg.x * wg.y > l.invocations {
+            return Err(crate::error::bad_input(format!(
+                "--workgroup {wg} exceeds this device's limits ({size} {}x{}, {invocations} {})",
+                l.group_size[0], l.group_size[1], l.invocations
+            )));
+        }
+        let groups = (width.div_ceil(wg.x), height.div_ceil(wg.y));
+        if groups.0 > l.group_count[0] || groups.1 > l.group_count[1] {
+            return Err(crate::error::bad_input(format!(
+                "--size {width}x{height} with --workgroup {wg} needs {}x{} workgroups, more than this device's {count} {}x{}",
+                groups.0, groups.1, l.group_count[0], l.group_count[1]
+            )));
+        }
+        Ok(groups)
+    }
+}
