@@ -34,7 +34,7 @@ impl Gl {
 
     /// Creates the context on the preferred device (or `knobs`'s); `debug` asks
     /// for a debug context so that KHR_debug reports everything the driver checks;
-    /// `robust` a robust-access one (bounds-checked buffer access).
+    /// `robust` one with bounds-checked buffer access.
     pub fn headless(debug: bool, robust: bool, knobs: &OpenGlKnobs) -> anyhow::Result<Gl> {
         // No libEGL, or one without the device extensions, is a missing driver
         // for the user, not a bug: glutin's error alone would not say what to install.

@@ -14,3 +14,4 @@ mod compute;
 mod fragment;
 mod mouse;
 mod no_window;
+mod switches;
