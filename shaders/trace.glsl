@@ -308,8 +308,9 @@ vec3 hit_triangle(TriRay r, Triangle tri, float t_min, float t_max) {
     float t = tz * inv;
     // Computed on every call, as naga always did for the call right of `||`
     // this once was (the product's timings include it; testing it only
-    // inside the branch was slower on the H100's brute-force teapot, along
-    // with early exits in the shadow test).
+    // inside the branch, along with early exits in the shadow test, was
+    // slower on the brute-force points:
+    // comparison/results/nvidia-h100/FINDINGS.md#naga-does-not-short-circuit--and--investigationnaga-and-or).
     bool degenerate = is_degenerate(tri);
     if (!(t > t_min && t < t_max) || degenerate) {
         return miss;
@@ -338,8 +339,9 @@ vec3 hit_triangle(TriRay r, Triangle tri, float t_min, float t_max) {
     float t = dot(e2, qv) * inv;
     // Computed on every call, as naga always did for the call right of `||`
     // this once was (the product's timings include it; testing it only
-    // inside the branch was slower on the H100's brute-force teapot, along
-    // with early exits in the shadow test).
+    // inside the branch, along with early exits in the shadow test, was
+    // slower on the brute-force points:
+    // comparison/results/nvidia-h100/FINDINGS.md#naga-does-not-short-circuit--and--investigationnaga-and-or).
     bool degenerate = is_degenerate(tri);
     if (!(t > t_min && t < t_max) || degenerate) {
         return miss;
@@ -396,9 +398,9 @@ const uint SPHERE_BIT = 0x80000000u;
 // The traversal stack holds the far children still to visit, each entry
 // uvec2(child reference, floatBitsToUint(entry t)), two entries to a uvec4: NVIDIA's
 // OpenGL compiler gives every element of a local array a whole 16-byte slot,
-// so two scalar arrays cost it four times the memory of these pairs (on an
-// H100 its teapot BVH tracer went from 259 slots to 21, and from 6.2 to
-// 0.54 ms on the compute path). BVH_STACK is the built tree's depth - 1
+// so two scalar arrays cost it four times the memory of these pairs (what
+// that was worth: comparison/results/nvidia-h100/FINDINGS.md#what-each-change-is-worth-one-removal-put-back-at-a-time).
+// BVH_STACK is the built tree's depth - 1
 // (common/src/shader/variant.rs): the traversal pushes at most one child per level of
 // the current path, so no push is ever dropped and no slot is wasted.
 //
@@ -498,9 +500,9 @@ bool hit_leaf(inout Hit h, vec3 origin, vec3 dir, TriRay ray, uint first, uint c
 // closest hit so far. With `any_hit` (shadow rays) it stops at the first hit
 // before t_max and reports it with kind != 0. The loop within a loop (Aila
 // and Laine 2009's "while-while") visits the same nodes and leaves in the
-// same order as one loop taking a node or a leaf per turn, and was up to 18 %
-// faster on an H100, in both APIs and never slower (comparison/results/
-// nvidia-h100/FINDINGS.md, "The node layout").
+// same order as one loop taking a node or a leaf per turn, and was faster in
+// both APIs, never slower (measured in
+// comparison/results/nvidia-h100/FINDINGS.md#the-node-layout-investigationnode-layout).
 Hit traverse(vec3 origin, vec3 dir, float t_max, bool any_hit) {
     Hit h;
     h.t = t_max;
@@ -605,8 +607,9 @@ Hit closest_hit_brute(vec3 origin, vec3 dir) {
 // naga's GLSL front end does not short-circuit && and ||: whatever stands
 // right of them is evaluated every time (gfx-rs/wgpu#4394), so the code says
 // so. The four tests of a group all run and are or-ed, which is what the GPU
-// runs fastest (early exits after each cost the brute-force sphere list 6-10 %
-// on an H100); the index is clamped so that the tests past the last primitive
+// runs fastest (early exits after each were slower on the brute-force points:
+// comparison/results/nvidia-h100/FINDINGS.md#naga-does-not-short-circuit--and--investigationnaga-and-or);
+// the index is clamped so that the tests past the last primitive
 // read a real one, and `i < COUNT` then discards them.
 bool sphere_blocks(vec3 origin, vec3 dir, float dist, uint i) {
     bool blocks = hit_sphere(origin, dir, sphere_buf.spheres[min(i, SPHERE_COUNT - 1u)], 0.0, dist) > 0.0;
@@ -738,19 +741,8 @@ float fresnel(float cos_i, float cos_t, float eta) {
 // trace/loop.glsl — the ray loop with its Phong shading, shadow, mirror and
 // glass rays; the last part of the tracer.
 //
-// The tracer is written in parts that follow the walkthrough's vocabulary, in
-// reading order:
-//   trace/inputs.glsl     switches, structs and bindings
-//   trace/intersect.glsl  ray-sphere and ray-triangle tests
-//   trace/bvh.glsl        the BVH traversal
-//   trace/hit.glsl        closest hit and shadow test, brute force or BVH
-//   trace/secondary.glsl  where secondary rays start; Fresnel
-//   trace/loop.glsl       the ray loop
-// naga has no #include, so shaders/trace.glsl is these parts put together, in
-// one place (TRACE_PARTS in common/src/shader/build.rs): the single tracer that
-// every entry point (trace.frag, trace.comp) and any external compiler takes.
-// A test keeps it equal to the parts; after editing one, regenerate it with
-// TWINRAY_UPDATE_DOCS=1 cargo test --release -p twinray-common --test shader_output
+// The tracer's parts, what each holds and how they are put together:
+// docs/architecture.md#the-tracers-parts
 //
 // Features a scene lacks are compiled out through defines chosen in
 // common's shader module: HAS_SPHERES, HAS_TRIANGLES, HAS_MIRROR, HAS_GLASS,
@@ -814,7 +806,8 @@ vec3 trace(vec3 origin, vec3 dir) {
 
         // The shading stays written out here rather than in functions: naga's
         // output for a struct returned by value and `out` parameters cost both
-        // APIs 2-20 % on the BVH (comparison/results/nvidia-h100/FINDINGS.md).
+        // APIs time on every BVH point
+        // (comparison/results/nvidia-h100/FINDINGS.md#one-query-site-for-every-ray-investigationone-query).
         Hit h = closest_hit(o, d);
         if (h.kind == 0u) {
             color += w * frame.background;
