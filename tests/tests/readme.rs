@@ -11,10 +11,20 @@ use std::path::{Path, PathBuf};
 const MAX_README_LINES: usize = 150;
 
 /// The pages a newcomer reads first, relative to the root.
-const FRONT_PAGES: [&str; 3] = ["README.md", "comparison/results/README.md", "tests/README.md"];
+const FRONT_PAGES: [&str; 3] = [
+    "README.md",
+    "comparison/results/README.md",
+    "tests/README.md",
+];
 
 /// Where code comments may cite a page, and the files read there.
-const CODE_DIRS: [&str; 5] = ["common/src", "vk/src", "gl/src", "comparison/src", "shaders"];
+const CODE_DIRS: [&str; 5] = [
+    "common/src",
+    "vk/src",
+    "gl/src",
+    "comparison/src",
+    "shaders",
+];
 const CODE_EXTENSIONS: [&str; 5] = ["rs", "glsl", "frag", "comp", "vert"];
 
 fn root() -> PathBuf {
@@ -115,10 +125,14 @@ fn broken(from: &Path, target: &str) -> Option<String> {
     }
     let anchor = anchor?;
     if file.extension().is_none_or(|e| e != "md") {
-        return Some(format!("{target}: an anchor into a file that is not Markdown"));
+        return Some(format!(
+            "{target}: an anchor into a file that is not Markdown"
+        ));
     }
     if !anchors(&read(&file)).iter().any(|a| a == anchor) {
-        return Some(format!("{target}: no heading with the anchor #{anchor} in {path}"));
+        return Some(format!(
+            "{target}: no heading with the anchor #{anchor} in {path}"
+        ));
     }
     None
 }
