@@ -7,9 +7,9 @@ const uint SPHERE_BIT = 0x80000000u;
 // The traversal stack holds the far children still to visit, each entry
 // uvec2(child reference, floatBitsToUint(entry t)), two entries to a uvec4: NVIDIA's
 // OpenGL compiler gives every element of a local array a whole 16-byte slot,
-// so two scalar arrays cost it four times the memory of these pairs (on an
-// H100 its teapot BVH tracer went from 259 slots to 21, and from 6.2 to
-// 0.54 ms on the compute path). BVH_STACK is the built tree's depth - 1
+// so two scalar arrays cost it four times the memory of these pairs (what
+// that was worth: comparison/results/nvidia-h100/FINDINGS.md#what-each-change-is-worth-one-removal-put-back-at-a-time).
+// BVH_STACK is the built tree's depth - 1
 // (common/src/shader/variant.rs): the traversal pushes at most one child per level of
 // the current path, so no push is ever dropped and no slot is wasted.
 //
@@ -109,9 +109,9 @@ bool hit_leaf(inout Hit h, vec3 origin, vec3 dir, TriRay ray, uint first, uint c
 // closest hit so far. With `any_hit` (shadow rays) it stops at the first hit
 // before t_max and reports it with kind != 0. The loop within a loop (Aila
 // and Laine 2009's "while-while") visits the same nodes and leaves in the
-// same order as one loop taking a node or a leaf per turn, and was up to 18 %
-// faster on an H100, in both APIs and never slower (comparison/results/
-// nvidia-h100/FINDINGS.md, "The node layout").
+// same order as one loop taking a node or a leaf per turn, and was faster in
+// both APIs, never slower (measured in
+// comparison/results/nvidia-h100/FINDINGS.md#the-node-layout-investigationnode-layout).
 Hit traverse(vec3 origin, vec3 dir, float t_max, bool any_hit) {
     Hit h;
     h.t = t_max;

@@ -36,8 +36,9 @@ Hit closest_hit_brute(vec3 origin, vec3 dir) {
 // naga's GLSL front end does not short-circuit && and ||: whatever stands
 // right of them is evaluated every time (gfx-rs/wgpu#4394), so the code says
 // so. The four tests of a group all run and are or-ed, which is what the GPU
-// runs fastest (early exits after each cost the brute-force sphere list 6-10 %
-// on an H100); the index is clamped so that the tests past the last primitive
+// runs fastest (early exits after each were slower on the brute-force points:
+// comparison/results/nvidia-h100/FINDINGS.md#naga-does-not-short-circuit--and--investigationnaga-and-or);
+// the index is clamped so that the tests past the last primitive
 // read a real one, and `i < COUNT` then discards them.
 bool sphere_blocks(vec3 origin, vec3 dir, float dist, uint i) {
     bool blocks = hit_sphere(origin, dir, sphere_buf.spheres[min(i, SPHERE_COUNT - 1u)], 0.0, dist) > 0.0;

@@ -120,8 +120,9 @@ vec3 hit_triangle(TriRay r, Triangle tri, float t_min, float t_max) {
     float t = tz * inv;
     // Computed on every call, as naga always did for the call right of `||`
     // this once was (the product's timings include it; testing it only
-    // inside the branch was slower on the H100's brute-force teapot, along
-    // with early exits in the shadow test).
+    // inside the branch, along with early exits in the shadow test, was
+    // slower on the brute-force points:
+    // comparison/results/nvidia-h100/FINDINGS.md#naga-does-not-short-circuit--and--investigationnaga-and-or).
     bool degenerate = is_degenerate(tri);
     if (!(t > t_min && t < t_max) || degenerate) {
         return miss;
@@ -150,8 +151,9 @@ vec3 hit_triangle(TriRay r, Triangle tri, float t_min, float t_max) {
     float t = dot(e2, qv) * inv;
     // Computed on every call, as naga always did for the call right of `||`
     // this once was (the product's timings include it; testing it only
-    // inside the branch was slower on the H100's brute-force teapot, along
-    // with early exits in the shadow test).
+    // inside the branch, along with early exits in the shadow test, was
+    // slower on the brute-force points:
+    // comparison/results/nvidia-h100/FINDINGS.md#naga-does-not-short-circuit--and--investigationnaga-and-or).
     bool degenerate = is_degenerate(tri);
     if (!(t > t_min && t < t_max) || degenerate) {
         return miss;

@@ -1,19 +1,8 @@
 // trace/loop.glsl — the ray loop with its Phong shading, shadow, mirror and
 // glass rays; the last part of the tracer.
 //
-// The tracer is written in parts that follow the walkthrough's vocabulary, in
-// reading order:
-//   trace/inputs.glsl     switches, structs and bindings
-//   trace/intersect.glsl  ray-sphere and ray-triangle tests
-//   trace/bvh.glsl        the BVH traversal
-//   trace/hit.glsl        closest hit and shadow test, brute force or BVH
-//   trace/secondary.glsl  where secondary rays start; Fresnel
-//   trace/loop.glsl       the ray loop
-// naga has no #include, so shaders/trace.glsl is these parts put together, in
-// one place (TRACE_PARTS in common/src/shader/build.rs): the single tracer that
-// every entry point (trace.frag, trace.comp) and any external compiler takes.
-// A test keeps it equal to the parts; after editing one, regenerate it with
-// TWINRAY_UPDATE_DOCS=1 cargo test --release -p twinray-common --test shader_output
+// The tracer's parts, what each holds and how they are put together:
+// docs/architecture.md#the-tracers-parts
 //
 // Features a scene lacks are compiled out through defines chosen in
 // common's shader module: HAS_SPHERES, HAS_TRIANGLES, HAS_MIRROR, HAS_GLASS,
@@ -77,7 +66,8 @@ vec3 trace(vec3 origin, vec3 dir) {
 
         // The shading stays written out here rather than in functions: naga's
         // output for a struct returned by value and `out` parameters cost both
-        // APIs 2-20 % on the BVH (comparison/results/nvidia-h100/FINDINGS.md).
+        // APIs time on every BVH point
+        // (comparison/results/nvidia-h100/FINDINGS.md#one-query-site-for-every-ray-investigationone-query).
         Hit h = closest_hit(o, d);
         if (h.kind == 0u) {
             color += w * frame.background;

@@ -49,6 +49,7 @@ fn documents() -> Vec<PathBuf> {
         "vk",
         "gl",
         "comparison",
+        "comparison/results",
         "tests",
         "scenes",
         "shaders",

@@ -7,8 +7,9 @@
 // GLSL. For a scalar the driver drops the dead store; for an array it cannot
 // prove every element is written before it is read, so it stores N zeros at
 // every call: the tracer's ray stack at every pixel and the BVH stack at every
-// traversal (128 stores into NVIDIA's local memory per traversal, 1.2-1.85x the
-// BVH time on an H100). trace.glsl only reads stack entries below the stack
+// traversal (stores into NVIDIA's local memory; what they cost:
+// comparison/results/nvidia-h100/FINDINGS.md#what-each-change-is-worth-one-removal-put-back-at-a-time).
+// trace.glsl only reads stack entries below the stack
 // pointer, each written by a push first, so the zeros are never read: both
 // passes remove the initialisers of per-invocation arrays (function-local, or
 // private at module scope), and only those.

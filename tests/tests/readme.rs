@@ -1,0 +1,251 @@
+//! The front pages stay short and lead somewhere: README.md is a five-minute
+//! read (at most 150 lines); every relative link of README.md,
+//! comparison/results/README.md and tests/README.md reaches a file or folder,
+//! and where it names a heading (`page.md#anchor`) that page has the heading;
+//! and every `page.md#anchor` a code comment cites (a FINDINGS section instead
+//! of a timing that would go stale, the module map in docs/architecture.md)
+//! names a heading that is there.
+
+use std::path::{Path, PathBuf};
+
+const MAX_README_LINES: usize = 150;
+
+/// The pages a newcomer reads first, relative to the root.
+const FRONT_PAGES: [&str; 3] = [
+    "README.md",
+    "comparison/results/README.md",
+    "tests/README.md",
+];
+
+/// Where code comments may cite a page, and the files read there.
+const CODE_DIRS: [&str; 5] = [
+    "common/src",
+    "vk/src",
+    "gl/src",
+    "comparison/src",
+    "shaders",
+];
+const CODE_EXTENSIONS: [&str; 5] = ["rs", "glsl", "frag", "comp", "vert"];
+
+fn root() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .parent()
+        .unwrap()
+        .to_path_buf()
+}
+
+fn read(path: &Path) -> String {
+    std::fs::read_to_string(path).unwrap_or_else(|e| panic!("{}: {e}", path.display()))
+}
+
+/// The lines of a Markdown text outside fenced code blocks.
+fn prose(text: &str) -> Vec<&str> {
+    let mut in_block = false;
+    let mut lines = Vec::new();
+    for line in text.lines() {
+        if line.trim_start().starts_with("```") {
+            in_block = !in_block;
+        } else if !in_block {
+            lines.push(line);
+        }
+    }
+    lines
+}
+
+/// The anchor GitHub gives a heading: lower case, everything but letters,
+/// digits, spaces, `-` and `_` dropped, each space a hyphen.
+fn slug(heading: &str) -> String {
+    heading
+        .trim()
+        .to_lowercase()
+        .chars()
+        .filter(|c| c.is_alphanumeric() || matches!(c, ' ' | '-' | '_'))
+        .map(|c| if c == ' ' { '-' } else { c })
+        .collect()
+}
+
+/// The anchors of a page's headings; a repeated heading gets `-1`, `-2`, …
+/// as on GitHub.
+fn anchors(text: &str) -> Vec<String> {
+    let mut found: Vec<String> = Vec::new();
+    for line in prose(text) {
+        let Some(heading) = line.strip_prefix('#') else {
+            continue;
+        };
+        let heading = heading.trim_start_matches('#');
+        if !heading.starts_with(' ') {
+            continue;
+        }
+        let base = slug(heading);
+        let numbered = |a: &str| {
+            a.strip_prefix(&format!("{base}-"))
+                .is_some_and(|n| n.parse::<u32>().is_ok())
+        };
+        let repeats = found.iter().filter(|a| **a == base || numbered(a)).count();
+        found.push(if repeats == 0 {
+            base
+        } else {
+            format!("{base}-{repeats}")
+        });
+    }
+    found
+}
+
+/// The targets of a page's Markdown links and images, `[text](target)`,
+/// outside code blocks.
+fn links(text: &str) -> Vec<String> {
+    let mut targets = Vec::new();
+    for line in prose(text) {
+        for part in line.split("](").skip(1) {
+            if let Some(end) = part.find(')') {
+                targets.push(part[..end].to_string());
+            }
+        }
+    }
+    targets
+}
+
+/// Why `target`, linked from the page `from`, leads nowhere; `None` where it
+/// resolves. Web addresses are not followed.
+fn broken(from: &Path, target: &str) -> Option<String> {
+    if target.contains("://") || target.starts_with("mailto:") {
+        return None;
+    }
+    let (path, anchor) = match target.split_once('#') {
+        Some((p, a)) => (p, Some(a)),
+        None => (target, None),
+    };
+    let file = if path.is_empty() {
+        from.to_path_buf()
+    } else {
+        from.parent().unwrap().join(path)
+    };
+    if !file.exists() {
+        return Some(format!("{target}: no file {}", file.display()));
+    }
+    let anchor = anchor?;
+    if file.extension().is_none_or(|e| e != "md") {
+        return Some(format!(
+            "{target}: an anchor into a file that is not Markdown"
+        ));
+    }
+    if !anchors(&read(&file)).iter().any(|a| a == anchor) {
+        return Some(format!(
+            "{target}: no heading with the anchor #{anchor} in {path}"
+        ));
+    }
+    None
+}
+
+fn code_files(dir: &Path, out: &mut Vec<PathBuf>) {
+    let entries = std::fs::read_dir(dir).unwrap_or_else(|e| panic!("{}: {e}", dir.display()));
+    for entry in entries {
+        let path = entry.unwrap().path();
+        if path.is_dir() {
+            code_files(&path, out);
+        } else if path
+            .extension()
+            .is_some_and(|e| CODE_EXTENSIONS.iter().any(|x| e == *x))
+        {
+            out.push(path);
+        }
+    }
+}
+
+/// Every `path.md#anchor` written in a line, as the text cites it.
+fn cited_anchors(line: &str) -> Vec<String> {
+    line.split(|c: char| c.is_whitespace() || "()\"'`,;<>[]".contains(c))
+        .filter(|word| word.contains(".md#"))
+        .map(|word| word.trim_end_matches(['.', ':']).to_string())
+        .collect()
+}
+
+#[test]
+fn the_readme_is_a_five_minute_read() {
+    let lines = read(&root().join("README.md")).lines().count();
+    assert!(
+        lines <= MAX_README_LINES,
+        "README.md has {lines} lines, more than {MAX_README_LINES}: move the detail to the page \
+         that owns it (docs/architecture.md, comparison/results/README.md, tests/README.md) and link to it"
+    );
+}
+
+#[test]
+fn every_link_of_the_front_pages_resolves() {
+    let mut broken_links = Vec::new();
+    let mut checked = 0;
+    for page in FRONT_PAGES {
+        let path = root().join(page);
+        for target in links(&read(&path)) {
+            checked += 1;
+            if let Some(why) = broken(&path, &target) {
+                broken_links.push(format!("{page}: {why}"));
+            }
+        }
+    }
+    assert!(
+        broken_links.is_empty(),
+        "links that lead nowhere:\n{}",
+        broken_links.join("\n")
+    );
+    assert!(
+        checked >= 20,
+        "only {checked} links found on the front pages: is the parser still reading them?"
+    );
+}
+
+#[test]
+fn every_page_a_code_comment_cites_has_the_heading() {
+    let mut files = Vec::new();
+    for dir in CODE_DIRS {
+        code_files(&root().join(dir), &mut files);
+    }
+    let mut missing = Vec::new();
+    let mut checked = 0;
+    for file in files {
+        let shown = file.strip_prefix(root()).unwrap().display().to_string();
+        for (n, line) in read(&file).lines().enumerate() {
+            for cited in cited_anchors(line) {
+                checked += 1;
+                // Code cites pages from the repository's root.
+                if let Some(why) = broken(&root().join("README.md"), &cited) {
+                    missing.push(format!("{shown}:{}: {why}", n + 1));
+                }
+            }
+        }
+    }
+    assert!(
+        missing.is_empty(),
+        "code comments cite sections that are not there:\n{}",
+        missing.join("\n")
+    );
+    assert!(
+        checked >= 5,
+        "only {checked} cited sections found in the code: is the search still reading it?"
+    );
+}
+
+#[test]
+fn anchors_are_githubs() {
+    assert_eq!(
+        slug(" Local memory and OpenGL's multiprocessors (`investigation/gl-multiprocessors/`)"),
+        "local-memory-and-opengls-multiprocessors-investigationgl-multiprocessors"
+    );
+    assert_eq!(slug(" `--set` keys"), "--set-keys");
+    assert_eq!(
+        slug(" naga does not short-circuit `&&` and `||` (`x/`)"),
+        "naga-does-not-short-circuit--and--x"
+    );
+    assert_eq!(
+        anchors("# A\n```\n# not a heading\n```\n## A\n#hashtag\n### B: c\n"),
+        ["a", "a-1", "b-c"]
+    );
+    assert_eq!(
+        links("[a](x.md#y) ![b](i.png)\n```\n[c](not-a-link.md)\n```\n"),
+        ["x.md#y", "i.png"]
+    );
+    assert_eq!(
+        cited_anchors("// (see docs/architecture.md#the-tracers-parts)."),
+        ["docs/architecture.md#the-tracers-parts"]
+    );
+}
