@@ -131,11 +131,11 @@ pub struct Workgroup {
 }
 
 impl Workgroup {
-    /// The default, chosen by measurement (README, "Compute path"): one warp.
-    /// On an H100 it was as fast as 16x8 or faster at every point in Vulkan,
-    /// and 13-23 % faster in OpenGL, whose driver fits more one-warp workgroups
-    /// on each multiprocessor; on lavapipe and llvmpipe it ties with 16x8
-    /// (4x8, as fast on the H100, is 1.5x slower there).
+    /// The default, chosen by measurement: one warp. On NVIDIA it was as fast
+    /// as 16x8 or faster in Vulkan, and faster in OpenGL, whose driver keeps
+    /// more one-warp workgroups resident on each multiprocessor; on lavapipe and
+    /// llvmpipe it ties with 16x8. The figures:
+    /// comparison/results/nvidia-h100/FINDINGS.md#local-memory-and-opengls-multiprocessors-investigationgl-multiprocessors
     pub const DEFAULT: Workgroup = Workgroup { x: 8, y: 4 };
     /// The sizes the comparison measures.
     pub const MEASURED: [Workgroup; 4] = [

@@ -242,13 +242,13 @@ pub fn build_compute(variant: &Variant, workgroup: Workgroup) -> anyhow::Result<
 /// breaks out after 2^64 iterations, so that a driver cannot assume an
 /// infinite loop away; the GLSL writer adds none, so it is a cost only Vulkan
 /// pays. Every loop of the tracer ends (the stacks shrink, the primitive loops
-/// count up to a constant), so it is never needed for correctness. On NVIDIA
-/// it costs the BVH variants time in Vulkan, but without it NVIDIA's Vulkan
-/// compiler, given the constant trip count of the brute-force sphere loop,
-/// made the 10,000-sphere list slower
-/// (comparison/results/nvidia-h100/FINDINGS.md, "Loop bounding"). So the BVH
-/// variants go without it and the brute-force ones keep it, unless the
-/// laboratory says otherwise.
+/// count up to a constant), so it is never needed for correctness. It costs
+/// the BVH variants time in Vulkan, but without it NVIDIA's Vulkan compiler,
+/// given the constant trip count of the brute-force sphere loop, made the
+/// 10,000-sphere list slower
+/// (comparison/results/nvidia-h100/FINDINGS.md#brute-force-the-studys-points-and-the-loop-bound-trap).
+/// So the BVH variants go without it and the brute-force ones keep it, unless
+/// the laboratory says otherwise.
 pub fn loop_bounding(variant: &Variant) -> bool {
     variant
         .passes

@@ -13,12 +13,12 @@
 // pointer, each written by a push first, so the zeros are never read: both
 // passes remove the initialisers of per-invocation arrays (function-local, or
 // private at module scope), and only those.
-// trace.glsl gives no array an explicit initialiser (a test holds it to that),
+// The tracer gives no array an explicit initialiser (a test holds it to that),
 // so every initialiser removed here is naga's.
 
 /// Removes the `OpConstantNull` initialiser of every `Function`- or
 /// `Private`-storage `OpVariable` whose type is an array (a private array is
-/// per invocation too: `--experiment global-bvh-stack`'s stack).
+/// per invocation too: the module-scope BVH stack both walks share).
 pub fn strip_local_array_zero_init_spirv(words: &[u32]) -> Vec<u32> {
     const OP_TYPE_ARRAY: u32 = 28;
     const OP_TYPE_POINTER: u32 = 32;
