@@ -24,7 +24,6 @@ use std::time::Instant;
 use twinray_common::cli::{OpenGlKnobs, RenderArgs, Workgroup};
 use twinray_common::explain;
 use twinray_common::lab;
-use twinray_common::limits::StorageLimit;
 use twinray_common::plan::requests::Api;
 use twinray_common::plan::{Planner, RunPlan};
 use twinray_common::reference::image_io::FloatImage;
@@ -95,7 +94,7 @@ fn render(
     target::check_size(gl, width, height)?;
     // The plan comes after the context, whose storage limit it is checked
     // against before any buffer exists.
-    let plan = planner.prepare(&storage_limit(gl), width, height)?;
+    let plan = planner.prepare(&context::storage_limit(gl), width, height)?;
     if let Some(dir) = &args.dump_shaders {
         dump_shaders(dir, &plan.shaders.stages())?;
     }
@@ -130,16 +129,6 @@ fn render(
     report.validation_messages = log.errors();
     Ok((report, image))
     // Every GL object is deleted here, newest first, then the context.
-}
-
-/// The largest storage block the context binds: what every run plan is checked against.
-pub fn storage_limit(gl: &glow::Context) -> StorageLimit {
-    // SAFETY: plain query; 64-bit because the limit may exceed 2 GiB.
-    let bytes = unsafe { gl.get_parameter_i64(glow::MAX_SHADER_STORAGE_BLOCK_SIZE) };
-    StorageLimit {
-        bytes: bytes.max(0) as u64,
-        name: "GL_MAX_SHADER_STORAGE_BLOCK_SIZE",
-    }
 }
 
 /// What both paths render from.

@@ -10,6 +10,7 @@ use glutin::prelude::*;
 use twinray_common::cli::OpenGlKnobs;
 use twinray_common::error::{bad_input, no_device};
 use twinray_common::explain;
+use twinray_common::limits::StorageLimit;
 use twinray_common::report::DeviceInfo;
 
 const NO_DEVICE: &str =
@@ -168,5 +169,15 @@ pub fn device_info(gl: &glow::Context) -> DeviceInfo {
         device: renderer,
         driver: format!("{vendor} {version}"),
         api_version: format!("OpenGL {version}"),
+    }
+}
+
+/// The largest storage block the context binds: what every run plan is checked against.
+pub fn storage_limit(gl: &glow::Context) -> StorageLimit {
+    // SAFETY: plain query; 64-bit because the limit may exceed 2 GiB.
+    let bytes = unsafe { gl.get_parameter_i64(glow::MAX_SHADER_STORAGE_BLOCK_SIZE) };
+    StorageLimit {
+        bytes: bytes.max(0) as u64,
+        name: "GL_MAX_SHADER_STORAGE_BLOCK_SIZE",
     }
 }

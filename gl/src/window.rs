@@ -155,7 +155,7 @@ pub fn run(planner: &Planner, started: Instant) -> Result<(WindowedRun, DeviceIn
     let size = window.inner_size();
     // The plan comes after the context, whose storage limit it is checked against.
     let plan = planner.prepare(
-        &crate::app::storage_limit(gl),
+        &crate::context::storage_limit(gl),
         size.width.max(1),
         size.height.max(1),
     )?;
@@ -299,7 +299,7 @@ impl Renderer for GlWindow<'_> {
     }
 
     fn storage_limit(&self) -> StorageLimit {
-        crate::app::storage_limit(self.gl)
+        crate::context::storage_limit(self.gl)
     }
 
     fn api(&self) -> &'static str {
