@@ -50,7 +50,7 @@ impl Instance {
                 "no Vulkan loader found (libvulkan.so.1): install libvulkan1 and a Vulkan driver, e.g. mesa-vulkan-drivers",
             )
         })?;
-        explain::step("Loader: libvulkan.so.1 opened (ash::Entry::load)", || {
+        explain::numbered(1, "Loader: libvulkan.so.1 opened (ash::Entry::load)", || {
             "the loader finds the installed drivers (ICDs) and layers at run time".into()
         });
 
@@ -114,7 +114,7 @@ impl Instance {
             e => anyhow::Error::new(e).context("creating the Vulkan instance"),
         })?;
 
-        explain::step("VkInstance (vkCreateInstance)", || {
+        explain::numbered(1, "VkInstance (vkCreateInstance)", || {
             let v = |v: u32| {
                 format!(
                     "{}.{}.{}",
@@ -153,7 +153,7 @@ impl Instance {
                 unsafe { functions.create_debug_utils_messenger(&messenger_info(), None) }
                     .context("creating the debug messenger")?;
             this.messenger = Some((functions, messenger));
-            explain::step("VkDebugUtilsMessengerEXT", || {
+            explain::numbered(2, "VkDebugUtilsMessengerEXT", || {
                 "severity WARNING|ERROR, types GENERAL|VALIDATION|PERFORMANCE: every message is counted and fails --validate".into()
             });
         }

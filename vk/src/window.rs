@@ -82,7 +82,7 @@ pub fn run(
     let scene = args.load_scene()?;
     let variant = Variant::chosen(&scene, args);
     let shaders = window::first_shaders(args, &scene)?;
-    explain::step(
+    explain::numbered(0,
         "Shaders: GLSL -> naga module -> SPIR-V (twinray-common)",
         || format!("variant {}, {} path", variant.label(), args.path),
     );
@@ -95,7 +95,7 @@ pub fn run(
     let window = event_loop
         .create_window(window::window_attributes(args, &scene.name, "Vulkan"))
         .context("creating the window")?;
-    explain::step("Window (winit)", || {
+    explain::numbered(12, "Window (winit)", || {
         let s = window.inner_size();
         format!("{}x{} physical pixels", s.width, s.height)
     });
@@ -170,7 +170,7 @@ pub fn run(
         _instance: instance,
         window,
     };
-    explain::step("Frame loop starts", || {
+    explain::numbered(17, "Frame loop starts", || {
         "per frame: wait fence, acquire image, re-record (fragment: render pass; compute: dispatch + blit),\n\
          submit (wait image-available, signal render-finished), present; C switches the path".into()
     });
