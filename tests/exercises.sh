@@ -56,7 +56,8 @@ check() { # exercise, expected (a message, or "freeze"), what the run printed, i
         seen=$(grep -c -- "$expected" <<<"$output" || true)
     fi
     if [[ $seen -gt 0 ]]; then
-        echo "exercise $n: $expected: seen ($seen lines), as the page says"
+        echo "exercise $n: $expected: seen ($seen lines), as the page says; every message:"
+        grep -o -e 'VUID-[A-Za-z0-9_-]*' -e 'SYNC-HAZARD-[A-Z_-]*' <<<"$output" | sort | uniq -c || true
     else
         echo "exercise $n: expected $expected, got exit $status and:" >&2
         head -c 3000 <<<"$output" >&2
