@@ -134,7 +134,8 @@ fn create(index: usize, device: &Device, debug: bool, robust: bool) -> anyhow::R
         .with_context(|| format!("creating an OpenGL 4.5 core context on {what}"))?
         .make_current_surfaceless()
         .with_context(|| format!("making the context current without a surface on {what}"))?;
-    explain::numbered(4,
+    explain::numbered(
+        4,
         "EGL display + config + context, made current without a surface",
         || {
             format!(

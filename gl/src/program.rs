@@ -272,7 +272,8 @@ impl<'gl> Program<'gl> {
                 }
             };
             link(gl, raw, &[vs, fs], "tracer")?;
-            explain::numbered(8,
+            explain::numbered(
+                8,
                 "glCreateShader x2 + glCompileShader + glCreateProgram + glLinkProgram",
                 || {
                     format!(

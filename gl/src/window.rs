@@ -64,7 +64,8 @@ pub fn run(args: &RenderArgs, started: Instant) -> Result<(WindowedRun, DeviceIn
     let scene = args.load_scene()?;
     let variant = Variant::chosen(&scene, args);
     let shaders = window::first_shaders(args, &scene)?;
-    explain::numbered(0,
+    explain::numbered(
+        0,
         "Shaders: GLSL -> naga module -> GLSL 450 core (twinray-common)",
         || format!("variant {}, {} path", variant.label(), args.path),
     );
@@ -82,7 +83,8 @@ pub fn run(args: &RenderArgs, started: Instant) -> Result<(WindowedRun, DeviceIn
         .build(&event_loop, template, pick_config)
         .map_err(|e| no_device(format!("no OpenGL display configuration for a window: {e}")))?;
     let window = window.context("glutin-winit made no window")?;
-    explain::numbered(12,
+    explain::numbered(
+        12,
         "Window + display + config (glutin-winit DisplayBuilder)",
         || {
             let s = window.inner_size();

@@ -24,7 +24,9 @@ fn exercise_on_the_page(doc: &str, n: u32) -> String {
         .find(&format!("\n{n}. **"))
         .unwrap_or_else(|| panic!("the page has no exercise {n}"));
     let item = &section[start + 1..];
-    let end = item[1..].find("\n\n").or_else(|| item[1..].find(&format!("\n{}. **", n + 1)));
+    let end = item[1..]
+        .find("\n\n")
+        .or_else(|| item[1..].find(&format!("\n{}. **", n + 1)));
     item[..end.map_or(item.len(), |e| e + 1)].to_string()
 }
 
@@ -44,17 +46,28 @@ fn the_script_checks_the_outcome_each_exercise_promises() {
         let outcome = words.next().expect("an outcome").trim_matches('"');
         let file = words.next().expect("a file");
         let item = exercise_on_the_page(&doc, n);
-        let promised = if outcome == "freeze" { "freezes" } else { outcome };
+        let promised = if outcome == "freeze" {
+            "freezes"
+        } else {
+            outcome
+        };
         if !item.contains(promised) {
-            wrong.push(format!("exercise {n}: the script checks for {promised}, the page does not say so"));
+            wrong.push(format!(
+                "exercise {n}: the script checks for {promised}, the page does not say so"
+            ));
         }
         if !item.contains(file) {
-            wrong.push(format!("exercise {n}: the script edits {file}, the page does not name it"));
+            wrong.push(format!(
+                "exercise {n}: the script edits {file}, the page does not name it"
+            ));
         }
         graded += 1;
     }
     assert!(wrong.is_empty(), "{}", wrong.join("\n"));
-    assert_eq!(graded, 4, "tests/exercises.sh grades {graded} exercises, not 4");
+    assert_eq!(
+        graded, 4,
+        "tests/exercises.sh grades {graded} exercises, not 4"
+    );
     assert!(
         doc.contains("1.3.239"),
         "the page names the layer version the messages were seen with"
@@ -87,7 +100,15 @@ fn the_window_survives_an_out_of_date_acquire() {
     let app = twinray_tests::bin("twinray-vk");
     let app = app.to_str().unwrap();
     let args = [
-        "60", app, "--scene", "box", "--size", "64x48", "--frames", "10", "--validate",
+        "60",
+        app,
+        "--scene",
+        "box",
+        "--size",
+        "64x48",
+        "--frames",
+        "10",
+        "--validate",
         "--explain",
     ];
     let out = xvfb.run(

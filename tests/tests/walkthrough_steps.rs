@@ -86,7 +86,11 @@ fn squeezed(text: &str) -> String {
 fn every_snippet_line_is_in_a_file_its_step_names() {
     let doc = page();
     let steps = steps(&doc);
-    assert!(steps.len() >= 22, "only {} numbered steps found", steps.len());
+    assert!(
+        steps.len() >= 22,
+        "only {} numbered steps found",
+        steps.len()
+    );
     let mut wrong = Vec::new();
     let mut checked = 0;
     for step in &steps {
@@ -106,7 +110,10 @@ fn every_snippet_line_is_in_a_file_its_step_names() {
             })
             .collect();
         if files.is_empty() {
-            wrong.push(format!("step {} names no source file under **Where.**", step.number));
+            wrong.push(format!(
+                "step {} names no source file under **Where.**",
+                step.number
+            ));
             continue;
         }
         for line in snippets.iter().flatten() {
@@ -172,7 +179,11 @@ fn explain_prints_the_pages_steps_in_the_pages_order() {
     let doc = page();
     let steps = steps(&doc);
     let orders = stated_orders(&doc);
-    assert_eq!(orders.len(), 2, "the page states the order of two headless runs");
+    assert_eq!(
+        orders.len(),
+        2,
+        "the page states the order of two headless runs"
+    );
     let program = twinray_tests::bin("twinray-vk");
     let mut wrong = Vec::new();
     for (command, stated) in &orders {

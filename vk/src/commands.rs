@@ -83,7 +83,8 @@ impl Commands {
                 t.record(cmd, 1);
             }
         })?;
-        explain::numbered(11,
+        explain::numbered(
+            11,
             "Command buffer recorded once (resubmitted every frame)",
             || {
                 let ts = if timestamps.is_some() {

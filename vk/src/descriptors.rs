@@ -43,7 +43,11 @@ impl Descriptors {
     ) -> Result<Descriptors> {
         let d = &device.device;
         // --explain: the compute path's set is part of its own step.
-        let step = if stage == vk::ShaderStageFlags::COMPUTE { 21 } else { 6 };
+        let step = if stage == vk::ShaderStageFlags::COMPUTE {
+            21
+        } else {
+            6
+        };
         let mut this = Descriptors {
             device: d.clone(),
             set_layout: vk::DescriptorSetLayout::null(),

@@ -50,9 +50,11 @@ impl Instance {
                 "no Vulkan loader found (libvulkan.so.1): install libvulkan1 and a Vulkan driver, e.g. mesa-vulkan-drivers",
             )
         })?;
-        explain::numbered(1, "Loader: libvulkan.so.1 opened (ash::Entry::load)", || {
-            "the loader finds the installed drivers (ICDs) and layers at run time".into()
-        });
+        explain::numbered(
+            1,
+            "Loader: libvulkan.so.1 opened (ash::Entry::load)",
+            || "the loader finds the installed drivers (ICDs) and layers at run time".into(),
+        );
 
         // The layer checks every call, which costs CPU time on every submit, and a
         // timing run must not pay for it. So it is on only when asked for:

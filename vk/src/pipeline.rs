@@ -274,7 +274,8 @@ impl Pipeline {
                 .context("creating the graphics pipeline")?;
         this.pipeline = pipelines[0];
         crate::statistics::capture(device, this.pipeline, "graphics");
-        explain::numbered(8,
+        explain::numbered(
+            8,
             "VkPipeline (vkCreateGraphicsPipelines: the driver compiles the tracer here)",
             || {
                 let size = match fixed_size {

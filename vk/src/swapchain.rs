@@ -277,7 +277,8 @@ impl Swapchain {
                     .context("creating a render-finished semaphore")?;
             this.render_finished.push(semaphore);
         }
-        explain::numbered(14,
+        explain::numbered(
+            14,
             "VkImageView + VkFramebuffer + VkSemaphore per swapchain image",
             || {
                 format!(

@@ -82,7 +82,8 @@ pub fn run(
     let scene = args.load_scene()?;
     let variant = Variant::chosen(&scene, args);
     let shaders = window::first_shaders(args, &scene)?;
-    explain::numbered(0,
+    explain::numbered(
+        0,
         "Shaders: GLSL -> naga module -> SPIR-V (twinray-common)",
         || format!("variant {}, {} path", variant.label(), args.path),
     );
