@@ -192,7 +192,7 @@ impl Frames {
             _ => None,
         };
 
-        let acquired = if self.forced_out_of_date.next() {
+        let acquired = if self.forced_out_of_date.this_acquire() {
             Err(vk::Result::ERROR_OUT_OF_DATE_KHR)
         } else {
             // SAFETY: the semaphore is unsignalled: its last signal was waited on by the slot's

@@ -45,7 +45,7 @@ impl ForcedOutOfDate {
     }
 
     /// Whether this acquire is to report out of date instead of running.
-    pub fn next(&mut self) -> bool {
+    pub fn this_acquire(&mut self) -> bool {
         let Some(every) = self.every else {
             return false;
         };
@@ -64,8 +64,8 @@ mod tests {
             every: Some(3),
             acquires: 0,
         };
-        let forced: Vec<bool> = (0..6).map(|_| hook.next()).collect();
+        let forced: Vec<bool> = (0..6).map(|_| hook.this_acquire()).collect();
         assert_eq!(forced, [false, false, true, false, false, true]);
-        assert!(!ForcedOutOfDate::default().next(), "off unless asked for");
+        assert!(!ForcedOutOfDate::default().this_acquire(), "off unless asked for");
     }
 }
