@@ -11,10 +11,11 @@
 //!   acquired swapchain image may be written; the submit waits on it at the
 //!   stage that first writes the image: the colour-output stage on the
 //!   fragment path, which lets the fragment shader trace before the image is
-//!   acquired; the transfer stage on the compute path, which does not, because
-//!   the frame's uniform update is itself a transfer command of the same
-//!   submit and the dispatch waits for it (with synchronization2 the wait could
-//!   name the blit stage alone, and the update, a clear command, would not wait);
+//!   acquired; the transfer stage on the compute path, which does not: the
+//!   dispatch waits for the frame's uniform update and (through the storage
+//!   image's transition) for the previous frame's blit, both transfer commands,
+//!   and so for the acquire. docs/vulkan-walkthrough.md, step 22, says what
+//!   synchronization2 would change;
 //! - the swapchain's per-image **render-finished semaphore** (GPU → presentation).
 //!
 //! Command buffers are **re-recorded every frame**, not pre-recorded once per
