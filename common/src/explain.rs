@@ -9,7 +9,7 @@
 //! it covers the creation call and whatever preparation led up to it; reports
 //! come in the order they happen, which is the order of the code, so a reader
 //! who runs `--explain` beside the page sees where the code's order and the
-//! page's differ (tests/tests/walkthrough.rs holds the two together).
+//! page's differ (tests/tests/walkthrough_steps.rs holds the two together).
 //!
 //! Global rather than passed around: the constructors that report are the same
 //! ones the timed runs use, and threading a logger through all of them would
