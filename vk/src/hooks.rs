@@ -66,6 +66,9 @@ mod tests {
         };
         let forced: Vec<bool> = (0..6).map(|_| hook.this_acquire()).collect();
         assert_eq!(forced, [false, false, true, false, false, true]);
-        assert!(!ForcedOutOfDate::default().this_acquire(), "off unless asked for");
+        assert!(
+            !ForcedOutOfDate::default().this_acquire(),
+            "off unless asked for"
+        );
     }
 }
