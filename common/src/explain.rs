@@ -1,40 +1,49 @@
 //! `--explain`: the live walkthrough. Each app reports every API object right
-//! after creating it, with the parameters that matter; this module numbers the
-//! steps, times them and prints them on stderr (stdout belongs to `--json`).
+//! after creating it, with the parameters that matter; this module prints those
+//! reports on stderr (stdout belongs to `--json`), each with the number of the
+//! docs/vulkan-walkthrough.md step that explains it (0: the run plan that
+//! twinray-common prepares, before or beside the API objects; an OpenGL line
+//! carries the number of the Vulkan step it twins), and times them.
 //!
-//! A step's time is the time since the previous step (or since `enable`), so it
-//! covers the creation call and whatever preparation led up to it; steps are
-//! reported in the order they happen, which is the order of the code.
+//! A step's time is the time since the previous report (or since `enable`), so
+//! it covers the creation call and whatever preparation led up to it; reports
+//! come in the order they happen, which is the order of the code, so a reader
+//! who runs `--explain` beside the page sees where the code's order and the
+//! page's differ (tests/tests/walkthrough_steps.rs holds the two together).
 //!
 //! Global rather than passed around: the constructors that report are the same
 //! ones the timed runs use, and threading a logger through all of them would
 //! change every signature for a flag that is off in every measured run.
 
-use std::sync::atomic::{AtomicBool, AtomicU32, Ordering};
+use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::Mutex;
 use std::time::Instant;
 
 static ON: AtomicBool = AtomicBool::new(false);
-static STEP: AtomicU32 = AtomicU32::new(0);
 static LAST: Mutex<Option<Instant>> = Mutex::new(None);
 
 /// Turns reporting on and prints the header; `program` names the app.
 pub fn enable(program: &str, api: &str) {
     ON.store(true, Ordering::SeqCst);
     *LAST.lock().unwrap_or_else(|e| e.into_inner()) = Some(Instant::now());
-    eprintln!("{program} --explain: every {api} object in the order it is created (time = since the previous step)");
+    eprintln!("{program} --explain: every {api} object in the order it is created; [n] = its step in docs/vulkan-walkthrough.md, time = since the previous line");
 }
 
 pub fn is_on() -> bool {
     ON.load(Ordering::Relaxed)
 }
 
-/// Reports one step. `details` is built only when reporting is on, so the
-/// measured runs pay nothing for it. Each line of it is printed indented.
-pub fn step(title: &str, details: impl FnOnce() -> String) {
+/// Reports an object of walkthrough step `step`. `details` is built only when
+/// reporting is on, so the measured runs pay nothing for it. Each line of it is
+/// printed indented.
+pub fn numbered(step: u32, title: &str, details: impl FnOnce() -> String) {
     if !is_on() {
         return;
     }
+    report(step, title, details);
+}
+
+fn report(n: u32, title: &str, details: impl FnOnce() -> String) {
     let now = Instant::now();
     let elapsed_ms = {
         let mut last = LAST.lock().unwrap_or_else(|e| e.into_inner());
@@ -42,11 +51,10 @@ pub fn step(title: &str, details: impl FnOnce() -> String) {
         *last = Some(now);
         ms
     };
-    let n = STEP.fetch_add(1, Ordering::SeqCst) + 1;
     eprintln!("{}", format_step(n, elapsed_ms, title, &details()));
 }
 
-/// `[ 3]  +0.42 ms  VkDevice` then the details, one per indented line.
+/// `[ 4]  +0.42 ms  VkDevice` then the details, one per indented line.
 pub fn format_step(n: u32, elapsed_ms: f64, title: &str, details: &str) -> String {
     let mut s = format!("[{n:>2}] {:>+9.2} ms  {title}", elapsed_ms);
     for line in details.lines().filter(|l| !l.trim().is_empty()) {
@@ -54,11 +62,6 @@ pub fn format_step(n: u32, elapsed_ms: f64, title: &str, details: &str) -> Strin
         s.push_str(line);
     }
     s
-}
-
-/// How many steps have been reported so far.
-pub fn steps() -> u32 {
-    STEP.load(Ordering::Relaxed)
 }
 
 #[cfg(test)]

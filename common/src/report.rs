@@ -266,7 +266,8 @@ pub fn timed_frames(
         let gpu_ms = gpu_ms()?;
         frames.push(FrameTime { gpu_ms, wall_ms });
         if i == 0 {
-            crate::explain::step(title, || {
+            // The frames are the walkthrough's step 11 in both APIs.
+            crate::explain::numbered(11, title, || {
                 let gpu = gpu_ms.map_or("no GPU time".into(), |g| format!("GPU {g:.3} ms"));
                 format!("wall {wall_ms:.3} ms, {gpu}; later frames repeat the same work")
             });

@@ -223,7 +223,7 @@ fn render_fragment(run: &HeadlessRun, shaders: &Shaders) -> Result<(Rendered, Ve
     };
     let (frames, setup_ms) = run.frames(&timer, &|| {}, &draw)?;
     let pixels = target.read();
-    explain::step("Readback", || {
+    explain::numbered(11, "Readback", || {
         format!("{width}x{height} {}, top row first", pass.format_name())
     });
     Ok(((frames, setup_ms, pixels), stats))
@@ -260,7 +260,7 @@ fn render_compute(
         eprintln!("twinray-gl: {}", probe.summary()?);
     }
     let pixels = compute.read();
-    explain::step("Readback", || {
+    explain::numbered(11, "Readback", || {
         format!("{}x{} RGBA32F, top row first", size.width, size.height)
     });
     Ok(((frames, setup_ms, pixels), stats))

@@ -46,7 +46,8 @@ impl<'gl> SceneBuffers<'gl> {
                 .buffer_data_u8_slice(target, bytes, glow::STATIC_DRAW);
             self.gl.bind_buffer_base(target, index, Some(buf));
         }
-        explain::step(
+        explain::numbered(
+            5,
             &format!("glCreateBuffer + glBufferData + glBindBufferBase (binding {index})"),
             || {
                 let kind = if target == glow::UNIFORM_BUFFER {

@@ -16,6 +16,7 @@ use anyhow::{anyhow, bail, Context as _};
 use glow::HasContext;
 use twinray_common::cli::Workgroup;
 use twinray_common::error::bad_input;
+use twinray_common::explain;
 use twinray_common::gpu::layout::binding;
 use twinray_common::plan::requests::ComputeLimits;
 use twinray_common::shader::build::ComputeShader;
@@ -86,6 +87,16 @@ impl<'gl> Compute<'gl> {
         this.storage()?;
         // SAFETY: the program is alive on the current context.
         unsafe { gl.use_program(Some(program)) };
+        explain::numbered(
+            21,
+            "Compute program + RGBA32F texture at image unit 5 (glBindImageTexture)",
+            || {
+                format!(
+                    "{width}x{height}, workgroup {}, {}x{} workgroups",
+                    shader.workgroup, groups.0, groups.1
+                )
+            },
+        );
         Ok(this)
     }
 

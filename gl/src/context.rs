@@ -45,7 +45,7 @@ impl Gl {
         if devices.is_empty() {
             return Err(no_device(NO_DEVICE));
         }
-        explain::step("EGL devices (eglQueryDevicesEXT)", || {
+        explain::numbered(3, "EGL devices (eglQueryDevicesEXT)", || {
             devices
                 .iter()
                 .enumerate()
@@ -135,7 +135,8 @@ fn create(index: usize, device: &Device, debug: bool, robust: bool) -> anyhow::R
         .with_context(|| format!("creating an OpenGL 4.5 core context on {what}"))?
         .make_current_surfaceless()
         .with_context(|| format!("making the context current without a surface on {what}"))?;
-    explain::step(
+    explain::numbered(
+        4,
         "EGL display + config + context, made current without a surface",
         || {
             format!(

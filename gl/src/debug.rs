@@ -35,7 +35,7 @@ impl DebugLog {
                 }
             });
         }
-        explain::step("KHR_debug: glDebugMessageCallback", || {
+        explain::numbered(2, "KHR_debug: glDebugMessageCallback", || {
             "DEBUG_OUTPUT + DEBUG_OUTPUT_SYNCHRONOUS; errors and high-severity messages are counted"
                 .into()
         });

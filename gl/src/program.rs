@@ -272,7 +272,8 @@ impl<'gl> Program<'gl> {
                 }
             };
             link(gl, raw, &[vs, fs], "tracer")?;
-            explain::step(
+            explain::numbered(
+                8,
                 "glCreateShader x2 + glCompileShader + glCreateProgram + glLinkProgram",
                 || {
                     format!(
@@ -413,7 +414,7 @@ impl<'gl> EmptyVertexArray<'gl> {
         // SAFETY: a fresh object on the current context.
         let raw = unsafe { gl.create_vertex_array() }
             .map_err(|e| anyhow!(e).context("glGenVertexArrays"))?;
-        explain::step("glGenVertexArrays (empty VAO)", || {
+        explain::numbered(8, "glGenVertexArrays (empty VAO)", || {
             "the core profile draws nothing without one bound".into()
         });
         Ok(EmptyVertexArray { gl, raw })

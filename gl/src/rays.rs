@@ -47,7 +47,8 @@ pub fn count_rays(gl: &glow::Context, run: &CountingRun) -> anyhow::Result<RayKi
     }
     let slots: Vec<GpuRayCount> = bytemuck::pod_collect_to_vec(&counts.read());
     let kinds = RayKinds::from_pixels(&slots);
-    explain::step(
+    explain::numbered(
+        11,
         "Ray count: one untimed frame of the COUNT_RAYS variant",
         || kinds.to_string(),
     );

@@ -116,7 +116,8 @@ impl<'gl> Target<'gl> {
                 );
             }
             gl.viewport(0, 0, width as i32, height as i32);
-            explain::step(
+            explain::numbered(
+                9,
                 &format!("glCreateRenderbuffer + glCreateFramebuffer ({format} target)"),
                 || {
                     format!("{width}x{height} {format} renderbuffer as COLOR_ATTACHMENT0; FRAMEBUFFER_COMPLETE; glViewport")

@@ -22,7 +22,7 @@ impl<'gl> Timer<'gl> {
         // query still runs, so that the loop is the same on every driver;
         // only its result is dropped.
         let reliable = !renderer.contains("llvmpipe");
-        explain::step("glGenQueries (GL_TIME_ELAPSED)", || {
+        explain::numbered(10, "glGenQueries (GL_TIME_ELAPSED)", || {
             let note = if reliable {
                 ""
             } else {

@@ -77,7 +77,8 @@ pub fn run(planner: &Planner, started: Instant) -> Result<(WindowedRun, DeviceIn
         .build(&event_loop, template, pick_config)
         .map_err(|e| no_device(format!("no OpenGL display configuration for a window: {e}")))?;
     let window = window.context("glutin-winit made no window")?;
-    explain::step(
+    explain::numbered(
+        12,
         "Window + display + config (glutin-winit DisplayBuilder)",
         || {
             let s = window.inner_size();
@@ -118,7 +119,7 @@ pub fn run(planner: &Planner, started: Instant) -> Result<(WindowedRun, DeviceIn
     let context = context
         .make_current(&surface)
         .context("making the OpenGL context current")?;
-    explain::step("Context + window surface, made current", || {
+    explain::numbered(4, "Context + window surface, made current", || {
         format!(
             "OpenGL 4.5 core{}; one surface, double-buffered by the driver",
             if args.validate { ", debug" } else { "" }
@@ -133,7 +134,7 @@ pub fn run(planner: &Planner, started: Instant) -> Result<(WindowedRun, DeviceIn
         // Some X servers refuse interval 0; the window still works, capped.
         eprintln!("twinray-gl: note: could not set swap interval {interval:?}: {e}");
     }
-    explain::step("Swap interval", || {
+    explain::numbered(13, "Swap interval", || {
         let how = if args.vsync {
             "1 (--vsync: wait for the display)"
         } else {
@@ -146,7 +147,7 @@ pub fn run(planner: &Planner, started: Instant) -> Result<(WindowedRun, DeviceIn
     let mut gl =
         unsafe { glow::Context::from_loader_function_cstr(|s| display.get_proc_address(s)) };
     let info = crate::context::device_info(&gl);
-    explain::step("glow function table loaded (eglGetProcAddress)", || {
+    explain::numbered(4, "glow function table loaded (eglGetProcAddress)", || {
         format!("{} / {}", info.device, info.driver)
     });
     let log = DebugLog::install(&mut gl);
@@ -193,7 +194,7 @@ pub fn run(planner: &Planner, started: Instant) -> Result<(WindowedRun, DeviceIn
         context: &context,
         window: &window,
     };
-    explain::step("Frame loop starts", || {
+    explain::numbered(17, "Frame loop starts", || {
         "per frame: glBufferSubData (camera), glDrawArrays (fragment) or glDispatchCompute + glMemoryBarrier\n\
          + glBlitFramebuffer (compute), SwapBuffers: the driver queues, syncs and presents; C switches the path".into()
     });
@@ -254,7 +255,7 @@ fn path_program<'gl>(
         PathShaders::Compute(s) => {
             let mut c = Compute::new(gl, s, None, size.0.max(1), size.1.max(1))?;
             c.attach()?;
-            explain::step(
+            explain::numbered(22,
                 "Compute path in the window: program + RGBA32F texture (glBindImageTexture) + read FBO",
                 || {
                     format!(

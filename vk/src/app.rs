@@ -190,7 +190,8 @@ fn render_fragment(run: &HeadlessRun, shaders: &Shaders) -> Result<Rendered> {
     )?;
     let (frames, setup_ms) = run.frames(&commands, timestamps.as_ref())?;
     let image = target.read_back(device)?;
-    explain::step(
+    explain::numbered(
+        11,
         "Readback: vkCmdCopyImageToBuffer + HOST barrier, then map",
         || format!("{width}x{height} {}, top row first", pass.format_name()),
     );

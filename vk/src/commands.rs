@@ -83,7 +83,8 @@ impl Commands {
                 t.record(cmd, 1);
             }
         })?;
-        explain::step(
+        explain::numbered(
+            11,
             "Command buffer recorded once (resubmitted every frame)",
             || {
                 let ts = if timestamps.is_some() {
@@ -130,7 +131,7 @@ impl Commands {
         // SAFETY: a plain create on the live device `d`; `this` destroys the fence.
         this.fence = unsafe { d.create_fence(&vk::FenceCreateInfo::default(), None) }
             .context("creating the fence")?;
-        explain::step("VkCommandPool + VkCommandBuffer + VkFence", || {
+        explain::numbered(11, "VkCommandPool + VkCommandBuffer + VkFence", || {
             format!(
                 "pool on queue family {}; 1 PRIMARY buffer; fence created unsignalled",
                 device.queue_family

@@ -82,6 +82,16 @@ impl Compute {
             Some(image.view),
         )?;
         let pipeline = ComputePipeline::new(device, descriptors.set_layout, &shader.stage.spirv)?;
+        explain::numbered(
+            21,
+            "Storage VkImage (GENERAL) + VkPipelineLayout + VkShaderModule + VkPipeline (vkCreateComputePipelines)",
+            || {
+                format!(
+                    "{width}x{height} {IMAGE_FORMAT:?} at binding 5; workgroup {}, {}x{} workgroups",
+                    shader.workgroup, groups.0, groups.1
+                )
+            },
+        );
         let commands = Commands::record_with(device, |d, cmd| {
             if let Some(t) = timestamps {
                 t.record_reset(cmd);
@@ -211,7 +221,7 @@ impl WindowCompute {
             Some(image.view),
         )?;
         let pipeline = ComputePipeline::new(device, descriptors.set_layout, &shader.stage.spirv)?;
-        explain::step(
+        explain::numbered(22,
             "Compute path in the window: VkPipeline (compute) + storage VkImage sized to the swapchain",
             || {
                 format!(

@@ -1,8 +1,10 @@
 //! Descriptors: how the shader's `layout(set = 0, binding = N)` blocks find our buffers.
 //!
 //! Vulkan splits this in three. The *set layout* is the shape (binding 0 is a
-//! uniform buffer, 1–4 are storage buffers, all read by the fragment stage; the
-//! compute path adds binding 5, a storage image, and names the compute stage); it
+//! uniform buffer; the storage buffers sit at bindings 1–4, 6, 7 and 9, as
+//! `common/src/gpu/layout.rs`'s `binding::STORAGE` lists them; all are read by
+//! the fragment stage; the compute path adds binding 5, a storage image, and
+//! names the compute stage); it
 //! exists on its own because the pipeline is compiled against it, before any
 //! buffer is chosen. Sets are allocated from a *pool*, so the driver can manage
 //! their memory in bulk. The *set* is then written once to point at the buffers.
@@ -40,6 +42,12 @@ impl Descriptors {
         image: Option<vk::ImageView>,
     ) -> Result<Descriptors> {
         let d = &device.device;
+        // --explain: the compute path's set is part of its own step.
+        let step = if stage == vk::ShaderStageFlags::COMPUTE {
+            21
+        } else {
+            6
+        };
         let mut this = Descriptors {
             device: d.clone(),
             set_layout: vk::DescriptorSetLayout::null(),
@@ -79,7 +87,7 @@ impl Descriptors {
         // layout) destroys it on drop.
         this.set_layout = unsafe { d.create_descriptor_set_layout(&info, None) }
             .context("creating the descriptor set layout")?;
-        explain::step("VkDescriptorSetLayout", || {
+        explain::numbered(step, "VkDescriptorSetLayout", || {
             all.iter()
                 .map(|(b, ty, _)| format!("binding {b}: {ty:?} x1, {stage:?} stage\n"))
                 .chain(image.map(|_| {
@@ -114,7 +122,7 @@ impl Descriptors {
         // frees its set.
         this.pool = unsafe { d.create_descriptor_pool(&info, None) }
             .context("creating the descriptor pool")?;
-        explain::step("VkDescriptorPool", || {
+        explain::numbered(step, "VkDescriptorPool", || {
             format!(
                 "max 1 set; 1 UNIFORM_BUFFER, {} STORAGE_BUFFER",
                 storage.len()
@@ -159,7 +167,8 @@ impl Descriptors {
         if let Some(view) = image {
             this.write_image(view);
         }
-        explain::step(
+        explain::numbered(
+            step,
             "VkDescriptorSet (allocated, then vkUpdateDescriptorSets)",
             || {
                 format!(

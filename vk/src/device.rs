@@ -137,7 +137,7 @@ impl Device {
         } else {
             graphics
         };
-        explain::step("VkPhysicalDevice chosen", || {
+        explain::numbered(3, "VkPhysicalDevice chosen", || {
             let mut s = String::new();
             for (i, c) in candidates.iter().enumerate() {
                 let mark = if c.physical == chosen.physical {
@@ -218,7 +218,8 @@ queue family {queue_family}: {flags:?}, timestampValidBits {timestamp_valid_bits
             .with_context(|| format!("opening the Vulkan device '{}'", chosen.name))?;
         // SAFETY: queue 0 of `queue_family` is the one queue the create info asked for.
         let queue = unsafe { device.get_device_queue(queue_family, 0) };
-        explain::step(
+        explain::numbered(
+            4,
             "VkDevice + VkQueue (vkCreateDevice, vkGetDeviceQueue)",
             || {
                 let ext = if surface.is_some() {

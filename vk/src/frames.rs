@@ -9,9 +9,13 @@
 //!   slot's command buffer; created signalled so the first wait passes;
 //! - an **image-available semaphore** (presentation → GPU): signalled when the
 //!   acquired swapchain image may be written; the submit waits on it at the
-//!   stage that first writes the image, so the tracing can start before: the
-//!   colour-output stage on the fragment path, the transfer stage (the blit)
-//!   on the compute path;
+//!   stage that first writes the image: the colour-output stage on the
+//!   fragment path, which lets the fragment shader trace before the image is
+//!   acquired; the transfer stage on the compute path, which does not: the
+//!   dispatch waits for the frame's uniform update and (through the storage
+//!   image's transition) for the previous frame's blit, both transfer commands,
+//!   and so for the acquire. docs/vulkan-walkthrough.md, step 22, says what
+//!   synchronization2 would change;
 //! - the swapchain's per-image **render-finished semaphore** (GPU → presentation).
 //!
 //! Command buffers are **re-recorded every frame**, not pre-recorded once per
@@ -30,6 +34,7 @@
 
 use crate::compute::WindowCompute;
 use crate::device::Device;
+use crate::hooks::ForcedOutOfDate;
 use crate::memory::{buffer_barrier, pipeline_barrier};
 use crate::scene::SceneResources;
 use crate::swapchain::Swapchain;
@@ -104,6 +109,8 @@ pub struct Frames {
     pool: vk::CommandPool,
     slots: Vec<Slot>,
     next: usize,
+    /// `TWINRAY_TEST_OUT_OF_DATE` (hooks.rs): acquires that report out of date.
+    forced_out_of_date: ForcedOutOfDate,
 }
 
 impl Frames {
@@ -122,6 +129,7 @@ impl Frames {
             pool,
             slots: Vec::new(),
             next: 0,
+            forced_out_of_date: ForcedOutOfDate::from_env()?,
         };
         let info = vk::CommandBufferAllocateInfo::default()
             .command_pool(pool)
@@ -157,7 +165,7 @@ impl Frames {
             let slot = this.slots.last_mut().expect("just pushed");
             slot.timestamps = Timestamps::new(device)?;
         }
-        explain::step("Frames in flight: VkCommandPool, then per frame a VkCommandBuffer, VkSemaphore, VkFence", || {
+        explain::numbered(16, "Frames in flight: VkCommandPool, then per frame a VkCommandBuffer, VkSemaphore, VkFence", || {
             format!(
                 "{FRAMES_IN_FLIGHT} frames; pool flag RESET_COMMAND_BUFFER (re-recorded every frame);\n\
                  fences created SIGNALED so the first wait returns; image-available semaphores unsignalled"
@@ -185,14 +193,19 @@ impl Frames {
             _ => None,
         };
 
-        // SAFETY: the semaphore is unsignalled: its last signal was waited on by the slot's last submit.
-        let acquired = unsafe {
-            loader.acquire_next_image(
-                swapchain.swapchain,
-                u64::MAX,
-                slot.image_available,
-                vk::Fence::null(),
-            )
+        let acquired = if self.forced_out_of_date.this_acquire() {
+            Err(vk::Result::ERROR_OUT_OF_DATE_KHR)
+        } else {
+            // SAFETY: the semaphore is unsignalled: its last signal was waited on by the slot's
+            // last submit.
+            unsafe {
+                loader.acquire_next_image(
+                    swapchain.swapchain,
+                    u64::MAX,
+                    slot.image_available,
+                    vk::Fence::null(),
+                )
+            }
         };
         let (index, suboptimal) = match acquired {
             Ok(r) => r,

@@ -50,9 +50,11 @@ impl Instance {
                 "no Vulkan loader found (libvulkan.so.1): install libvulkan1 and a Vulkan driver, e.g. mesa-vulkan-drivers",
             )
         })?;
-        explain::step("Loader: libvulkan.so.1 opened (ash::Entry::load)", || {
-            "the loader finds the installed drivers (ICDs) and layers at run time".into()
-        });
+        explain::numbered(
+            1,
+            "Loader: libvulkan.so.1 opened (ash::Entry::load)",
+            || "the loader finds the installed drivers (ICDs) and layers at run time".into(),
+        );
 
         // The layer checks every call, which costs CPU time on every submit, and a
         // timing run must not pay for it. So it is on only when asked for:
@@ -114,7 +116,7 @@ impl Instance {
             e => anyhow::Error::new(e).context("creating the Vulkan instance"),
         })?;
 
-        explain::step("VkInstance (vkCreateInstance)", || {
+        explain::numbered(1, "VkInstance (vkCreateInstance)", || {
             let v = |v: u32| {
                 format!(
                     "{}.{}.{}",
@@ -153,7 +155,7 @@ impl Instance {
                 unsafe { functions.create_debug_utils_messenger(&messenger_info(), None) }
                     .context("creating the debug messenger")?;
             this.messenger = Some((functions, messenger));
-            explain::step("VkDebugUtilsMessengerEXT", || {
+            explain::numbered(2, "VkDebugUtilsMessengerEXT", || {
                 "severity WARNING|ERROR, types GENERAL|VALIDATION|PERFORMANCE: every message is counted and fails --validate".into()
             });
         }

@@ -22,6 +22,7 @@ pub mod app;
 pub mod surface;
 pub mod swapchain;
 pub mod frames;
+pub mod hooks;
 pub mod window;
 // Part 3, the compute path, what the driver made of the shaders, and the
 // untimed frame that counts rays.

@@ -6,9 +6,11 @@
 //! with the properties it needs, allocates, and binds. (Large apps sub-allocate
 //! from big blocks, e.g. with VMA; this app has seven allocations, so one each.)
 //!
-//! The GPU reads scene data fastest from device-local memory, which on a
-//! discrete GPU the CPU cannot map. So scene buffers are filled by writing into a
-//! host-visible *staging* buffer and letting the GPU copy it across.
+//! The GPU reads scene data fastest from device-local memory, which the CPU may
+//! or may not be able to map: an integrated GPU's is, a discrete GPU's only
+//! through a 256 MiB window or with Resizable BAR. So that one code path works
+//! on every device, scene buffers are filled by writing into a host-visible
+//! *staging* buffer and letting the GPU copy it across.
 
 use crate::device::Device;
 use anyhow::{anyhow, Context, Result};
@@ -239,7 +241,7 @@ impl<'a> Uploads<'a> {
             &[Flags::DEVICE_LOCAL, Flags::empty()],
             what,
         )?;
-        explain::step(&format!("VkBuffer + VkDeviceMemory: {what}"), || {
+        explain::numbered(5, &format!("VkBuffer + VkDeviceMemory: {what}"), || {
             format!(
                 "{size} bytes, usage {usage:?}, memory {:?}\nfilled from a HOST_VISIBLE staging buffer: vkCmdCopyBuffer, then a TRANSFER -> FRAGMENT_SHADER barrier",
                 buffer.memory_flags

@@ -119,7 +119,7 @@ impl RenderPass {
         // returned destroys the pass.
         let render_pass =
             unsafe { d.create_render_pass(&info, None) }.context("creating the render pass")?;
-        explain::step("VkRenderPass", || {
+        explain::numbered(7, "VkRenderPass", || {
             format!(
                 "1 colour attachment {format:?}, load {load:?} (every pixel is written), store STORE\n\
                  layout UNDEFINED -> COLOR_ATTACHMENT_OPTIMAL -> {final_layout:?}; {} subpass dependencies",
@@ -196,13 +196,13 @@ impl Pipeline {
         };
 
         this.layout = layout(d, set_layout, "graphics")?;
-        explain::step("VkPipelineLayout", || {
+        explain::numbered(8, "VkPipelineLayout", || {
             "1 descriptor set layout (set 0), no push constants".into()
         });
 
         let vertex = module(d, &shaders.vertex.spirv, "vertex")?;
         let fragment = module(d, &shaders.fragment.spirv, "fragment")?;
-        explain::step("VkShaderModule x2 (naga SPIR-V)", || {
+        explain::numbered(8, "VkShaderModule x2 (naga SPIR-V)", || {
             format!(
                 "vertex {} words, fragment {} words; variant {}",
                 shaders.vertex.spirv.len(),
@@ -274,7 +274,8 @@ impl Pipeline {
                 .context("creating the graphics pipeline")?;
         this.pipeline = pipelines[0];
         crate::statistics::capture(device, this.pipeline, "graphics");
-        explain::step(
+        explain::numbered(
+            8,
             "VkPipeline (vkCreateGraphicsPipelines: the driver compiles the tracer here)",
             || {
                 let size = match fixed_size {

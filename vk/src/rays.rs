@@ -90,7 +90,8 @@ pub fn count_rays(device: &Device, run: &CountingRun) -> Result<RayKinds> {
         .last()
         .expect("the ray count buffer was pushed last");
     let kinds = RayKinds::from_pixels(&counts.read::<GpuRayCount>()?);
-    explain::step(
+    explain::numbered(
+        11,
         "Ray count: one untimed frame of the COUNT_RAYS variant",
         || kinds.to_string(),
     );

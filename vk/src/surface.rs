@@ -48,7 +48,7 @@ impl Surface {
             ash_window::create_surface(&instance.entry, &instance.instance, display, handle, None)
         }
         .context("creating the window surface")?;
-        explain::step("VkSurfaceKHR (ash_window::create_surface)", || {
+        explain::numbered(12, "VkSurfaceKHR (ash_window::create_surface)", || {
             format!("for the {} window", window_system(&handle))
         });
         Ok(Surface {

@@ -60,7 +60,7 @@ pub fn choose_format(device: &Device, surface: &Surface) -> Result<vk::SurfaceFo
         .or_else(|| formats.first())
         .copied()
         .context("the surface offers no formats")?;
-    explain::step("Surface format chosen", || {
+    explain::numbered(13, "Surface format chosen", || {
         let offered: Vec<String> = formats
             .iter()
             .map(|f| format!("{:?}/{:?}", f.format, f.color_space))
@@ -98,7 +98,7 @@ pub fn choose_present_mode(
             .find(|m| modes.contains(m))
             .unwrap_or(vk::PresentModeKHR::FIFO)
     };
-    explain::step("Present mode chosen", || {
+    explain::numbered(13, "Present mode chosen", || {
         let why = match (vsync, chosen) {
             (true, _) => "--vsync: FIFO waits for the display's refresh (every device supports it)",
             (false, vk::PresentModeKHR::FIFO) => {
@@ -229,7 +229,7 @@ impl Swapchain {
         this.images = unsafe { loader.get_swapchain_images(this.swapchain) }
             .context("getting the swapchain images")?;
         let images = this.images.clone();
-        explain::step("VkSwapchainKHR", || {
+        explain::numbered(14, "VkSwapchainKHR", || {
             format!(
                 "{}x{} {:?}, {} images (asked {image_count}: min {} + 1), {present_mode:?}\n\
                  usage {usage:?}, EXCLUSIVE, transform {:?}, alpha {alpha:?}, clipped{}",
@@ -277,7 +277,8 @@ impl Swapchain {
                     .context("creating a render-finished semaphore")?;
             this.render_finished.push(semaphore);
         }
-        explain::step(
+        explain::numbered(
+            14,
             "VkImageView + VkFramebuffer + VkSemaphore per swapchain image",
             || {
                 format!(

@@ -44,7 +44,7 @@ impl Target {
         let d = &device.device;
         let readback = sized_readback(device, width as u64 * height as u64 * pass.texel_bytes())?;
         let bytes = readback.size;
-        explain::step("VkBuffer + VkDeviceMemory: readback buffer", || {
+        explain::numbered(9, "VkBuffer + VkDeviceMemory: readback buffer", || {
             format!(
                 "{bytes} bytes, TRANSFER_DST, memory {:?} (the CPU reads it)",
                 readback.memory_flags
@@ -70,10 +70,10 @@ impl Target {
             "colour image",
             (&mut this.image, &mut this.memory, &mut this.view),
         )?;
-        explain::step("VkImage + VkDeviceMemory: colour target", || {
+        explain::numbered(9, "VkImage + VkDeviceMemory: colour target", || {
             format!("{width}x{height} {format:?}, OPTIMAL tiling, usage COLOR_ATTACHMENT|TRANSFER_SRC, {image_bytes} bytes DEVICE_LOCAL")
         });
-        explain::step("VkImageView", || {
+        explain::numbered(9, "VkImageView", || {
             "2D, COLOR aspect, 1 mip level, 1 layer".into()
         });
 
@@ -88,7 +88,7 @@ impl Target {
         // pass (alive, the caller's) was made for; `this` destroys the framebuffer first.
         this.framebuffer =
             unsafe { d.create_framebuffer(&info, None) }.context("creating the framebuffer")?;
-        explain::step("VkFramebuffer", || {
+        explain::numbered(9, "VkFramebuffer", || {
             format!("{width}x{height}, 1 layer, attachment 0 = the view")
         });
         Ok(this)

@@ -35,7 +35,7 @@ impl Timestamps {
         // it.
         let pool = unsafe { device.device.create_query_pool(&info, None) }
             .context("creating the timestamp query pool")?;
-        explain::step("VkQueryPool (2 TIMESTAMP queries)", || {
+        explain::numbered(10, "VkQueryPool (2 TIMESTAMP queries)", || {
             format!(
                 "timestampPeriod {} ns per tick, timestampValidBits {bits}; results read as 64-bit",
                 device.properties.limits.timestamp_period

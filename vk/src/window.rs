@@ -90,7 +90,7 @@ pub fn run(
     let window = event_loop
         .create_window(window::window_attributes(args, &args.scene, "Vulkan"))
         .context("creating the window")?;
-    explain::step("Window (winit)", || {
+    explain::numbered(12, "Window (winit)", || {
         let s = window.inner_size();
         format!("{}x{} physical pixels", s.width, s.height)
     });
@@ -170,7 +170,7 @@ pub fn run(
         _instance: instance,
         window,
     };
-    explain::step("Frame loop starts", || {
+    explain::numbered(17, "Frame loop starts", || {
         "per frame: wait fence, acquire image, re-record (fragment: render pass; compute: dispatch + blit),\n\
          submit (wait image-available, signal render-finished), present; C switches the path".into()
     });

@@ -136,7 +136,7 @@ impl Planner {
         (width, height): (u32, u32),
     ) -> anyhow::Result<RunPlan> {
         let scene = Scene::load(name, overrides)?;
-        explain::step("Scene (twinray-common)", || {
+        explain::numbered(0, "Scene (twinray-common)", || {
             format!(
                 "{}: {} spheres, {} triangles, {} lights",
                 scene.name,
@@ -149,7 +149,7 @@ impl Planner {
             let t0 = Instant::now();
             let bvh = build_bvh(&scene);
             let ms = t0.elapsed().as_secs_f64() * 1e3;
-            explain::step("BVH (twinray-common)", || {
+            explain::numbered(0, "BVH (twinray-common)", || {
                 format!(
                     "{} nodes over {} primitives, {} deep; built in {ms:.1} ms",
                     bvh.nodes.len(),
@@ -169,7 +169,8 @@ impl Planner {
             Api::Vulkan => "SPIR-V",
             Api::OpenGl => "GLSL 450 core",
         };
-        explain::step(
+        explain::numbered(
+            0,
             &format!("Shaders: GLSL -> naga module -> {target} (twinray-common)"),
             || format!("variant {}, {} path", variant.label(), variant.entry.path()),
         );

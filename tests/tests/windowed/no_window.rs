@@ -1,5 +1,6 @@
-//! What runs without a window: `--explain`'s ordered steps on stderr, and the
-//! one sentence (exit 3) when there is no X display at all.
+//! What runs without a window: `--explain`'s numbered steps on stderr, and the
+//! one sentence (exit 3) when there is no X display at all. (Whether its numbers
+//! and order agree with the walkthrough is tests/tests/walkthrough_steps.rs's.)
 
 use crate::common::stderr;
 use twinray_tests::{scratch, App};
@@ -36,30 +37,13 @@ fn explain_prints_ordered_steps_on_stderr_only() {
             steps.len(),
             stderr(&o)
         );
-        assert_eq!(
-            steps,
-            (1..=steps.len() as u32).collect::<Vec<_>>(),
-            "{app:?}: steps out of order"
+        // Each line carries the number of the walkthrough step it belongs to.
+        assert!(
+            steps.iter().all(|&n| n <= 22),
+            "{app:?}: a step number past the walkthrough's 22:\n{}",
+            stderr(&o)
         );
     }
-    // The Vulkan steps name the objects in the order the walkthrough teaches them.
-    let o = twinray_tests::run(&App::Vulkan.exe(), &args, &[]);
-    let err = stderr(&o);
-    let order = [
-        "VkInstance",
-        "VkPhysicalDevice",
-        "VkDevice",
-        "VkRenderPass",
-        "VkDescriptorSetLayout",
-        "VkPipeline ",
-        "VkFramebuffer",
-        "VkCommandPool",
-    ];
-    let pos: Vec<usize> = order
-        .iter()
-        .map(|s| err.find(s).unwrap_or_else(|| panic!("no {s} in:\n{err}")))
-        .collect();
-    assert!(pos.windows(2).all(|w| w[0] < w[1]), "out of order:\n{err}");
     let _ = dir;
 }
 
