@@ -8,13 +8,12 @@
 //! report.md, accuracy.csv, hard_cases.csv, random.csv, one SVG per scene and
 //! the images.
 
-mod csv;
-mod hard;
-mod pareto;
+pub(crate) mod hard;
+pub(crate) mod pareto;
 mod plot;
-mod random;
+pub(crate) mod random;
 mod report;
-mod sweeps;
+pub(crate) mod sweeps;
 
 use anyhow::Context;
 use hard::HardRow;
@@ -66,7 +65,7 @@ pub fn run(args: &AccuracyArgs) -> anyhow::Result<()> {
         let size = random::random_size(args.quick);
         eprintln!("twinray accuracy: {random_n} random scenes at {size} x (2 APIs + reference)");
         let r = random::run_random(random_n, size, &args.out)?;
-        write(&args.out, "random.csv", csv::random_csv(&r)?)?;
+        write(&args.out, "random.csv", crate::csv::accuracy::random(&r)?)?;
         r
     } else {
         Vec::new()
@@ -94,7 +93,11 @@ fn write_reports(
     started: std::time::Instant,
 ) -> anyhow::Result<()> {
     let cpu = crate::report::cpu_model();
-    write(&args.out, "hard_cases.csv", csv::hard_csv(hard_rows)?)?;
+    write(
+        &args.out,
+        "hard_cases.csv",
+        crate::csv::accuracy::hard_cases(hard_rows)?,
+    )?;
     // With the hard cases known, numerics that fail any of them leave the front.
     // (The world-origin column is not a numerical choice of the sweeps: every
     // sweep runs with the local origin.)
@@ -110,7 +113,11 @@ fn write_reports(
         .map(|st| st.numerics)
         .collect();
     pareto::mark_pareto(rows, &unsound);
-    write(&args.out, "accuracy.csv", csv::csv(rows)?)?;
+    write(
+        &args.out,
+        "accuracy.csv",
+        crate::csv::accuracy::accuracy(rows)?,
+    )?;
     let mut plots = Vec::new();
     for (scene_name, _, _) in sweeps::scenes(args.quick) {
         let file = format!("accuracy-{scene_name}.svg");

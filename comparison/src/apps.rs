@@ -322,6 +322,26 @@ fn rayon_threads() -> usize {
     rayon::current_num_threads()
 }
 
+/// The API's name in every CSV, table, plot and file name.
+pub fn api_name(api: Api) -> &'static str {
+    match api {
+        Api::Vulkan => "vulkan",
+        Api::Opengl => "opengl",
+        Api::OpenglSpirv => "opengl-spirv",
+        Api::Reference => "reference",
+    }
+}
+
+/// A run's `--set KEY=VALUE` list as the (key, value) pairs `Scene::load`
+/// takes: the orchestrator loads the scene a run renders for its reference
+/// image, its BVH figures or its shader's defines.
+pub fn overrides(set: &[String]) -> Vec<(String, String)> {
+    set.iter()
+        .filter_map(|kv| kv.split_once('='))
+        .map(|(k, v)| (k.into(), v.into()))
+        .collect()
+}
+
 #[cfg(test)]
 mod tests {
     use super::app_args;

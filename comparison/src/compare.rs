@@ -1,12 +1,19 @@
 //! `twinray compare`: the study's three experiments (teapot and box resolution
 //! sweeps, the sphere-list count sweep) with both apps, each point in fresh
 //! processes with the API order alternating, then results.csv, report.md and
-//! plots, and the why step's experiments at each remaining gap (why.rs).
+//! plots, and the why step's experiments at each remaining gap (compare/why.rs).
 
+mod accel;
+mod agreement;
+pub(crate) mod runs;
+mod shaders;
+pub(crate) mod study;
+pub(crate) mod why;
+
+use crate::apps::api_name;
 use crate::apps::{is_software, run_json, Api};
-use crate::runs::{api_name, Outcome, Plan, Point};
-use crate::why::WhyPlan;
 use anyhow::Context;
+use runs::{Outcome, Plan, Point};
 use std::collections::HashMap;
 use std::path::PathBuf;
 use std::sync::atomic::{AtomicBool, Ordering};
@@ -14,6 +21,7 @@ use std::sync::Arc;
 use twinray_common::cli::{parse_workgroup, RenderArgs, RenderPath, Size, Workgroup};
 use twinray_common::scene::accel::Accel;
 use twinray_common::value_name::ValueName;
+use why::WhyPlan;
 
 #[derive(clap::Args, Debug, Clone)]
 pub struct CompareArgs {
@@ -195,21 +203,21 @@ pub fn run(args: &CompareArgs) -> anyhow::Result<()> {
     {
         Vec::new()
     } else {
-        crate::accel::acceleration(&plan, &stop)
+        accel::acceleration(&plan, &stop)
     };
     // `--only why` alone runs the why step and nothing else.
     let only_why = !args.only.is_empty() && args.only.iter().all(|o| o == "why");
     let agreement = if only_why || interrupted || stop.load(Ordering::SeqCst) {
         Vec::new()
     } else {
-        crate::agreement::agreement(&args.out, &plan, &paths, args.workgroup, &stop)
+        agreement::agreement(&args.out, &plan, &paths, args.workgroup, &stop)
     };
     let shader_rows = if only_why || interrupted || stop.load(Ordering::SeqCst) {
         Vec::new()
     } else {
-        crate::shaders::collect(&args.out, &paths, &stop)
+        shaders::collect(&args.out, &paths, &stop)
     };
-    let results = crate::runs::Results {
+    let results = runs::Results {
         plan: &plan,
         outcomes: &outcomes,
         accel: &accel,
@@ -218,7 +226,7 @@ pub fn run(args: &CompareArgs) -> anyhow::Result<()> {
     };
     if !only_why {
         crate::report::write_all(&args.out, &results)?;
-        crate::shaders::append_to_report(&args.out.join("report.md"), &shader_rows)?;
+        shaders::append_to_report(&args.out.join("report.md"), &shader_rows)?;
     }
     let why_wanted = args.only.is_empty() || args.only.iter().any(|o| o == "why");
     if why_wanted && !interrupted && !stop.load(Ordering::SeqCst) {
@@ -227,7 +235,7 @@ pub fn run(args: &CompareArgs) -> anyhow::Result<()> {
         let mut why_plan = Preset::of(args.quick).why;
         why_plan.frames = args.frames.unwrap_or(why_plan.frames);
         why_plan.seconds_per_point = args.seconds_per_point.unwrap_or(why_plan.seconds_per_point);
-        let why = crate::why::run(&args.out, &why_plan, &paths, &stop);
+        let why = why::run(&args.out, &why_plan, &paths, &stop);
         if only_why {
             // No study ran, so no study sections: a title naming the device
             // the why step measured, then its section.
@@ -237,7 +245,7 @@ pub fn run(args: &CompareArgs) -> anyhow::Result<()> {
             std::fs::write(&report, format!("{title}\n"))
                 .with_context(|| format!("writing '{}'", report.display()))?;
         }
-        crate::report::why::write(&args.out, &why)?;
+        crate::report::why_table::write(&args.out, &why)?;
         interrupted = stop.load(Ordering::SeqCst);
     }
     eprintln!(

@@ -3,8 +3,8 @@
 //! with both apps, as the share of wrong pixels against the f64 truth.
 
 use super::sweeps::render_app;
+use crate::apps::api_name;
 use crate::apps::Api;
-use crate::runs::api_name;
 use std::path::{Path, PathBuf};
 use twinray_common::cli::Size;
 use twinray_common::reference;

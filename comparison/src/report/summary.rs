@@ -4,8 +4,8 @@
 
 use super::cells::{f, first_report, paths_in, range, ratio, report_of};
 use crate::apps::Api;
-use crate::runs::{Outcome, Results, EXPERIMENTS};
-use crate::study::{self, StudyRow};
+use crate::compare::runs::{Outcome, Results, EXPERIMENTS};
+use crate::compare::study::{self, StudyRow};
 use std::fmt::Write as _;
 use twinray_common::cli::RenderPath;
 
@@ -330,7 +330,7 @@ fn four_numbers(outcomes: &[Outcome]) -> String {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::runs::test_outcome;
+    use crate::compare::runs::test_outcome;
 
     #[test]
     fn the_summary_compares_paths() {

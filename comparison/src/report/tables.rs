@@ -2,9 +2,10 @@
 //! study's figures, the image agreement, and the points that failed.
 
 use super::cells::{f, first_report, paths_in, ratio, report_of};
+use crate::apps::api_name;
 use crate::apps::Api;
-use crate::runs::{api_name, Agreement, Outcome, EXPERIMENTS};
-use crate::study::{self, StudyRow};
+use crate::compare::runs::{Agreement, Outcome, EXPERIMENTS};
+use crate::compare::study::{self, StudyRow};
 use std::fmt::Write as _;
 use twinray_common::report::RunReport;
 

@@ -2,10 +2,11 @@
 //! the experiments that each isolate one candidate cause (`CASES`, one line
 //! per gap × experiment), run at each gap point in fresh processes with the
 //! order alternating, like the sweeps. The report's "Why the gaps" section and
-//! why.csv are written from what this returns (report/why.rs).
+//! why.csv are written from what this returns (report/why_table.rs).
 
+use crate::apps::api_name;
 use crate::apps::{run_json, Api};
-use crate::runs::{api_name, Case, Gap, GapMeasure, Why, WhyFigures, WhyRow};
+use crate::compare::runs::{Case, Gap, GapMeasure, Why, WhyFigures, WhyRow};
 use std::collections::BTreeMap;
 use std::ffi::OsStr;
 use std::path::Path;
@@ -439,7 +440,7 @@ mod tests {
         const VK: &str = "NVIDIA H100 80GB HBM3";
         const GL: &str = "NVIDIA H100 80GB HBM3/PCIe/SSE2";
         let report = |device: &str| {
-            let mut r = crate::runs::test_outcome(Api::Vulkan, RenderPath::Fragment, 1.0)
+            let mut r = crate::compare::runs::test_outcome(Api::Vulkan, RenderPath::Fragment, 1.0)
                 .result
                 .expect("a test outcome succeeds");
             r.device = device.into();

@@ -6,8 +6,8 @@
 //! from OpenGL's program binary. Where a driver offers neither (Mesa's
 //! software drivers), the table says so.
 
+use crate::apps::api_name;
 use crate::apps::{run_json, Api};
-use crate::runs::api_name;
 use std::fmt::Write as _;
 use std::path::Path;
 use std::sync::atomic::{AtomicBool, Ordering};

@@ -2,8 +2,9 @@
 //! the all-features shader, its own variant, specialization constants and a
 //! BVH; the sphere-list crossover behind `--accel auto`; and the BVH scaled up.
 
+use crate::apps::overrides;
 use crate::apps::{run_json, Api};
-use crate::runs::{overrides, AccelRun, BvhStats, Plan, ACCEL_CONFIGS};
+use crate::compare::runs::{AccelRun, BvhStats, Plan, ACCEL_CONFIGS};
 use std::sync::atomic::{AtomicBool, Ordering};
 use twinray_common::cli::{RenderArgs, Size};
 use twinray_common::scene::accel::Accel;

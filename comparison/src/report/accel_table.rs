@@ -3,8 +3,9 @@
 //! BVH, and where `--accel auto` switches to the BVH.
 
 use super::cells::{f, ratio};
+use crate::apps::api_name;
 use crate::apps::Api;
-use crate::runs::{api_name, AccelRun};
+use crate::compare::runs::AccelRun;
 use std::fmt::Write as _;
 
 /// The section, or nothing when the acceleration runs were not made.

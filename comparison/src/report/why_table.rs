@@ -3,8 +3,9 @@
 //! share of the gap it closes and a verdict computed from those figures with
 //! the thresholds below.
 
-use crate::csv_out::{self, Num};
-use crate::runs::{api_name, Case, GapMeasure, Why, WhyRow};
+use crate::apps::api_name;
+use crate::compare::runs::{Case, GapMeasure, Why, WhyRow};
+use crate::csv::Num;
 use anyhow::Context;
 use std::fmt::Write as _;
 use std::path::Path;
@@ -185,7 +186,7 @@ fn csv_row(r: &WhyRow) -> CsvRow {
 
 /// why.csv's text: a header even without rows.
 pub fn csv(why: &Why) -> anyhow::Result<String> {
-    csv_out::to_string(why.rows.iter().map(csv_row))
+    crate::csv::to_string(why.rows.iter().map(csv_row))
 }
 
 /// The section's Markdown.

@@ -1,6 +1,12 @@
-//! How every CSV of the orchestrator is written: rows are `#[derive(Serialize)]`
-//! structs whose field names are the columns, written by the csv crate (which
-//! quotes what needs quoting), with the numbers printed as Rust prints them.
+//! Every CSV the orchestrator writes, and the one way they are written: rows
+//! are `#[derive(Serialize)]` structs whose field names are the columns,
+//! written by the csv crate (which quotes what needs quoting), with the numbers
+//! printed as Rust prints them. The columns of compare's results.csv are in
+//! `results`, those of accuracy's three CSVs in `accuracy`; why.csv's sit with
+//! the verdicts they print (`report::why_table`).
+
+pub mod accuracy;
+pub mod results;
 
 use anyhow::Context;
 use serde::{Serialize, Serializer};

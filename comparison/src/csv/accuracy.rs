@@ -3,12 +3,12 @@
 //! field order of each row is its column order, which the committed results
 //! and the tests read.
 
-use super::hard::HardRow;
-use super::pareto::point;
-use super::random::RandomRow;
-use super::sweeps::Row;
-use crate::csv_out::{self, Num};
-use crate::runs::api_name;
+use super::Num;
+use crate::accuracy::hard::HardRow;
+use crate::accuracy::pareto::point;
+use crate::accuracy::random::RandomRow;
+use crate::accuracy::sweeps::Row;
+use crate::apps::api_name;
 use serde::Serialize;
 use twinray_common::scene::random as random_scene;
 use twinray_common::value_name::ValueName;
@@ -42,8 +42,8 @@ struct ConfigLine<'a> {
 }
 
 /// accuracy.csv's text.
-pub fn csv(rows: &[Row]) -> anyhow::Result<String> {
-    csv_out::to_string(rows.iter().enumerate().map(|(i, r)| {
+pub fn accuracy(rows: &[Row]) -> anyhow::Result<String> {
+    super::to_string(rows.iter().enumerate().map(|(i, r)| {
         let n = &r.config.numerics;
         let ok = r.result.as_ref().ok();
         let error = r.error();
@@ -66,7 +66,7 @@ pub fn csv(rows: &[Row]) -> anyhow::Result<String> {
                 .map(|t| t.to_string())
                 .collect::<Vec<_>>()
                 .join(";"),
-            status: csv_out::status(&r.result),
+            status: super::status(&r.result),
             gpu_min_ms: ok.and_then(|(g, ..)| g.map(Num)),
             wall_min_ms: ok.map(|(_, w, ..)| Num(*w)),
             rmse: error.map(|e| Num(e.rmse)),
@@ -97,15 +97,15 @@ struct HardLine<'a> {
 }
 
 /// hard_cases.csv's text.
-pub fn hard_csv(rows: &[HardRow]) -> anyhow::Result<String> {
-    csv_out::to_string(rows.iter().map(|r| {
+pub fn hard_cases(rows: &[HardRow]) -> anyhow::Result<String> {
+    super::to_string(rows.iter().map(|r| {
         let ok = r.result.as_ref().ok();
         HardLine {
             case: &r.case,
             tolerance_pct: Num(r.tolerance_pct),
             strategy: &r.strategy,
             api: api_name(r.api),
-            status: csv_out::status(&r.result),
+            status: super::status(&r.result),
             wrong_pct: ok.map(|(w, ..)| Num(100.0 * w)),
             crack_pixels: ok.and_then(|(_, c, ..)| *c),
             time_ms: ok.map(|(_, _, t, _)| Num(*t)),
@@ -128,8 +128,8 @@ struct RandomLine<'a> {
 }
 
 /// random.csv's text.
-pub fn random_csv(rows: &[RandomRow]) -> anyhow::Result<String> {
-    csv_out::to_string(rows.iter().map(random_line))
+pub fn random(rows: &[RandomRow]) -> anyhow::Result<String> {
+    super::to_string(rows.iter().map(random_line))
 }
 
 fn random_line(r: &RandomRow) -> RandomLine<'_> {
@@ -139,7 +139,7 @@ fn random_line(r: &RandomRow) -> RandomLine<'_> {
         pair: r.pair,
         status: match m {
             Some(m) if random_scene::disagreement(m).is_some() => "disagree".into(),
-            _ => csv_out::status(&r.result),
+            _ => super::status(&r.result),
         },
         off_8_pct: m.map(|m| Num(100.0 * m.above_8)),
         within_1_pct: m.map(|m| Num(100.0 * m.within_1())),
@@ -158,15 +158,15 @@ mod tests {
     #[test]
     fn the_columns_stay_as_committed_even_without_rows() {
         assert_eq!(
-            csv(&[]).unwrap(),
+            accuracy(&[]).unwrap(),
             "scene,width,height,api,max_depth,offset,triangle,sphere,sweeps,default,pareto,point_ms,repeat_ms,status,gpu_min_ms,wall_min_ms,rmse,max_abs,above_1,above_8,flip_mean,nonfinite_pixels\n"
         );
         assert_eq!(
-            hard_csv(&[]).unwrap(),
+            hard_cases(&[]).unwrap(),
             "case,tolerance_pct,strategy,api,status,wrong_pct,crack_pixels,time_ms,nonfinite_pixels\n"
         );
         assert_eq!(
-            random_csv(&[]).unwrap(),
+            random(&[]).unwrap(),
             "seed,pair,status,off_8_pct,within_1_pct,max_abs,rmse,nonfinite_pixels\n"
         );
     }

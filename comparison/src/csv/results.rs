@@ -1,8 +1,9 @@
 //! results.csv: one row per API × path × point, every figure of the run's
 //! JSON report that a spreadsheet wants, and why a point failed.
 
-use crate::csv_out::{self, Decimals};
-use crate::runs::{api_name, Outcome};
+use super::Decimals;
+use crate::apps::api_name;
+use crate::compare::runs::Outcome;
 use serde::Serialize;
 use twinray_common::rays::RateClock;
 use twinray_common::stats::Summary;
@@ -105,7 +106,7 @@ fn row<'a>(o: &'a Outcome, cpu: &'a str) -> Row<'a> {
             }
         }
         Err(_) => {
-            row.status = csv_out::status(&o.result);
+            row.status = super::status(&o.result);
             row.width = p.size.width;
             row.height = p.size.height;
             row
@@ -114,15 +115,15 @@ fn row<'a>(o: &'a Outcome, cpu: &'a str) -> Row<'a> {
 }
 
 /// results.csv's text.
-pub fn csv(outcomes: &[Outcome], cpu: &str) -> anyhow::Result<String> {
-    csv_out::to_string(outcomes.iter().map(|o| row(o, cpu)))
+pub fn results(outcomes: &[Outcome], cpu: &str) -> anyhow::Result<String> {
+    super::to_string(outcomes.iter().map(|o| row(o, cpu)))
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
     use crate::apps::Api;
-    use crate::runs::test_outcome;
+    use crate::compare::runs::test_outcome;
     use twinray_common::cli::RenderPath;
 
     #[test]
@@ -144,7 +145,7 @@ mod tests {
             counted,
             failed,
         ];
-        let text = csv(&rows, "cpu, 2 threads").unwrap();
+        let text = results(&rows, "cpu, 2 threads").unwrap();
         let mut lines = text.lines();
         assert_eq!(
             lines.next().unwrap(),

@@ -1,9 +1,8 @@
 //! What a comparison runs and what each run gave back: the plan of points,
 //! every API's outcome at a point, the runs of "model only what a scene
 //! needs", the image agreement, the gaps and the experiments that explain
-//! them, and the API names every output prints. The
-//! runner (compare.rs, accel.rs, agreement.rs) fills these in and the report
-//! reads them, so neither imports the other.
+//! them. The steps (compare.rs and its accel.rs, agreement.rs, why.rs) fill
+//! these in and the report reads them, so neither imports the other.
 
 use crate::apps::Api;
 use twinray_common::cli::{Experiment, RenderPath, Size};
@@ -46,16 +45,6 @@ pub struct Outcome {
     pub result: Result<RunReport, String>,
 }
 
-/// The API's name in every CSV, table, plot and file name.
-pub fn api_name(api: Api) -> &'static str {
-    match api {
-        Api::Vulkan => "vulkan",
-        Api::Opengl => "opengl",
-        Api::OpenglSpirv => "opengl-spirv",
-        Api::Reference => "reference",
-    }
-}
-
 /// Image agreement of one scene: both APIs against each other and the f64 reference.
 #[derive(Debug, Clone)]
 pub struct Agreement {
@@ -96,16 +85,6 @@ pub struct BvhStats {
     pub nodes: usize,
     pub bytes: usize,
     pub build_ms: f64,
-}
-
-/// A run's `--set KEY=VALUE` list as the (key, value) pairs `Scene::load`
-/// takes: the orchestrator loads the scene a run renders for its reference
-/// image, its BVH figures or its shader's defines.
-pub fn overrides(set: &[String]) -> Vec<(String, String)> {
-    set.iter()
-        .filter_map(|kv| kv.split_once('='))
-        .map(|(k, v)| (k.into(), v.into()))
-        .collect()
 }
 
 /// What a gap is a gap in.

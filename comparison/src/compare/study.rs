@@ -1,7 +1,7 @@
 //! The 2018 study's published numbers (comparison/data/thesis-vk-vs-gl-results.csv,
 //! seconds per render-loop iteration), so every report can put ours beside them.
 
-const CSV: &str = include_str!("../data/thesis-vk-vs-gl-results.csv");
+const CSV: &str = include_str!("../../data/thesis-vk-vs-gl-results.csv");
 
 #[derive(Debug, Clone)]
 pub struct StudyRow {

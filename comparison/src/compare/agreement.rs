@@ -2,8 +2,9 @@
 //! apps and the f64 reference (PNGs under images/), and, with the compute path
 //! measured, each API's compute image against its fragment image.
 
+use crate::apps::{api_name, overrides};
 use crate::apps::{run_json, Api};
-use crate::runs::{api_name, overrides, Agreement, Plan, EXPERIMENTS};
+use crate::compare::runs::{Agreement, Plan, EXPERIMENTS};
 use std::path::Path;
 use std::sync::atomic::{AtomicBool, Ordering};
 use twinray_common::cli::{RenderArgs, RenderPath, Size, Workgroup};
