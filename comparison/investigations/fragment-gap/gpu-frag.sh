@@ -11,15 +11,15 @@
 # Two rounds in alternating API order, 60 frames a run; about 2 minutes on an
 # H100 (box brute force ~8 ms a frame, teapot BVH ~7 ms).
 # Writes OUT_DIR/frag.jsonl (one label line, then the app's --json report).
-# Usage: comparison/gpu-frag.sh BIN_DIR OUT_DIR
+# Usage: comparison/investigations/fragment-gap/gpu-frag.sh BIN_DIR OUT_DIR
 set -uo pipefail
 bin=$1
 out=$2
 mkdir -p "$out"
 errors="$out/frag.log"
 log="$out/frag.jsonl"
-# shellcheck source=comparison/gpu-lib.sh
-source "$(dirname "$0")/gpu-lib.sh"
+# shellcheck source=comparison/investigations/lib.sh
+source "$(dirname "$0")/../lib.sh"
 
 points=(
     "--scene box --size 1000x1000 --accel none --frames 60"

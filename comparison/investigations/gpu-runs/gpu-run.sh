@@ -3,13 +3,15 @@
 # OpenGL also on naga's SPIR-V), the compute workgroup sizes, and the full
 # accuracy report. It takes about 25 minutes on an H200; where a machine is
 # lent for less, run the parts as comparison/results/nvidia-h200/FINDINGS.md
-# lists them (compare --only ..., gpu-followup.sh). Usage: comparison/gpu-run.sh BIN_DIR OUT_DIR
+# lists them (compare --only ..., gpu-followup.sh). Usage: comparison/investigations/gpu-runs/gpu-run.sh BIN_DIR OUT_DIR
 # (BIN_DIR holds release builds of twinray, twinray-vk and twinray-gl).
 set -uo pipefail
 bin=$1
 out=$2
 mkdir -p "$out"
-nvidia-smi --query-gpu=name,driver_version,clocks.max.sm --format=csv > "$out/gpu.txt" 2>&1 || true
+# shellcheck source=comparison/investigations/lib.sh
+source "$(dirname "$0")/../lib.sh"
+gpu_info
 "$bin/twinray" compare --full --gl-spirv --seconds-per-point 5 --out "$out/compare" > "$out/compare.log" 2>&1
 for wg in 8x8 16x8 16x16; do
     for app in vk gl; do

@@ -5,7 +5,8 @@ set -uo pipefail
 out=$1
 mkdir -p "$out"
 log="$out/loops.jsonl"; errors="$out/loops.log"
-source comparison/gpu-lib.sh
+# shellcheck source=comparison/investigations/lib.sh
+source comparison/investigations/lib.sh
 points=(
     "--scene teapot --size 1920x1080 --accel bvh --frames 60 --path compute --count-rays"
     "--scene teapot --size 1920x1080 --accel bvh --frames 60 --path compute --count-rays --workgroup 8x8"

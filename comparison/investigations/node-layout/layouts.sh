@@ -6,7 +6,8 @@ set -uo pipefail
 out=$1
 mkdir -p "$out"
 log="$out/layouts.jsonl"; errors="$out/layouts.log"
-source comparison/gpu-lib.sh
+# shellcheck source=comparison/investigations/lib.sh
+source comparison/investigations/lib.sh
 points=(
     "--scene teapot --size 1000x1000 --accel bvh --frames 60"
     "--scene spherelist --size 300x300 --set extra_spheres=10000 --accel bvh --frames 60"

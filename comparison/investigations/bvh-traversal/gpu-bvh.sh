@@ -6,20 +6,17 @@
 # back one at a time (--experiment), plus the study's brute-force points, to
 # check that nothing else got slower. Two rounds, the API order alternating.
 # With OLD_BIN_DIR (release builds of an earlier commit) it also times those.
-# Usage: comparison/gpu-bvh.sh BIN_DIR OUT_DIR [OLD_BIN_DIR]
+# Usage: comparison/investigations/bvh-traversal/gpu-bvh.sh BIN_DIR OUT_DIR [OLD_BIN_DIR]
 set -uo pipefail
 bin=$1
 out=$2
 old=${3:-}
 mkdir -p "$out"
-nvidia-smi --query-gpu=name,driver_version,clocks.max.sm --format=csv > "$out/gpu.txt" 2>&1 || true
 log="$out/bvh.jsonl"
-run() { # label, binary dir, app, then the app's options
-    local label=$1 dir=$2 app=$3
-    shift 3
-    echo "{\"label\":\"$label\",\"cmd\":\"twinray-$app $*\"}" >> "$log"
-    timeout 120 "$dir/twinray-$app" --headless --json "$@" >> "$log" 2>> "$out/bvh.log" || echo "{\"failed\":\"twinray-$app $*\"}" >> "$log"
-}
+errors="$out/bvh.log"
+# shellcheck source=comparison/investigations/lib.sh
+source "$(dirname "$0")/../lib.sh"
+gpu_info
 bvh_points=(
     "--scene teapot --size 1000x1000 --accel bvh --frames 60"
     "--scene spherelist --size 300x300 --set extra_spheres=10000 --accel bvh --frames 60"
@@ -32,8 +29,8 @@ brute_points=(
 # Shader dumps of the teapot BVH tracer, both paths, for the lmem and register figures.
 for app in vk gl; do
     for path in fragment compute; do
-        run "dump" "$bin" $app --scene teapot --size 64x64 --accel bvh --path $path --dump-shaders "$out/dump-$app-$path"
-        run "dump shared" "$bin" $app --scene teapot --size 64x64 --accel bvh --path $path --experiment shared-bvh-stack --dump-shaders "$out/dump-$app-$path-shared"
+        run "dump" $app --scene teapot --size 64x64 --accel bvh --path $path --dump-shaders "$out/dump-$app-$path"
+        run "dump shared" $app --scene teapot --size 64x64 --accel bvh --path $path --experiment shared-bvh-stack --dump-shaders "$out/dump-$app-$path-shared"
     done
 done
 for round in 1 2; do
@@ -42,11 +39,11 @@ for round in 1 2; do
         for path in compute fragment; do
             for app in "${apps[@]}"; do
                 # shellcheck disable=SC2086
-                run "default" "$bin" $app $c --path $path
-                run "naga-zero-init" "$bin" $app $c --path $path --experiment naga-zero-init
-                run "naga-loop-bounding" "$bin" $app $c --path $path --experiment naga-loop-bounding
-                [ $path = compute ] && run "shared-bvh-stack" "$bin" $app $c --path $path --experiment shared-bvh-stack
-                [ -n "$old" ] && run "before" "$old" $app $c --path $path
+                run "default" $app $c --path $path
+                run "naga-zero-init" $app $c --path $path --experiment naga-zero-init
+                run "naga-loop-bounding" $app $c --path $path --experiment naga-loop-bounding
+                [ $path = compute ] && run "shared-bvh-stack" $app $c --path $path --experiment shared-bvh-stack
+                [ -n "$old" ] && bin=$old run "before" $app $c --path $path
             done
         done
     done
@@ -56,9 +53,9 @@ for round in 1 2; do
     for c in "${points[@]}"; do
         for app in "${apps[@]}"; do
             # shellcheck disable=SC2086
-            run "default" "$bin" $app $c
-            run "naga-loop-bounding" "$bin" $app $c --experiment naga-loop-bounding
-            [ -n "$old" ] && run "before" "$old" $app $c
+            run "default" $app $c
+            run "naga-loop-bounding" $app $c --experiment naga-loop-bounding
+            [ -n "$old" ] && bin=$old run "before" $app $c
         done
     done
 done

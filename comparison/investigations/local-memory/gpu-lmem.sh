@@ -5,15 +5,15 @@
 # --experiment warp-probe (its sentence in probe.log after a label line) and
 # --dump-shaders, and one Vulkan run with --dump-shaders (every dump's
 # statistics.json in dumps.tar).
-# Usage: comparison/gpu-lmem.sh BIN_DIR OUT_DIR
+# Usage: comparison/investigations/local-memory/gpu-lmem.sh BIN_DIR OUT_DIR
 set -uo pipefail
 bin=$1
 out=$2
 mkdir -p "$out"
 log="$out/lmem.jsonl"
 errors="$out/lmem.log"
-# shellcheck source=comparison/gpu-lib.sh
-source "$(dirname "$0")/gpu-lib.sh"
+# shellcheck source=comparison/investigations/lib.sh
+source "$(dirname "$0")/../lib.sh"
 points=(
     "--scene teapot --size 1000x1000 --accel bvh --frames 60"
     "--scene box --size 1000x1000 --accel bvh --frames 60"
@@ -22,12 +22,15 @@ points=(
     "--scene box --size 1000x1000 --accel none --frames 60"
     "--scene spherelist --size 300x300 --set extra_spheres=10000 --accel none --frames 20"
 )
+# Where the stack lives: local to each walk (the default when FINDINGS was
+# measured, now --experiment local-bvh-stack), at module scope (then
+# --experiment global-bvh-stack, now the default), or in shared memory.
 configs=(
+    "--workgroup 16x8 --experiment local-bvh-stack"
+    "--workgroup 4x8 --experiment local-bvh-stack"
     "--workgroup 16x8"
     "--workgroup 4x8"
-    "--workgroup 16x8 --experiment global-bvh-stack"
-    "--workgroup 4x8 --experiment global-bvh-stack"
-    "--workgroup 16x8 --experiment unpaired-bvh-stack"
+    "--workgroup 16x8 --experiment local-bvh-stack --experiment unpaired-bvh-stack"
     "--workgroup 4x8 --experiment shared-bvh-stack"
     "--workgroup 8x8 --experiment shared-bvh-stack"
 )

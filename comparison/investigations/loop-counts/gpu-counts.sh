@@ -4,15 +4,15 @@
 # uniform-counts, as before), each with and without naga's loop bounding
 # (--experiment naga-loop-bounding). Two rounds, the API order alternating, and
 # the driver's statistics for the sphere list's shaders.
-# Usage: comparison/gpu-counts.sh BIN_DIR OUT_DIR
+# Usage: comparison/investigations/loop-counts/gpu-counts.sh BIN_DIR OUT_DIR
 set -uo pipefail
 bin=$1
 out=$2
 mkdir -p "$out"
 log="$out/counts.jsonl"
 errors="$out/counts.log"
-# shellcheck source=comparison/gpu-lib.sh
-source "$(dirname "$0")/gpu-lib.sh"
+# shellcheck source=comparison/investigations/lib.sh
+source "$(dirname "$0")/../lib.sh"
 points=(
     "--scene spherelist --size 300x300 --set extra_spheres=10000 --accel none --frames 10"
     "--scene box --size 1000x1000 --accel none --frames 60"

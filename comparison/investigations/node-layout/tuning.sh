@@ -5,7 +5,8 @@ set -uo pipefail
 out=$1
 mkdir -p "$out"
 log="$out/tuning.jsonl"; errors="$out/tuning.log"
-source comparison/gpu-lib.sh
+# shellcheck source=comparison/investigations/lib.sh
+source comparison/investigations/lib.sh
 points=(
     "--scene teapot --size 1000x1000 --accel bvh --frames 60 --path compute"
     "--scene teapot --size 1000x1000 --accel bvh --frames 60 --path fragment"

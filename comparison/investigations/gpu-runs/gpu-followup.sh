@@ -6,7 +6,7 @@
 # (--specialize) and with the all-features shader (--generic), both APIs,
 # two rounds in alternating order; and the spherelist sweep again, as its
 # variant's ray stack shrank to one slot (no glass) after the first session.
-# Usage: comparison/gpu-followup.sh BIN_DIR OUT_DIR [accuracy|specialize|spherelist]
+# Usage: comparison/investigations/gpu-runs/gpu-followup.sh BIN_DIR OUT_DIR [accuracy|specialize|spherelist]
 # (BIN_DIR holds release builds of twinray, twinray-vk and twinray-gl; the
 # third argument runs one part, for machines that limit a command's time).
 set -uo pipefail
@@ -14,7 +14,9 @@ bin=$1
 out=$2
 part=${3:-all}
 mkdir -p "$out"
-nvidia-smi --query-gpu=name,driver_version,clocks.max.sm --format=csv > "$out/gpu.txt" 2>&1 || true
+# shellcheck source=comparison/investigations/lib.sh
+source "$(dirname "$0")/../lib.sh"
+gpu_info
 if [ "$part" = all ] || [ "$part" = accuracy ]; then
     "$bin/twinray" accuracy --out "$out/accuracy" > "$out/accuracy.log" 2>&1
 fi
@@ -24,13 +26,8 @@ if [ "$part" = all ] || [ "$part" = spherelist ]; then
 fi
 [ "$part" = spherelist ] && exit 0
 
-spec="$out/specialize.jsonl"
-run() { # app, then the app's options
-    local app=$1
-    shift
-    echo "{\"cmd\":\"twinray-$app $*\"}" >> "$spec"
-    "$bin/twinray-$app" --headless --json "$@" >> "$spec" 2>> "$out/specialize.log" || echo "{\"failed\":\"twinray-$app $*\"}" >> "$spec"
-}
+log="$out/specialize.jsonl"
+errors="$out/specialize.log"
 cases=(
     "--scene teapot --size 1000x1000 --accel none --frames 5"
     "--scene teapot --size 1000x1000 --accel bvh --frames 20"
@@ -46,7 +43,7 @@ for round in 1 2; do
             if [ "$m" = --generic ] && [[ $c == *"accel bvh"* ]]; then continue; fi
             for app in vk gl; do
                 # shellcheck disable=SC2086
-                run $app $c $m
+                run "${m:-defines}" $app $c $m
             done
         done
     done

@@ -7,15 +7,15 @@
 # traversal issue, both paths, two rounds in alternating order; then the
 # teapot BVH compute tracer's dumps (NV assembly of each OpenGL form, Vulkan's
 # statistics) packed into dumps.tar.
-# Usage: comparison/gpu-aliasing.sh BIN_DIR OUT_DIR
+# Usage: comparison/investigations/local-memory/gpu-aliasing.sh BIN_DIR OUT_DIR
 set -uo pipefail
 bin=$1
 out=$2
 mkdir -p "$out"
 log="$out/aliasing.jsonl"
 errors="$out/aliasing.log"
-# shellcheck source=comparison/gpu-lib.sh
-source "$(dirname "$0")/gpu-lib.sh"
+# shellcheck source=comparison/investigations/lib.sh
+source "$(dirname "$0")/../lib.sh"
 points=(
     "--scene box --size 1000x1000 --accel none --frames 60"
     "--scene spherelist --size 300x300 --set extra_spheres=10000 --accel none --frames 20"

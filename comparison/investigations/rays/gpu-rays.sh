@@ -3,15 +3,15 @@
 # (--count-rays) at the built-in scenes, both paths, two rounds in alternating
 # API order; the teapot also at 1920x1080, the issue's Grays/s point.
 # Writes OUT_DIR/rays.jsonl.
-# Usage: comparison/gpu-rays.sh BIN_DIR OUT_DIR
+# Usage: comparison/investigations/rays/gpu-rays.sh BIN_DIR OUT_DIR
 set -uo pipefail
 bin=$1
 out=$2
 mkdir -p "$out"
 log="$out/rays.jsonl"
 errors="$out/rays.log"
-# shellcheck source=comparison/gpu-lib.sh
-source "$(dirname "$0")/gpu-lib.sh"
+# shellcheck source=comparison/investigations/lib.sh
+source "$(dirname "$0")/../lib.sh"
 points=(
     "--scene teapot --size 1920x1080 --accel bvh --frames 60"
     "--scene teapot --size 1000x1000 --accel bvh --frames 60"

@@ -7,15 +7,15 @@
 # and at the brute-force sphere list where it does not. Two rounds in
 # alternating API order; then Vulkan's statistics for each padded pipeline
 # (dumps.tar).
-# Usage: comparison/gpu-occupancy.sh BIN_DIR OUT_DIR
+# Usage: comparison/investigations/local-memory/gpu-occupancy.sh BIN_DIR OUT_DIR
 set -uo pipefail
 bin=$1
 out=$2
 mkdir -p "$out"
 log="$out/occupancy.jsonl"
 errors="$out/occupancy.log"
-# shellcheck source=comparison/gpu-lib.sh
-source "$(dirname "$0")/gpu-lib.sh"
+# shellcheck source=comparison/investigations/lib.sh
+source "$(dirname "$0")/../lib.sh"
 points=(
     "--scene teapot --size 1000x1000 --accel bvh --frames 60"
     "--scene box --size 1000x1000 --accel bvh --frames 60"

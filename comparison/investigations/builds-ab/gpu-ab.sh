@@ -5,7 +5,7 @@
 # round of 4 frames for the slow brute-force teapot).
 # Writes OUT_DIR/ab.jsonl, each report after a label line naming the build
 # ("old" or "new") and the command.
-# Usage: comparison/gpu-ab.sh OLD_BIN_DIR NEW_BIN_DIR OUT_DIR [brute]
+# Usage: comparison/investigations/builds-ab/gpu-ab.sh OLD_BIN_DIR NEW_BIN_DIR OUT_DIR [brute]
 # ("brute": the brute-force points only, for a change that leaves the BVH alone)
 set -uo pipefail
 old=$1
@@ -15,8 +15,8 @@ only=${4:-all}
 mkdir -p "$out"
 log="$out/ab.jsonl"
 errors="$out/ab.log"
-# shellcheck source=comparison/gpu-lib.sh
-source "$(dirname "$0")/gpu-lib.sh"
+# shellcheck source=comparison/investigations/lib.sh
+source "$(dirname "$0")/../lib.sh"
 points=(
     "--scene box --size 1000x1000 --accel none --frames 60"
     "--scene spherelist --size 300x300 --set extra_spheres=10000 --accel none --frames 20"

@@ -4,7 +4,7 @@
 # product's shader and with each `--experiment` named, two rounds in
 # alternating API order, and dumps the teapot tracer of each. Writes
 # OUT_DIR/experiments.jsonl.
-# Usage: comparison/gpu-experiments.sh BIN_DIR OUT_DIR EXPERIMENT...
+# Usage: comparison/investigations/bvh-traversal/gpu-experiments.sh BIN_DIR OUT_DIR EXPERIMENT...
 set -uo pipefail
 bin=$1
 out=$2
@@ -12,8 +12,8 @@ shift 2
 mkdir -p "$out"
 log="$out/experiments.jsonl"
 errors="$out/experiments.log"
-# shellcheck source=comparison/gpu-lib.sh
-source "$(dirname "$0")/gpu-lib.sh"
+# shellcheck source=comparison/investigations/lib.sh
+source "$(dirname "$0")/../lib.sh"
 for e in "$@"; do
     for app in vk gl; do
         for path in fragment compute; do

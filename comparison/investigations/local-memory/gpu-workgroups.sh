@@ -6,15 +6,15 @@
 # OpenGL's occupancy at the teapot's BVH with each workgroup and shared-memory
 # pad (--experiment warp-probe; its sentence lands in probe.log after a label
 # line).
-# Usage: comparison/gpu-workgroups.sh BIN_DIR OUT_DIR
+# Usage: comparison/investigations/local-memory/gpu-workgroups.sh BIN_DIR OUT_DIR
 set -uo pipefail
 bin=$1
 out=$2
 mkdir -p "$out"
 log="$out/workgroups.jsonl"
 errors="$out/workgroups.log"
-# shellcheck source=comparison/gpu-lib.sh
-source "$(dirname "$0")/gpu-lib.sh"
+# shellcheck source=comparison/investigations/lib.sh
+source "$(dirname "$0")/../lib.sh"
 points=(
     "--scene teapot --size 1920x1080 --accel bvh --frames 60"
     "--scene box --size 1000x1000 --accel none --frames 60"

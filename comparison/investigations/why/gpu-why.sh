@@ -10,14 +10,14 @@
 #     alternating API order;
 #   - the driver's statistics of naga's and glslang's SPIR-V.
 # Writes OUT_DIR/why.jsonl (timings), OUT_DIR/agreement.jsonl and OUT_DIR/dumps.
-# Usage: comparison/gpu-why.sh BIN_DIR OUT_DIR (glslangValidator on PATH)
+# Usage: comparison/investigations/why/gpu-why.sh BIN_DIR OUT_DIR (glslangValidator on PATH)
 set -uo pipefail
 bin=$1
 out=$2
 mkdir -p "$out/images" "$out/dumps"
 errors="$out/why.log"
-# shellcheck source=comparison/gpu-lib.sh
-source "$(dirname "$0")/gpu-lib.sh"
+# shellcheck source=comparison/investigations/lib.sh
+source "$(dirname "$0")/../lib.sh"
 
 log="$out/agreement.jsonl"
 scenes=("box --size 1000x1000" "teapot --size 1000x1000" "spherelist --size 1000x1000")

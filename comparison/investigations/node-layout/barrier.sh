@@ -6,7 +6,8 @@ set -uo pipefail
 out=$1
 mkdir -p "$out"
 log="$out/barrier.jsonl"; errors="$out/barrier.log"
-source comparison/gpu-lib.sh
+# shellcheck source=comparison/investigations/lib.sh
+source comparison/investigations/lib.sh
 points=(
     "--scene box --size 1000x1000 --accel none --frames 60"
     "--scene box --size 1000x1000 --accel bvh --frames 60"

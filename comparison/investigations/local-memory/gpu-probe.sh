@@ -5,12 +5,15 @@
 # only) and local memory (--dump-shaders), Vulkan's registers, local and
 # shared memory (--dump-shaders). Writes OUT_DIR/probe.log (a label line, then
 # the probe's sentence) and OUT_DIR/statistics.tar (each dump's statistics.json).
-# Usage: comparison/gpu-probe.sh BIN_DIR OUT_DIR [EXTRA OPTIONS...]
+# Usage: comparison/investigations/local-memory/gpu-probe.sh BIN_DIR OUT_DIR [EXTRA OPTIONS...]
 set -uo pipefail
 bin=$1
 out=$2
 shift 2
 mkdir -p "$out"
+# shellcheck source=comparison/investigations/lib.sh
+source "$(dirname "$0")/../lib.sh"
+gpu_info
 points=(
     "--scene teapot --size 1000x1000 --accel bvh"
     "--scene box --size 1000x1000 --accel bvh"
