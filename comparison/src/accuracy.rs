@@ -45,6 +45,12 @@ pub struct AccuracyArgs {
 }
 
 pub fn run(args: &AccuracyArgs) -> anyhow::Result<()> {
+    // Every input first: refusing one costs no sweep and creates nothing.
+    let cases = if args.no_hard {
+        Vec::new()
+    } else {
+        hard::cases(args.hard.as_deref())?
+    };
     twinray_common::reference::image_io::prepare_output_dir("--out", &args.out)?;
     twinray_common::reference::image_io::prepare_output_dir("--out", &args.out.join("images"))?;
     let frames = if args.quick { 5 } else { 30 };
@@ -55,10 +61,10 @@ pub fn run(args: &AccuracyArgs) -> anyhow::Result<()> {
             scene_name, size, &set, frames, &args.out,
         )?);
     }
-    let (cases, hard_rows) = if args.no_hard {
-        (Vec::new(), Vec::new())
+    let hard_rows = if args.no_hard {
+        Vec::new()
     } else {
-        hard::run_all(args.hard.as_deref(), &args.out)?
+        hard::run_all(&cases, &args.out)?
     };
     let random_n = args.random.unwrap_or(if args.quick { 10 } else { 100 });
     let random_rows = if random_n > 0 {
@@ -75,7 +81,45 @@ pub fn run(args: &AccuracyArgs) -> anyhow::Result<()> {
         "twinray accuracy: report: {}",
         args.out.join("report.md").display()
     );
-    Ok(())
+    crate::failures::check(&failures(&rows, &hard_rows, &random_rows))
+}
+
+/// Every run that gave no result (an app's error, not an inaccurate image),
+/// with its error line.
+fn failures(
+    rows: &[Row],
+    hard_rows: &[HardRow],
+    random_rows: &[RandomRow],
+) -> Vec<(String, String)> {
+    let mut failed = Vec::new();
+    for r in rows {
+        if let Err(e) = &r.result {
+            let run = format!(
+                "{} {} {}",
+                r.scene,
+                crate::apps::api_name(r.api),
+                r.config.label()
+            );
+            failed.push((run, e.clone()));
+        }
+    }
+    for r in hard_rows {
+        if let Err(e) = &r.result {
+            let run = format!(
+                "hard case {} {} {}",
+                r.case,
+                r.strategy,
+                crate::apps::api_name(r.api)
+            );
+            failed.push((run, e.clone()));
+        }
+    }
+    for r in random_rows {
+        if let Err(e) = &r.result {
+            failed.push((format!("random:{} {}", r.seed, r.pair), e.clone()));
+        }
+    }
+    failed
 }
 
 fn write(out: &Path, name: &str, text: String) -> anyhow::Result<()> {

@@ -5,13 +5,16 @@
 //! The modules follow the subcommands: `apps` runs the two apps (and serves
 //! `render`); `compare` is `twinray compare`'s plan and steps, `report` its
 //! report.md and plots; `accuracy` is `twinray accuracy` with its own report;
-//! `diff` is `twinray diff`; `csv` writes every CSV file.
+//! `diff` is `twinray diff`; `csv` writes every CSV file; `failures` and
+//! `interrupt` are how a long run ends when some run failed or a signal came.
 
 mod accuracy;
 mod apps;
 mod compare;
 mod csv;
 mod diff;
+mod failures;
+mod interrupt;
 mod report;
 
 use clap::{Parser, Subcommand};

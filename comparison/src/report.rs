@@ -10,7 +10,7 @@ mod summary;
 mod tables;
 pub mod why_table;
 
-pub use summary::title;
+pub use summary::{interrupted_note, interrupted_suffix, title};
 
 use crate::compare::runs::{Outcome, Results, EXPERIMENTS};
 use crate::compare::study::{self, StudyRow};
@@ -85,13 +85,14 @@ pub fn write_all(out: &Path, results: &Results) -> anyhow::Result<()> {
 /// report.md, section by section.
 pub fn markdown(results: &Results, study: &[StudyRow], cpu: &str, plots: &[String]) -> String {
     [
-        summary::headline(results.outcomes, study),
+        summary::headline(results.outcomes, study, results.interrupted),
         summary::by_path(results, study),
         tables::machine(results.outcomes, cpu),
         tables::experiments(results.outcomes, study, plots),
         accel_table::section(results.accel, plots),
         tables::agreement(results.agreement),
         tables::failures(results.outcomes),
+        tables::not_run(results),
         "Full statistics (mean, median, min, max of wall and GPU time) are in `results.csv`.\n"
             .to_string(),
     ]

@@ -158,8 +158,19 @@ pub struct Results<'a> {
     pub outcomes: &'a [Outcome],
     pub accel: &'a [AccelRun],
     pub agreement: &'a [Agreement],
-    /// Ctrl-C stopped the run: the report says that only finished points are in.
-    pub interrupted: bool,
+    /// Every API × path each point was to run with, so that the report can
+    /// name the runs an interruption left out.
+    pub runs: &'a [(Api, RenderPath)],
+    /// A signal stopped the run: the report says so in its title and summary.
+    pub interrupted: Option<Interruption>,
+}
+
+/// What stopped a comparison early: the signal, and the step it stopped.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Interruption {
+    pub signal: &'static str,
+    /// "the sweep", "the acceleration runs", ... as a sentence reads it.
+    pub step: &'static str,
 }
 
 /// A successful outcome of `api` on `path` at the box's 8x8 point whose every
