@@ -23,7 +23,7 @@ pub fn check(failed: &[(String, String)]) -> anyhow::Result<()> {
         }
     }
     let mut text = format!(
-        "{} run{} failed (the report lists each)",
+        "{} run{} failed (report.md has each)",
         failed.len(),
         if failed.len() == 1 { "" } else { "s" }
     );
@@ -63,7 +63,7 @@ mod tests {
         let e = check(&failed).unwrap_err().to_string();
         assert_eq!(
             e,
-            "3 runs failed (the report lists each): 2 like box 100x100 vulkan \
+            "3 runs failed (report.md has each): 2 like box 100x100 vulkan \
              fragment: twinray-vk: error: no GPU; box 100x100 opengl fragment: twinray-gl: error: no EGL"
         );
     }

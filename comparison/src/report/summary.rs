@@ -32,7 +32,7 @@ pub fn interrupted_note(interrupted: Option<Interruption>) -> String {
     match interrupted {
         Some(i) => format!(
             "> Interrupted by {} during {}: only the runs that finished are below, and the steps \
-             after it did not run (\"Points not run\" lists the sweep's).\n\n",
+             after it did not run.\n\n",
             i.signal, i.step
         ),
         None => String::new(),
