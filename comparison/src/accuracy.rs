@@ -51,6 +51,7 @@ pub fn run(args: &AccuracyArgs) -> anyhow::Result<()> {
     } else {
         hard::cases(args.hard.as_deref())?
     };
+    crate::apps::check_present()?;
     twinray_common::reference::image_io::prepare_output_dir("--out", &args.out)?;
     twinray_common::reference::image_io::prepare_output_dir("--out", &args.out.join("images"))?;
     let frames = if args.quick { 5 } else { 30 };

@@ -107,6 +107,17 @@ pub fn app_path(name: &str) -> anyhow::Result<PathBuf> {
     Ok(path)
 }
 
+/// Both apps are where the runs will look for them: checked before the first
+/// render, so a build without them is one error, not a failure per run.
+pub fn check_present() -> anyhow::Result<()> {
+    for api in [Api::Vulkan, Api::Opengl] {
+        if let Some(bin) = api.binary() {
+            app_path(bin)?;
+        }
+    }
+    Ok(())
+}
+
 /// The app's command line for `args` (always headless: the orchestrator never opens windows).
 pub fn app_args(args: &RenderArgs) -> Vec<String> {
     // Destructured field by field, so that an option added to RenderArgs does

@@ -193,6 +193,7 @@ pub fn run(args: &CompareArgs) -> anyhow::Result<()> {
             "--paths names no path; use fragment, compute or both",
         ));
     }
+    crate::apps::check_present()?;
     // Before the device probe and every render: a bad --out must cost nothing.
     twinray_common::reference::image_io::prepare_output_dir("--out", &args.out)?;
     let stop = crate::interrupt::Stop::install()?;
