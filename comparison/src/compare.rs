@@ -244,10 +244,16 @@ pub fn run(args: &CompareArgs) -> anyhow::Result<()> {
     } else {
         None
     };
-    step("the why step", &stop);
+    // Past the why step (or the last step this run had), only the report is left.
+    let last = if why.is_some() {
+        "the why step"
+    } else {
+        "the report"
+    };
+    step(last, &stop);
     let interrupted = stop.signal().map(|(signal, _)| runs::Interruption {
         signal,
-        step: stopped_in.unwrap_or("the why step"),
+        step: stopped_in.unwrap_or(last),
     });
     let results = runs::Results {
         plan: &plan,
