@@ -8,13 +8,12 @@
 //! report.md, accuracy.csv, hard_cases.csv, random.csv, one SVG per scene and
 //! the images.
 
-mod csv;
-mod hard;
-mod pareto;
+pub(crate) mod hard;
+pub(crate) mod pareto;
 mod plot;
-mod random;
+pub(crate) mod random;
 mod report;
-mod sweeps;
+pub(crate) mod sweeps;
 
 use anyhow::Context;
 use hard::HardRow;
@@ -46,6 +45,13 @@ pub struct AccuracyArgs {
 }
 
 pub fn run(args: &AccuracyArgs) -> anyhow::Result<()> {
+    // Every input first: refusing one costs no sweep and creates nothing.
+    let cases = if args.no_hard {
+        Vec::new()
+    } else {
+        hard::cases(args.hard.as_deref())?
+    };
+    crate::apps::check_present()?;
     twinray_common::reference::image_io::prepare_output_dir("--out", &args.out)?;
     twinray_common::reference::image_io::prepare_output_dir("--out", &args.out.join("images"))?;
     let frames = if args.quick { 5 } else { 30 };
@@ -56,17 +62,17 @@ pub fn run(args: &AccuracyArgs) -> anyhow::Result<()> {
             scene_name, size, &set, frames, &args.out,
         )?);
     }
-    let (cases, hard_rows) = if args.no_hard {
-        (Vec::new(), Vec::new())
+    let hard_rows = if args.no_hard {
+        Vec::new()
     } else {
-        hard::run_all(args.hard.as_deref(), &args.out)?
+        hard::run_all(&cases, &args.out)?
     };
     let random_n = args.random.unwrap_or(if args.quick { 10 } else { 100 });
     let random_rows = if random_n > 0 {
         let size = random::random_size(args.quick);
         eprintln!("twinray accuracy: {random_n} random scenes at {size} x (2 APIs + reference)");
         let r = random::run_random(random_n, size, &args.out)?;
-        write(&args.out, "random.csv", csv::random_csv(&r)?)?;
+        write(&args.out, "random.csv", crate::csv::accuracy::random(&r)?)?;
         r
     } else {
         Vec::new()
@@ -76,7 +82,45 @@ pub fn run(args: &AccuracyArgs) -> anyhow::Result<()> {
         "twinray accuracy: report: {}",
         args.out.join("report.md").display()
     );
-    Ok(())
+    crate::failures::check(&failures(&rows, &hard_rows, &random_rows))
+}
+
+/// Every run that gave no result (an app's error, not an inaccurate image),
+/// with its error line.
+fn failures(
+    rows: &[Row],
+    hard_rows: &[HardRow],
+    random_rows: &[RandomRow],
+) -> Vec<(String, String)> {
+    let mut failed = Vec::new();
+    for r in rows {
+        if let Err(e) = &r.result {
+            let run = format!(
+                "{} {} {}",
+                r.scene,
+                crate::apps::api_name(r.api),
+                r.config.label()
+            );
+            failed.push((run, e.clone()));
+        }
+    }
+    for r in hard_rows {
+        if let Err(e) = &r.result {
+            let run = format!(
+                "hard case {} {} {}",
+                r.case,
+                r.strategy,
+                crate::apps::api_name(r.api)
+            );
+            failed.push((run, e.clone()));
+        }
+    }
+    for r in random_rows {
+        if let Err(e) = &r.result {
+            failed.push((format!("random:{} {}", r.seed, r.pair), e.clone()));
+        }
+    }
+    failed
 }
 
 fn write(out: &Path, name: &str, text: String) -> anyhow::Result<()> {
@@ -94,7 +138,11 @@ fn write_reports(
     started: std::time::Instant,
 ) -> anyhow::Result<()> {
     let cpu = crate::report::cpu_model();
-    write(&args.out, "hard_cases.csv", csv::hard_csv(hard_rows)?)?;
+    write(
+        &args.out,
+        "hard_cases.csv",
+        crate::csv::accuracy::hard_cases(hard_rows)?,
+    )?;
     // With the hard cases known, numerics that fail any of them leave the front.
     // (The world-origin column is not a numerical choice of the sweeps: every
     // sweep runs with the local origin.)
@@ -110,7 +158,11 @@ fn write_reports(
         .map(|st| st.numerics)
         .collect();
     pareto::mark_pareto(rows, &unsound);
-    write(&args.out, "accuracy.csv", csv::csv(rows)?)?;
+    write(
+        &args.out,
+        "accuracy.csv",
+        crate::csv::accuracy::accuracy(rows)?,
+    )?;
     let mut plots = Vec::new();
     for (scene_name, _, _) in sweeps::scenes(args.quick) {
         let file = format!("accuracy-{scene_name}.svg");

@@ -44,15 +44,39 @@ pub fn set_bin_dir(dir: Option<PathBuf>) {
     }
 }
 
-/// `--bin-dir`'s check, at parse time: a folder that does not exist is a typo
-/// worth one sentence before any render, not a failure in the middle of a sweep.
+/// `--bin-dir`'s check, at parse time, the same whether the folder came from
+/// the option or from `TWINRAY_BIN_DIR` (clap names whichever it was): a
+/// folder that does not exist or lacks the apps is a typo worth one sentence
+/// before any render, not a failure in every run of a sweep.
 pub fn parse_bin_dir(s: &str) -> Result<PathBuf, String> {
     let dir = PathBuf::from(s);
-    if dir.is_dir() {
-        Ok(dir)
-    } else {
-        Err("not a folder".to_string())
+    if !dir.is_dir() {
+        return Err("not a folder".to_string());
     }
+    let missing: Vec<&str> = [Api::Vulkan, Api::Opengl]
+        .iter()
+        .filter_map(|api| api.binary())
+        .filter(|bin| !dir.join(bin).is_file())
+        .collect();
+    match missing.as_slice() {
+        [] => Ok(dir),
+        _ => Err(format!(
+            "the folder holds no {}; point it at the folder of the release build",
+            missing.join(" or ")
+        )),
+    }
+}
+
+/// The line of an app's stderr that says why it failed: its own
+/// `twinray-vk: error: ...` sentence or clap's `error: ...` line (not the
+/// "For more information, try '--help'." that clap ends with), else the last
+/// line it wrote.
+pub fn error_line(stderr: &str) -> &str {
+    let lines = || stderr.lines().map(str::trim).filter(|l| !l.is_empty());
+    lines()
+        .find(|l| l.starts_with("error:") || l.contains(": error: "))
+        .or_else(|| lines().next_back())
+        .unwrap_or("no message")
 }
 
 /// Where the app binaries live: `--bin-dir` (`TWINRAY_BIN_DIR`), else next to this executable.
@@ -82,6 +106,17 @@ pub fn app_path(name: &str) -> anyhow::Result<PathBuf> {
         ));
     }
     Ok(path)
+}
+
+/// Both apps are where the runs will look for them: checked before the first
+/// render, so a build without them is one error, not a failure per run.
+pub fn check_present() -> anyhow::Result<()> {
+    for api in [Api::Vulkan, Api::Opengl] {
+        if let Some(bin) = api.binary() {
+            app_path(bin)?;
+        }
+    }
+    Ok(())
 }
 
 /// The app's command line for `args` (always headless: the orchestrator never opens windows).
@@ -201,12 +236,7 @@ pub fn run_json(api: Api, args: &RenderArgs) -> anyhow::Result<RunReport> {
         .with_context(|| format!("starting {bin}"))?;
     if !out.status.success() {
         let stderr = String::from_utf8_lossy(&out.stderr);
-        let line = stderr
-            .lines()
-            .rev()
-            .find(|l| !l.trim().is_empty())
-            .unwrap_or("no message")
-            .to_string();
+        let line = error_line(&stderr).to_string();
         let kind = match out.status.code() {
             Some(2) => Some(FailureKind::BadInput),
             Some(3) => Some(FailureKind::NoDevice),
@@ -325,8 +355,47 @@ fn rayon_threads() -> usize {
     rayon::current_num_threads()
 }
 
+/// The API's name in every CSV, table, plot and file name.
+pub fn api_name(api: Api) -> &'static str {
+    match api {
+        Api::Vulkan => "vulkan",
+        Api::Opengl => "opengl",
+        Api::OpenglSpirv => "opengl-spirv",
+        Api::Reference => "reference",
+    }
+}
+
+/// A run's `--set KEY=VALUE` list as the (key, value) pairs `Scene::load`
+/// takes: the orchestrator loads the scene a run renders for its reference
+/// image, its BVH figures or its shader's defines.
+pub fn overrides(set: &[String]) -> Vec<(String, String)> {
+    set.iter()
+        .filter_map(|kv| kv.split_once('='))
+        .map(|(k, v)| (k.into(), v.into()))
+        .collect()
+}
+
 #[cfg(test)]
 mod tests {
+    #[test]
+    fn the_error_line_is_the_apps_sentence_not_claps_last_line() {
+        let clap = "error: invalid value 'x' for '--size <WxH>': no 'x'\n\nFor more information, try '--help'.\n";
+        assert_eq!(
+            super::error_line(clap),
+            "error: invalid value 'x' for '--size <WxH>': no 'x'"
+        );
+        let own = "warning: slow\ntwinray-vk: error: scene 'kettle' does not exist\n";
+        assert_eq!(
+            super::error_line(own),
+            "twinray-vk: error: scene 'kettle' does not exist"
+        );
+        assert_eq!(
+            super::error_line("Segmentation fault\n\n"),
+            "Segmentation fault"
+        );
+        assert_eq!(super::error_line(""), "no message");
+    }
+
     use super::app_args;
     use clap::Parser;
     use std::path::PathBuf;

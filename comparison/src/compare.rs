@@ -1,19 +1,26 @@
 //! `twinray compare`: the study's three experiments (teapot and box resolution
 //! sweeps, the sphere-list count sweep) with both apps, each point in fresh
 //! processes with the API order alternating, then results.csv, report.md and
-//! plots, and the why step's experiments at each remaining gap (why.rs).
+//! plots, and the why step's experiments at each remaining gap (compare/why.rs).
 
+mod accel;
+mod agreement;
+pub(crate) mod runs;
+mod shaders;
+pub(crate) mod study;
+pub(crate) mod why;
+
+use crate::apps::api_name;
 use crate::apps::{is_software, run_json, Api};
-use crate::runs::{api_name, Outcome, Plan, Point};
-use crate::why::WhyPlan;
 use anyhow::Context;
+use runs::{Outcome, Plan, Point};
 use std::collections::HashMap;
 use std::path::PathBuf;
 use std::sync::atomic::{AtomicBool, Ordering};
-use std::sync::Arc;
 use twinray_common::cli::{parse_workgroup, RenderArgs, RenderPath, Size, Workgroup};
 use twinray_common::scene::accel::Accel;
 use twinray_common::value_name::ValueName;
+use why::WhyPlan;
 
 #[derive(clap::Args, Debug, Clone)]
 pub struct CompareArgs {
@@ -28,7 +35,7 @@ pub struct CompareArgs {
     #[arg(long, default_value = "comparison-out")]
     pub out: PathBuf,
     /// Frames per point (the study: 60; statistics over the last 30).
-    #[arg(long)]
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..))]
     pub frames: Option<u32>,
     /// Fewer frames for slow points so that one app spends at most about this long on one point.
     #[arg(long)]
@@ -121,14 +128,7 @@ fn square(side: u32) -> Size {
 }
 
 pub fn plan(args: &CompareArgs) -> anyhow::Result<Plan> {
-    for e in &args.only {
-        if !ONLY_CHOICES.contains(&e.as_str()) {
-            return Err(twinray_common::error::bad_input(format!(
-                "--only '{e}' is not an experiment ({})",
-                ONLY_CHOICES.join(", ")
-            )));
-        }
-    }
+    check_only(args)?;
     let preset = Preset::of(args.quick);
     let mut points = Vec::new();
     let wanted = |e: &str| args.only.is_empty() || args.only.iter().any(|o| o == e);
@@ -170,17 +170,22 @@ pub fn plan(args: &CompareArgs) -> anyhow::Result<Plan> {
     })
 }
 
-pub fn run(args: &CompareArgs) -> anyhow::Result<()> {
-    // Before the device probe and every render: a bad --out must cost nothing.
-    twinray_common::reference::image_io::prepare_output_dir("--out", &args.out)?;
-    let args = &with_preset(args)?;
-    let plan = plan(args)?;
-    let stop = Arc::new(AtomicBool::new(false));
-    {
-        let stop = stop.clone();
-        ctrlc::set_handler(move || stop.store(true, Ordering::SeqCst))
-            .context("installing the Ctrl-C handler")?;
+/// `--only`'s names, checked before anything is created or run.
+fn check_only(args: &CompareArgs) -> anyhow::Result<()> {
+    for e in &args.only {
+        if !ONLY_CHOICES.contains(&e.as_str()) {
+            return Err(twinray_common::error::bad_input(format!(
+                "--only '{e}' is not an experiment ({})",
+                ONLY_CHOICES.join(", ")
+            )));
+        }
     }
+    Ok(())
+}
+
+pub fn run(args: &CompareArgs) -> anyhow::Result<()> {
+    // Every option first: refusing one creates nothing.
+    check_only(args)?;
     let mut paths = args.paths.clone();
     paths.dedup();
     if paths.is_empty() {
@@ -188,73 +193,187 @@ pub fn run(args: &CompareArgs) -> anyhow::Result<()> {
             "--paths names no path; use fragment, compute or both",
         ));
     }
-    let apis = if args.gl_spirv { 3 } else { 2 };
-    let runs = apis * paths.len();
-    let (outcomes, mut interrupted) = sweep(args, &plan, &paths, &stop);
-    let accel = if interrupted || !(args.only.is_empty() || args.only.iter().any(|o| o == "accel"))
-    {
-        Vec::new()
-    } else {
-        crate::accel::acceleration(&plan, &stop)
+    crate::apps::check_present()?;
+    // Before the device probe and every render: a bad --out must cost nothing.
+    twinray_common::reference::image_io::prepare_output_dir("--out", &args.out)?;
+    let stop = crate::interrupt::Stop::install()?;
+    let args = &with_preset(args)?;
+    let plan = plan(args)?;
+    let mut apis = vec![Api::Vulkan, Api::Opengl];
+    if args.gl_spirv {
+        apis.push(Api::OpenglSpirv);
+    }
+    let runs: Vec<(Api, RenderPath)> = paths
+        .iter()
+        .flat_map(|&p| apis.iter().map(move |&a| (a, p)))
+        .collect();
+    // The first step a signal stopped; the steps after it do not start.
+    let mut stopped_in: Option<&'static str> = None;
+    let mut step = |name: &'static str, stop: &crate::interrupt::Stop| {
+        if stop.stopped() && stopped_in.is_none() {
+            stopped_in = Some(name);
+        }
+        stopped_in.is_none()
     };
+    let wanted = |e: &str| args.only.is_empty() || args.only.iter().any(|o| o == e);
     // `--only why` alone runs the why step and nothing else.
     let only_why = !args.only.is_empty() && args.only.iter().all(|o| o == "why");
-    let agreement = if only_why || interrupted || stop.load(Ordering::SeqCst) {
-        Vec::new()
+    let outcomes = sweep(args, &plan, &runs, stop.flag());
+    let accel = if step("the sweep", &stop) && wanted("accel") {
+        accel::acceleration(&plan, stop.flag())
     } else {
-        crate::agreement::agreement(&args.out, &plan, &paths, args.workgroup, &stop)
-    };
-    let shader_rows = if only_why || interrupted || stop.load(Ordering::SeqCst) {
         Vec::new()
+    };
+    let agreement = if step("the acceleration runs", &stop) && !only_why {
+        agreement::agreement(&args.out, &plan, &paths, args.workgroup, stop.flag())
     } else {
-        crate::shaders::collect(&args.out, &paths, &stop)
+        Vec::new()
     };
-    let results = crate::runs::Results {
-        plan: &plan,
-        outcomes: &outcomes,
-        accel: &accel,
-        agreement: &agreement,
-        interrupted,
+    let shader_rows = if step("the image agreement", &stop) && !only_why {
+        shaders::collect(&args.out, &paths, stop.flag())
+    } else {
+        Vec::new()
     };
-    if !only_why {
-        crate::report::write_all(&args.out, &results)?;
-        crate::shaders::append_to_report(&args.out.join("report.md"), &shader_rows)?;
-    }
-    let why_wanted = args.only.is_empty() || args.only.iter().any(|o| o == "why");
-    if why_wanted && !interrupted && !stop.load(Ordering::SeqCst) {
+    let why = if step("the shader statistics", &stop) && wanted("why") {
         // The step keeps its own sizes, but --frames and --seconds-per-point
         // bound its runs too, so a short GPU lease can afford it.
         let mut why_plan = Preset::of(args.quick).why;
         why_plan.frames = args.frames.unwrap_or(why_plan.frames);
         why_plan.seconds_per_point = args.seconds_per_point.unwrap_or(why_plan.seconds_per_point);
-        let why = crate::why::run(&args.out, &why_plan, &paths, &stop);
-        if only_why {
+        Some(why::run(&args.out, &why_plan, &paths, stop.flag()))
+    } else {
+        None
+    };
+    // Past the why step (or the last step this run had), only the report is left.
+    let last = if why.is_some() {
+        "the why step"
+    } else {
+        "the report"
+    };
+    step(last, &stop);
+    let interrupted = stop.signal().map(|(signal, _)| runs::Interruption {
+        signal,
+        step: stopped_in.unwrap_or(last),
+    });
+    let results = runs::Results {
+        plan: &plan,
+        outcomes: &outcomes,
+        accel: &accel,
+        agreement: &agreement,
+        runs: &runs,
+        interrupted,
+    };
+    write_report(&args.out, &results, &shader_rows, why.as_ref(), only_why)?;
+    let failed = failures(&results, &shader_rows, why.as_ref());
+    eprintln!(
+        "twinray compare: {} of {} runs done{}; report: {}",
+        outcomes.iter().filter(|o| o.result.is_ok()).count(),
+        plan.points.len() * runs.len(),
+        match interrupted {
+            Some(i) => format!(
+                " (interrupted by {} during {}: the finished points are kept)",
+                i.signal, i.step
+            ),
+            None => String::new(),
+        },
+        args.out.join("report.md").display()
+    );
+    if let Some((_, code)) = stop.signal() {
+        std::process::exit(code);
+    }
+    crate::failures::check(&failed)
+}
+
+/// report.md (or, for `--only why`, its title alone) with results.csv and
+/// the plots, the shader table and the why section; written once, after
+/// every step, so that an interruption in any of them is in its title.
+fn write_report(
+    out: &std::path::Path,
+    results: &runs::Results,
+    shader_rows: &[shaders::ShaderRow],
+    why: Option<&runs::Why>,
+    only_why: bool,
+) -> anyhow::Result<()> {
+    match why {
+        Some(why) if only_why => {
             // No study ran, so no study sections: a title naming the device
             // the why step measured, then its section.
             let title =
                 crate::report::title(why.vulkan_device.as_deref(), why.opengl_device.as_deref());
-            let report = args.out.join("report.md");
-            std::fs::write(&report, format!("{title}\n"))
+            let report = out.join("report.md");
+            let text = format!(
+                "{title}{}\n{}",
+                crate::report::interrupted_suffix(results.interrupted),
+                crate::report::interrupted_note(results.interrupted)
+            );
+            std::fs::write(&report, text)
                 .with_context(|| format!("writing '{}'", report.display()))?;
         }
-        crate::report::why::write(&args.out, &why)?;
-        interrupted = stop.load(Ordering::SeqCst);
+        _ => {
+            crate::report::write_all(out, results)?;
+            shaders::append_to_report(&out.join("report.md"), shader_rows)?;
+        }
     }
-    eprintln!(
-        "twinray compare: {} of {} runs done{}; report: {}",
-        outcomes.iter().filter(|o| o.result.is_ok()).count(),
-        plan.points.len() * runs,
-        if interrupted {
-            " (interrupted: the finished points are kept)"
-        } else {
-            ""
-        },
-        args.out.join("report.md").display()
-    );
-    if interrupted {
-        std::process::exit(130);
+    if let Some(why) = why {
+        crate::report::why_table::write(out, why)?;
     }
     Ok(())
+}
+
+/// Every run that failed, in every step, with the app's own error line: a
+/// comparison in which any failed is not a success. The why step's rows that
+/// were not run (an experiment this device refuses, a missing tool) are not
+/// failures; they are the table's answer.
+fn failures(
+    results: &runs::Results,
+    shader_rows: &[shaders::ShaderRow],
+    why: Option<&runs::Why>,
+) -> Vec<(String, String)> {
+    let mut failed: Vec<(String, String)> = Vec::new();
+    for o in results.outcomes {
+        if let Err(e) = &o.result {
+            let run = format!(
+                "{} {} {} {}",
+                o.point.experiment,
+                o.point.param_value,
+                api_name(o.api),
+                o.path
+            );
+            failed.push((run, e.clone()));
+        }
+    }
+    for r in results.accel {
+        if let Err(e) = &r.result {
+            let run = format!("{} {} {}", r.scene, r.config, api_name(r.api));
+            failed.push((run, e.clone()));
+        }
+    }
+    for a in results.agreement {
+        let paths = a.paths.as_ref().and_then(|p| p.as_ref().err());
+        for e in a.result.as_ref().err().into_iter().chain(paths) {
+            failed.push((format!("{} image agreement", a.scene), e.clone()));
+        }
+    }
+    for r in shader_rows {
+        if let Err(e) = &r.result {
+            let run = format!(
+                "{} shader statistics {} {}",
+                r.scene,
+                api_name(r.api),
+                r.path
+            );
+            failed.push((run, e.clone()));
+        }
+    }
+    for r in why.map(|w| w.rows.as_slice()).unwrap_or_default() {
+        if let Err(e) = &r.result {
+            if !e.starts_with("not run") {
+                let reason = e.strip_prefix("failed: ").unwrap_or(e).to_string();
+                failed.push((format!("why: {}", r.case.gap.name), reason));
+            }
+        }
+    }
+    failed
 }
 
 /// The arguments with the preset decided: without --quick or --full, a probe
@@ -283,31 +402,30 @@ fn with_preset(args: &CompareArgs) -> anyhow::Result<CompareArgs> {
     Ok(args)
 }
 
-/// Every point of the plan with each API on each path, in fresh processes,
-/// the order alternating from point to point; true with it when Ctrl-C
-/// stopped the sweep (the finished points are kept).
+/// Every point of the plan with each API on each path (`runs`), in fresh
+/// processes, the order alternating from point to point, until `stop` is
+/// raised (the finished points are kept).
 fn sweep(
     args: &CompareArgs,
     plan: &Plan,
-    paths: &[RenderPath],
+    runs: &[(Api, RenderPath)],
     stop: &AtomicBool,
-) -> (Vec<Outcome>, bool) {
-    let mut apis = vec![Api::Vulkan, Api::Opengl];
-    if args.gl_spirv {
-        apis.push(Api::OpenglSpirv);
-    }
+) -> Vec<Outcome> {
+    let mut paths: Vec<RenderPath> = runs.iter().map(|r| r.1).collect();
+    paths.dedup();
+    let apis = runs.len() / paths.len().max(1);
     eprintln!(
         "twinray compare: {} preset, {} points x {} APIs x {} paths ({}), up to {} frames each (about {} s per app per point at most) -> {}",
         plan.preset,
         plan.points.len(),
-        apis.len(),
+        apis,
         paths.len(),
         paths.iter().map(|p| p.name()).collect::<Vec<_>>().join(", "),
         plan.frames,
         plan.seconds_per_point,
         args.out.display()
     );
-    let bar = indicatif::ProgressBar::new((plan.points.len() * apis.len() * paths.len()) as u64);
+    let bar = indicatif::ProgressBar::new((plan.points.len() * runs.len()) as u64);
     bar.set_style(
         indicatif::ProgressStyle::with_template(
             "{bar:40} {pos}/{len} [{elapsed_precise} elapsed, ETA {eta}] {msg}",
@@ -315,19 +433,15 @@ fn sweep(
         .expect("valid template"),
     );
     let mut outcomes: Vec<Outcome> = Vec::new();
-    let mut interrupted = false;
     // Frame-time prediction per experiment and path (on a GPU the paths differ by
     // up to 30x): (work, wall ms) of the last finished point.
     let mut last: HashMap<(&str, RenderPath), (f64, f64)> = HashMap::new();
     'points: for (i, point) in plan.points.iter().enumerate() {
-        let mut order: Vec<(RenderPath, Api)> = paths
-            .iter()
-            .flat_map(|&p| apis.iter().map(move |&a| (p, a)))
-            .collect();
+        let mut order = runs.to_vec();
         if i % 2 == 1 {
             order.reverse();
         }
-        for (path, api) in order {
+        for (api, path) in order {
             let frames = match last.get(&(point.experiment, path)) {
                 Some(&(work, ms)) if ms > 0.0 => {
                     let predicted = ms * point.work / work;
@@ -337,7 +451,6 @@ fn sweep(
                 _ => plan.frames,
             };
             if stop.load(Ordering::SeqCst) {
-                interrupted = true;
                 break 'points;
             }
             bar.set_message(format!(
@@ -364,9 +477,9 @@ fn sweep(
                 ..RenderArgs::headless(point.scene, point.size)
             };
             let result = run_json(api, &ra).map_err(|e| format!("{e:#}"));
-            if stop.load(Ordering::SeqCst) {
+            if stop.load(Ordering::SeqCst) && result.is_err() {
                 // The child got the Ctrl-C too: this point did not finish.
-                interrupted = true;
+                // (A SIGTERM sent to this process alone let it finish: kept.)
                 break 'points;
             }
             if let Ok(r) = &result {
@@ -391,5 +504,5 @@ fn sweep(
         }
     }
     bar.finish_and_clear();
-    (outcomes, interrupted)
+    outcomes
 }

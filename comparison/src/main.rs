@@ -1,19 +1,21 @@
 //! `twinray`: the orchestrator. It never links Vulkan or OpenGL: it runs the
 //! apps as child processes (one API per process) and reads their JSON, renders
 //! the f64 reference itself, and compares images.
+//!
+//! The modules follow the subcommands: `apps` runs the two apps (and serves
+//! `render`); `compare` is `twinray compare`'s plan and steps, `report` its
+//! report.md and plots; `accuracy` is `twinray accuracy` with its own report;
+//! `diff` is `twinray diff`; `csv` writes every CSV file; `failures` and
+//! `interrupt` are how a long run ends when some run failed or a signal came.
 
-mod accel;
 mod accuracy;
-mod agreement;
 mod apps;
 mod compare;
-mod csv_out;
+mod csv;
 mod diff;
+mod failures;
+mod interrupt;
 mod report;
-mod runs;
-mod shaders;
-mod study;
-mod why;
 
 use clap::{Parser, Subcommand};
 use twinray_common::cli::{named_in_env, RenderArgs};

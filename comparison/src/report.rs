@@ -3,18 +3,17 @@
 //! a summary derived from the numbers) and one SVG plot per experiment. Each
 //! section of report.md is written by its own module, in the order it appears.
 
-mod accel;
+mod accel_table;
 mod cells;
-mod csv;
 pub mod plots;
 mod summary;
 mod tables;
-pub mod why;
+pub mod why_table;
 
-pub use summary::title;
+pub use summary::{interrupted_note, interrupted_suffix, title};
 
-use crate::runs::{Outcome, Results, EXPERIMENTS};
-use crate::study::{self, StudyRow};
+use crate::compare::runs::{Outcome, Results, EXPERIMENTS};
+use crate::compare::study::{self, StudyRow};
 use anyhow::Context;
 use std::path::Path;
 
@@ -43,8 +42,11 @@ pub fn cpu_model() -> String {
 /// Writes results.csv, the plots and report.md into `out`.
 pub fn write_all(out: &Path, results: &Results) -> anyhow::Result<()> {
     let cpu = cpu_model();
-    std::fs::write(out.join("results.csv"), csv::csv(results.outcomes, &cpu)?)
-        .context("writing results.csv")?;
+    std::fs::write(
+        out.join("results.csv"),
+        crate::csv::results::results(results.outcomes, &cpu)?,
+    )
+    .context("writing results.csv")?;
     let study = study::rows();
     let mut plots: Vec<String> = Vec::new();
     for exp in EXPERIMENTS {
@@ -83,13 +85,14 @@ pub fn write_all(out: &Path, results: &Results) -> anyhow::Result<()> {
 /// report.md, section by section.
 pub fn markdown(results: &Results, study: &[StudyRow], cpu: &str, plots: &[String]) -> String {
     [
-        summary::headline(results.outcomes, study),
+        summary::headline(results.outcomes, study, results.interrupted),
         summary::by_path(results, study),
         tables::machine(results.outcomes, cpu),
         tables::experiments(results.outcomes, study, plots),
-        accel::section(results.accel, plots),
+        accel_table::section(results.accel, plots),
         tables::agreement(results.agreement),
         tables::failures(results.outcomes),
+        tables::not_run(results),
         "Full statistics (mean, median, min, max of wall and GPU time) are in `results.csv`.\n"
             .to_string(),
     ]

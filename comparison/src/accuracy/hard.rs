@@ -3,8 +3,8 @@
 //! with both apps, as the share of wrong pixels against the f64 truth.
 
 use super::sweeps::render_app;
+use crate::apps::api_name;
 use crate::apps::Api;
-use crate::runs::api_name;
 use std::path::{Path, PathBuf};
 use twinray_common::cli::Size;
 use twinray_common::reference;
@@ -32,9 +32,9 @@ impl HardRow {
     }
 }
 
-/// Every hard case of `dir` (default: scenes/hard of this source tree) at
-/// 64x64 under every strategy, and the cases.
-pub fn run_all(dir: Option<&Path>, out: &Path) -> anyhow::Result<(Vec<HardCase>, Vec<HardRow>)> {
+/// The hard cases of `dir` (default: scenes/hard of this source tree), read
+/// before any sweep runs, so that a bad `--hard` costs nothing.
+pub fn cases(dir: Option<&Path>) -> anyhow::Result<Vec<HardCase>> {
     let dir = dir.map(Path::to_path_buf).unwrap_or_else(|| {
         let local = PathBuf::from("scenes/hard");
         if local.is_dir() {
@@ -43,7 +43,11 @@ pub fn run_all(dir: Option<&Path>, out: &Path) -> anyhow::Result<(Vec<HardCase>,
             PathBuf::from(hard::SOURCE_DIR)
         }
     });
-    let cases = hard::list(&dir)?;
+    hard::list(&dir)
+}
+
+/// Every hard case at 64x64 under every strategy.
+pub fn run_all(cases: &[HardCase], out: &Path) -> anyhow::Result<Vec<HardRow>> {
     let size = Size {
         width: 64,
         height: 64,
@@ -54,10 +58,10 @@ pub fn run_all(dir: Option<&Path>, out: &Path) -> anyhow::Result<(Vec<HardCase>,
         hard_strategies().len()
     );
     let mut rows = Vec::new();
-    for case in &cases {
+    for case in cases {
         rows.extend(run_hard(case, size, out)?);
     }
-    Ok((cases, rows))
+    Ok(rows)
 }
 
 /// One column of the hard-case table: numerical choices and where the GPU's

@@ -2,9 +2,9 @@
 //! front as a step line and the default ringed.
 
 use super::sweeps::Row;
+use crate::apps::api_name;
 use crate::apps::Api;
 use crate::report::plots::{finish_chart, log_log_chart};
-use crate::runs::api_name;
 use plotters::prelude::*;
 use std::path::Path;
 

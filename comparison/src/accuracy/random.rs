@@ -2,8 +2,8 @@
 //! f64 reference, compared pairwise, and the distribution of their errors.
 
 use super::sweeps::render_app;
+use crate::apps::api_name;
 use crate::apps::Api;
-use crate::runs::api_name;
 use std::fmt::Write as _;
 use std::path::Path;
 use twinray_common::cli::Size;

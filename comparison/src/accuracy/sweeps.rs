@@ -3,8 +3,8 @@
 //! secondary-ray offset, the triangle and sphere tests), each image measured
 //! against the f64 truth.
 
+use crate::apps::{api_name, overrides};
 use crate::apps::{run_json, Api};
-use crate::runs::{api_name, overrides};
 use std::path::Path;
 use twinray_common::cli::RenderPath;
 use twinray_common::cli::{RenderArgs, Size};

@@ -3,7 +3,7 @@
 //! median range, and the dash for a number that is missing.
 
 use crate::apps::Api;
-use crate::runs::Outcome;
+use crate::compare::runs::Outcome;
 use twinray_common::cli::RenderPath;
 use twinray_common::report::RunReport;
 

@@ -2,9 +2,10 @@
 //! the study's times) and scaling.svg (frame time against primitives), on the
 //! log-log chart that the accuracy plots share.
 
+use crate::apps::api_name;
 use crate::apps::Api;
-use crate::runs::{api_name, AccelRun, Outcome};
-use crate::study::StudyRow;
+use crate::compare::runs::{AccelRun, Outcome};
+use crate::compare::study::StudyRow;
 use plotters::prelude::*;
 use std::path::Path;
 use twinray_common::cli::RenderPath;

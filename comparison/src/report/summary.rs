@@ -4,8 +4,8 @@
 
 use super::cells::{f, first_report, paths_in, range, ratio, report_of};
 use crate::apps::Api;
-use crate::runs::{Outcome, Results, EXPERIMENTS};
-use crate::study::{self, StudyRow};
+use crate::compare::runs::{Interruption, Outcome, Results, EXPERIMENTS};
+use crate::compare::study::{self, StudyRow};
 use std::fmt::Write as _;
 use twinray_common::cli::RenderPath;
 
@@ -19,12 +19,42 @@ pub fn title(vulkan: Option<&str>, opengl: Option<&str>) -> String {
     )
 }
 
+/// The title's tail for a run a signal stopped: read before any number below.
+pub fn interrupted_suffix(interrupted: Option<Interruption>) -> String {
+    match interrupted {
+        Some(i) => format!(" (interrupted by {} during {})", i.signal, i.step),
+        None => String::new(),
+    }
+}
+
+/// The summary's line for a run a signal stopped: what is in and what is not.
+pub fn interrupted_note(interrupted: Option<Interruption>) -> String {
+    match interrupted {
+        Some(i) => format!(
+            "> Interrupted by {} during {}: only the runs that finished are below, and the steps \
+             after it did not run.\n\n",
+            i.signal, i.step
+        ),
+        None => String::new(),
+    }
+}
+
 /// The title and the three-line summary: one line per experiment, computed
 /// from the rows of the tables below it.
-pub fn headline(outcomes: &[Outcome], study: &[StudyRow]) -> String {
+pub fn headline(
+    outcomes: &[Outcome],
+    study: &[StudyRow],
+    interrupted: Option<Interruption>,
+) -> String {
     let mut s = String::new();
     let device = |api| first_report(outcomes, api).map(|r| r.device.as_str());
-    let _ = writeln!(s, "{}\n", title(device(Api::Vulkan), device(Api::Opengl)));
+    let _ = writeln!(
+        s,
+        "{}{}\n",
+        title(device(Api::Vulkan), device(Api::Opengl)),
+        interrupted_suffix(interrupted)
+    );
+    let _ = write!(s, "{}", interrupted_note(interrupted));
 
     let paths = paths_in(outcomes);
     let med = |v: &[f64]| range(v).map(|(_, m, _)| m);
@@ -81,12 +111,7 @@ pub fn headline(outcomes: &[Outcome], study: &[StudyRow]) -> String {
 /// "Summary by path": the ratios' ranges per experiment and path, the two
 /// paths compared, and the paragraph on method.
 pub fn by_path(results: &Results, study: &[StudyRow]) -> String {
-    let Results {
-        plan,
-        outcomes,
-        interrupted,
-        ..
-    } = *results;
+    let Results { plan, outcomes, .. } = *results;
     let mut s = String::new();
     let paths = paths_in(outcomes);
     let _ = writeln!(s, "## Summary by path\n");
@@ -141,12 +166,6 @@ pub fn by_path(results: &Results, study: &[StudyRow]) -> String {
         let _ = write!(s, "{}", four_numbers(outcomes));
     }
     let _ = writeln!(s);
-    if interrupted {
-        let _ = writeln!(
-            s,
-            "> Interrupted with Ctrl-C: only the points that finished are below.\n"
-        );
-    }
     let _ = writeln!(
         s,
         "Ratios are Vulkan time / OpenGL time (above 1: OpenGL faster). Wall time is one render-loop iteration \
@@ -330,7 +349,7 @@ fn four_numbers(outcomes: &[Outcome]) -> String {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::runs::test_outcome;
+    use crate::compare::runs::test_outcome;
 
     #[test]
     fn the_summary_compares_paths() {

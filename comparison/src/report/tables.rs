@@ -2,10 +2,12 @@
 //! study's figures, the image agreement, and the points that failed.
 
 use super::cells::{f, first_report, paths_in, ratio, report_of};
+use crate::apps::api_name;
 use crate::apps::Api;
-use crate::runs::{api_name, Agreement, Outcome, EXPERIMENTS};
-use crate::study::{self, StudyRow};
+use crate::compare::runs::{Agreement, Outcome, Point, Results, EXPERIMENTS};
+use crate::compare::study::{self, StudyRow};
 use std::fmt::Write as _;
+use twinray_common::cli::RenderPath;
 use twinray_common::report::RunReport;
 
 /// Device, driver, API version and OS of each API, and the CPU.
@@ -230,6 +232,43 @@ pub fn failures(outcomes: &[Outcome]) -> String {
             );
         }
         let _ = writeln!(s);
+    }
+    s
+}
+
+/// "Points not run": every point × API × path of the plan that a signal left
+/// out, so that a missing row is never read as a row that was not planned.
+pub fn not_run(results: &Results) -> String {
+    let mut s = String::new();
+    let Some(i) = results.interrupted else {
+        return s;
+    };
+    let done = |p: &Point, api: Api, path: RenderPath| {
+        results.outcomes.iter().any(|o| {
+            o.point.experiment == p.experiment
+                && o.point.param_value == p.param_value
+                && o.api == api
+                && o.path == path
+        })
+    };
+    let missing: Vec<String> = results
+        .plan
+        .points
+        .iter()
+        .flat_map(|p| results.runs.iter().map(move |&(api, path)| (p, api, path)))
+        .filter(|&(p, api, path)| !done(p, api, path))
+        .map(|(p, api, path)| {
+            format!(
+                "- {} {} {} {path}: not run ({})",
+                p.experiment,
+                p.param_value,
+                api_name(api),
+                i.signal
+            )
+        })
+        .collect();
+    if !missing.is_empty() {
+        let _ = writeln!(s, "## Points not run\n\n{}\n", missing.join("\n"));
     }
     s
 }

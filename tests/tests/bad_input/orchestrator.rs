@@ -1,5 +1,7 @@
 //! The orchestrator's own bad input: `twinray diff` of images that cannot be
-//! compared, and `twinray render` of an unknown scene.
+//! compared, `twinray render` of an unknown scene, and the options of
+//! `compare` and `accuracy` that must be refused before any render and
+//! before their output folder is created.
 
 use crate::common::expect_one;
 use twinray_tests::{bin, scratch};
@@ -40,4 +42,89 @@ fn orchestrator_diff_and_render_errors() {
         2,
         &["'kettle'"],
     );
+}
+
+/// A folder that exists but lacks the apps is refused the same way from the
+/// option and from the variable, each naming itself and the folder, before
+/// anything runs: no run of a sweep may fail on it and be counted as done.
+#[test]
+fn a_bin_folder_without_the_apps_is_refused_from_option_and_variable() {
+    let dir = scratch("bin-dir");
+    let empty = dir.join("no-apps");
+    std::fs::create_dir_all(&empty).unwrap();
+    let empty_s = empty.to_str().unwrap();
+    let out = dir.join("out");
+    let out_s = out.to_str().unwrap();
+    let tw = bin("twinray");
+    let compare = ["compare", "--quick", "--out", out_s];
+    expect_one(
+        &tw,
+        &compare,
+        &[("TWINRAY_BIN_DIR", empty_s)],
+        2,
+        &["TWINRAY_BIN_DIR", empty_s, "twinray-vk"],
+    );
+    let with_option = [&["--bin-dir", empty_s][..], &compare[..]].concat();
+    expect_one(
+        &tw,
+        &with_option,
+        &[],
+        2,
+        &["--bin-dir", empty_s, "twinray-vk"],
+    );
+    let accuracy = ["accuracy", "--quick", "--out", out_s];
+    expect_one(
+        &tw,
+        &accuracy,
+        &[("TWINRAY_BIN_DIR", empty_s)],
+        2,
+        &["TWINRAY_BIN_DIR", empty_s],
+    );
+    assert!(!out.exists(), "a refused run created {out_s}");
+}
+
+/// Refusing an option creates nothing and costs no render: `--frames 0`,
+/// an unknown `--only`, a missing `--hard` folder.
+#[test]
+fn compare_and_accuracy_refuse_before_creating_or_rendering() {
+    let dir = scratch("refuse-first");
+    let out = dir.join("out");
+    let out_s = out.to_str().unwrap();
+    let tw = bin("twinray");
+    expect_one(
+        &tw,
+        &["compare", "--quick", "--frames", "0", "--out", out_s],
+        &[],
+        2,
+        &["--frames", "'0'"],
+    );
+    expect_one(
+        &tw,
+        &["compare", "--quick", "--only", "bogus", "--out", out_s],
+        &[],
+        2,
+        &["--only", "'bogus'"],
+    );
+    let started = std::time::Instant::now();
+    expect_one(
+        &tw,
+        &[
+            "accuracy",
+            "--quick",
+            "--hard",
+            "/nonexistent",
+            "--out",
+            out_s,
+        ],
+        &[],
+        2,
+        &["/nonexistent"],
+    );
+    // Before the first sweep, which takes minutes on a software driver.
+    assert!(
+        started.elapsed().as_secs() < 10,
+        "--hard /nonexistent was refused after {:?}",
+        started.elapsed()
+    );
+    assert!(!out.exists(), "a refused option created {out_s}");
 }

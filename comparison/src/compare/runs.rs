@@ -1,0 +1,212 @@
+//! What a comparison runs and what each run gave back: the plan of points,
+//! every API's outcome at a point, the runs of "model only what a scene
+//! needs", the image agreement, the gaps and the experiments that explain
+//! them. The steps (compare.rs and its accel.rs, agreement.rs, why.rs) fill
+//! these in and the report reads them, so neither imports the other.
+
+use crate::apps::Api;
+use twinray_common::cli::{RenderPath, Size};
+use twinray_common::lab::experiment::Experiment;
+use twinray_common::reference::metrics::Metrics;
+use twinray_common::report::RunReport;
+use twinray_common::scene::accel::Accel;
+
+/// The study's three experiments, in the order every output lists them.
+pub const EXPERIMENTS: [&str; 3] = ["teapot", "box", "spherelist"];
+
+/// One point of a sweep: a scene at one size or one extra-sphere count.
+#[derive(Debug, Clone)]
+pub struct Point {
+    pub experiment: &'static str,
+    pub param_name: &'static str,
+    pub param_value: String,
+    pub scene: &'static str,
+    pub size: Size,
+    pub set: Vec<String>,
+    /// Work relative to the sweep's first point (pixels or primitives), to predict frame time.
+    pub work: f64,
+}
+
+/// The points of a comparison and how long each may run.
+pub struct Plan {
+    pub points: Vec<Point>,
+    pub frames: u32,
+    /// Fewer frames for a point predicted to take longer than this per app.
+    pub seconds_per_point: f64,
+    /// "quick" or "full".
+    pub preset: &'static str,
+}
+
+/// One API at one point: its report, or why it failed.
+#[derive(Debug, Clone)]
+pub struct Outcome {
+    pub point: Point,
+    pub api: Api,
+    pub path: RenderPath,
+    pub result: Result<RunReport, String>,
+}
+
+/// Image agreement of one scene: both APIs against each other and the f64 reference.
+#[derive(Debug, Clone)]
+pub struct Agreement {
+    pub scene: &'static str,
+    pub size: Size,
+    /// Vulkan vs OpenGL, Vulkan vs reference, OpenGL vs reference.
+    pub result: Result<[Metrics; 3], String>,
+    /// With the compute path measured: each API's compute image against its fragment image.
+    pub paths: Option<Result<[Metrics; 2], String>>,
+}
+
+/// The all-features shader; the scene's own variant (defines); the one
+/// all-features source specialised to the scene through specialization
+/// constants (`--specialize`); the scene's variant with a BVH.
+pub const ACCEL_CONFIGS: [&str; 4] = [
+    "generic, brute force",
+    "variant, brute force",
+    "specialized, brute force",
+    "variant, BVH",
+];
+
+/// One run of "model only what a scene needs": a scene in one configuration.
+#[derive(Debug, Clone)]
+pub struct AccelRun {
+    pub scene: &'static str,
+    pub size: Size,
+    pub set: Vec<String>,
+    /// One of ACCEL_CONFIGS.
+    pub config: &'static str,
+    pub api: Api,
+    pub result: Result<RunReport, String>,
+    /// The BVH, built here as the apps build it (BVH configurations only).
+    pub bvh: Option<BvhStats>,
+}
+
+#[derive(Debug, Clone, Copy)]
+pub struct BvhStats {
+    pub nodes: usize,
+    pub bytes: usize,
+    pub build_ms: f64,
+}
+
+/// What a gap is a gap in.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum GapMeasure {
+    /// Vulkan's median frame time over OpenGL's.
+    Ratio,
+    /// The share of pixels on which Vulkan's and OpenGL's images agree within 1/255.
+    Agreement,
+}
+
+/// A point where the two APIs differ: one scene, accel and path, at the
+/// preset's size for that scene.
+#[derive(Debug, Clone, Copy)]
+pub struct Gap {
+    pub name: &'static str,
+    pub scene: &'static str,
+    pub accel: Accel,
+    pub path: RenderPath,
+    pub measure: GapMeasure,
+}
+
+/// One candidate cause of a gap: what each API runs instead of its default.
+/// `opengl` names the OpenGL front door: `Api::OpenglSpirv` runs Vulkan's SPIR-V.
+#[derive(Debug, Clone, Copy)]
+pub struct Case {
+    pub gap: &'static Gap,
+    pub vulkan: &'static [Experiment],
+    pub opengl: &'static [Experiment],
+    pub opengl_api: Api,
+}
+
+/// A gap's figure (VK/GL ratio or % of pixels within 1/255) by default and
+/// with the experiment, and the times behind a ratio.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct WhyFigures {
+    pub before: f64,
+    pub after: f64,
+    /// "GPU" or "wall" for a ratio (GPU where all four runs have a timer), "image" for agreement.
+    pub clock: &'static str,
+    /// Median ms: Vulkan and OpenGL by default, then with the experiment (ratios only).
+    pub ms: Option<[f64; 4]>,
+}
+
+/// One case as measured: at which size, and its figures or why there are none
+/// ("not run: ..." or "failed: ...").
+#[derive(Debug, Clone)]
+pub struct WhyRow {
+    pub case: Case,
+    pub size: Size,
+    pub result: Result<WhyFigures, String>,
+}
+
+/// The why step's rows, the devices they ran on, and whether it is a software
+/// driver (whose ratios say nothing about GPUs).
+#[derive(Debug, Clone, Default)]
+pub struct Why {
+    pub rows: Vec<WhyRow>,
+    /// The device of the first Vulkan run that succeeded: the title's choice
+    /// (report::title).
+    pub vulkan_device: Option<String>,
+    /// The device of the first OpenGL run that succeeded: the title's fallback.
+    pub opengl_device: Option<String>,
+    pub software: bool,
+}
+
+/// Everything one `twinray compare` measured: what its report is written from.
+#[derive(Clone, Copy)]
+pub struct Results<'a> {
+    pub plan: &'a Plan,
+    pub outcomes: &'a [Outcome],
+    pub accel: &'a [AccelRun],
+    pub agreement: &'a [Agreement],
+    /// Every API × path each point was to run with, so that the report can
+    /// name the runs an interruption left out.
+    pub runs: &'a [(Api, RenderPath)],
+    /// A signal stopped the run: the report says so in its title and summary.
+    pub interrupted: Option<Interruption>,
+}
+
+/// What stopped a comparison early: the signal, and the step it stopped.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Interruption {
+    pub signal: &'static str,
+    /// "the sweep", "the acceleration runs", ... as a sentence reads it.
+    pub step: &'static str,
+}
+
+/// A successful outcome of `api` on `path` at the box's 8x8 point whose every
+/// frame took `ms`, for the report's tests.
+#[cfg(test)]
+pub fn test_outcome(api: Api, path: RenderPath, ms: f64) -> Outcome {
+    let json = format!(
+        r#"{{"api":"x","device":"d","driver":"v","api_version":"1","os":"o","scene":{{"name":"box","triangles":30,"spheres":2,"lights":1,"materials":3,"max_depth":5}},
+           "variant":"v","width":8,"height":8,{}"frames":[{{"gpu_ms":{ms},"wall_ms":{ms}}}],"gpu_ms":null,"wall_ms":null,
+           "nonfinite_pixels":0,"setup_ms":1.0,"validation_messages":0}}"#,
+        if path == RenderPath::Compute {
+            r#""path":"compute","workgroup":"16x8","#
+        } else {
+            ""
+        }
+    );
+    let mut r: RunReport =
+        serde_json::from_str(&json).expect("a report without `path` still parses");
+    r.summarise();
+    let point = Point {
+        experiment: "box",
+        param_name: "resolution",
+        param_value: "8x8".into(),
+        scene: "box",
+        size: Size {
+            width: 8,
+            height: 8,
+        },
+        set: vec![],
+        work: 1.0,
+    };
+    Outcome {
+        point,
+        api,
+        path,
+        result: Ok(r),
+    }
+}

@@ -1,0 +1,504 @@
+//! `twinray compare`'s why step: the Vulkan/OpenGL gaps the study leaves and
+//! the experiments that each isolate one candidate cause (`CASES`, one line
+//! per gap × experiment), run at each gap point in fresh processes with the
+//! order alternating, like the sweeps. The report's "Why the gaps" section and
+//! why.csv are written from what this returns (report/why_table.rs).
+
+use crate::apps::api_name;
+use crate::apps::{run_json, Api};
+use crate::compare::runs::{Case, Gap, GapMeasure, Why, WhyFigures, WhyRow};
+use std::collections::BTreeMap;
+use std::ffi::OsStr;
+use std::path::Path;
+use std::sync::atomic::{AtomicBool, Ordering};
+use twinray_common::cli::{RenderArgs, RenderPath, Size};
+use twinray_common::error::{Failure, FailureKind};
+use twinray_common::lab::experiment::Experiment;
+use twinray_common::reference::image_io::load_png;
+use twinray_common::reference::metrics;
+use twinray_common::report::RunReport;
+use twinray_common::scene::accel::Accel;
+use twinray_common::value_name::ValueName;
+
+const BOX_FRAGMENT: Gap = Gap {
+    name: "box brute fragment",
+    scene: "box",
+    accel: Accel::None,
+    path: RenderPath::Fragment,
+    measure: GapMeasure::Ratio,
+};
+const BOX_COMPUTE: Gap = Gap {
+    name: "box brute compute",
+    scene: "box",
+    accel: Accel::None,
+    path: RenderPath::Compute,
+    measure: GapMeasure::Ratio,
+};
+const TEAPOT_FRAGMENT: Gap = Gap {
+    name: "teapot brute fragment",
+    scene: "teapot",
+    accel: Accel::None,
+    path: RenderPath::Fragment,
+    measure: GapMeasure::Ratio,
+};
+const TEAPOT_BVH_COMPUTE: Gap = Gap {
+    name: "teapot BVH compute",
+    scene: "teapot",
+    accel: Accel::Bvh,
+    path: RenderPath::Compute,
+    measure: GapMeasure::Ratio,
+};
+const BOX_IMAGES: Gap = Gap {
+    name: "box image agreement",
+    scene: "box",
+    accel: Accel::None,
+    path: RenderPath::Fragment,
+    measure: GapMeasure::Agreement,
+};
+
+/// What each API runs at `gap` instead of its default.
+const fn case(
+    gap: &'static Gap,
+    vulkan: &'static [Experiment],
+    opengl: &'static [Experiment],
+    opengl_api: Api,
+) -> Case {
+    Case {
+        gap,
+        vulkan,
+        opengl,
+        opengl_api,
+    }
+}
+
+/// Vulkan alone runs the experiment; OpenGL as shipped.
+const fn vulkan(gap: &'static Gap, e: &'static [Experiment]) -> Case {
+    case(gap, e, &[], Api::Opengl)
+}
+
+/// Both APIs run the experiment.
+const fn both(gap: &'static Gap, e: &'static [Experiment]) -> Case {
+    case(gap, e, e, Api::Opengl)
+}
+
+/// OpenGL alone runs the experiment; Vulkan as shipped.
+const fn opengl(gap: &'static Gap, e: &'static [Experiment]) -> Case {
+    case(gap, &[], e, Api::Opengl)
+}
+
+/// OpenGL runs naga's SPIR-V (`--gl-spirv`), the very binary Vulkan runs.
+const fn gl_spirv(gap: &'static Gap) -> Case {
+    case(gap, &[], &[], Api::OpenglSpirv)
+}
+
+/// Every gap × experiment the step measures, in the report's order.
+pub const CASES: &[Case] = &[
+    vulkan(&BOX_FRAGMENT, &[Experiment::Glslang]),
+    vulkan(&BOX_FRAGMENT, &[Experiment::NoLoopBounding]),
+    gl_spirv(&BOX_FRAGMENT),
+    both(&BOX_FRAGMENT, &[Experiment::Quad]),
+    both(&BOX_FRAGMENT, &[Experiment::LoadClear]),
+    both(&BOX_FRAGMENT, &[Experiment::Rgba8]),
+    vulkan(&BOX_FRAGMENT, &[Experiment::DynamicViewport]),
+    vulkan(&BOX_COMPUTE, &[Experiment::ComputeQueue]),
+    gl_spirv(&BOX_COMPUTE),
+    both(&BOX_COMPUTE, &[Experiment::SplitRayStack]),
+    vulkan(&TEAPOT_FRAGMENT, &[Experiment::Glslang]),
+    vulkan(&TEAPOT_FRAGMENT, &[Experiment::NoLoopBounding]),
+    gl_spirv(&TEAPOT_FRAGMENT),
+    both(&TEAPOT_BVH_COMPUTE, &[Experiment::UnpairedBvhStack]),
+    both(&TEAPOT_BVH_COMPUTE, &[Experiment::SharedBvhStack]),
+    both(&TEAPOT_BVH_COMPUTE, &[Experiment::LocalBvhStack]),
+    opengl(&TEAPOT_BVH_COMPUTE, &[Experiment::NagaAliasing]),
+    both(&TEAPOT_BVH_COMPUTE, &[Experiment::RobustAccess]),
+    gl_spirv(&TEAPOT_BVH_COMPUTE),
+    both(&BOX_IMAGES, &[Experiment::NoContraction]),
+    vulkan(&BOX_IMAGES, &[Experiment::NoContraction]),
+    vulkan(&BOX_IMAGES, &[Experiment::FloatControls]),
+];
+
+/// The why step's share of a preset: the side of each scene's gap points,
+/// frames per run, the longest one app may take at a point, and rounds.
+#[derive(Debug, Clone, Copy)]
+pub struct WhyPlan {
+    pub box_side: u32,
+    pub teapot_side: u32,
+    pub frames: u32,
+    pub seconds_per_point: f64,
+    pub rounds: u32,
+}
+
+/// One process to run at a gap: an API with its experiments.
+type Run = (Api, &'static [Experiment]);
+
+/// What `case` runs: its Vulkan run and its OpenGL run.
+fn runs_of(case: &Case) -> [Run; 2] {
+    [(Api::Vulkan, case.vulkan), (case.opengl_api, case.opengl)]
+}
+
+/// A run's label in file names and messages: `vulkan`, `opengl-glslang`...
+pub fn run_label(run: Run) -> String {
+    std::iter::once(api_name(run.0).to_string())
+        .chain(run.1.iter().map(|e| e.name()))
+        .collect::<Vec<_>>()
+        .join("-")
+}
+
+/// The tool an experiment needs on PATH, if any.
+fn tool_needed(run: Run) -> Option<&'static str> {
+    run.1
+        .contains(&Experiment::Glslang)
+        .then_some("glslangValidator")
+}
+
+/// Whether `tool` is an executable file in one of PATH's folders (`path`).
+pub fn on_path(tool: &str, path: Option<&OsStr>) -> bool {
+    use std::os::unix::fs::PermissionsExt;
+    path.map(|p| {
+        std::env::split_paths(p).any(|dir| {
+            std::fs::metadata(dir.join(tool))
+                .is_ok_and(|m| m.is_file() && m.permissions().mode() & 0o111 != 0)
+        })
+    })
+    .unwrap_or(false)
+}
+
+/// Every case whose gap is on one of `paths`, measured; images go under `out/why/`.
+pub fn run(out: &Path, plan: &WhyPlan, paths: &[RenderPath], stop: &AtomicBool) -> Why {
+    let mut why = Why::default();
+    let dir = out.join("why");
+    if let Err(e) = std::fs::create_dir_all(&dir) {
+        eprintln!(
+            "twinray compare: why step skipped: cannot create '{}': {e}",
+            dir.display()
+        );
+        return why;
+    }
+    let mut gaps: Vec<&'static Gap> = Vec::new();
+    for case in CASES.iter().filter(|c| paths.contains(&c.gap.path)) {
+        if !gaps.iter().any(|g| std::ptr::eq(*g, case.gap)) {
+            gaps.push(case.gap);
+        }
+    }
+    eprintln!(
+        "twinray compare: why step: {} gaps, {} experiments",
+        gaps.len(),
+        CASES
+            .iter()
+            .filter(|c| gaps.iter().any(|g| std::ptr::eq(*g, c.gap)))
+            .count()
+    );
+    for (i, gap) in gaps.into_iter().enumerate() {
+        if stop.load(Ordering::SeqCst) {
+            break;
+        }
+        let side = if gap.scene == "teapot" {
+            plan.teapot_side
+        } else {
+            plan.box_side
+        };
+        let size = Size {
+            width: side,
+            height: side,
+        };
+        let cases: Vec<Case> = CASES
+            .iter()
+            .filter(|c| std::ptr::eq(c.gap, gap))
+            .copied()
+            .collect();
+        // Every case is read against the defaults, whether a case runs them or not.
+        let mut order: Vec<Run> = vec![(Api::Vulkan, &[]), (Api::Opengl, &[])];
+        for run in cases.iter().flat_map(runs_of) {
+            if !order.contains(&run) {
+                order.push(run);
+            }
+        }
+        let measured = measure(&dir, gap, size, plan, &order, i, stop);
+        note_devices(&mut why, &order, &measured);
+        for case in cases {
+            let result = figures(gap, &case, &measured, &dir);
+            if let Err(e) = &result {
+                let [vk, gl] = runs_of(&case);
+                eprintln!(
+                    "  {} / {} + {}: {e}",
+                    gap.name,
+                    run_label(vk),
+                    run_label(gl)
+                );
+            }
+            why.rows.push(WhyRow { case, size, result });
+        }
+    }
+    why
+}
+
+/// Keeps the device of the gap's first Vulkan run and first OpenGL run that
+/// succeeded where no earlier gap gave one, so the title can prefer Vulkan's
+/// name whichever API a gap's runs reached first.
+fn note_devices(why: &mut Why, order: &[Run], measured: &Measured) {
+    let first = |vulkan: bool| {
+        order
+            .iter()
+            .filter(|run| (run.0 == Api::Vulkan) == vulkan)
+            .find_map(|&run| {
+                measured
+                    .get(&run_label(run))?
+                    .iter()
+                    .find_map(|r| r.as_ref().ok())
+            })
+    };
+    let (vk, gl) = (first(true), first(false));
+    why.software |= vk
+        .iter()
+        .chain(&gl)
+        .any(|r| crate::apps::is_software(&r.device));
+    for (slot, r) in [(&mut why.vulkan_device, vk), (&mut why.opengl_device, gl)] {
+        if let (None, Some(r)) = (&slot, r) {
+            *slot = Some(r.device.clone());
+        }
+    }
+}
+
+/// Each run's reports at one gap, rounds in alternating order.
+type Measured = BTreeMap<String, Vec<Result<RunReport, String>>>;
+
+/// Runs every one of `order` at the gap: once for images, `plan.rounds`
+/// times for timings (reversed every other round and gap), after a short
+/// probe that sizes the frame count to `plan.seconds_per_point`.
+fn measure(
+    dir: &Path,
+    gap: &Gap,
+    size: Size,
+    plan: &WhyPlan,
+    order: &[Run],
+    gap_index: usize,
+    stop: &AtomicBool,
+) -> Measured {
+    let images = gap.measure == GapMeasure::Agreement;
+    let base = RenderArgs {
+        accel: gap.accel,
+        path: gap.path,
+        ..RenderArgs::headless(gap.scene, size)
+    };
+    let frames = if images {
+        1
+    } else {
+        let probe = RenderArgs {
+            frames: Some(2),
+            ..base.clone()
+        };
+        match run_json(Api::Vulkan, &probe) {
+            Ok(r) => r
+                .frames
+                .iter()
+                .map(|f| f.wall_ms)
+                .reduce(f64::min)
+                .filter(|&ms| ms > 0.0)
+                .map(|ms| {
+                    ((plan.seconds_per_point * 1e3 / ms).floor() as u32)
+                        .clamp(plan.frames.min(3), plan.frames)
+                })
+                .unwrap_or(plan.frames),
+            Err(_) => plan.frames,
+        }
+    };
+    let rounds = if images { 1 } else { plan.rounds };
+    let mut measured = Measured::new();
+    for round in 0..rounds {
+        let mut runs = order.to_vec();
+        if (gap_index + round as usize) % 2 == 1 {
+            runs.reverse();
+        }
+        for run in runs {
+            if stop.load(Ordering::SeqCst) {
+                return measured;
+            }
+            let label = run_label(run);
+            let result = match tool_needed(run) {
+                Some(tool) if !on_path(tool, std::env::var_os("PATH").as_deref()) => {
+                    Err(format!("not run: {tool} not on PATH"))
+                }
+                _ => {
+                    let args = RenderArgs {
+                        frames: Some(frames),
+                        out: images.then(|| dir.join(format!("{}-{label}.png", gap.scene))),
+                        experiment: run.1.to_vec(),
+                        ..base.clone()
+                    };
+                    run_json(run.0, &args).map_err(|e| refused_or_failed(run, &e))
+                }
+            };
+            measured.entry(label).or_default().push(result);
+        }
+    }
+    measured
+}
+
+/// Why a run gave no report: an experiment the app refuses on this device
+/// (its one sentence, exit 2) was not run; anything else failed.
+fn refused_or_failed(run: Run, e: &anyhow::Error) -> String {
+    match e.downcast_ref::<Failure>() {
+        Some(f) if f.kind == FailureKind::BadInput && !run.1.is_empty() => {
+            format!("not run: {}", f.message)
+        }
+        _ => format!("failed: {e:#}"),
+    }
+}
+
+/// The median over rounds of each round's median: GPU ms with `gpu`, else wall ms.
+fn median_ms(reports: &[Result<RunReport, String>], gpu: bool) -> Result<f64, String> {
+    let mut v = Vec::new();
+    for r in reports {
+        let r = r.as_ref().map_err(Clone::clone)?;
+        let s = if gpu { r.gpu_ms } else { r.wall_ms };
+        v.push(s.map(|s| s.median).ok_or("failed: no frame times")?);
+    }
+    v.sort_by(f64::total_cmp);
+    v.get(v.len() / 2)
+        .copied()
+        .ok_or_else(|| "failed: not run (stopped)".to_string())
+}
+
+/// The case's figures from the runs at its gap.
+fn figures(gap: &Gap, case: &Case, measured: &Measured, dir: &Path) -> Result<WhyFigures, String> {
+    let [vk, gl] = runs_of(case);
+    let default = [(Api::Vulkan, &[][..]), (Api::Opengl, &[][..])];
+    let four = [default[0], default[1], vk, gl];
+    let reports = |run: Run| -> Result<&Vec<Result<RunReport, String>>, String> {
+        measured
+            .get(&run_label(run))
+            .ok_or_else(|| "failed: not run (stopped)".to_string())
+    };
+    match gap.measure {
+        GapMeasure::Agreement => {
+            let within = |a: Run, b: Run| -> Result<f64, String> {
+                for run in [a, b] {
+                    reports(run)?
+                        .iter()
+                        .try_for_each(|r| r.as_ref().map(|_| ()).map_err(Clone::clone))?;
+                }
+                let png = |run| dir.join(format!("{}-{}.png", gap.scene, run_label(run)));
+                let (a, b) = (load_png(&png(a)), load_png(&png(b)));
+                let m = metrics::compare(
+                    &a.map_err(|e| format!("failed: {e:#}"))?,
+                    &b.map_err(|e| format!("failed: {e:#}"))?,
+                )
+                .map_err(|e| format!("failed: {e:#}"))?;
+                Ok(100.0 * m.within_1())
+            };
+            Ok(WhyFigures {
+                before: within(default[0], default[1])?,
+                after: within(vk, gl)?,
+                clock: "image",
+                ms: None,
+            })
+        }
+        GapMeasure::Ratio => {
+            let all: Vec<_> = four.iter().map(|&r| reports(r)).collect::<Result<_, _>>()?;
+            let gpu = all.iter().all(|rs| {
+                rs.iter()
+                    .all(|r| r.as_ref().is_ok_and(|r| r.gpu_ms.is_some()))
+            });
+            let ms: Vec<f64> = all
+                .iter()
+                .map(|rs| median_ms(rs, gpu))
+                .collect::<Result<_, _>>()?;
+            Ok(WhyFigures {
+                before: ms[0] / ms[1],
+                after: ms[2] / ms[3],
+                clock: if gpu { "GPU" } else { "wall" },
+                ms: Some([ms[0], ms[1], ms[2], ms[3]]),
+            })
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_tool_is_found_only_as_an_executable_on_path() {
+        let dir = std::env::temp_dir().join(format!("twinray-why-path-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let joined = std::env::join_paths([Path::new("/nonexistent"), &dir]).unwrap();
+        assert!(!on_path("glslangValidator", Some(&joined)));
+        let tool = dir.join("glslangValidator");
+        std::fs::write(&tool, "#!/bin/sh\n").unwrap();
+        assert!(
+            !on_path("glslangValidator", Some(&joined)),
+            "not executable"
+        );
+        use std::os::unix::fs::PermissionsExt;
+        std::fs::set_permissions(&tool, std::fs::Permissions::from_mode(0o755)).unwrap();
+        assert!(on_path("glslangValidator", Some(&joined)));
+        assert!(!on_path("glslangValidator", None));
+        std::fs::remove_dir_all(&dir).ok();
+    }
+
+    #[test]
+    fn the_title_names_the_vulkan_device_and_else_the_opengl_one() {
+        const VK: &str = "NVIDIA H100 80GB HBM3";
+        const GL: &str = "NVIDIA H100 80GB HBM3/PCIe/SSE2";
+        let report = |device: &str| {
+            let mut r = crate::compare::runs::test_outcome(Api::Vulkan, RenderPath::Fragment, 1.0)
+                .result
+                .expect("a test outcome succeeds");
+            r.device = device.into();
+            Ok(r)
+        };
+        let gap = |vulkan: Result<RunReport, String>| -> Measured {
+            [
+                ("vulkan".to_string(), vec![vulkan]),
+                ("opengl".to_string(), vec![report(GL)]),
+                ("opengl-spirv".to_string(), vec![report(GL)]),
+            ]
+            .into()
+        };
+        let order: Vec<Run> = vec![
+            (Api::Vulkan, &[]),
+            (Api::Opengl, &[]),
+            (Api::OpenglSpirv, &[]),
+        ];
+        let title = |why: &Why| {
+            crate::report::title(why.vulkan_device.as_deref(), why.opengl_device.as_deref())
+        };
+        let mut why = Why::default();
+        note_devices(&mut why, &order, &gap(Err("failed: no device".into())));
+        assert_eq!(title(&why), format!("# twinray compare — {GL}"));
+        // A later gap's Vulkan run still wins over an earlier gap's OpenGL one.
+        note_devices(&mut why, &order, &gap(report(VK)));
+        assert_eq!(title(&why), format!("# twinray compare — {VK}"));
+        let mut why = Why::default();
+        note_devices(&mut why, &order, &gap(report(VK)));
+        assert_eq!(title(&why), format!("# twinray compare — {VK}"));
+        assert!(!why.software);
+        assert_eq!(title(&Why::default()), "# twinray compare — no device");
+    }
+
+    #[test]
+    fn each_gap_has_its_default_runs_and_a_glslang_case_needs_the_tool() {
+        for case in CASES {
+            let [vk, gl] = runs_of(case);
+            assert_eq!(vk.0, Api::Vulkan);
+            assert_ne!(gl.0, Api::Vulkan);
+            assert!(
+                !case.vulkan.is_empty() || !case.opengl.is_empty() || gl.0 == Api::OpenglSpirv,
+                "{} has a case that changes nothing",
+                case.gap.name
+            );
+        }
+        assert_eq!(
+            tool_needed((Api::Vulkan, &[Experiment::Glslang])),
+            Some("glslangValidator")
+        );
+        assert_eq!(
+            tool_needed((Api::Vulkan, &[Experiment::NoLoopBounding])),
+            None
+        );
+        assert_eq!(
+            run_label((Api::Opengl, &[Experiment::NoContraction])),
+            "opengl-no-contraction"
+        );
+    }
+}

@@ -1,0 +1,59 @@
+//! The signals that stop a long comparison: SIGINT (Ctrl-C), SIGTERM (a job
+//! scheduler, `kill`, a container's stop) and SIGHUP (a closed terminal). Each
+//! only raises a flag that every step polls between runs, so the runs that
+//! finished are kept and the report is written; the exit code then says which
+//! signal it was, the way a shell reports a process the signal killed
+//! (128 + its number: 130, 143, 129).
+
+use anyhow::Context;
+use signal_hook::consts::{SIGHUP, SIGINT, SIGTERM};
+use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
+use std::sync::Arc;
+
+const SIGNALS: [(i32, &str); 3] = [(SIGINT, "SIGINT"), (SIGTERM, "SIGTERM"), (SIGHUP, "SIGHUP")];
+
+/// Whether a stopping signal arrived, and which (the last, if several did).
+pub struct Stop {
+    flag: Arc<AtomicBool>,
+    signal: Arc<AtomicUsize>,
+}
+
+impl Stop {
+    /// Takes SIGINT, SIGTERM and SIGHUP over from their default (ending the
+    /// process at once, losing every finished point).
+    pub fn install() -> anyhow::Result<Stop> {
+        let stop = Stop {
+            flag: Arc::new(AtomicBool::new(false)),
+            signal: Arc::new(AtomicUsize::new(0)),
+        };
+        for (signal, name) in SIGNALS {
+            // The number first: whoever sees the flag raised finds it set.
+            signal_hook::flag::register_usize(signal, stop.signal.clone(), signal as usize)
+                .and_then(|_| signal_hook::flag::register(signal, stop.flag.clone()))
+                .with_context(|| format!("installing the {name} handler"))?;
+        }
+        Ok(stop)
+    }
+
+    /// The flag the steps poll.
+    pub fn flag(&self) -> &AtomicBool {
+        &self.flag
+    }
+
+    pub fn stopped(&self) -> bool {
+        self.flag.load(Ordering::SeqCst)
+    }
+
+    /// The signal's name and the exit code it gives, once one arrived.
+    pub fn signal(&self) -> Option<(&'static str, i32)> {
+        if !self.stopped() {
+            return None;
+        }
+        let n = self.signal.load(Ordering::SeqCst) as i32;
+        let name = SIGNALS
+            .iter()
+            .find(|(s, _)| *s == n)
+            .map_or("a signal", |(_, name)| name);
+        Some((name, 128 + n))
+    }
+}

@@ -1,0 +1,196 @@
+//! How `twinray compare` ends when it cannot finish: a run that failed makes
+//! the command fail, in the apps' own words, and a signal (SIGTERM, SIGHUP,
+//! SIGINT) at any step keeps the finished runs, writes the report marked
+//! interrupted, and gives the signal's exit code (128 + its number).
+//! Linux only: the tests read /proc for the orchestrator's children.
+
+use std::path::Path;
+use std::process::{Child, Command, Stdio};
+use std::time::{Duration, Instant};
+use twinray_tests::{bin, scratch};
+
+/// Two stand-in apps that fail every run the way a real one fails on bad
+/// input (clap's `error:` line, then its "For more information" line), and
+/// that take `slow_s` seconds over a run with `--dump-shaders`, so that a
+/// test can catch the orchestrator in its shader-statistics step.
+fn failing_apps(dir: &Path, slow_s: u32) -> String {
+    let bin_dir = dir.join("apps");
+    std::fs::create_dir_all(&bin_dir).unwrap();
+    for app in ["twinray-vk", "twinray-gl"] {
+        let script = format!(
+            "#!/bin/sh\n\
+             case \"$*\" in *--dump-shaders*) sleep {slow_s} ;; esac\n\
+             echo \"error: unexpected argument '--frobnicate' found ({app})\" >&2\n\
+             echo >&2\n\
+             echo \"For more information, try '--help'.\" >&2\n\
+             exit 2\n"
+        );
+        let path = bin_dir.join(app);
+        std::fs::write(&path, script).unwrap();
+        use std::os::unix::fs::PermissionsExt;
+        std::fs::set_permissions(&path, std::fs::Permissions::from_mode(0o755)).unwrap();
+    }
+    bin_dir.to_str().unwrap().to_string()
+}
+
+fn compare(out: &Path, bin_dir: Option<&str>, extra: &[&str]) -> Child {
+    let mut cmd = Command::new(bin("twinray"));
+    if let Some(dir) = bin_dir {
+        cmd.args(["--bin-dir", dir]);
+    }
+    cmd.args(["compare", "--quick", "--out", out.to_str().unwrap()])
+        .args(extra)
+        .env(
+            "MESA_SHADER_CACHE_DIR",
+            std::env::temp_dir().join("twinray-mesa-cache"),
+        )
+        .stdout(Stdio::null())
+        .stderr(Stdio::piped())
+        .spawn()
+        .expect("starting twinray compare")
+}
+
+/// The command lines of `pid`'s children now.
+fn children(pid: u32) -> Vec<(u32, String)> {
+    let list =
+        std::fs::read_to_string(format!("/proc/{pid}/task/{pid}/children")).unwrap_or_default();
+    list.split_whitespace()
+        .filter_map(|c| c.parse::<u32>().ok())
+        .map(|c| {
+            let cmdline = std::fs::read(format!("/proc/{c}/cmdline")).unwrap_or_default();
+            (c, String::from_utf8_lossy(&cmdline).replace('\0', " "))
+        })
+        .collect()
+}
+
+/// Waits (at most `limit`) until `ready` says yes about the children seen so far.
+fn wait_for(child: &Child, limit: Duration, mut ready: impl FnMut(&[(u32, String)]) -> bool) {
+    let started = Instant::now();
+    let mut seen: Vec<(u32, String)> = Vec::new();
+    while started.elapsed() < limit {
+        for c in children(child.id()) {
+            if !seen.iter().any(|s| s.0 == c.0) {
+                seen.push(c);
+            }
+        }
+        if ready(&seen) {
+            return;
+        }
+        std::thread::sleep(Duration::from_millis(20));
+    }
+    panic!("gave up after {limit:?}; children seen: {seen:?}");
+}
+
+fn signal(child: &Child, name: &str) {
+    let ok = Command::new("kill")
+        .args([format!("-{name}"), child.id().to_string()])
+        .status()
+        .expect("running kill")
+        .success();
+    assert!(ok, "kill -{name} failed");
+}
+
+/// Its exit code and stderr, within `limit`, or the test fails (no hang).
+fn finish(mut child: Child, limit: Duration) -> (Option<i32>, String) {
+    let started = Instant::now();
+    loop {
+        if let Some(status) = child.try_wait().unwrap() {
+            let mut stderr = String::new();
+            use std::io::Read;
+            child
+                .stderr
+                .take()
+                .unwrap()
+                .read_to_string(&mut stderr)
+                .unwrap();
+            return (status.code(), stderr);
+        }
+        if started.elapsed() > limit {
+            let _ = child.kill();
+            panic!("twinray compare still ran {limit:?} after the signal");
+        }
+        std::thread::sleep(Duration::from_millis(50));
+    }
+}
+
+#[test]
+fn a_comparison_in_which_runs_failed_fails_quoting_the_apps_error() {
+    let dir = scratch("orch-failed-runs");
+    let apps = failing_apps(&dir, 0);
+    let out = dir.join("out");
+    let child = compare(&out, Some(&apps), &["--only", "box", "--paths", "fragment"]);
+    let (code, stderr) = finish(child, Duration::from_secs(60));
+    assert_eq!(code, Some(1), "{stderr}");
+    let last = stderr.lines().last().unwrap_or_default();
+    assert!(
+        last.starts_with("twinray: error: ") && last.contains(" runs failed"),
+        "{stderr}"
+    );
+    // The app's own sentence, not clap's closing line.
+    assert!(
+        last.contains("unexpected argument '--frobnicate' found (twinray-vk)"),
+        "{last}"
+    );
+    assert!(!stderr.contains("For more information"), "{stderr}");
+    // Nothing is lost: the report is written and names the failed points.
+    let report = std::fs::read_to_string(out.join("report.md")).unwrap();
+    assert!(report.contains("## Failed points"), "{report}");
+    assert!(report.contains("--frobnicate"), "{report}");
+}
+
+#[test]
+fn sigterm_during_the_sweep_keeps_the_finished_points_and_exits_143() {
+    let dir = scratch("orch-sigterm");
+    let out = dir.join("out");
+    // Box at three sizes, fragment path: six runs of the real apps.
+    let child = compare(&out, None, &["--only", "box", "--paths", "fragment"]);
+    // The third app started: two runs finished.
+    wait_for(&child, Duration::from_secs(40), |seen| {
+        seen.iter().filter(|c| c.1.contains("twinray-")).count() >= 3
+    });
+    signal(&child, "TERM");
+    let (code, stderr) = finish(child, Duration::from_secs(30));
+    assert_eq!(code, Some(143), "{stderr}");
+    let report = std::fs::read_to_string(out.join("report.md")).unwrap();
+    let title = report.lines().next().unwrap_or_default();
+    assert!(
+        title.contains("(interrupted by SIGTERM during the sweep)"),
+        "{title}"
+    );
+    assert!(
+        report.contains("> Interrupted by SIGTERM during the sweep"),
+        "{report}"
+    );
+    assert!(report.contains("## Points not run"), "{report}");
+    let csv = std::fs::read_to_string(out.join("results.csv")).unwrap();
+    let ok = csv.lines().filter(|l| l.contains(",ok,")).count();
+    assert!((2..6).contains(&ok), "{ok} finished rows:\n{csv}");
+}
+
+#[test]
+fn sighup_and_sigint_after_the_sweep_are_stated_and_exit_129_and_130() {
+    for (name, code) in [("HUP", 129), ("INT", 130)] {
+        let dir = scratch(&format!("orch-sig{name}"));
+        let apps = failing_apps(&dir, 3);
+        let out = dir.join("out");
+        let child = compare(&out, Some(&apps), &["--only", "box", "--paths", "fragment"]);
+        // The shader statistics come after the sweep and the image agreement.
+        wait_for(&child, Duration::from_secs(40), |seen| {
+            seen.iter().any(|c| c.1.contains("--dump-shaders"))
+        });
+        signal(&child, name);
+        let (got, stderr) = finish(child, Duration::from_secs(30));
+        // Interrupted, not failed: the signal's code, though every run failed.
+        assert_eq!(got, Some(code), "SIG{name}: {stderr}");
+        let report = std::fs::read_to_string(out.join("report.md")).unwrap();
+        let stated = format!("interrupted by SIG{name} during the shader statistics");
+        assert!(report.lines().next().unwrap().contains(&stated), "{report}");
+        assert!(
+            report.contains(&format!(
+                "> Interrupted by SIG{name} during the shader statistics"
+            )),
+            "{report}"
+        );
+        assert!(out.join("results.csv").is_file());
+    }
+}
