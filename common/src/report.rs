@@ -205,15 +205,23 @@ impl RunReportBuilder {
 /// Writes what `--dump-shaders DIR` promises of naga's output: the SPIR-V and
 /// the GLSL of each stage this run compiled, named `<stage>.spv` and
 /// `<stage>.glsl` (the apps add what their driver reports).
+/// Failures are bad input (exit 2) naming the folder: the user chose the place.
 pub fn dump_shaders(dir: &std::path::Path, stages: &[(&str, &[u32], &str)]) -> anyhow::Result<()> {
-    use anyhow::Context;
-    std::fs::create_dir_all(dir)
-        .with_context(|| format!("--dump-shaders: cannot create '{}'", dir.display()))?;
+    use crate::error::bad_input;
+    std::fs::create_dir_all(dir).map_err(|e| {
+        bad_input(format!(
+            "--dump-shaders '{}': the folder cannot be created ({e})",
+            dir.display()
+        ))
+    })?;
     for (stage, spirv, glsl) in stages {
         let write = |name: String, bytes: &[u8]| {
-            let path = dir.join(name);
-            std::fs::write(&path, bytes)
-                .with_context(|| format!("--dump-shaders: cannot write '{}'", path.display()))
+            std::fs::write(dir.join(&name), bytes).map_err(|e| {
+                bad_input(format!(
+                    "--dump-shaders '{}': '{name}' cannot be written there ({e})",
+                    dir.display()
+                ))
+            })
         };
         write(format!("{stage}.spv"), bytemuck::cast_slice(spirv))?;
         write(format!("{stage}.glsl"), glsl.as_bytes())?;
@@ -226,8 +234,12 @@ pub fn dump_statistics(dir: &std::path::Path, stats: &[ShaderStats]) -> anyhow::
     use anyhow::Context;
     let path = dir.join("statistics.json");
     let text = serde_json::to_string_pretty(stats).context("serialising shader statistics")?;
-    std::fs::write(&path, text)
-        .with_context(|| format!("--dump-shaders: cannot write '{}'", path.display()))
+    std::fs::write(&path, text).map_err(|e| {
+        crate::error::bad_input(format!(
+            "--dump-shaders '{}': 'statistics.json' cannot be written there ({e})",
+            dir.display()
+        ))
+    })
 }
 
 /// "Debian GNU/Linux 12 (bookworm), Linux 6.1" — for reports.
