@@ -374,3 +374,83 @@ pub fn load_png(path: &Path) -> anyhow::Result<image::RgbImage> {
     })?;
     Ok(img.to_rgb8())
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn scratch(name: &str) -> PathBuf {
+        let dir = std::env::temp_dir().join(format!("twinray-io-{name}-{}", std::process::id()));
+        let _ = std::fs::remove_dir_all(&dir);
+        std::fs::create_dir_all(&dir).unwrap();
+        dir
+    }
+
+    fn names(dir: &Path) -> Vec<String> {
+        let mut v: Vec<String> = std::fs::read_dir(dir)
+            .unwrap()
+            .map(|e| e.unwrap().file_name().to_string_lossy().to_string())
+            .collect();
+        v.sort();
+        v
+    }
+
+    #[test]
+    fn a_rewrite_keeps_the_targets_mode() {
+        use std::os::unix::fs::PermissionsExt;
+        let dir = scratch("mode");
+        let out = dir.join("out.png");
+        write_file("--out", &out, b"one").unwrap();
+        std::fs::set_permissions(&out, std::fs::Permissions::from_mode(0o600)).unwrap();
+        write_file("--out", &out, b"two").unwrap();
+        let mode = std::fs::metadata(&out).unwrap().permissions().mode() & 0o777;
+        assert_eq!(mode, 0o600, "{mode:o}");
+        assert_eq!(std::fs::read(&out).unwrap(), b"two");
+        let _ = std::fs::remove_dir_all(&dir);
+    }
+
+    #[test]
+    fn a_write_removes_the_temporary_files_of_dead_writers_only() {
+        let dir = scratch("stale");
+        let out = dir.join("out.png");
+        // PIDs stop below 2^22 on Linux, so this writer cannot be alive; PID 1 always is.
+        let dead = format!(".out.png.{}.3.tmp", 1u64 << 40);
+        let alive = ".out.png.1.0.tmp".to_string();
+        let other = ".other.png.99999999999.0.tmp".to_string();
+        for name in [&dead, &alive, &other] {
+            std::fs::write(dir.join(name), b"partial").unwrap();
+        }
+        write_file("--out", &out, b"png").unwrap();
+        assert_eq!(names(&dir), vec![other, alive, "out.png".to_string()]);
+        let _ = std::fs::remove_dir_all(&dir);
+    }
+
+    #[test]
+    fn a_legal_name_of_255_bytes_is_written_and_a_longer_one_refused_first() {
+        let dir = scratch("long");
+        let out = dir.join(format!("{}.png", "é".repeat(125) + "a")); // 255 bytes
+        assert_eq!(out.file_name().unwrap().len(), 255);
+        check_output_file("--out", &out).unwrap();
+        write_file("--out", &out, b"png").unwrap();
+        write_file("--out", &out, b"png").unwrap();
+        assert_eq!(names(&dir).len(), 1);
+        let longer = dir.join(format!("{}.png", "a".repeat(252)));
+        let e = check_output_file("--out", &longer).unwrap_err().to_string();
+        assert!(e.contains("256 bytes") && e.contains("255"), "{e}");
+        let _ = std::fs::remove_dir_all(&dir);
+    }
+
+    #[test]
+    fn a_trailing_slash_is_refused_before_any_work() {
+        let dir = scratch("slash");
+        for out in [
+            dir.join("new/"),
+            PathBuf::from(format!("{}/", dir.display())),
+        ] {
+            let e = check_output_file("--out", &out).unwrap_err().to_string();
+            assert!(e.contains("ends with '/'"), "{e}");
+        }
+        assert!(names(&dir).is_empty());
+        let _ = std::fs::remove_dir_all(&dir);
+    }
+}

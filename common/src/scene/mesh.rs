@@ -343,6 +343,7 @@ fn face_vertex(
     face: bool,
 ) -> Result<(), String> {
     const KINDS: [&str; 3] = ["vertex", "texture coordinate", "normal"];
+    const PLURAL: [&str; 3] = ["vertices", "texture coordinates", "normals"];
     let parts: Vec<&str> = word.split('/').collect();
     if parts.len() > 3 || parts[0].is_empty() {
         return Err("not a valid OBJ file: give v, v/vt, v//vn or v/vt/vn".to_string());
@@ -361,11 +362,11 @@ fn face_vertex(
         // tobj ignores a texture or normal index when the file has none of them.
         if index >= total[k] && (k == 0 || total[k] > 0) && face {
             return Err(format!(
-                "{} {} is beyond the file's {} {}s",
+                "{} {} is beyond the file's {} {}",
                 KINDS[k],
                 index + 1,
                 total[k],
-                KINDS[k]
+                PLURAL[k]
             ));
         }
         if k == 2 && face && zero_normals.contains(&index) {
