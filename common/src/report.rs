@@ -205,41 +205,36 @@ impl RunReportBuilder {
 /// Writes what `--dump-shaders DIR` promises of naga's output: the SPIR-V and
 /// the GLSL of each stage this run compiled, named `<stage>.spv` and
 /// `<stage>.glsl` (the apps add what their driver reports).
-/// Failures are bad input (exit 2) naming the folder: the user chose the place.
 pub fn dump_shaders(dir: &std::path::Path, stages: &[(&str, &[u32], &str)]) -> anyhow::Result<()> {
-    use crate::error::bad_input;
     std::fs::create_dir_all(dir).map_err(|e| {
-        bad_input(format!(
+        crate::error::bad_input(format!(
             "--dump-shaders '{}': the folder cannot be created ({e})",
             dir.display()
         ))
     })?;
     for (stage, spirv, glsl) in stages {
-        let write = |name: String, bytes: &[u8]| {
-            std::fs::write(dir.join(&name), bytes).map_err(|e| {
-                bad_input(format!(
-                    "--dump-shaders '{}': '{name}' cannot be written there ({e})",
-                    dir.display()
-                ))
-            })
-        };
-        write(format!("{stage}.spv"), bytemuck::cast_slice(spirv))?;
-        write(format!("{stage}.glsl"), glsl.as_bytes())?;
+        dump_file(dir, &format!("{stage}.spv"), bytemuck::cast_slice(spirv))?;
+        dump_file(dir, &format!("{stage}.glsl"), glsl.as_bytes())?;
     }
     Ok(())
+}
+
+/// Writes one file of `--dump-shaders DIR`. A failure (a full disk, a
+/// read-only place) is bad input (exit 2) naming the folder: the user chose it.
+pub fn dump_file(dir: &std::path::Path, name: &str, bytes: &[u8]) -> anyhow::Result<()> {
+    std::fs::write(dir.join(name), bytes).map_err(|e| {
+        crate::error::bad_input(format!(
+            "--dump-shaders '{}': '{name}' cannot be written there ({e})",
+            dir.display()
+        ))
+    })
 }
 
 /// Writes the driver's figures beside the dumped shaders as `statistics.json`.
 pub fn dump_statistics(dir: &std::path::Path, stats: &[ShaderStats]) -> anyhow::Result<()> {
     use anyhow::Context;
-    let path = dir.join("statistics.json");
     let text = serde_json::to_string_pretty(stats).context("serialising shader statistics")?;
-    std::fs::write(&path, text).map_err(|e| {
-        crate::error::bad_input(format!(
-            "--dump-shaders '{}': 'statistics.json' cannot be written there ({e})",
-            dir.display()
-        ))
-    })
+    dump_file(dir, "statistics.json", text.as_bytes())
 }
 
 /// "Debian GNU/Linux 12 (bookworm), Linux 6.1" — for reports.
