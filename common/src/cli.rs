@@ -26,7 +26,8 @@ pub struct RenderArgs {
     #[arg(long)]
     pub headless: bool,
     /// Frames to render, then exit (headless default: 1).
-    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=100_000))]
+    // Hyphen values reach parse_frames, so `-1` is refused as a count, not as an unknown option.
+    #[arg(long, value_parser = parse_frames, allow_hyphen_values = true)]
     pub frames: Option<u32>,
     /// Save the last frame as PNG (top row first, same orientation in both APIs).
     #[arg(long)]
@@ -214,6 +215,15 @@ pub fn parse_size(s: &str) -> Result<Size, String> {
     Ok(Size { width, height })
 }
 
+/// `--frames`: a whole number from 1 to 100,000 (clap prefixes the option and value).
+fn parse_frames(s: &str) -> Result<u32, String> {
+    const MAX: u32 = 100_000;
+    match s.trim().parse::<i64>() {
+        Ok(n) if (1..=MAX as i64).contains(&n) => Ok(n as u32),
+        _ => Err(format!("give a whole number of frames from 1 to {MAX}")),
+    }
+}
+
 impl RenderArgs {
     /// A headless run of `scene` at `size` with every other option at its default.
     pub fn headless(scene: &str, size: Size) -> RenderArgs {
@@ -274,6 +284,7 @@ impl RenderArgs {
     pub fn check_outputs(&self) -> anyhow::Result<()> {
         if let Some(out) = &self.out {
             crate::reference::image_io::check_output_file("--out", out)?;
+            crate::scene::load::check_output_not_input("--out", out, &self.scene)?;
         }
         Ok(())
     }

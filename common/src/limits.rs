@@ -134,6 +134,45 @@ pub fn check_storage_bytes(what: &str, count: usize, element_bytes: usize) -> an
     Ok(())
 }
 
+/// The largest storage buffer a run may bind, and whose limit it is. Scenes
+/// are checked against it while they are loaded, before a tessellation or a
+/// list of spheres is made, so that a scene no device could take costs no work;
+/// each app passes its device's own figure, the rest `ANY`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct StorageLimit {
+    pub bytes: u64,
+    /// Whose limit, as a message names it: "this device's maxStorageBufferRange".
+    pub name: &'static str,
+}
+
+impl StorageLimit {
+    /// What any device could bind: where no device is known (the reference, tools).
+    pub const ANY: StorageLimit = StorageLimit {
+        bytes: MAX_STORAGE_BUFFER_BYTES,
+        name: "twinray's 4 GiB storage-buffer limit",
+    };
+
+    /// Refuses `count` elements of `element_bytes` in the scene's `buffer`
+    /// buffer when they would not fit, in the sentence of the apps' upload check.
+    /// `what` names the source of the count (a field, `--set KEY`).
+    pub fn check(
+        &self,
+        what: &str,
+        buffer: &str,
+        count: usize,
+        element_bytes: usize,
+    ) -> anyhow::Result<()> {
+        let bytes = (count as u64).saturating_mul(element_bytes as u64);
+        if bytes > self.bytes {
+            return Err(bad_input(format!(
+                "{what}: the scene's {buffer} buffer would need {bytes} bytes for {count} {buffer}, more than {} ({} bytes); use fewer primitives",
+                self.name, self.bytes
+            )));
+        }
+        Ok(())
+    }
+}
+
 /// MemAvailable from /proc/meminfo (Linux); None where it cannot be read, in
 /// which case only the fixed limits apply.
 pub fn available_memory() -> Option<u64> {
@@ -172,20 +211,28 @@ mod tests {
         assert!(check_storage_bytes("t", MAX_TRIANGLES, size_of::<GpuTriangle>()).is_ok());
         assert!(check_storage_bytes("t", MAX_TRIANGLES + 1, size_of::<GpuTriangle>()).is_err());
     }
-}
 
-/// The largest storage buffer a run may bind, and the name of the limit that
-/// sets it: the device's own once there is one, twinray's otherwise.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub struct StorageLimit {
-    pub bytes: u64,
-    pub name: &'static str,
-}
-
-impl StorageLimit {
-    /// No device: only twinray's own limit (the f64 reference, the tests).
-    pub const ANY: StorageLimit = StorageLimit {
-        bytes: MAX_STORAGE_BUFFER_BYTES,
-        name: "twinray's storage-buffer limit",
-    };
+    #[test]
+    fn a_storage_limit_names_itself_and_the_buffer() {
+        let t = size_of::<GpuTriangle>();
+        assert!(StorageLimit::ANY
+            .check("x", "triangles", MAX_TRIANGLES, t)
+            .is_ok());
+        assert!(StorageLimit::ANY
+            .check("x", "triangles", MAX_TRIANGLES + 1, t)
+            .is_err());
+        let small = StorageLimit {
+            bytes: 1000,
+            name: "a test device's limit",
+        };
+        let e = small
+            .check("--set tessellation", "triangles", 11, 96)
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("--set tessellation") && e.contains("1056 bytes"),
+            "{e}"
+        );
+        assert!(e.contains("a test device's limit (1000 bytes)"), "{e}");
+    }
 }

@@ -220,24 +220,21 @@ impl RunReportBuilder {
 /// takes (`<stage>.source.glsl`: the variant's defines, then the tracer's parts
 /// put together). The apps add what their driver reports.
 pub fn dump_shaders(dir: &std::path::Path, stages: &[&Stage]) -> anyhow::Result<()> {
-    use anyhow::Context;
-    std::fs::create_dir_all(dir)
-        .with_context(|| format!("--dump-shaders: cannot create '{}'", dir.display()))?;
+    std::fs::create_dir_all(dir).map_err(|e| {
+        crate::error::bad_input(format!(
+            "--dump-shaders '{}': the folder cannot be created ({e})",
+            dir.display()
+        ))
+    })?;
     for stage in stages {
-        let write = |name: String, bytes: &[u8]| {
-            let path = dir.join(name);
-            std::fs::write(&path, bytes)
-                .with_context(|| format!("--dump-shaders: cannot write '{}'", path.display()))
-        };
-        write(
-            format!("{}.spv", stage.name),
+        let name = stage.name;
+        dump_file(
+            dir,
+            &format!("{name}.spv"),
             bytemuck::cast_slice(&stage.spirv),
         )?;
-        write(format!("{}.glsl", stage.name), stage.glsl.as_bytes())?;
-        write(
-            format!("{}.source.glsl", stage.name),
-            stage.source.as_bytes(),
-        )?;
+        dump_file(dir, &format!("{name}.glsl"), stage.glsl.as_bytes())?;
+        dump_file(dir, &format!("{name}.source.glsl"), stage.source.as_bytes())?;
     }
     Ok(())
 }
@@ -276,13 +273,22 @@ pub fn timed_frames(
     Ok((frames, setup_ms))
 }
 
+/// Writes one file of `--dump-shaders DIR`. A failure (a full disk, a
+/// read-only place) is bad input (exit 2) naming the folder: the user chose it.
+pub fn dump_file(dir: &std::path::Path, name: &str, bytes: &[u8]) -> anyhow::Result<()> {
+    std::fs::write(dir.join(name), bytes).map_err(|e| {
+        crate::error::bad_input(format!(
+            "--dump-shaders '{}': '{name}' cannot be written there ({e})",
+            dir.display()
+        ))
+    })
+}
+
 /// Writes the driver's figures beside the dumped shaders as `statistics.json`.
 pub fn dump_statistics(dir: &std::path::Path, stats: &[ShaderStats]) -> anyhow::Result<()> {
     use anyhow::Context;
-    let path = dir.join("statistics.json");
     let text = serde_json::to_string_pretty(stats).context("serialising shader statistics")?;
-    std::fs::write(&path, text)
-        .with_context(|| format!("--dump-shaders: cannot write '{}'", path.display()))
+    dump_file(dir, "statistics.json", text.as_bytes())
 }
 
 /// "Debian GNU/Linux 12 (bookworm), Linux 6.1" — for reports.

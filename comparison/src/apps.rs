@@ -6,7 +6,7 @@ use std::path::PathBuf;
 use std::process::Command;
 use std::sync::OnceLock;
 use std::time::Instant;
-use twinray_common::cli::RenderArgs;
+use twinray_common::cli::{RenderArgs, RenderPath};
 use twinray_common::error::{bad_input, Failure, FailureKind};
 use twinray_common::report::{DeviceInfo, FrameTime, RunReport};
 use twinray_common::scene::accel::Accel;
@@ -271,6 +271,13 @@ pub fn render_reference(args: &RenderArgs) -> anyhow::Result<()> {
     }
     // The reference takes the apps' options; one that cannot apply is refused as they refuse it.
     args.compute_workgroup()?;
+    let ignored = gpu_only_options(args);
+    if !ignored.is_empty() {
+        return Err(bad_input(format!(
+            "render --api reference does not take {}: the f64 reference renders one frame on the CPU, with no shader or GPU path to apply them to",
+            ignored.join(", ")
+        )));
+    }
     args.check_outputs()?;
     let scene = Scene::load(&args.scene, &args.overrides()?)?;
     let (w, h) = (args.size.width, args.size.height);
@@ -304,6 +311,53 @@ pub fn render_reference(args: &RenderArgs) -> anyhow::Result<()> {
         report.print_json()?;
     }
     Ok(())
+}
+
+/// The options given that the reference cannot honour (it honours the scene,
+/// size, output, JSON, ray counts, `--set` and `--accel`). Destructured field
+/// by field, like `app_args`, so that a new option is sorted here before it compiles.
+fn gpu_only_options(args: &RenderArgs) -> Vec<&'static str> {
+    let RenderArgs {
+        scene: _,
+        size: _,
+        headless: _,
+        frames,
+        out: _,
+        json: _,
+        count_rays: _,
+        set: _,
+        validate,
+        generic,
+        specialize,
+        accel: _,
+        gl_spirv,
+        vsync,
+        explain,
+        path,
+        workgroup,
+        shared_pad,
+        experiment,
+        experiments,
+        dump_shaders,
+    } = args;
+    [
+        (frames.is_some_and(|f| f > 1), "--frames above 1"),
+        (*validate, "--validate"),
+        (*generic, "--generic"),
+        (*specialize, "--specialize"),
+        (*gl_spirv, "--gl-spirv"),
+        (*vsync, "--vsync"),
+        (*explain, "--explain"),
+        (*path == RenderPath::Compute, "--path compute"),
+        (workgroup.is_some(), "--workgroup"),
+        (shared_pad.is_some(), "--shared-pad"),
+        (!experiment.is_empty(), "--experiment"),
+        (*experiments, "--experiments"),
+        (dump_shaders.is_some(), "--dump-shaders"),
+    ]
+    .into_iter()
+    .filter_map(|(given, name)| given.then_some(name))
+    .collect()
 }
 
 /// The reference render, with a progress bar on stderr once it has run for a

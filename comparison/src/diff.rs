@@ -8,6 +8,15 @@ pub fn run(a: &Path, b: &Path, json: bool, heatmap: Option<&Path>) -> anyhow::Re
     // Checked first: a bad --heatmap path is said before any image is read.
     if let Some(path) = heatmap {
         twinray_common::reference::image_io::check_output_file("--heatmap", path)?;
+        for input in [a, b] {
+            if twinray_common::reference::image_io::same_file(path, input) {
+                return Err(twinray_common::error::bad_input(format!(
+                    "--heatmap '{}' is the input image '{}': writing it would replace an input; choose another file name",
+                    path.display(),
+                    input.display()
+                )));
+            }
+        }
     }
     let (ia, ib) = (load_png(a)?, load_png(b)?);
     let m = compare(&ia, &ib).map_err(|e| {

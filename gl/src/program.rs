@@ -198,9 +198,7 @@ pub fn dump_binary(
         unsafe { gl.get_program_binary(program) }
     };
     if let Some(b) = binary.filter(|b| !b.buffer.is_empty()) {
-        let path = dir.join(format!("{name}.bin"));
-        std::fs::write(&path, &b.buffer)
-            .with_context(|| format!("--dump-shaders: cannot write '{}'", path.display()))?;
+        twinray_common::report::dump_file(dir, &format!("{name}.bin"), &b.buffer)?;
         statistics.push((
             "program binary bytes".to_string(),
             b.buffer.len().to_string(),

@@ -6,6 +6,7 @@ use crate::gpu::layout::{
     binding, Bvh, GpuBvhNode, GpuBvhPrim, GpuFrame, GpuLight, GpuMaterial, GpuSphere, GpuTriangle,
     PRIM_SPHERE_BIT,
 };
+use crate::limits::StorageLimit;
 use crate::scene::camera::{in_local_frame, RayFrame};
 use crate::scene::{Camera, Scene};
 use bytemuck::Pod;
@@ -203,9 +204,9 @@ pub fn storage_name(binding: u32) -> &'static str {
 }
 
 /// A clear bad-input error when the scene's largest buffer exceeds the device limit.
-pub fn check_storage_limit(gpu: &GpuScene, limit: u64, limit_name: &str) -> anyhow::Result<()> {
+pub fn check_storage_limit(gpu: &GpuScene, limit: &StorageLimit) -> anyhow::Result<()> {
     let (b, n) = gpu.largest_storage();
-    if n as u64 > limit {
+    if n as u64 > limit.bytes {
         // The BVH's buffers are the largest only when it is on, and brute
         // force needs less for the same scene.
         let remedy = match b {
@@ -215,8 +216,10 @@ pub fn check_storage_limit(gpu: &GpuScene, limit: u64, limit_name: &str) -> anyh
             _ => "use fewer primitives",
         };
         return Err(crate::error::bad_input(format!(
-            "the scene's {} buffer needs {n} bytes, more than this device's {limit_name} limit of {limit} bytes; {remedy}",
-            storage_name(b)
+            "the scene's {} buffer needs {n} bytes, more than {} ({} bytes); {remedy}",
+            storage_name(b),
+            limit.name,
+            limit.bytes
         )));
     }
     Ok(())

@@ -135,7 +135,7 @@ impl Planner {
         limit: &StorageLimit,
         (width, height): (u32, u32),
     ) -> anyhow::Result<RunPlan> {
-        let scene = Scene::load(name, overrides)?;
+        let scene = Scene::load_limited(name, overrides, limit)?;
         explain::numbered(0, "Scene (twinray-common)", || {
             format!(
                 "{}: {} spheres, {} triangles, {} lights",
@@ -163,7 +163,7 @@ impl Planner {
         };
         let variant = self.variant(&scene, bvh.as_ref(), path);
         let gpu = GpuScene::new(&scene, bvh.as_ref(), width, height);
-        check_storage_limit(&gpu, limit.bytes, limit.name)?;
+        check_storage_limit(&gpu, limit)?;
         let shaders = PathShaders::build(&variant)?;
         let target = match self.api {
             Api::Vulkan => "SPIR-V",

@@ -1,8 +1,9 @@
 //! Float images (what the tracer writes before quantisation), their conversion
 //! to 8-bit PNG — identical for both APIs and the reference — PNG loading, and
 //! the one way every output file is written: checked before the render, encoded
-//! in memory, written beside the target, synced and renamed, so that a failed
-//! write never leaves a truncated or empty file behind.
+//! in memory, written beside the target under a recognisable temporary name,
+//! synced and renamed, so that a failed write never leaves a truncated or empty
+//! file behind and an interrupted one leaves a name the next write removes.
 
 use crate::error::bad_input;
 use image::ImageEncoder as _;
@@ -113,6 +114,11 @@ pub fn write_png(img: &image::RgbImage, option: &str, path: &Path) -> anyhow::Re
 /// over the target (atomic on one file system). `option` names the option the
 /// path came from in the error. Errors are bad input (exit 2): the user chose the
 /// place, and on a full or read-only disk only the user can choose another.
+///
+/// An existing target keeps its permission bits. Its other hard links, if it
+/// has any, keep the previous contents: the rename gives the name a new file,
+/// and writing in place to keep the links would give up the promise that a
+/// failed write leaves the old image whole.
 pub fn write_file(option: &str, path: &Path, bytes: &[u8]) -> anyhow::Result<()> {
     let target = check_output_file(option, path)?;
     let fail = |what: &str, e: std::io::Error| {
@@ -121,6 +127,7 @@ pub fn write_file(option: &str, path: &Path, bytes: &[u8]) -> anyhow::Result<()>
             path.display()
         ))
     };
+    remove_stale_temps(&target);
     let tmp = temp_beside(&target);
     let result = (|| {
         let mut f = std::fs::OpenOptions::new()
@@ -132,6 +139,10 @@ pub fn write_file(option: &str, path: &Path, bytes: &[u8]) -> anyhow::Result<()>
         f.flush().map_err(|e| fail("flushing", e))?;
         f.sync_all().map_err(|e| fail("syncing to disk", e))?;
         drop(f);
+        if let Ok(meta) = std::fs::metadata(&target) {
+            std::fs::set_permissions(&tmp, meta.permissions())
+                .map_err(|e| fail("keeping the file's permissions", e))?;
+        }
         std::fs::rename(&tmp, &target).map_err(|e| fail("renaming the temporary file", e))
     })();
     if result.is_err() {
@@ -146,16 +157,108 @@ pub fn write_file(option: &str, path: &Path, bytes: &[u8]) -> anyhow::Result<()>
     result
 }
 
-/// A hidden name in the target's folder, unique to this process and write.
-fn temp_beside(target: &Path) -> PathBuf {
-    use std::sync::atomic::{AtomicU32, Ordering};
-    static N: AtomicU32 = AtomicU32::new(0);
+/// The longest file name most file systems take (Linux's NAME_MAX).
+const NAME_MAX: usize = 255;
+
+/// What `.STEM.PID.N.tmp` adds to the stem at most: a dot, two dots and up to
+/// ten digits each, `.tmp`.
+const TEMP_EXTRA: usize = 1 + 2 * (1 + 10) + 4;
+
+/// The stem of the target's temporary names: the target's own name, or, where
+/// that would take the temporary name past `NAME_MAX`, its start and a hash of
+/// the whole, so that a legal name of 255 bytes still gets a temporary one.
+fn temp_stem(target: &Path) -> String {
     let name = target
         .file_name()
         .map(|n| n.to_string_lossy().to_string())
         .unwrap_or_default();
+    if name.len() + TEMP_EXTRA <= NAME_MAX {
+        return name;
+    }
+    // FNV-1a: stable across runs and builds, so a later write finds the stem again.
+    let hash = name.bytes().fold(0xcbf2_9ce4_8422_2325_u64, |h, b| {
+        (h ^ b as u64).wrapping_mul(0x0100_0000_01b3)
+    });
+    let mut cut = NAME_MAX - TEMP_EXTRA - 17;
+    while !name.is_char_boundary(cut) {
+        cut -= 1;
+    }
+    format!("{}~{hash:016x}", &name[..cut])
+}
+
+/// A hidden name in the target's folder, unique to this process and write:
+/// `.STEM.PID.N.tmp`, which `remove_stale_temps` recognises.
+fn temp_beside(target: &Path) -> PathBuf {
+    use std::sync::atomic::{AtomicU32, Ordering};
+    static N: AtomicU32 = AtomicU32::new(0);
     let n = N.fetch_add(1, Ordering::Relaxed);
-    target.with_file_name(format!(".{name}.{}.{n}.tmp", std::process::id()))
+    target.with_file_name(format!(
+        ".{}.{}.{n}.tmp",
+        temp_stem(target),
+        std::process::id()
+    ))
+}
+
+/// Removes the target's temporary files that a killed writer left: those named
+/// `.STEM.PID.N.tmp` whose process is gone. A live writer's file is left alone.
+/// Best effort: a file that cannot be removed costs nothing but its space.
+fn remove_stale_temps(target: &Path) {
+    let Some(dir) = target.parent() else { return };
+    let dir = if dir.as_os_str().is_empty() {
+        Path::new(".")
+    } else {
+        dir
+    };
+    let prefix = format!(".{}.", temp_stem(target));
+    let Ok(entries) = std::fs::read_dir(dir) else {
+        return;
+    };
+    for entry in entries.flatten() {
+        let name = entry.file_name().to_string_lossy().to_string();
+        let Some(rest) = name
+            .strip_prefix(&prefix)
+            .and_then(|r| r.strip_suffix(".tmp"))
+        else {
+            continue;
+        };
+        let Some((pid, n)) = rest.split_once('.') else {
+            continue;
+        };
+        let digits = |s: &str| !s.is_empty() && s.bytes().all(|b| b.is_ascii_digit());
+        if digits(pid) && digits(n) && !process_alive(pid) {
+            let _ = std::fs::remove_file(entry.path());
+        }
+    }
+}
+
+/// Whether process `pid` (decimal) is running; where that cannot be known
+/// (no /proc), it is taken to be, so that nothing is removed on a guess.
+fn process_alive(pid: &str) -> bool {
+    if pid == std::process::id().to_string() {
+        return true;
+    }
+    let proc = Path::new("/proc");
+    !proc.join("self").exists() || proc.join(pid).exists()
+}
+
+/// Whether two paths name one existing file, through links and other
+/// spellings of the path: on Unix the same device and inode.
+pub fn same_file(a: &Path, b: &Path) -> bool {
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::MetadataExt;
+        match (std::fs::metadata(a), std::fs::metadata(b)) {
+            (Ok(x), Ok(y)) => x.dev() == y.dev() && x.ino() == y.ino(),
+            _ => false,
+        }
+    }
+    #[cfg(not(unix))]
+    {
+        match (std::fs::canonicalize(a), std::fs::canonicalize(b)) {
+            (Ok(x), Ok(y)) => x == y,
+            _ => false,
+        }
+    }
 }
 
 /// Checks, before any work is spent, that a file can be written at `path`: it is
@@ -166,6 +269,13 @@ pub fn check_output_file(option: &str, path: &Path) -> anyhow::Result<PathBuf> {
     let shown = path.display();
     if path.as_os_str().is_empty() {
         return Err(bad_input(format!("{option} is empty; give a file name")));
+    }
+    // Path drops a trailing slash ("out/" has the file name "out"), and the
+    // rename after the render would then fail on it.
+    if path.to_string_lossy().ends_with('/') {
+        return Err(bad_input(format!(
+            "{option} '{shown}' ends with '/', which names a folder; give a file name"
+        )));
     }
     let target = match std::fs::metadata(path) {
         Ok(meta) if meta.is_dir() => {
@@ -182,16 +292,23 @@ pub fn check_output_file(option: &str, path: &Path) -> anyhow::Result<PathBuf> {
         Ok(_) => std::fs::canonicalize(path).unwrap_or_else(|_| path.to_path_buf()),
         Err(_) => path.to_path_buf(),
     };
-    if target.file_name().is_none() {
+    let Some(name) = target.file_name() else {
         return Err(bad_input(format!(
             "{option} '{shown}' names no file; give a file name"
+        )));
+    };
+    if name.len() > NAME_MAX {
+        return Err(bad_input(format!(
+            "{option} '{shown}': the file name is {} bytes, more than the limit of {NAME_MAX}",
+            name.len()
         )));
     }
     let dir = match target.parent().filter(|d| !d.as_os_str().is_empty()) {
         Some(d) => d.to_path_buf(),
         None => PathBuf::from("."),
     };
-    check_writable_dir(option, &shown.to_string(), &dir)?;
+    // Probed with the very temporary name the write will use.
+    check_writable_dir(option, &shown.to_string(), &dir, &temp_beside(&target))?;
     Ok(target)
 }
 
@@ -209,26 +326,30 @@ pub fn prepare_output_dir(option: &str, dir: &Path) -> anyhow::Result<()> {
             "{option} '{shown}': the folder cannot be created ({e})"
         ))
     })?;
-    check_writable_dir(option, &shown.to_string(), dir)
+    check_writable_dir(
+        option,
+        &shown.to_string(),
+        dir,
+        &temp_beside(&dir.join("probe")),
+    )
 }
 
-/// Proves that `dir` exists and accepts a new file by creating and removing one
-/// (permission bits alone miss read-only mounts and ACLs).
-fn check_writable_dir(option: &str, shown: &str, dir: &Path) -> anyhow::Result<()> {
+/// Proves that `dir` exists and accepts a new file by creating and removing
+/// `probe` in it (permission bits alone miss read-only mounts and ACLs).
+fn check_writable_dir(option: &str, shown: &str, dir: &Path, probe: &Path) -> anyhow::Result<()> {
     if !dir.is_dir() {
         return Err(bad_input(format!(
             "{option} '{shown}': folder '{}' does not exist",
             dir.display()
         )));
     }
-    let probe = temp_beside(&dir.join("probe"));
     match std::fs::OpenOptions::new()
         .write(true)
         .create_new(true)
-        .open(&probe)
+        .open(probe)
     {
         Ok(_) => {
-            let _ = std::fs::remove_file(&probe);
+            let _ = std::fs::remove_file(probe);
             Ok(())
         }
         Err(e) => Err(bad_input(format!(
@@ -252,4 +373,84 @@ pub fn load_png(path: &Path) -> anyhow::Result<image::RgbImage> {
         ))
     })?;
     Ok(img.to_rgb8())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn scratch(name: &str) -> PathBuf {
+        let dir = std::env::temp_dir().join(format!("twinray-io-{name}-{}", std::process::id()));
+        let _ = std::fs::remove_dir_all(&dir);
+        std::fs::create_dir_all(&dir).unwrap();
+        dir
+    }
+
+    fn names(dir: &Path) -> Vec<String> {
+        let mut v: Vec<String> = std::fs::read_dir(dir)
+            .unwrap()
+            .map(|e| e.unwrap().file_name().to_string_lossy().to_string())
+            .collect();
+        v.sort();
+        v
+    }
+
+    #[test]
+    fn a_rewrite_keeps_the_targets_mode() {
+        use std::os::unix::fs::PermissionsExt;
+        let dir = scratch("mode");
+        let out = dir.join("out.png");
+        write_file("--out", &out, b"one").unwrap();
+        std::fs::set_permissions(&out, std::fs::Permissions::from_mode(0o600)).unwrap();
+        write_file("--out", &out, b"two").unwrap();
+        let mode = std::fs::metadata(&out).unwrap().permissions().mode() & 0o777;
+        assert_eq!(mode, 0o600, "{mode:o}");
+        assert_eq!(std::fs::read(&out).unwrap(), b"two");
+        let _ = std::fs::remove_dir_all(&dir);
+    }
+
+    #[test]
+    fn a_write_removes_the_temporary_files_of_dead_writers_only() {
+        let dir = scratch("stale");
+        let out = dir.join("out.png");
+        // PIDs stop below 2^22 on Linux, so this writer cannot be alive; PID 1 always is.
+        let dead = format!(".out.png.{}.3.tmp", 1u64 << 40);
+        let alive = ".out.png.1.0.tmp".to_string();
+        let other = ".other.png.99999999999.0.tmp".to_string();
+        for name in [&dead, &alive, &other] {
+            std::fs::write(dir.join(name), b"partial").unwrap();
+        }
+        write_file("--out", &out, b"png").unwrap();
+        assert_eq!(names(&dir), vec![other, alive, "out.png".to_string()]);
+        let _ = std::fs::remove_dir_all(&dir);
+    }
+
+    #[test]
+    fn a_legal_name_of_255_bytes_is_written_and_a_longer_one_refused_first() {
+        let dir = scratch("long");
+        let out = dir.join(format!("{}.png", "é".repeat(125) + "a")); // 255 bytes
+        assert_eq!(out.file_name().unwrap().len(), 255);
+        check_output_file("--out", &out).unwrap();
+        write_file("--out", &out, b"png").unwrap();
+        write_file("--out", &out, b"png").unwrap();
+        assert_eq!(names(&dir).len(), 1);
+        let longer = dir.join(format!("{}.png", "a".repeat(252)));
+        let e = check_output_file("--out", &longer).unwrap_err().to_string();
+        assert!(e.contains("256 bytes") && e.contains("255"), "{e}");
+        let _ = std::fs::remove_dir_all(&dir);
+    }
+
+    #[test]
+    fn a_trailing_slash_is_refused_before_any_work() {
+        let dir = scratch("slash");
+        for out in [
+            dir.join("new/"),
+            PathBuf::from(format!("{}/", dir.display())),
+        ] {
+            let e = check_output_file("--out", &out).unwrap_err().to_string();
+            assert!(e.contains("ends with '/'"), "{e}");
+        }
+        assert!(names(&dir).is_empty());
+        let _ = std::fs::remove_dir_all(&dir);
+    }
 }

@@ -2,7 +2,8 @@
 //! or `random:SEED`, parsed and handed to `resolve` with the `--set` overrides.
 
 use crate::error::bad_input;
-use crate::limits;
+use crate::limits::{self, StorageLimit};
+use crate::reference::image_io::same_file;
 use crate::scene::format::SceneFile;
 use crate::scene::mesh::{line_col, read_file, FileSource};
 use crate::scene::overrides::apply_overrides;
@@ -23,6 +24,17 @@ pub const BUILTIN_SCENES: &[(&str, &str)] = &[
 impl Scene {
     /// Loads a built-in scene by name, or a scene file by path, and applies `--set` overrides.
     pub fn load(name_or_path: &str, overrides: &[(String, String)]) -> anyhow::Result<Scene> {
+        Scene::load_limited(name_or_path, overrides, &StorageLimit::ANY)
+    }
+
+    /// `load` for a device that binds at most `limit` per storage buffer: a
+    /// tessellation, an OBJ's faces or `extra_spheres` that would not fit are
+    /// refused from their count, before they are made.
+    pub fn load_limited(
+        name_or_path: &str,
+        overrides: &[(String, String)],
+        limit: &StorageLimit,
+    ) -> anyhow::Result<Scene> {
         if let Some(seed) = random::seed_of(name_or_path) {
             let seed = seed?;
             return Scene::parse(
@@ -31,6 +43,7 @@ impl Scene {
                 &format!("random scene {seed}"),
                 FileSource::Builtin,
                 overrides,
+                limit,
             );
         }
         if let Some((name, text)) = BUILTIN_SCENES.iter().find(|(n, _)| *n == name_or_path) {
@@ -40,10 +53,13 @@ impl Scene {
                 &format!("built-in scene '{name}'"),
                 FileSource::Builtin,
                 overrides,
+                limit,
             );
         }
         let path = Path::new(name_or_path);
-        if !path.exists() {
+        // Only a missing file is "does not exist"; a loop of links or a
+        // forbidden folder is said by `read_file` in its own words.
+        if std::fs::metadata(path).is_err_and(|e| e.kind() == std::io::ErrorKind::NotFound) {
             let names: Vec<&str> = BUILTIN_SCENES.iter().map(|(n, _)| *n).collect();
             if path.extension().is_none() && !name_or_path.contains('/') {
                 return Err(bad_input(format!(
@@ -72,6 +88,7 @@ impl Scene {
             &format!("scene file '{name_or_path}'"),
             FileSource::Dir(dir),
             overrides,
+            limit,
         )
     }
 
@@ -88,6 +105,7 @@ impl Scene {
             &format!("scene '{name}'"),
             FileSource::Dir(dir.to_path_buf()),
             overrides,
+            &StorageLimit::ANY,
         )
     }
 
@@ -121,6 +139,7 @@ impl Scene {
         origin: &str,
         files: FileSource,
         overrides: &[(String, String)],
+        limit: &StorageLimit,
     ) -> anyhow::Result<Scene> {
         let mut def: SceneFile = toml::from_str(text).map_err(|e| {
             let (line, col) = e.span().map(|s| line_col(text, s.start)).unwrap_or((1, 1));
@@ -128,6 +147,204 @@ impl Scene {
             bad_input(format!("{origin}, line {line}, column {col}: {msg}"))
         })?;
         let set = apply_overrides(&mut def, overrides)?;
-        resolve(name, def, &Labels { origin, set }, &files)
+        resolve(name, def, &Labels { origin, set }, &files, limit)
+    }
+}
+
+/// Refuses an output path (`option`, e.g. `--out`) that names the scene file
+/// `name_or_path` or a mesh file it loads: the write would replace an input
+/// with a PNG. Compared as files, so a link or another spelling of the same
+/// path is caught too. Cheap, and meant for before any work: a scene that
+/// cannot be read or parsed is left to `Scene::load` to refuse in its words.
+pub fn check_output_not_input(option: &str, out: &Path, name_or_path: &str) -> anyhow::Result<()> {
+    if random::seed_of(name_or_path).is_some()
+        || BUILTIN_SCENES.iter().any(|(n, _)| *n == name_or_path)
+    {
+        return Ok(());
+    }
+    let scene = Path::new(name_or_path);
+    let mut inputs = vec![("the scene file".to_string(), scene.to_path_buf())];
+    let def = read_file("", scene, limits::MAX_SCENE_FILE_BYTES)
+        .ok()
+        .and_then(|text| toml::from_str::<SceneFile>(&text).ok());
+    if let Some(def) = def {
+        let dir = scene.parent().unwrap_or(Path::new(""));
+        for (i, m) in def.meshes.iter().enumerate() {
+            for file in m.obj.iter().chain(&m.bpt) {
+                inputs.push((format!("the mesh of meshes[{i}]"), dir.join(file)));
+            }
+        }
+    }
+    match inputs.into_iter().find(|(_, input)| same_file(out, input)) {
+        Some((what, input)) => Err(bad_input(format!(
+            "{option} '{}' is {what} '{}': writing it would replace an input; choose another file name",
+            out.display(),
+            input.display()
+        ))),
+        None => Ok(()),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use std::time::Instant;
+
+    /// A device that binds 100 MB per storage buffer: a million triangles.
+    const SMALL: StorageLimit = StorageLimit {
+        bytes: 100 << 20,
+        name: "a test device's limit",
+    };
+
+    fn scratch(name: &str) -> std::path::PathBuf {
+        let dir = std::env::temp_dir().join(format!("twinray-load-{name}-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        dir
+    }
+
+    fn message(r: anyhow::Result<Scene>) -> String {
+        let e = r.expect_err("refused");
+        assert_eq!(crate::error::exit_code_of(&e), 2, "{e}");
+        e.to_string()
+    }
+
+    #[test]
+    fn a_tessellation_beyond_the_device_limit_is_refused_before_it_is_made() {
+        let set = [("tessellation".to_string(), "400x400".to_string())];
+        let t = Instant::now();
+        let e = message(Scene::load_limited("teapot", &set, &SMALL));
+        // Tessellating 10.2 million triangles takes seconds; counting them, nothing.
+        assert!(t.elapsed().as_secs_f64() < 0.5, "{:?}", t.elapsed());
+        for word in [
+            "--set tessellation = 400x400",
+            "32 patches",
+            "a test device's limit",
+        ] {
+            assert!(e.contains(word), "lacks '{word}': {e}");
+        }
+        let set = [("tessellation".to_string(), "20x15".to_string())];
+        assert!(Scene::load_limited("teapot", &set, &SMALL).is_ok());
+    }
+
+    #[test]
+    fn extra_spheres_beyond_the_device_limit_are_refused_before_they_are_made() {
+        let set = [("extra_spheres".to_string(), "9000000".to_string())];
+        let e = message(Scene::load_limited("spherelist", &set, &SMALL));
+        assert!(
+            e.contains("--set extra_spheres") && e.contains("a test device's limit"),
+            "{e}"
+        );
+        assert!(Scene::load("spherelist", &set).is_ok());
+    }
+
+    fn obj_scene(dir: &Path, obj: &[u8]) -> String {
+        std::fs::write(dir.join("mesh.obj"), obj).unwrap();
+        let scene = dir.join("scene.toml");
+        std::fs::write(
+            &scene,
+            "[camera]\neye = [0.0, 0.0, 5.0]\nlook_at = [0.0, 0.0, 0.0]\n\
+             [[materials]]\nname = \"m\"\n[[meshes]]\nobj = \"mesh.obj\"\nmaterial = \"m\"\n",
+        )
+        .unwrap();
+        scene.to_str().unwrap().to_string()
+    }
+
+    #[test]
+    fn a_polygon_is_counted_from_its_line_before_tobj_expands_it() {
+        let dir = scratch("polygon");
+        // One face of 2 million vertices (4 MB): 2 million triangles, twice SMALL.
+        let mut obj = b"v 0 0 0\nv 1 0 0\nv 0 1 0\n# a fan\nf ".to_vec();
+        obj.extend(b"1 2 3 ".repeat(2_000_000 / 3));
+        let scene = obj_scene(&dir, &obj);
+        let t = Instant::now();
+        let e = message(Scene::load_limited(&scene, &[], &SMALL));
+        assert!(t.elapsed().as_secs_f64() < 1.0, "{:?}", t.elapsed());
+        assert!(
+            e.contains("mesh.obj', line 5") && e.contains("a test device's limit"),
+            "{e}"
+        );
+        let _ = std::fs::remove_dir_all(&dir);
+    }
+
+    #[test]
+    fn obj_errors_name_their_line_and_a_byte_order_mark_is_read_past() {
+        let dir = scratch("obj-lines");
+        let tri = "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n";
+        let scene = obj_scene(&dir, format!("\u{feff}{tri}").as_bytes());
+        assert_eq!(Scene::load(&scene, &[]).unwrap().triangles.len(), 1);
+        for (obj, words) in [
+            (
+                "v 0 0 0\nv 1 0 0\nv 0 1 0\n\nf 1 2 7\n",
+                &["line 5", "vertex 7", "3 vertices"][..],
+            ),
+            ("v 0 0 0\nv 1 x 0\n", &["line 2", "`v` needs three numbers"]),
+            (
+                "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 0\n",
+                &["line 4", "start at 1"],
+            ),
+            (
+                "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 -4\n",
+                &["line 4", "counts back"],
+            ),
+            (
+                "v 0 0 0\nv 1 0 0\nvn 0 0 0\nv 0 1 0\nf 1//1 2//1 3//1\n",
+                &["line 5", "normal 1 has zero length"],
+            ),
+            (
+                "v 0 0 0\nv 1e39 0 0\n",
+                &["line 2", "vertex 2", "not finite"],
+            ),
+            ("v 0 0 0 0\n", &["line 1", "w must be"]),
+            (
+                "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1/2/3/4 2 3\n",
+                &["line 4", "'1/2/3/4'"],
+            ),
+        ] {
+            let scene = obj_scene(&dir, obj.as_bytes());
+            let e = message(Scene::load(&scene, &[]));
+            for word in words {
+                assert!(e.contains(word), "{obj:?}: lacks '{word}': {e}");
+            }
+        }
+        let _ = std::fs::remove_dir_all(&dir);
+    }
+
+    #[test]
+    fn an_output_may_not_name_the_scene_or_its_mesh() {
+        let dir = scratch("clobber");
+        let scene = obj_scene(&dir, b"v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n");
+        let other = dir.join("sub/../scene.toml");
+        std::fs::create_dir_all(dir.join("sub")).unwrap();
+        for (out, words) in [
+            (
+                Path::new(&scene).to_path_buf(),
+                ["the scene file", "scene.toml"],
+            ),
+            (other, ["the scene file", "scene.toml"]),
+            (dir.join("mesh.obj"), ["the mesh of meshes[0]", "mesh.obj"]),
+        ] {
+            let e = check_output_not_input("--out", &out, &scene).unwrap_err();
+            for word in words {
+                assert!(e.to_string().contains(word), "{e}");
+            }
+        }
+        assert!(check_output_not_input("--out", &dir.join("image.png"), &scene).is_ok());
+        assert!(check_output_not_input("--out", &dir.join("scene.toml"), "box").is_ok());
+        let _ = std::fs::remove_dir_all(&dir);
+    }
+
+    #[test]
+    fn a_loop_of_links_is_named_as_a_loop() {
+        let dir = scratch("loop");
+        let (a, b) = (dir.join("a.toml"), dir.join("b.toml"));
+        let _ = (std::fs::remove_file(&a), std::fs::remove_file(&b));
+        std::os::unix::fs::symlink(&b, &a).unwrap();
+        std::os::unix::fs::symlink(&a, &b).unwrap();
+        let e = message(Scene::load(a.to_str().unwrap(), &[]));
+        assert!(
+            e.contains("loop of symbolic links") && e.contains("a.toml"),
+            "{e}"
+        );
+        let _ = std::fs::remove_dir_all(&dir);
     }
 }

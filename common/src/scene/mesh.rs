@@ -1,12 +1,15 @@
 //! The files a scene names: the built-in ones embedded in the binary, any file
-//! read within its size limit, OBJ meshes through tobj and Bezier-patch (.bpt)
-//! meshes tessellated by `teapot`.
+//! read within its size limit, OBJ meshes (each line checked and every face's
+//! triangles counted here, then read by tobj) and Bezier-patch (.bpt) meshes
+//! tessellated by `teapot` — both counted against the limits before they are made.
 
 use crate::error::bad_input;
-use crate::limits;
+use crate::gpu::layout::GpuTriangle;
+use crate::limits::{self, StorageLimit};
 use crate::scene::check::{coord3, coord_ok, unit_normal};
 use crate::scene::teapot;
 use glam::DVec3;
+use std::collections::HashSet;
 use std::path::{Path, PathBuf};
 
 /// Files the built-in scenes name, embedded in the binary.
@@ -41,7 +44,7 @@ pub(super) type ObjTriangle = ([DVec3; 3], Option<[DVec3; 3]>);
 /// UTF-8 (with the line and column of the first bad byte).
 pub fn read_file(what: &str, path: &Path, max: u64) -> anyhow::Result<String> {
     use std::io::Read;
-    let cannot = |e: std::io::Error| bad_input(format!("{what} cannot be read: {e}"));
+    let cannot = |e: std::io::Error| bad_input(format!("{what} cannot be read: {}", io_reason(&e)));
     let meta = std::fs::metadata(path).map_err(cannot)?;
     if !meta.is_file() {
         return Err(bad_input(format!(
@@ -65,7 +68,7 @@ pub fn read_file(what: &str, path: &Path, max: u64) -> anyhow::Result<String> {
     if bytes.len() as u64 > max {
         return Err(too_big());
     }
-    String::from_utf8(bytes).map_err(|e| {
+    let mut text = String::from_utf8(bytes).map_err(|e| {
         let bad = e.utf8_error().valid_up_to();
         let good = std::str::from_utf8(&e.as_bytes()[..bad]).unwrap_or("");
         let (line, col) = line_col(good, good.len());
@@ -73,7 +76,28 @@ pub fn read_file(what: &str, path: &Path, max: u64) -> anyhow::Result<String> {
             "{what}, line {line}, column {col}: not UTF-8 text (byte 0x{:02x})",
             e.as_bytes()[bad]
         ))
-    })
+    })?;
+    // Editors on Windows start UTF-8 files with a byte-order mark; kept, it
+    // would glue itself to the first keyword (`\u{feff}v`) and hide that line.
+    if text.starts_with('\u{feff}') {
+        text.drain(..'\u{feff}'.len_utf8());
+    }
+    Ok(text)
+}
+
+/// Linux's ELOOP: std has no stable `ErrorKind` for it.
+const ELOOP: i32 = 40;
+
+/// Why a file could not be opened, in words: a loop of symbolic links is said
+/// as one, not as the "does not exist" that a plain existence test reports.
+pub fn io_reason(e: &std::io::Error) -> String {
+    if cfg!(target_os = "linux") && e.raw_os_error() == Some(ELOOP) {
+        return "it is a loop of symbolic links (ELOOP)".to_string();
+    }
+    if e.kind() == std::io::ErrorKind::NotFound {
+        return "it does not exist".to_string();
+    }
+    e.to_string()
 }
 
 /// The text of a file a scene names: built in, or next to the scene file.
@@ -96,13 +120,15 @@ fn read_text(what: &str, file: &str, files: &FileSource) -> anyhow::Result<Strin
 }
 
 /// Newell-style Bezier patches, tessellated as twinray-gen-teapot does.
-/// `t_at` names the tessellation's source; `room` is how many triangles may still be added.
+/// `t_at` names the tessellation's source; `before` is how many triangles the
+/// scene holds already. The triangles are counted, against the triangle limit
+/// and `limit`, before any is made.
 pub(super) fn load_bpt(
     at: &str,
     t_at: &str,
     file: &str,
     [nu, nv]: [u32; 2],
-    room: usize,
+    (before, limit): (usize, &StorageLimit),
     files: &FileSource,
 ) -> anyhow::Result<Vec<ObjTriangle>> {
     let max = limits::MAX_TESSELLATION;
@@ -114,17 +140,17 @@ pub(super) fn load_bpt(
     let text = read_text(&format!("{at}.bpt"), file, files)?;
     let patches = teapot::parse_bpt(&text)
         .map_err(|e| bad_input(format!("{at}.bpt '{file}' is not a valid patch file: {e}")))?;
-    // Counted before tessellating: a large patch count times a fine
-    // tessellation must be refused, not allocated.
-    let n = patches.len().saturating_mul(nu as usize * nv as usize * 2);
-    limits::check_count(
-        &format!(
-            "{at}: triangles of '{file}' ({} patches at {t_at} = {nu}x{nv}) with those before it",
-            patches.len()
-        ),
-        n,
-        room,
-    )?;
+    // A large patch count times a fine tessellation must be refused, not allocated.
+    let n = patches
+        .len()
+        .saturating_mul(nu as usize * nv as usize * 2)
+        .saturating_add(before);
+    let what = format!(
+        "{t_at} = {nu}x{nv} ({} patches of '{file}', with the triangles before them)",
+        patches.len()
+    );
+    limits::check_count(&format!("{what}: triangles"), n, limits::MAX_TRIANGLES)?;
+    limit.check(&what, "triangles", n, size_of::<GpuTriangle>())?;
     let mesh = teapot::tessellate(&patches, nu, nv);
     let v = |i: u32| DVec3::from_array(mesh.positions[i as usize]);
     let n = |i: u32| DVec3::from_array(mesh.normals[i as usize]);
@@ -140,12 +166,18 @@ pub(super) fn load_bpt(
         .collect())
 }
 
+/// An OBJ mesh's triangles. The text is checked line by line first
+/// (`scan_obj`), so that an error names its line and a face's triangles are
+/// counted before tobj expands them; tobj then reads what the scan passed.
 pub(super) fn load_obj(
     at: &str,
     file: &str,
+    (before, limit): (usize, &StorageLimit),
     files: &FileSource,
 ) -> anyhow::Result<Vec<ObjTriangle>> {
     let text = read_text(&format!("{at}.obj"), file, files)?;
+    let what = format!("{at}.obj '{file}'");
+    scan_obj(&what, &text, before, limit)?;
     let opts = tobj::LoadOptions {
         triangulate: true,
         single_index: true,
@@ -155,53 +187,42 @@ pub(super) fn load_obj(
         // Materials come from the scene file, never from an OBJ's mtllib.
         Err(tobj::LoadError::OpenFileFailed)
     })
-    .map_err(|e| bad_input(format!("{at}.obj '{file}' is not a valid OBJ file: {e}")))?;
+    .map_err(|e| bad_input(format!("{what} is not a valid OBJ file: {e}")))?;
+    drop(text);
     let mut out = Vec::new();
     for model in &models {
         let mesh = &model.mesh;
-        let pos = |i: u32| -> anyhow::Result<DVec3> {
+        // The scan has checked every index and coordinate; these guard tobj's output.
+        let at3 = |list: &[f32], i: u32, kind: &str| -> anyhow::Result<DVec3> {
             let i = i as usize * 3;
-            let v = mesh.positions.get(i..i + 3).ok_or_else(|| {
-                bad_input(format!(
-                    "{at}.obj '{file}' has a face index beyond its vertex list"
-                ))
+            let v = list.get(i..i + 3).ok_or_else(|| {
+                bad_input(format!("{what} has a face index beyond its {kind} list"))
             })?;
-            let p = DVec3::new(v[0] as f64, v[1] as f64, v[2] as f64);
-            if coord_ok(p) {
-                return Ok(p);
-            }
-            coord3(
-                &format!("{at}.obj '{file}' vertex {}", i / 3 + 1),
-                p.to_array(),
-            )
+            Ok(DVec3::new(v[0] as f64, v[1] as f64, v[2] as f64))
         };
         let has_normals = !mesh.normals.is_empty();
         for (f, tri) in mesh.indices.chunks(3).enumerate() {
             if tri.len() != 3 {
-                return Err(bad_input(format!(
-                    "{at}.obj '{file}' has an incomplete face"
-                )));
+                return Err(bad_input(format!("{what} has an incomplete face")));
             }
-            let p = [pos(tri[0])?, pos(tri[1])?, pos(tri[2])?];
+            let mut p = [DVec3::ZERO; 3];
+            for k in 0..3 {
+                p[k] = at3(&mesh.positions, tri[k], "vertex")?;
+                if !coord_ok(p[k]) {
+                    coord3(
+                        &format!("{what} triangle {} vertex {k}", f + 1),
+                        p[k].to_array(),
+                    )?;
+                }
+            }
             let n = if has_normals {
                 let mut n = [DVec3::ZERO; 3];
                 for k in 0..3 {
-                    let i = tri[k] as usize * 3;
-                    let v = mesh.normals.get(i..i + 3).ok_or_else(|| {
-                        bad_input(format!(
-                            "{at}.obj '{file}' has a normal index beyond its normal list"
-                        ))
-                    })?;
-                    let raw = DVec3::new(v[0] as f64, v[1] as f64, v[2] as f64);
-                    let len = raw.length();
-                    n[k] = if len > 1e-12 && len.is_finite() {
-                        raw / len
-                    } else {
-                        unit_normal(
-                            &format!("{at}.obj '{file}' face {} normal {k}", f + 1),
-                            raw.to_array(),
-                        )?
-                    };
+                    let raw = at3(&mesh.normals, tri[k], "normal")?;
+                    n[k] = unit_normal(
+                        &format!("{what} triangle {} normal {k}", f + 1),
+                        raw.to_array(),
+                    )?;
                 }
                 Some(n)
             } else {
@@ -211,4 +232,146 @@ pub(super) fn load_obj(
         }
     }
     Ok(out)
+}
+
+/// Checks an OBJ text the way tobj reads it (`v`, `vt`, `vn`, `f` and `l`
+/// lines; others are ignored), naming the line of the first fault, and counts
+/// each face's triangles (a polygon of k vertices gives k - 2) against the
+/// triangle limit and `limit` as it goes. Memory stays within the text's own:
+/// a polygon of 50 million vertices is refused from its vertex count alone,
+/// where tobj would have expanded it to gigabytes first.
+fn scan_obj(what: &str, text: &str, before: usize, limit: &StorageLimit) -> anyhow::Result<()> {
+    let at = |line: usize, msg: &str| bad_input(format!("{what}, line {line}: {msg}"));
+    // tobj resolves a positive index at the end of its object, so it may name
+    // a vertex further down; relative (negative) ones count back from the line.
+    let mut total = [0usize; 3];
+    for line in text.lines() {
+        match line.split_whitespace().next() {
+            Some("v") => total[0] += 1,
+            Some("vt") => total[1] += 1,
+            Some("vn") => total[2] += 1,
+            _ => {}
+        }
+    }
+    let mut seen = [0usize; 3];
+    let mut zero_normals = HashSet::new();
+    let mut triangles = before;
+    for (i, line) in text.lines().enumerate() {
+        let n = i + 1;
+        let mut words = line.split_whitespace();
+        match words.next() {
+            Some("v") => {
+                let p = vertex(&mut words).map_err(|e| at(n, e))?;
+                if !coord_ok(p) {
+                    coord3(
+                        &format!("{what}, line {n}: vertex {}", seen[0] + 1),
+                        p.to_array(),
+                    )?;
+                }
+                seen[0] += 1;
+            }
+            Some("vt") => {
+                floats::<2>(&mut words)
+                    .ok_or_else(|| at(n, "not a valid OBJ file: `vt` needs two numbers"))?;
+                seen[1] += 1;
+            }
+            Some("vn") => {
+                let v = floats::<3>(&mut words)
+                    .ok_or_else(|| at(n, "not a valid OBJ file: `vn` needs three numbers"))?;
+                let len = DVec3::from_array(v.map(|c| c as f64)).length();
+                if !(len > 1e-12 && len.is_finite()) {
+                    zero_normals.insert(seen[2]);
+                }
+                seen[2] += 1;
+            }
+            Some(kind @ ("f" | "l")) => {
+                if kind == "f" {
+                    // Counted before a single index is parsed: this line may hold millions.
+                    triangles = triangles.saturating_add(words.clone().count().saturating_sub(2));
+                    let what =
+                        format!("{what}, line {n}: triangles of its faces with those before them");
+                    limits::check_count(&what, triangles, limits::MAX_TRIANGLES)?;
+                    limit.check(&what, "triangles", triangles, size_of::<GpuTriangle>())?;
+                }
+                for word in words {
+                    face_vertex(word, &total, &seen, &zero_normals, kind == "f")
+                        .map_err(|e| at(n, &format!("'{word}': {e}")))?;
+                }
+            }
+            _ => {}
+        }
+    }
+    Ok(())
+}
+
+/// The first `N` words as f32, as tobj parses them.
+fn floats<'a, const N: usize>(words: &mut impl Iterator<Item = &'a str>) -> Option<[f32; N]> {
+    let mut v = [0.0; N];
+    for x in &mut v {
+        *x = words.next()?.parse().ok()?;
+    }
+    Some(v)
+}
+
+/// A `v` line's position: x y z, then nothing, a w to divide by, or an RGB colour.
+fn vertex<'a>(words: &mut impl Iterator<Item = &'a str>) -> Result<DVec3, &'static str> {
+    let p = floats::<3>(words).ok_or("not a valid OBJ file: `v` needs three numbers")?;
+    let rest: Vec<&str> = words.take(4).collect();
+    let w: f32 = match rest.len() {
+        0 | 3 => 1.0,
+        1 => rest[0]
+            .parse()
+            .ok()
+            .filter(|w| *w != 0.0)
+            .ok_or("not a valid OBJ file: a vertex's w must be a non-zero number")?,
+        _ => {
+            return Err(
+                "not a valid OBJ file: `v` takes 3, 4 (with w) or 6 (with a colour) numbers",
+            )
+        }
+    };
+    Ok(DVec3::from_array(p.map(|c| (c / w) as f64)))
+}
+
+/// One `v`, `v/vt`, `v//vn` or `v/vt/vn` of a face: every index a whole number
+/// that names an element the file has (1-based, or negative counting back).
+fn face_vertex(
+    word: &str,
+    total: &[usize; 3],
+    seen: &[usize; 3],
+    zero_normals: &HashSet<usize>,
+    face: bool,
+) -> Result<(), String> {
+    const KINDS: [&str; 3] = ["vertex", "texture coordinate", "normal"];
+    const PLURAL: [&str; 3] = ["vertices", "texture coordinates", "normals"];
+    let parts: Vec<&str> = word.split('/').collect();
+    if parts.len() > 3 || parts[0].is_empty() {
+        return Err("not a valid OBJ file: give v, v/vt, v//vn or v/vt/vn".to_string());
+    }
+    for (k, part) in parts.iter().enumerate().filter(|(_, p)| !p.is_empty()) {
+        let x: isize = part
+            .parse()
+            .map_err(|_| format!("not a valid OBJ file: '{part}' is not a whole number"))?;
+        let index = match x {
+            0 => return Err("index 0: OBJ indices start at 1".to_string()),
+            x if x > 0 => x as usize - 1,
+            x => seen[k].checked_sub(x.unsigned_abs()).ok_or_else(|| {
+                format!("{} {x} counts back past the first {}", KINDS[k], KINDS[k])
+            })?,
+        };
+        // tobj ignores a texture or normal index when the file has none of them.
+        if index >= total[k] && (k == 0 || total[k] > 0) && face {
+            return Err(format!(
+                "{} {} is beyond the file's {} {}",
+                KINDS[k],
+                index + 1,
+                total[k],
+                PLURAL[k]
+            ));
+        }
+        if k == 2 && face && zero_normals.contains(&index) {
+            return Err(format!("normal {} has zero length", index + 1));
+        }
+    }
+    Ok(())
 }

@@ -4,7 +4,8 @@
 //! meets them in the file, so the first bad value is the one reported.
 
 use crate::error::bad_input;
-use crate::limits;
+use crate::gpu::layout::GpuSphere;
+use crate::limits::{self, StorageLimit};
 use crate::scene::check::{
     colour3, coord3, coord_ok, count, finite, flat_normal, positive, unit_normal, within,
 };
@@ -75,16 +76,17 @@ pub(super) fn resolve(
     def: SceneFile,
     labels: &Labels,
     files: &FileSource,
+    limit: &StorageLimit,
 ) -> anyhow::Result<Scene> {
     let camera = camera(&def.camera, labels)?;
     let render = render(&def.render, labels)?;
     let (materials, names) = materials(&def.materials, labels)?;
     let lights = lights(&def.lights, labels)?;
-    let spheres = spheres(&def, labels, &names)?;
+    let spheres = spheres(&def, labels, &names, limit)?;
     let mut triangles = triangles(&def.triangles, labels, &names)?;
     quads(&def.quads, labels, &names, &mut triangles)?;
     for (i, m) in def.meshes.iter().enumerate() {
-        mesh(i, m, labels, &names, files, &mut triangles)?;
+        mesh(i, m, (labels, &names, files, limit), &mut triangles)?;
     }
     let primitives = spheres.len() + triangles.len();
     limits::check_count(
@@ -270,8 +272,14 @@ fn lights(defs: &[LightDef], labels: &Labels) -> anyhow::Result<Vec<Light>> {
     Ok(lights)
 }
 
-/// The listed spheres, then `extra_spheres` copies of its sphere.
-fn spheres(def: &SceneFile, labels: &Labels, names: &MaterialNames) -> anyhow::Result<Vec<Sphere>> {
+/// The listed spheres, then `extra_spheres` copies of its sphere, counted
+/// against the limits before any is made.
+fn spheres(
+    def: &SceneFile,
+    labels: &Labels,
+    names: &MaterialNames,
+    limit: &StorageLimit,
+) -> anyhow::Result<Vec<Sphere>> {
     let field = |f: &str| labels.field(f);
     let sphere = |at: &str, center: [f64; 3], radius: f64, mat: &str| -> anyhow::Result<Sphere> {
         Ok(Sphere {
@@ -295,11 +303,13 @@ fn spheres(def: &SceneFile, labels: &Labels, names: &MaterialNames) -> anyhow::R
         None => None,
     };
     let sphere_count = def.spheres.len() + extra.as_ref().map_or(0, |e| e.1);
-    limits::check_count(
-        &field("spheres + extra_spheres.count"),
-        sphere_count,
-        limits::MAX_SPHERES,
-    )?;
+    let what = field("spheres + extra_spheres.count");
+    limits::check_count(&what, sphere_count, limits::MAX_SPHERES)?;
+    let what = match &def.extra_spheres {
+        Some(_) => labels.settable("extra_spheres", "spheres + extra_spheres.count"),
+        None => what,
+    };
+    limit.check(&what, "spheres", sphere_count, size_of::<GpuSphere>())?;
     let mut spheres = Vec::with_capacity(sphere_count);
     for (i, s) in def.spheres.iter().enumerate() {
         spheres.push(sphere(
@@ -376,9 +386,7 @@ fn quads(
 fn mesh(
     i: usize,
     m: &MeshDef,
-    labels: &Labels,
-    names: &MaterialNames,
-    files: &FileSource,
+    (labels, names, files, limit): (&Labels, &MaterialNames, &FileSource, &StorageLimit),
     triangles: &mut Vec<Triangle>,
 ) -> anyhow::Result<()> {
     let at = labels.field(&format!("meshes[{i}]"));
@@ -386,14 +394,14 @@ fn mesh(
     let scale = positive(&format!("{at}.scale"), m.scale, limits::MAX_COORDINATE)?;
     let rot = DMat3::from_rotation_y(finite(&format!("{at}.rotate_y"), m.rotate_y)?.to_radians());
     let translate = coord3(&format!("{at}.translate"), m.translate.0)?;
-    // The room left under the triangle limit, so that no mesh is expanded beyond it.
-    let room = limits::MAX_TRIANGLES - triangles.len().min(limits::MAX_TRIANGLES);
+    // Each mesh counts its triangles with those before it, so that none is expanded beyond the limits.
+    let before = (triangles.len(), limit);
     let (obj, file) = match (&m.obj, &m.bpt) {
-        (Some(obj), None) if m.tessellation.is_none() => (load_obj(&at, obj, files)?, obj),
+        (Some(obj), None) if m.tessellation.is_none() => (load_obj(&at, obj, before, files)?, obj),
         (None, Some(bpt)) => {
             let t = m.tessellation.map_or([20, 15], |t| t.0);
             let t_at = labels.settable("tessellation", &format!("meshes[{i}].tessellation"));
-            (load_bpt(&at, &t_at, bpt, t, room, files)?, bpt)
+            (load_bpt(&at, &t_at, bpt, t, before, files)?, bpt)
         }
         _ => {
             return Err(bad_input(format!(

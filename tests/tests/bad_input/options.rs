@@ -79,3 +79,50 @@ fn bad_path_and_workgroup_options() {
         }
     }
 }
+
+#[test]
+fn dump_shaders_to_a_place_that_takes_no_folder() {
+    let dir = twinray_tests::scratch("dump-shaders");
+    let file = dir.join("a-file");
+    std::fs::write(&file, "not a folder").unwrap();
+    for place in [file.to_str().unwrap(), "/proc/twinray-shaders"] {
+        expect_both(
+            &["--headless", "--size", "16x16", "--dump-shaders", place],
+            &[],
+            2,
+            &["--dump-shaders", place],
+        );
+    }
+}
+
+#[test]
+fn an_output_name_of_255_bytes_is_written() {
+    // Its temporary name would be longer than 255 bytes; it must still be written.
+    let dir = twinray_tests::scratch("out-255");
+    for (app, name) in App::BOTH.into_iter().zip(["v", "g"]) {
+        let out = dir.join(format!("{name}{}.png", "a".repeat(250)));
+        let o = twinray_tests::run(
+            &app.exe(),
+            &[
+                "--headless",
+                "--size",
+                "16x16",
+                "--out",
+                out.to_str().unwrap(),
+            ],
+            &[],
+        );
+        assert!(
+            o.status.success(),
+            "{app:?}: {}",
+            String::from_utf8_lossy(&o.stderr)
+        );
+        assert!(out.is_file(), "{app:?}");
+    }
+    let mut left: Vec<_> = std::fs::read_dir(&dir)
+        .unwrap()
+        .map(|e| e.unwrap().file_name())
+        .collect();
+    left.sort();
+    assert_eq!(left.len(), 2, "{left:?}");
+}

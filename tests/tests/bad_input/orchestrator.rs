@@ -42,6 +42,31 @@ fn orchestrator_diff_and_render_errors() {
         2,
         &["'kettle'"],
     );
+    // What the reference cannot honour is refused, not ignored.
+    for (option, value) in [
+        ("--gl-spirv", None),
+        ("--experiment", Some("naga-zero-init")),
+        ("--dump-shaders", Some("shaders")),
+        ("--path", Some("compute")),
+    ] {
+        let mut args = vec!["render", "--api", "reference", "--scene", "box", "--json"];
+        args.push(option);
+        args.extend(value);
+        expect_one(&tw, &args, &[], 2, &["--api reference", option]);
+    }
+    // Neither may the heatmap replace an image it compares.
+    let c = dir.join("c.png");
+    image::RgbImage::new(4, 4).save(&c).unwrap();
+    for input in [&a, &c] {
+        let args = [
+            "diff",
+            a.to_str().unwrap(),
+            c.to_str().unwrap(),
+            "--heatmap",
+            input.to_str().unwrap(),
+        ];
+        expect_one(&tw, &args, &[], 2, &["--heatmap", "input image"]);
+    }
 }
 
 /// A folder that exists but lacks the apps is refused the same way from the

@@ -2,7 +2,7 @@
 //! bad values and meshes, each named by file, line or field.
 
 use crate::common::{expect_both, headless, scene_file, strs};
-use twinray_tests::scratch;
+use twinray_tests::{bin, fail, scratch};
 
 #[test]
 fn missing_and_unknown_scenes() {
@@ -101,5 +101,105 @@ fn unknown_numerics_value() {
         &[],
         2,
         &["n.toml", "render.offset", "'far'"],
+    );
+}
+
+/// The three tools: both apps, and the reference through `twinray render`.
+fn three_tools() -> [(std::path::PathBuf, Vec<&'static str>); 3] {
+    [
+        (bin("twinray-vk"), vec![]),
+        (bin("twinray-gl"), vec![]),
+        (
+            bin("twinray"),
+            vec!["render", "--api", "reference", "--json"],
+        ),
+    ]
+}
+
+#[test]
+fn a_polygon_past_the_triangle_limit_is_refused_from_its_line_in_little_memory() {
+    // One face of 44.8 million vertices in 90 MB, just past the 44.7 million
+    // triangle limit: expanded first, it took gigabytes and seconds (8.1 GB
+    // and 15 s at 50 million); counted from its line it needs the file's size.
+    let dir = scratch("polygon");
+    let mut obj = b"v 0 0 0\nv 1 0 0\nv 0 1 0\nf ".to_vec();
+    let n = twinray_common::limits::MAX_TRIANGLES + 3;
+    obj.extend(b"1 2 3 ".repeat(n / 3 + 1));
+    std::fs::write(dir.join("big.obj"), &obj).unwrap();
+    drop(obj);
+    let p = scene_file(
+        &dir,
+        "big.toml",
+        "[[meshes]]\nobj = \"big.obj\"\nmaterial = \"m\"\n",
+    );
+    for (exe, mut args) in three_tools() {
+        args.extend(["--headless", "--size", "8x8", "--scene", &p]);
+        // 500 MiB of address space: enough for the file and the tool, far
+        // from what expanding the polygon would take.
+        let mut all = vec!["--as=524288000", exe.to_str().unwrap()];
+        all.extend(&args);
+        let start = std::time::Instant::now();
+        let (code, stderr) = fail(std::path::Path::new("prlimit"), &all, &[]);
+        let secs = start.elapsed().as_secs_f64();
+        assert_eq!(code, 2, "{exe:?}: {stderr}");
+        assert!(
+            stderr.contains("big.obj', line 4") && stderr.contains("limit of"),
+            "{exe:?}: {stderr}"
+        );
+        assert!(secs < 5.0, "{exe:?} took {secs:.1} s");
+    }
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn an_obj_with_a_byte_order_mark_renders() {
+    let dir = scratch("bom");
+    std::fs::write(
+        dir.join("bom.obj"),
+        "\u{feff}v -1 -1 0\nv 1 -1 0\nv 0 1 0\nf 1 2 3\n",
+    )
+    .unwrap();
+    let p = scene_file(
+        &dir,
+        "bom.toml",
+        "[[meshes]]\nobj = \"bom.obj\"\nmaterial = \"m\"\n",
+    );
+    for (exe, mut args) in three_tools() {
+        args.extend(["--headless", "--size", "8x8", "--scene", &p]);
+        let o = twinray_tests::run(&exe, &args, &[]);
+        assert!(
+            o.status.success(),
+            "{exe:?}: {}",
+            String::from_utf8_lossy(&o.stderr)
+        );
+    }
+}
+
+#[test]
+fn a_loop_of_symbolic_links_is_named_as_one() {
+    let dir = scratch("symlink-loop");
+    for (a, b) in [("a.toml", "b.toml"), ("a.obj", "b.obj")] {
+        let _ = std::fs::remove_file(dir.join(a));
+        let _ = std::fs::remove_file(dir.join(b));
+        std::os::unix::fs::symlink(dir.join(b), dir.join(a)).unwrap();
+        std::os::unix::fs::symlink(dir.join(a), dir.join(b)).unwrap();
+    }
+    let scene = dir.join("a.toml");
+    expect_both(
+        &strs(&headless(scene.to_str().unwrap())),
+        &[],
+        2,
+        &["a.toml", "loop of symbolic links"],
+    );
+    let p = scene_file(
+        &dir,
+        "mesh.toml",
+        "[[meshes]]\nobj = \"a.obj\"\nmaterial = \"m\"\n",
+    );
+    expect_both(
+        &strs(&headless(&p)),
+        &[],
+        2,
+        &["a.obj", "loop of symbolic links"],
     );
 }

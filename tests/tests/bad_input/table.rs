@@ -163,10 +163,13 @@ fn cases() -> Vec<Case> {
         Case { name: "non-utf8-scene", input: Input::Raw(b"[camera]\neye = [0.0, 0.0, 5.0]\nlook_at = [0.0, \xff0.0, 0.0]\n"), args: &[], expect: &["scene.toml", "line 3, column 17", "UTF-8"] },
         // Meshes.
         mesh("obj-missing", "[[meshes]]\nobj = \"absent.obj\"\nmaterial = \"m\"\n", b"", &["meshes[0].obj", "absent.obj", "cannot be read"]),
-        mesh("obj-face-index", OBJ, b"v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 7\n", &["meshes[0].obj", "mesh.obj"]),
-        mesh("obj-bad-number", OBJ, b"v 1 2 x\nf 1 1 1\n", &["mesh.obj", "not a valid OBJ"]),
-        mesh("obj-vertex-f32-inf", OBJ, b"v 0 0 0\nv 1e39 0 0\nv 0 1 0\nf 1 2 3\n", &["mesh.obj", "vertex 2"]),
-        mesh("obj-normal-zero", OBJ, b"v 0 0 0\nv 1 0 0\nv 0 1 0\nvn 0 0 0\nf 1//1 2//1 3//1\n", &["mesh.obj", "face 1 normal"]),
+        mesh("obj-face-index", OBJ, b"v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 7\n", &["meshes[0].obj", "mesh.obj", "line 4", "vertex 7"]),
+        mesh("obj-index-0", OBJ, b"v 0 0 0\nv 1 0 0\nv 0 1 0\n\nf 0 1 2\n", &["mesh.obj", "line 5", "start at 1"]),
+        mesh("obj-relative-too-far", OBJ, b"v 0 0 0\nv 1 0 0\nf -1 -2 -3\n", &["mesh.obj", "line 3", "counts back"]),
+        mesh("obj-bad-number", OBJ, b"v 1 2 x\nf 1 1 1\n", &["mesh.obj", "line 1", "not a valid OBJ"]),
+        mesh("obj-bad-normal", OBJ, b"v 0 0 0\nvn 0 0\n", &["mesh.obj", "line 2", "`vn` needs three numbers"]),
+        mesh("obj-vertex-f32-inf", OBJ, b"v 0 0 0\nv 1e39 0 0\nv 0 1 0\nf 1 2 3\n", &["mesh.obj", "line 2", "vertex 2"]),
+        mesh("obj-normal-zero", OBJ, b"v 0 0 0\nv 1 0 0\nv 0 1 0\nvn 0 0 0\nf 1//1 2//1 3//1\n", &["mesh.obj", "line 5", "normal 1 has zero length"]),
         mesh("obj-no-faces", OBJ, b"v 0 0 0\nv 1 0 0\n", &["mesh.obj", "no faces"]),
         mesh("obj-non-utf8", OBJ, b"v 0 0 0\nv 1 0 0\nv 0 \xfe1 0\nf 1 2 3\n", &["mesh.obj", "line 3, column 5", "UTF-8"]),
         mesh("obj-scaled-far", "[[meshes]]\nobj = \"mesh.obj\"\nmaterial = \"m\"\nscale = 1e17\ntranslate = [0.0, 0.0, 0.0]\n", b"v 0 0 0\nv 100 0 0\nv 0 1 0\nf 1 2 3\n", &["meshes[0]", "face 1", "coordinate limit"]),
@@ -201,7 +204,8 @@ fn cases() -> Vec<Case> {
         opts("set-extra-no-section", &["--set", "extra_spheres=5"], &["--set extra_spheres", "[extra_spheres]"]),
         opts("set-triangle-unknown", &["--set", "triangle=octagonal"], &["--set triangle", "octagonal"]),
         opts("set-tessellation-0", &["--scene", "teapot", "--set", "tessellation=0x5"], &["--set tessellation", "0x5"]),
-        opts("frames-0", &["--frames", "0"], &["--frames", "0"]),
+        opts("frames-0", &["--frames", "0"], &["--frames", "'0'", "from 1 to 100000"]),
+        opts("frames-negative", &["--frames", "-1"], &["--frames", "'-1'", "from 1 to 100000"]),
         opts("path-unknown", &["--path", "warp"], &["--path", "warp"]),
         opts("accel-unknown", &["--accel", "fast"], &["--accel", "fast"]),
         opts("workgroup-on-fragment", &["--workgroup", "8x8"], &["--workgroup", "--path compute"]),
@@ -211,6 +215,10 @@ fn cases() -> Vec<Case> {
         opts("out-dev-full", &["--out", "/dev/full"], &["--out", "/dev/full", "not a regular file"]),
         opts("out-unwritable", &["--out", "/proc/twinray.png"], &["--out", "/proc/twinray.png", "not writable"]),
         opts("out-empty", &["--out", ""], &["--out"]),
+        opts("out-trailing-slash", &["--out", "{dir}/new/"], &["--out", "new/", "ends with '/'"]),
+        // An output that names an input would replace it.
+        Case { name: "out-is-the-scene", input: Input::Edit(&[]), args: &["--out", "{dir}/scene.toml"], expect: &["--out", "is the scene file", "scene.toml"] },
+        Case { name: "out-is-the-mesh", input: Input::Mesh(OBJ, CUBE_OBJ.as_bytes()), args: &["--out", "{dir}/mesh.obj"], expect: &["--out", "meshes[0]", "mesh.obj"] },
     ]
 }
 
