@@ -143,7 +143,7 @@ pub fn app_args(args: &RenderArgs) -> Vec<String> {
         workgroup,
         shared_pad,
         experiment,
-        experiments: _,
+        experiments,
         dump_shaders,
     } = args;
     let mut v = vec![
@@ -171,6 +171,7 @@ pub fn app_args(args: &RenderArgs) -> Vec<String> {
         (gl_spirv, "--gl-spirv"),
         (vsync, "--vsync"),
         (explain, "--explain"),
+        (experiments, "--experiments"),
     ];
     v.extend(
         flags
@@ -485,7 +486,7 @@ mod tests {
             workgroup: Some(Workgroup { x: 8, y: 4 }),
             shared_pad: Some(24),
             experiment: vec![Experiment::NagaZeroInit, Experiment::UnpairedBvhStack],
-            experiments: false,
+            experiments: true,
             dump_shaders: Some(PathBuf::from("dump")),
         }
     }

@@ -179,6 +179,6 @@ pub fn storage_limit(gl: &glow::Context) -> StorageLimit {
     let bytes = unsafe { gl.get_parameter_i64(glow::MAX_SHADER_STORAGE_BLOCK_SIZE) };
     StorageLimit {
         bytes: bytes.max(0) as u64,
-        name: "this device's GL_MAX_SHADER_STORAGE_BLOCK_SIZE",
+        name: "this device's GL_MAX_SHADER_STORAGE_BLOCK_SIZE limit",
     }
 }

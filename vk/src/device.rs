@@ -261,7 +261,7 @@ queue family {queue_family}: {flags:?}, timestampValidBits {timestamp_valid_bits
     pub fn storage_limit(&self) -> StorageLimit {
         StorageLimit {
             bytes: self.properties.limits.max_storage_buffer_range as u64,
-            name: "this device's maxStorageBufferRange",
+            name: "this device's maxStorageBufferRange limit",
         }
     }
 

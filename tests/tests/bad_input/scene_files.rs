@@ -134,9 +134,11 @@ fn a_polygon_past_the_triangle_limit_is_refused_from_its_line_in_little_memory()
     );
     for (exe, mut args) in three_tools() {
         args.extend(["--headless", "--size", "8x8", "--scene", &p]);
-        // 500 MiB of address space: enough for the file and the tool, far
-        // from what expanding the polygon would take.
-        let mut all = vec!["--as=524288000", exe.to_str().unwrap()];
+        // 1 GiB of address space: enough for the file, the tool and the
+        // driver's reservations (the device is open before the scene is read,
+        // so that its storage limit can refuse a scene before it is built),
+        // far from the 8 GB that expanding the polygon took.
+        let mut all = vec!["--as=1073741824", exe.to_str().unwrap()];
         all.extend(&args);
         let start = std::time::Instant::now();
         let (code, stderr) = fail(std::path::Path::new("prlimit"), &all, &[]);
