@@ -140,6 +140,53 @@ impl Bvh {
         self.depth.saturating_sub(1).max(1)
     }
 
+    /// Interior nodes (the GPU's node array; leaves live in their parents' child references).
+    pub fn node_count(&self) -> usize {
+        self.nodes.len()
+    }
+
+    /// The tree's SAH cost with the builder's own costs: a node visit costs
+    /// TRAVERSAL_COST and a primitive test INTERSECT_COST, each weighted by the
+    /// chance that a ray through the root's box meets the box it is in (its
+    /// area over the root's). Lower is a better tree for the same scene;
+    /// comparable between builders because it reads only the flattened output.
+    pub fn sah_cost(&self) -> f64 {
+        let Some(root) = self.nodes.first() else {
+            return 0.0;
+        };
+        let area = |(lo, hi): ([f32; 3], [f32; 3])| {
+            let d = [0, 1, 2].map(|a| (hi[a] as f64 - lo[a] as f64).max(0.0));
+            2.0 * (d[0] * d[1] + d[1] * d[2] + d[2] * d[0])
+        };
+        let union = |a: ([f32; 3], [f32; 3]), b: ([f32; 3], [f32; 3])| {
+            (
+                [0, 1, 2].map(|i| a.0[i].min(b.0[i])),
+                [0, 1, 2].map(|i| a.1[i].max(b.1[i])),
+            )
+        };
+        let root_area = area(union(
+            (root.left_min, root.left_max),
+            (root.right_min, root.right_max),
+        ))
+        .max(f64::MIN_POSITIVE);
+        // Each interior node pays one visit for the ray that reaches it, and
+        // each child box (node or leaf) is entered by the share of rays its area says.
+        let mut cost = TRAVERSAL_COST;
+        for n in &self.nodes {
+            for (b, child) in [
+                ((n.left_min, n.left_max), n.left),
+                ((n.right_min, n.right_max), n.right),
+            ] {
+                let p = area(b) / root_area;
+                cost += match child_ref::as_leaf(child) {
+                    Some((_, count)) => INTERSECT_COST * count as f64 * p,
+                    None => TRAVERSAL_COST * p,
+                };
+            }
+        }
+        cost
+    }
+
     /// Bytes on the GPU: the nodes plus the leaves' primitives (`GpuBvhPrim`).
     pub fn bytes(&self) -> usize {
         std::mem::size_of_val(self.nodes.as_slice())
