@@ -14,6 +14,7 @@
 
 use crate::gpu::layout::{child_ref, Bounds, Bvh, GpuBvhNode, GpuBvhPrim, PRIM_SPHERE_BIT};
 use crate::scene::Scene;
+use glam::Vec3A;
 use rayon::prelude::*;
 
 /// Primitives per leaf at most; SAH may stop splitting earlier.
@@ -27,61 +28,67 @@ const INTERSECT_COST: f64 = 1.0;
 const PARALLEL_BINNING: usize = 1 << 15;
 const BIN_CHUNK: usize = 1 << 13;
 /// A subtree with at least this many primitives builds its two halves as
-/// separate tasks, each into a piece of the node array of its own.
+/// separate tasks.
 const PARALLEL_SUBTREE: usize = 1 << 12;
 
-/// An f32 box; empty when min > max.
+/// An f32 box; empty when min > max. SIMD lanes: the builder's inner loops
+/// are a few min and max operations per primitive.
 #[derive(Clone, Copy, Debug, PartialEq)]
 struct Box3 {
-    min: [f32; 3],
-    max: [f32; 3],
+    min: Vec3A,
+    max: Vec3A,
 }
 
 impl Box3 {
     const EMPTY: Box3 = Box3 {
-        min: [f32::INFINITY; 3],
-        max: [f32::NEG_INFINITY; 3],
+        min: Vec3A::INFINITY,
+        max: Vec3A::NEG_INFINITY,
     };
 
     fn grow(&mut self, o: &Box3) {
-        for a in 0..3 {
-            self.min[a] = self.min[a].min(o.min[a]);
-            self.max[a] = self.max[a].max(o.max[a]);
-        }
+        self.min = self.min.min(o.min);
+        self.max = self.max.max(o.max);
     }
 
-    fn grow_point(&mut self, p: [f32; 3]) {
-        for a in 0..3 {
-            self.min[a] = self.min[a].min(p[a]);
-            self.max[a] = self.max[a].max(p[a]);
-        }
+    fn grow_point(&mut self, p: Vec3A) {
+        self.min = self.min.min(p);
+        self.max = self.max.max(p);
     }
 
     /// In f64, so that near-equal plane costs are told apart the same way every run.
     fn area(&self) -> f64 {
-        let d = [0, 1, 2].map(|a| (self.max[a] as f64 - self.min[a] as f64).max(0.0));
-        2.0 * (d[0] * d[1] + d[1] * d[2] + d[2] * d[0])
+        let d = (self.max.as_dvec3() - self.min.as_dvec3()).max(glam::DVec3::ZERO);
+        2.0 * (d.x * d.y + d.y * d.z + d.z * d.x)
     }
 
     fn bounds(&self) -> Bounds {
-        (self.min, self.max)
+        (self.min.to_array(), self.max.to_array())
     }
 }
 
 /// One primitive while building: its f32 box and its code (`PRIM_SPHERE_BIT`
-/// | sphere, or triangle). 28 bytes; the centroid is recomputed when needed.
+/// | sphere, or triangle). 32 bytes; the centroid is recomputed when needed.
 #[derive(Clone, Copy)]
+#[repr(C, align(16))]
 struct PrimRef {
     min: [f32; 3],
-    max: [f32; 3],
     code: u32,
+    max: [f32; 3],
+    pad: u32,
 }
 
 impl PrimRef {
-    /// Twice the box's centre: only compared with itself, so the half is never taken.
-    fn centroid2(&self, a: usize) -> f32 {
-        self.min[a] + self.max[a]
+    fn bounds(&self) -> Box3 {
+        Box3 {
+            min: Vec3A::from_array(self.min),
+            max: Vec3A::from_array(self.max),
+        }
     }
+}
+
+/// Twice a box's centre: only compared with itself, so the half is never taken.
+fn centroid2(b: &Box3) -> Vec3A {
+    b.min + b.max
 }
 
 /// The f32 box of a sphere as the GPU holds it (centre and radius rounded to
@@ -92,8 +99,9 @@ fn sphere_ref(center: glam::DVec3, radius: f64, code: u32) -> PrimRef {
     let hi = (c + r).to_array();
     PrimRef {
         min: lo.map(|v| next_down(v as f32, v)),
-        max: hi.map(|v| next_up(v as f32, v)),
         code,
+        max: hi.map(|v| next_up(v as f32, v)),
+        pad: 0,
     }
 }
 
@@ -129,8 +137,9 @@ fn prim_refs(scene: &Scene) -> Vec<PrimRef> {
         let (lo, hi) = (p[0].min(p[1]).min(p[2]), p[0].max(p[1]).max(p[2]));
         PrimRef {
             min: lo.to_array(),
-            max: hi.to_array(),
             code: i as u32,
+            max: hi.to_array(),
+            pad: 0,
         }
     }));
     refs
@@ -142,23 +151,28 @@ impl Bvh {
         let mut refs = prim_refs(scene);
         let mut bvh = Bvh::default();
         if !refs.is_empty() {
-            let mut bounds = Box3::EMPTY;
-            let mut centroids = Box3::EMPTY;
-            for r in &refs {
-                bounds.grow(&Box3 {
-                    min: r.min,
-                    max: r.max,
-                });
-                centroids.grow_point([0, 1, 2].map(|a| r.centroid2(a)));
-            }
+            let (bounds, centroids) = refs
+                .par_chunks(BIN_CHUNK)
+                .map(boxes)
+                .reduce(
+                    || (Box3::EMPTY, Box3::EMPTY),
+                    |(mut b, mut c), (b2, c2)| {
+                        b.grow(&b2);
+                        c.grow(&c2);
+                        (b, c)
+                    },
+                );
             let node = Node {
                 bounds,
                 centroids,
                 first: 0,
             };
-            let built = build(&mut refs, node);
+            // Zeroed pages that no node is written to are never touched, so
+            // the slots cost about what the tree needs (see `build`).
+            let mut slots = bytemuck::zeroed_vec(refs.len() - 1);
+            let built = build(&mut refs, node, &mut slots);
             bvh.depth = built.depth;
-            bvh.nodes = flatten(built.pieces, built.interior);
+            bvh.nodes = compact(slots, built.interior);
             if let Some((first, count)) = child_ref::as_leaf(built.child) {
                 // Node 0 is always an interior node: a tree that is one leaf
                 // gets a root whose two children are that leaf. The second
@@ -195,7 +209,10 @@ impl Bvh {
         let Some(root) = self.nodes.first() else {
             return 0.0;
         };
-        let boxed = |(min, max): Bounds| Box3 { min, max };
+        let boxed = |(min, max): Bounds| Box3 {
+            min: min.into(),
+            max: max.into(),
+        };
         let mut root_box = boxed((root.left_min, root.left_max));
         root_box.grow(&boxed((root.right_min, root.right_max)));
         let root_area = root_box.area().max(f64::MIN_POSITIVE);
@@ -234,33 +251,34 @@ struct Node {
 }
 
 /// A built subtree: its child reference (a leaf, or `RELATIVE` for an interior
-/// node whose own node is the first of `pieces`), its interior node count,
-/// its depth and its nodes, depth-first, in one or more pieces. Inside the
-/// pieces an interior child is referred to by its distance from its parent
-/// (the left child is always the next node, the right one after the left's
-/// subtree), so pieces built apart join without renumbering; `flatten` makes
-/// the distances indices.
+/// node, which is then the first of its slots), its interior node count and
+/// its depth.
 struct Built {
     child: u32,
     interior: usize,
     depth: u32,
-    pieces: Vec<Vec<GpuBvhNode>>,
 }
 
 /// The child reference of a built interior subtree until it is placed.
 const RELATIVE: u32 = 0;
 
-/// Builds the subtree over `refs` (which it reorders into leaf order).
-fn build(refs: &mut [PrimRef], node: Node) -> Built {
+/// Builds the subtree over `refs` (which it reorders into leaf order) into
+/// `slots`, one fewer than `refs`: a binary tree with a primitive or more in
+/// each leaf has fewer interior nodes than primitives. The node goes first,
+/// then the left subtree's slots (one fewer than its primitives), then the
+/// right's, so every subtree's nodes are depth-first in its own window and
+/// the two halves can be built at once; `compact` closes the gaps left at
+/// the end of each window. An interior child is referred to by its distance
+/// from its parent in the compacted array (the left child is always the next
+/// node, the right one after the left's subtree), which the gaps do not change.
+fn build(refs: &mut [PrimRef], node: Node, slots: &mut [GpuBvhNode]) -> Built {
     if refs.len() < PARALLEL_SUBTREE {
-        let mut nodes = Vec::new();
-        let (child, depth) = build_serial(refs, node, &mut nodes);
-        let interior = nodes.len();
+        let mut used = 0;
+        let (child, depth) = build_serial(refs, node, slots, &mut used);
         return Built {
             child,
-            interior,
+            interior: used,
             depth,
-            pieces: if interior == 0 { vec![] } else { vec![nodes] },
         };
     }
     let Some((mid, left, right)) = split(refs, &node) else {
@@ -268,87 +286,88 @@ fn build(refs: &mut [PrimRef], node: Node) -> Built {
             child: child_ref::leaf(node.first as u32, refs.len() as u32),
             interior: 0,
             depth: 1,
-            pieces: vec![],
         };
     };
     let (lrefs, rrefs) = refs.split_at_mut(mid);
-    let (l, r) = rayon::join(|| build(lrefs, left), || build(rrefs, right));
-    let mut pieces = Vec::with_capacity(1 + l.pieces.len() + r.pieces.len());
-    pieces.push(vec![joined(&left, &l, &right, &r)]);
-    pieces.extend(l.pieces);
-    pieces.extend(r.pieces);
+    let (own, rest) = slots
+        .split_first_mut()
+        .expect("two or more primitives have a slot");
+    let (lslots, rslots) = rest.split_at_mut(mid - 1);
+    let (l, r) = rayon::join(
+        || build(lrefs, left, lslots),
+        || build(rrefs, right, rslots),
+    );
+    *own = GpuBvhNode::new(
+        left.bounds.bounds(),
+        relative(l.child, 1),
+        right.bounds.bounds(),
+        relative(r.child, 1 + l.interior),
+    );
     Built {
         child: RELATIVE,
         interior: 1 + l.interior + r.interior,
         depth: 1 + l.depth.max(r.depth),
-        pieces,
     }
 }
 
-/// The node joining two built subtrees, with relative child references.
-fn joined(left: &Node, l: &Built, right: &Node, r: &Built) -> GpuBvhNode {
-    let rel = |b: &Built, distance: usize| {
-        if b.child == RELATIVE {
-            distance as u32
-        } else {
-            b.child
-        }
-    };
-    GpuBvhNode::new(
-        left.bounds.bounds(),
-        rel(l, 1),
-        right.bounds.bounds(),
-        rel(r, 1 + l.interior),
-    )
+/// A child's reference as its parent holds it: a leaf's own, or an interior
+/// child's distance from the parent.
+fn relative(child: u32, distance: usize) -> u32 {
+    if child == RELATIVE {
+        distance as u32
+    } else {
+        child
+    }
 }
 
-/// `build` for a small subtree: on this thread, into `nodes` depth-first.
-/// Returns its child reference and depth.
-fn build_serial(refs: &mut [PrimRef], node: Node, nodes: &mut Vec<GpuBvhNode>) -> (u32, u32) {
+/// `build` for a small subtree: on this thread, depth-first into
+/// `slots[*used..]`. Returns its child reference and depth.
+fn build_serial(
+    refs: &mut [PrimRef],
+    node: Node,
+    slots: &mut [GpuBvhNode],
+    used: &mut usize,
+) -> (u32, u32) {
     let Some((mid, left, right)) = split(refs, &node) else {
-        return (
-            child_ref::leaf(node.first as u32, refs.len() as u32),
-            1,
-        );
+        return (child_ref::leaf(node.first as u32, refs.len() as u32), 1);
     };
-    let index = nodes.len();
-    nodes.push(GpuBvhNode::default());
+    let index = *used;
+    *used += 1;
     let (lrefs, rrefs) = refs.split_at_mut(mid);
-    let (l, ldepth) = build_serial(lrefs, left, nodes);
-    let lsize = nodes.len() - index - 1;
-    let (r, rdepth) = build_serial(rrefs, right, nodes);
-    let rel = |child: u32, distance: usize| {
-        if child == RELATIVE {
-            distance as u32
-        } else {
-            child
-        }
-    };
-    nodes[index] = GpuBvhNode::new(
+    let (l, ldepth) = build_serial(lrefs, left, slots, used);
+    let lsize = *used - index - 1;
+    let (r, rdepth) = build_serial(rrefs, right, slots, used);
+    slots[index] = GpuBvhNode::new(
         left.bounds.bounds(),
-        rel(l, 1),
+        relative(l, 1),
         right.bounds.bounds(),
-        rel(r, 1 + lsize),
+        relative(r, 1 + lsize),
     );
     (RELATIVE, 1 + ldepth.max(rdepth))
 }
 
-/// Joins the pieces into one array and turns relative child references into
-/// indices. `interior` is the total node count.
-fn flatten(pieces: Vec<Vec<GpuBvhNode>>, interior: usize) -> Vec<GpuBvhNode> {
-    let mut nodes = Vec::with_capacity(interior);
-    for p in pieces {
-        nodes.extend_from_slice(&p);
+/// Closes the gaps between the windows of `build`, in order, and turns the
+/// relative child references into indices. A written slot is never all
+/// zero: its left child is a leaf (LEAF_BIT) or at least one node away.
+fn compact(mut slots: Vec<GpuBvhNode>, interior: usize) -> Vec<GpuBvhNode> {
+    let mut w = 0;
+    for r in 0..slots.len() {
+        if slots[r].left != 0 {
+            slots[w] = slots[r];
+            w += 1;
+        }
     }
-    debug_assert_eq!(nodes.len(), interior);
-    nodes.par_iter_mut().enumerate().for_each(|(i, n)| {
+    debug_assert_eq!(w, interior);
+    slots.truncate(w);
+    slots.shrink_to_fit();
+    slots.par_iter_mut().enumerate().for_each(|(i, n)| {
         for c in [&mut n.left, &mut n.right] {
             if child_ref::as_leaf(*c).is_none() {
                 *c += i as u32;
             }
         }
     });
-    nodes
+    slots
 }
 
 /// The bins of one axis: each bin's box, its centroids' box and its count.
@@ -371,39 +390,37 @@ const EMPTY_BIN: Bin = Bin {
 /// bins and later partitions, so the two always agree.
 #[derive(Clone, Copy)]
 struct Binning {
-    min: [f32; 3],
-    scale: [f32; 3],
+    min: Vec3A,
+    scale: Vec3A,
 }
 
 impl Binning {
     fn new(centroids: &Box3) -> Binning {
-        let mut scale = [0.0; 3];
-        for (a, s) in scale.iter_mut().enumerate() {
-            let extent = centroids.max[a] - centroids.min[a];
-            if extent > 0.0 && extent.is_finite() {
-                *s = BINS as f32 / extent;
-            }
-        }
+        let extent = centroids.max - centroids.min;
+        // A flat axis puts everything in bin 0, where no plane separates anything.
+        let usable = extent.cmpgt(Vec3A::ZERO) & extent.is_finite_mask();
+        let scale = Vec3A::select(usable, BINS as f32 / extent, Vec3A::ZERO);
         Binning {
             min: centroids.min,
             scale,
         }
     }
 
-    fn bin(&self, r: &PrimRef, a: usize) -> usize {
-        (((r.centroid2(a) - self.min[a]) * self.scale[a]) as usize).min(BINS - 1)
+    /// The primitive's bin on each axis.
+    fn bins(&self, c: Vec3A) -> [usize; 3] {
+        let b = ((c - self.min) * self.scale).as_uvec3();
+        b.min(glam::UVec3::splat(BINS as u32 - 1))
+            .to_array()
+            .map(|x| x as usize)
     }
 
     fn count(&self, refs: &[PrimRef]) -> Bins {
         let mut bins = [[EMPTY_BIN; BINS]; 3];
         for r in refs {
-            let b = Box3 {
-                min: r.min,
-                max: r.max,
-            };
-            let c = [0, 1, 2].map(|a| r.centroid2(a));
-            for (a, axis) in bins.iter_mut().enumerate() {
-                let bin = &mut axis[self.bin(r, a)];
+            let b = r.bounds();
+            let c = centroid2(&b);
+            for (axis, i) in bins.iter_mut().zip(self.bins(c)) {
+                let bin = &mut axis[i];
                 bin.bounds.grow(&b);
                 bin.centroids.grow_point(c);
                 bin.count += 1;
@@ -434,6 +451,17 @@ impl Binning {
     }
 }
 
+/// The box of some primitives and the box of their doubled centroids.
+fn boxes(refs: &[PrimRef]) -> (Box3, Box3) {
+    let (mut b, mut c) = (Box3::EMPTY, Box3::EMPTY);
+    for r in refs {
+        let rb = r.bounds();
+        b.grow(&rb);
+        c.grow_point(centroid2(&rb));
+    }
+    (b, c)
+}
+
 /// Splits the node's primitives if SAH (or a leaf's size limit) says so:
 /// reorders `refs` so the left half comes first and returns its length and
 /// both halves. None makes the node a leaf.
@@ -452,19 +480,12 @@ fn split(refs: &mut [PrimRef], node: &Node) -> Option<(usize, Node, Node)> {
         // centroids): split the list in the middle.
         let mid = count / 2;
         let half = |refs: &[PrimRef], first| {
-            let mut n = Node {
-                bounds: Box3::EMPTY,
-                centroids: Box3::EMPTY,
+            let (bounds, centroids) = boxes(refs);
+            Node {
+                bounds,
+                centroids,
                 first,
-            };
-            for r in refs {
-                n.bounds.grow(&Box3 {
-                    min: r.min,
-                    max: r.max,
-                });
-                n.centroids.grow_point([0, 1, 2].map(|a| r.centroid2(a)));
             }
-            n
         };
         return Some((
             mid,
@@ -484,7 +505,7 @@ fn split(refs: &mut [PrimRef], node: &Node) -> Option<(usize, Node, Node)> {
         }
         n
     };
-    let mid = partition(refs, |r| binning.bin(r, axis) <= last_left);
+    let mid = partition(refs, |r| binning.bins(centroid2(&r.bounds()))[axis] <= last_left);
     Some((
         mid,
         side(0..last_left + 1, node.first),
@@ -503,15 +524,22 @@ fn best_plane(bins: &Bins, node: &Node, count: usize) -> Option<(usize, usize)> 
         // Sweep from the right for the right side's area and count per plane.
         let mut right = [(0.0, 0u32); BINS];
         let mut acc = Box3::EMPTY;
-        let mut n = 0;
+        let mut side = (0.0, 0);
         for i in (1..BINS).rev() {
-            acc.grow(&axis[i].bounds);
-            n += axis[i].count;
-            right[i] = (acc.area(), n);
+            // An empty bin changes neither side: the plane beside it costs the
+            // same, and the first of equal planes wins anyway, so it is skipped.
+            if axis[i].count != 0 {
+                acc.grow(&axis[i].bounds);
+                side = (acc.area(), side.1 + axis[i].count);
+            }
+            right[i] = side;
         }
         let mut acc = Box3::EMPTY;
         let mut n = 0;
         for i in 0..BINS - 1 {
+            if axis[i].count == 0 {
+                continue;
+            }
             acc.grow(&axis[i].bounds);
             n += axis[i].count;
             let (right_area, nr) = right[i + 1];
@@ -533,21 +561,17 @@ fn best_plane(bins: &Bins, node: &Node, count: usize) -> Option<(usize, usize)> 
 
 /// Moves the primitives for which `left` holds to the front, keeping no
 /// particular order within either side (but the same order every run), and
-/// returns how many there are.
+/// returns how many there are. Without a branch on `left`: which side a
+/// primitive goes to is a coin toss to the branch predictor.
 fn partition(refs: &mut [PrimRef], left: impl Fn(&PrimRef) -> bool) -> usize {
-    let (mut i, mut j) = (0, refs.len());
-    loop {
-        while i < j && left(&refs[i]) {
-            i += 1;
-        }
-        while i < j && !left(&refs[j - 1]) {
-            j -= 1;
-        }
-        if i >= j {
-            return i;
-        }
-        refs.swap(i, j - 1);
-        i += 1;
-        j -= 1;
+    // refs[..i] go left and refs[i..j] go right; the swap with i == j, or of
+    // a right-going primitive to the front of the right side, changes nothing
+    // that matters.
+    let mut i = 0;
+    for j in 0..refs.len() {
+        let goes_left = left(&refs[j]);
+        refs.swap(i, j);
+        i += goes_left as usize;
     }
+    i
 }
