@@ -126,7 +126,11 @@ impl GpuScene {
         };
         // Copied from the f32 buffers, so a leaf tests exactly the positions
         // that the brute-force loops and the shading read.
-        gpu.bvh_prims = bvh.prims.par_iter().map(|&code| gpu.bvh_prim(code)).collect();
+        gpu.bvh_prims = bvh
+            .prims
+            .par_iter()
+            .map(|&code| gpu.bvh_prim(code))
+            .collect();
         gpu
     }
 

@@ -380,14 +380,22 @@ mod tests {
     #[test]
     fn the_reference_walks_the_gpus_tree() {
         let hard = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../scenes/hard");
-        let far = |case: &str| hard.join(format!("{case}.toml")).to_str().unwrap().to_string();
+        let far = |case: &str| {
+            hard.join(format!("{case}.toml"))
+                .to_str()
+                .unwrap()
+                .to_string()
+        };
         for name in ["teapot".to_string(), far("far-1e6"), far("closed-mesh")] {
             let mut scene = Scene::load(&name, &[]).unwrap();
             scene.set_accel(crate::scene::accel::Accel::Bvh);
             let gpu = crate::gpu::upload::GpuScene::new(&scene, 8, 8);
             let local = in_local_frame(&scene).rounded_to_f32();
             let reference = Tracer::new(&local);
-            let tree = reference.bvh.as_ref().expect("a BVH above a few primitives");
+            let tree = reference
+                .bvh
+                .as_ref()
+                .expect("a BVH above a few primitives");
             assert!(tree.nodes == gpu.bvh_nodes, "{name}: the nodes differ");
             let codes: Vec<u32> = gpu.bvh_prims.iter().map(|p| p.code).collect();
             assert_eq!(tree.prims, codes, "{name}: the leaves differ");

@@ -12,85 +12,14 @@
 //! the same answer in any order, so each run gives the same tree and the images
 //! compare byte for byte.
 
+use super::split::{boxes, split, Box3, Node, PrimRef, BIN_CHUNK, INTERSECT_COST, TRAVERSAL_COST};
 use crate::gpu::layout::{child_ref, Bounds, Bvh, GpuBvhNode, GpuBvhPrim, PRIM_SPHERE_BIT};
 use crate::scene::Scene;
-use glam::Vec3A;
 use rayon::prelude::*;
 
-/// Primitives per leaf at most; SAH may stop splitting earlier.
-pub const MAX_LEAF: usize = child_ref::MAX_LEAF_COUNT;
-const BINS: usize = 16;
-/// Relative cost of one node visit vs one primitive test, for SAH.
-const TRAVERSAL_COST: f64 = 1.0;
-const INTERSECT_COST: f64 = 1.0;
-/// A node with at least this many primitives counts its bins in parallel
-/// chunks of `BIN_CHUNK`: below it, the tasks would cost more than they save.
-const PARALLEL_BINNING: usize = 1 << 15;
-const BIN_CHUNK: usize = 1 << 13;
 /// A subtree with at least this many primitives builds its two halves as
 /// separate tasks.
 const PARALLEL_SUBTREE: usize = 1 << 12;
-
-/// An f32 box; empty when min > max. SIMD lanes: the builder's inner loops
-/// are a few min and max operations per primitive.
-#[derive(Clone, Copy, Debug, PartialEq)]
-struct Box3 {
-    min: Vec3A,
-    max: Vec3A,
-}
-
-impl Box3 {
-    const EMPTY: Box3 = Box3 {
-        min: Vec3A::INFINITY,
-        max: Vec3A::NEG_INFINITY,
-    };
-
-    fn grow(&mut self, o: &Box3) {
-        self.min = self.min.min(o.min);
-        self.max = self.max.max(o.max);
-    }
-
-    fn grow_point(&mut self, p: Vec3A) {
-        self.min = self.min.min(p);
-        self.max = self.max.max(p);
-    }
-
-    /// In f64, so that near-equal plane costs are told apart the same way every run.
-    fn area(&self) -> f64 {
-        let d = (self.max.as_dvec3() - self.min.as_dvec3()).max(glam::DVec3::ZERO);
-        2.0 * (d.x * d.y + d.y * d.z + d.z * d.x)
-    }
-
-    fn bounds(&self) -> Bounds {
-        (self.min.to_array(), self.max.to_array())
-    }
-}
-
-/// One primitive while building: its f32 box and its code (`PRIM_SPHERE_BIT`
-/// | sphere, or triangle). 32 bytes; the centroid is recomputed when needed.
-#[derive(Clone, Copy)]
-#[repr(C, align(16))]
-struct PrimRef {
-    min: [f32; 3],
-    code: u32,
-    max: [f32; 3],
-    pad: u32,
-}
-
-impl PrimRef {
-    fn bounds(&self) -> Box3 {
-        Box3 {
-            min: Vec3A::from_array(self.min),
-            max: Vec3A::from_array(self.max),
-        }
-    }
-}
-
-/// Twice a box's centre: only compared with itself, so the half is never taken.
-fn centroid2(b: &Box3) -> Vec3A {
-    b.min + b.max
-}
-
 /// The f32 box of a sphere as the GPU holds it (centre and radius rounded to
 /// f32), rounded outwards so that it contains the sphere.
 fn sphere_ref(center: glam::DVec3, radius: f64, code: u32) -> PrimRef {
@@ -151,17 +80,14 @@ impl Bvh {
         let mut refs = prim_refs(scene);
         let mut bvh = Bvh::default();
         if !refs.is_empty() {
-            let (bounds, centroids) = refs
-                .par_chunks(BIN_CHUNK)
-                .map(boxes)
-                .reduce(
-                    || (Box3::EMPTY, Box3::EMPTY),
-                    |(mut b, mut c), (b2, c2)| {
-                        b.grow(&b2);
-                        c.grow(&c2);
-                        (b, c)
-                    },
-                );
+            let (bounds, centroids) = refs.par_chunks(BIN_CHUNK).map(boxes).reduce(
+                || (Box3::EMPTY, Box3::EMPTY),
+                |(mut b, mut c), (b2, c2)| {
+                    b.grow(&b2);
+                    c.grow(&c2);
+                    (b, c)
+                },
+            );
             let node = Node {
                 bounds,
                 centroids,
@@ -169,10 +95,10 @@ impl Bvh {
             };
             // Zeroed pages that no node is written to are never touched, so
             // the slots cost about what the tree needs (see `build`).
-            let mut slots = bytemuck::zeroed_vec(refs.len() - 1);
+            let mut slots: Vec<GpuBvhNode> = bytemuck::zeroed_vec(refs.len() - 1);
             let built = build(&mut refs, node, &mut slots);
             bvh.depth = built.depth;
-            bvh.nodes = compact(slots, built.interior);
+            bvh.nodes = compact(&slots, &built.runs, built.interior);
             if let Some((first, count)) = child_ref::as_leaf(built.child) {
                 // Node 0 is always an interior node: a tree that is one leaf
                 // gets a root whose two children are that leaf. The second
@@ -241,15 +167,6 @@ impl Bvh {
     }
 }
 
-/// A subtree to build: the box of its primitives, the box of their doubled
-/// centroids, and where its primitives start in the final primitive list.
-#[derive(Clone, Copy)]
-struct Node {
-    bounds: Box3,
-    centroids: Box3,
-    first: usize,
-}
-
 /// A built subtree: its child reference (a leaf, or `RELATIVE` for an interior
 /// node, which is then the first of its slots), its interior node count and
 /// its depth.
@@ -257,6 +174,8 @@ struct Built {
     child: u32,
     interior: usize,
     depth: u32,
+    /// The written runs of its slots, (first slot, count), in order.
+    runs: Vec<(usize, usize)>,
 }
 
 /// The child reference of a built interior subtree until it is placed.
@@ -279,6 +198,7 @@ fn build(refs: &mut [PrimRef], node: Node, slots: &mut [GpuBvhNode]) -> Built {
             child,
             interior: used,
             depth,
+            runs: if used == 0 { vec![] } else { vec![(0, used)] },
         };
     }
     let Some((mid, left, right)) = split(refs, &node) else {
@@ -286,6 +206,7 @@ fn build(refs: &mut [PrimRef], node: Node, slots: &mut [GpuBvhNode]) -> Built {
             child: child_ref::leaf(node.first as u32, refs.len() as u32),
             interior: 0,
             depth: 1,
+            runs: vec![],
         };
     };
     let (lrefs, rrefs) = refs.split_at_mut(mid);
@@ -303,10 +224,15 @@ fn build(refs: &mut [PrimRef], node: Node, slots: &mut [GpuBvhNode]) -> Built {
         right.bounds.bounds(),
         relative(r.child, 1 + l.interior),
     );
+    let mut runs = Vec::with_capacity(1 + l.runs.len() + r.runs.len());
+    runs.push((0, 1));
+    runs.extend(l.runs.iter().map(|&(first, n)| (1 + first, n)));
+    runs.extend(r.runs.iter().map(|&(first, n)| (mid + first, n)));
     Built {
         child: RELATIVE,
         interior: 1 + l.interior + r.interior,
         depth: 1 + l.depth.max(r.depth),
+        runs,
     }
 }
 
@@ -346,232 +272,30 @@ fn build_serial(
     (RELATIVE, 1 + ldepth.max(rdepth))
 }
 
-/// Closes the gaps between the windows of `build`, in order, and turns the
-/// relative child references into indices. A written slot is never all
-/// zero: its left child is a leaf (LEAF_BIT) or at least one node away.
-fn compact(mut slots: Vec<GpuBvhNode>, interior: usize) -> Vec<GpuBvhNode> {
-    let mut w = 0;
-    for r in 0..slots.len() {
-        if slots[r].left != 0 {
-            slots[w] = slots[r];
-            w += 1;
-        }
+/// Copies the written runs of the slots into one array, in order (closing
+/// the gaps at the ends of the windows of `build`), and turns the relative
+/// child references into indices. The runs are copied at once, each by a task.
+fn compact(slots: &[GpuBvhNode], runs: &[(usize, usize)], interior: usize) -> Vec<GpuBvhNode> {
+    let mut nodes: Vec<GpuBvhNode> = bytemuck::zeroed_vec(interior);
+    let mut jobs = Vec::with_capacity(runs.len());
+    let mut rest = nodes.as_mut_slice();
+    let mut at = 0;
+    for &(first, n) in runs {
+        let (dst, tail) = rest.split_at_mut(n);
+        jobs.push((at, &slots[first..first + n], dst));
+        rest = tail;
+        at += n;
     }
-    debug_assert_eq!(w, interior);
-    slots.truncate(w);
-    slots.shrink_to_fit();
-    slots.par_iter_mut().enumerate().for_each(|(i, n)| {
-        for c in [&mut n.left, &mut n.right] {
-            if child_ref::as_leaf(*c).is_none() {
-                *c += i as u32;
+    debug_assert_eq!(at, interior);
+    jobs.into_par_iter().for_each(|(at, src, dst)| {
+        dst.copy_from_slice(src);
+        for (i, n) in dst.iter_mut().enumerate() {
+            for c in [&mut n.left, &mut n.right] {
+                if child_ref::as_leaf(*c).is_none() {
+                    *c += (at + i) as u32;
+                }
             }
         }
     });
-    slots
-}
-
-/// The bins of one axis: each bin's box, its centroids' box and its count.
-#[derive(Clone, Copy)]
-struct Bin {
-    bounds: Box3,
-    centroids: Box3,
-    count: u32,
-}
-
-type Bins = [[Bin; BINS]; 3];
-
-const EMPTY_BIN: Bin = Bin {
-    bounds: Box3::EMPTY,
-    centroids: Box3::EMPTY,
-    count: 0,
-};
-
-/// Where each axis's centroids fall into bins: the same arithmetic counts the
-/// bins and later partitions, so the two always agree.
-#[derive(Clone, Copy)]
-struct Binning {
-    min: Vec3A,
-    scale: Vec3A,
-}
-
-impl Binning {
-    fn new(centroids: &Box3) -> Binning {
-        let extent = centroids.max - centroids.min;
-        // A flat axis puts everything in bin 0, where no plane separates anything.
-        let usable = extent.cmpgt(Vec3A::ZERO) & extent.is_finite_mask();
-        let scale = Vec3A::select(usable, BINS as f32 / extent, Vec3A::ZERO);
-        Binning {
-            min: centroids.min,
-            scale,
-        }
-    }
-
-    /// The primitive's bin on each axis.
-    fn bins(&self, c: Vec3A) -> [usize; 3] {
-        let b = ((c - self.min) * self.scale).as_uvec3();
-        b.min(glam::UVec3::splat(BINS as u32 - 1))
-            .to_array()
-            .map(|x| x as usize)
-    }
-
-    fn count(&self, refs: &[PrimRef]) -> Bins {
-        let mut bins = [[EMPTY_BIN; BINS]; 3];
-        for r in refs {
-            let b = r.bounds();
-            let c = centroid2(&b);
-            for (axis, i) in bins.iter_mut().zip(self.bins(c)) {
-                let bin = &mut axis[i];
-                bin.bounds.grow(&b);
-                bin.centroids.grow_point(c);
-                bin.count += 1;
-            }
-        }
-        bins
-    }
-
-    /// `count`, in parallel chunks for a large node. Min, max and integer sums
-    /// give the same bins whichever way the chunks are merged.
-    fn count_parallel(&self, refs: &[PrimRef]) -> Bins {
-        if refs.len() < PARALLEL_BINNING {
-            return self.count(refs);
-        }
-        refs.par_chunks(BIN_CHUNK)
-            .map(|c| self.count(c))
-            .reduce(
-                || [[EMPTY_BIN; BINS]; 3],
-                |mut a, b| {
-                    for (x, y) in a.iter_mut().flatten().zip(b.iter().flatten()) {
-                        x.bounds.grow(&y.bounds);
-                        x.centroids.grow(&y.centroids);
-                        x.count += y.count;
-                    }
-                    a
-                },
-            )
-    }
-}
-
-/// The box of some primitives and the box of their doubled centroids.
-fn boxes(refs: &[PrimRef]) -> (Box3, Box3) {
-    let (mut b, mut c) = (Box3::EMPTY, Box3::EMPTY);
-    for r in refs {
-        let rb = r.bounds();
-        b.grow(&rb);
-        c.grow_point(centroid2(&rb));
-    }
-    (b, c)
-}
-
-/// Splits the node's primitives if SAH (or a leaf's size limit) says so:
-/// reorders `refs` so the left half comes first and returns its length and
-/// both halves. None makes the node a leaf.
-fn split(refs: &mut [PrimRef], node: &Node) -> Option<(usize, Node, Node)> {
-    let count = refs.len();
-    if count <= 1 {
-        return None;
-    }
-    let binning = Binning::new(&node.centroids);
-    let bins = binning.count_parallel(refs);
-    let Some((axis, last_left)) = best_plane(&bins, node, count) else {
-        if count <= MAX_LEAF {
-            return None;
-        }
-        // Too many for a leaf but no plane separates them (identical
-        // centroids): split the list in the middle.
-        let mid = count / 2;
-        let half = |refs: &[PrimRef], first| {
-            let (bounds, centroids) = boxes(refs);
-            Node {
-                bounds,
-                centroids,
-                first,
-            }
-        };
-        return Some((
-            mid,
-            half(&refs[..mid], node.first),
-            half(&refs[mid..], node.first + mid),
-        ));
-    };
-    let side = |range: std::ops::Range<usize>, first| {
-        let mut n = Node {
-            bounds: Box3::EMPTY,
-            centroids: Box3::EMPTY,
-            first,
-        };
-        for b in &bins[axis][range] {
-            n.bounds.grow(&b.bounds);
-            n.centroids.grow(&b.centroids);
-        }
-        n
-    };
-    let mid = partition(refs, |r| binning.bins(centroid2(&r.bounds()))[axis] <= last_left);
-    Some((
-        mid,
-        side(0..last_left + 1, node.first),
-        side(last_left + 1..BINS, node.first + mid),
-    ))
-}
-
-/// Binned SAH: the cheapest of BINS-1 planes per axis, as (axis, last bin on
-/// the left), or None when a leaf is cheaper (and allowed) or no plane has
-/// primitives on both sides. Ties go to the first plane found.
-fn best_plane(bins: &Bins, node: &Node, count: usize) -> Option<(usize, usize)> {
-    let leaf_cost = INTERSECT_COST * count as f64;
-    let area = node.bounds.area().max(1e-300);
-    let mut best: Option<(f64, usize, usize)> = None;
-    for (a, axis) in bins.iter().enumerate() {
-        // Sweep from the right for the right side's area and count per plane.
-        let mut right = [(0.0, 0u32); BINS];
-        let mut acc = Box3::EMPTY;
-        let mut side = (0.0, 0);
-        for i in (1..BINS).rev() {
-            // An empty bin changes neither side: the plane beside it costs the
-            // same, and the first of equal planes wins anyway, so it is skipped.
-            if axis[i].count != 0 {
-                acc.grow(&axis[i].bounds);
-                side = (acc.area(), side.1 + axis[i].count);
-            }
-            right[i] = side;
-        }
-        let mut acc = Box3::EMPTY;
-        let mut n = 0;
-        for i in 0..BINS - 1 {
-            if axis[i].count == 0 {
-                continue;
-            }
-            acc.grow(&axis[i].bounds);
-            n += axis[i].count;
-            let (right_area, nr) = right[i + 1];
-            if n == 0 || nr == 0 {
-                continue;
-            }
-            let cost = TRAVERSAL_COST
-                + INTERSECT_COST * (acc.area() * n as f64 + right_area * nr as f64) / area;
-            if best.is_none_or(|b| cost < b.0) {
-                best = Some((cost, a, i));
-            }
-        }
-    }
-    match best {
-        Some((cost, a, i)) if cost < leaf_cost || count > MAX_LEAF => Some((a, i)),
-        _ => None,
-    }
-}
-
-/// Moves the primitives for which `left` holds to the front, keeping no
-/// particular order within either side (but the same order every run), and
-/// returns how many there are. Without a branch on `left`: which side a
-/// primitive goes to is a coin toss to the branch predictor.
-fn partition(refs: &mut [PrimRef], left: impl Fn(&PrimRef) -> bool) -> usize {
-    // refs[..i] go left and refs[i..j] go right; the swap with i == j, or of
-    // a right-going primitive to the front of the right side, changes nothing
-    // that matters.
-    let mut i = 0;
-    for j in 0..refs.len() {
-        let goes_left = left(&refs[j]);
-        refs.swap(i, j);
-        i += goes_left as usize;
-    }
-    i
+    nodes
 }

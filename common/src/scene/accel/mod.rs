@@ -1,10 +1,11 @@
 //! Acceleration: `--accel` and the scene's choice of a BVH; `build` makes the
 //! bounding volume hierarchy itself (`gpu::layout::Bvh`), which
-//! shaders/trace/bvh.glsl walks.
+//! shaders/trace/bvh.glsl walks, and `split` its split of one node.
 
 mod build;
+mod split;
 
-pub use build::MAX_LEAF;
+pub use split::MAX_LEAF;
 
 use crate::gpu::layout::Bvh;
 use crate::scene::camera::in_local_frame;
