@@ -9,8 +9,9 @@
 //! reference, which traces the same f32-rounded scene, builds the very same
 //! tree. Every decision depends only on the input order, never on the thread
 //! count or timing: the bins merge with min, max and integer sums, which give
-//! the same answer in any order, so each run gives the same tree and the images
-//! compare byte for byte.
+//! the same answer in any order, and the partitions move primitives by fixed
+//! chunks, so each run gives the same tree, byte for byte, and so the same
+//! images.
 
 use super::split::{boxes, split, Box3, Node, PrimRef, BIN_CHUNK, INTERSECT_COST, TRAVERSAL_COST};
 use crate::gpu::layout::{child_ref, Bounds, Bvh, GpuBvhNode, GpuBvhPrim, PRIM_SPHERE_BIT};
@@ -20,6 +21,14 @@ use rayon::prelude::*;
 /// A subtree with at least this many primitives builds its two halves as
 /// separate tasks.
 const PARALLEL_SUBTREE: usize = 1 << 12;
+
+/// -0.0 as +0.0. SIMD min and max return either zero when both meet, so a
+/// box merged in another order could hold the other one: same tree, other
+/// bytes. The teapot has both (its y-up conversion negates zeros).
+fn positive_zero(v: [f32; 3]) -> [f32; 3] {
+    v.map(|x| x + 0.0)
+}
+
 /// The f32 box of a sphere as the GPU holds it (centre and radius rounded to
 /// f32), rounded outwards so that it contains the sphere.
 fn sphere_ref(center: glam::DVec3, radius: f64, code: u32) -> PrimRef {
@@ -27,9 +36,9 @@ fn sphere_ref(center: glam::DVec3, radius: f64, code: u32) -> PrimRef {
     let lo = (c - r).to_array();
     let hi = (c + r).to_array();
     PrimRef {
-        min: lo.map(|v| next_down(v as f32, v)),
+        min: positive_zero(lo.map(|v| next_down(v as f32, v))),
         code,
-        max: hi.map(|v| next_up(v as f32, v)),
+        max: positive_zero(hi.map(|v| next_up(v as f32, v))),
         pad: 0,
     }
 }
@@ -65,9 +74,9 @@ fn prim_refs(scene: &Scene) -> Vec<PrimRef> {
         let p = t.p.map(|v| v.as_vec3());
         let (lo, hi) = (p[0].min(p[1]).min(p[2]), p[0].max(p[1]).max(p[2]));
         PrimRef {
-            min: lo.to_array(),
+            min: positive_zero(lo.to_array()),
             code: i as u32,
-            max: hi.to_array(),
+            max: positive_zero(hi.to_array()),
             pad: 0,
         }
     }));
