@@ -4,6 +4,7 @@
 //! SAH cost, bytes, and whether every round gave the same tree; then the
 //! resident memory each step of a run's preparation peaks at and keeps
 //! (loading the scene, building the BVH, laying out the GPU's bytes).
+use std::io::Write as _;
 use twinray_common::gpu::layout::Bvh;
 use twinray_common::gpu::upload::GpuScene;
 use twinray_common::scene::accel::Accel;
@@ -41,7 +42,10 @@ fn main() {
     let cpu_ms = (cpu_seconds() - cpu_before) * 1e3 / rounds as f64;
     let b = first.expect("at least one round");
     memory.step("Bvh::build (the tree kept, rounds-1 dropped)");
-    println!(
+    // Written, not println!: a closed pipe (`| head`) ends the output, not the process with a panic.
+    let mut out = std::io::stdout().lock();
+    let _ = writeln!(
+        out,
         "{} {}: {n} primitives, load {load_ms:.0} ms, build {best:.1} ms ({:.2} M prims/s, {} threads; {cpu_ms:.0} ms of CPU a build), {} nodes, depth {}, SAH {:.3}, {:.1} MB, same tree every round: {same}",
         a[1],
         a.get(2).map_or("", |s| s.as_str()),
@@ -61,7 +65,7 @@ fn main() {
     let gpu = GpuScene::new(&scene, 64, 48);
     let upload_ms = t.elapsed().as_secs_f64() * 1e3;
     memory.step(&format!("GpuScene::new ({upload_ms:.0} ms)"));
-    memory.print(n);
+    memory.print(&mut out, n);
     drop(gpu);
 }
 
@@ -84,12 +88,16 @@ impl Memory {
         reset_peak();
     }
 
-    fn print(&self, n: usize) {
-        println!("resident memory (MB, and bytes per primitive), step by step:");
+    fn print(&self, out: &mut impl std::io::Write, n: usize) {
+        let _ = writeln!(
+            out,
+            "resident memory (MB, and bytes per primitive), step by step:"
+        );
         let mut before = 0.0;
         for (what, peak, now) in &self.rows {
             let b = |kb: f64| kb * 1024.0 / n.max(1) as f64;
-            println!(
+            let _ = writeln!(
+                out,
                 "  {what}: peak {:.0} MB ({:.0} B), after {:.0} MB ({:.0} B, {:+.0} B)",
                 peak / 1024.0,
                 b(*peak),
