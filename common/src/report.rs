@@ -63,6 +63,12 @@ pub struct RunReport {
     /// of the setup of its own (absent without a BVH).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub bvh_ms: Option<f64>,
+    /// The BVH's nodes and its SAH cost (the builder's own costs, relative to
+    /// the root's area: lower traces faster), where the run built one.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub bvh_nodes: Option<usize>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub bvh_sah_cost: Option<f64>,
 }
 
 /// One compiled stage and the figures its driver gives for it, as the driver
@@ -125,6 +131,8 @@ impl RunReport {
                 grays_per_s: None,
                 grays_clock: None,
                 bvh_ms: None,
+                bvh_nodes: None,
+                bvh_sah_cost: None,
             },
         }
     }
@@ -201,9 +209,19 @@ impl RunReportBuilder {
         self
     }
 
-    /// The BVH's build time, where the run built one.
-    pub fn bvh_ms(mut self, ms: Option<f64>) -> Self {
+    /// The BVH's build time, node count and SAH cost, where the run built one.
+    pub fn bvh(mut self, bvh: Option<&crate::gpu::layout::Bvh>, ms: Option<f64>) -> Self {
         self.report.bvh_ms = ms;
+        self.report.bvh_nodes = bvh.map(|b| b.node_count());
+        self.report.bvh_sah_cost = bvh.map(|b| b.sah_cost());
+        self
+    }
+
+    /// As `bvh`, from figures kept after the tree is gone (a window's first scene).
+    pub fn bvh_figures(mut self, ms: Option<f64>, figures: Option<(usize, f64)>) -> Self {
+        self.report.bvh_ms = ms;
+        self.report.bvh_nodes = figures.map(|f| f.0);
+        self.report.bvh_sah_cost = figures.map(|f| f.1);
         self
     }
 

@@ -250,7 +250,7 @@ fn report(
         .frames(frames, setup_ms)
         .nonfinite_pixels(image.nonfinite_pixels())
         .shader_stats(shader_stats)
-        .bvh_ms(plan.bvh_ms)
+        .bvh(plan.bvh.as_ref(), plan.bvh_ms)
         .build();
     Ok((report, image))
 }

@@ -10,6 +10,7 @@ use crate::limits::StorageLimit;
 use crate::scene::camera::{in_local_frame, RayFrame};
 use crate::scene::{Camera, Scene};
 use bytemuck::Pod;
+use rayon::prelude::*;
 
 /// Everything a frame needs on the GPU, as bytes. Both apps upload exactly these.
 #[derive(Clone, Debug)]
@@ -77,9 +78,10 @@ impl GpuScene {
                     pad: [0; 3],
                 })
                 .collect(),
+            // Millions of triangles for a fine mesh: converted on every core.
             triangles: scene
                 .triangles
-                .iter()
+                .par_iter()
                 .map(|t| GpuTriangle {
                     p0: v3(t.p[0]),
                     material: t.material,
@@ -125,7 +127,11 @@ impl GpuScene {
         };
         // Copied from the f32 buffers, so a leaf tests exactly the positions
         // that the brute-force loops and the shading read.
-        gpu.bvh_prims = bvh.prims.iter().map(|&code| gpu.bvh_prim(code)).collect();
+        gpu.bvh_prims = bvh
+            .prims
+            .par_iter()
+            .map(|&code| gpu.bvh_prim(code))
+            .collect();
         gpu
     }
 

@@ -151,10 +151,12 @@ impl Planner {
             let ms = t0.elapsed().as_secs_f64() * 1e3;
             explain::numbered(0, "BVH (twinray-common)", || {
                 format!(
-                    "{} nodes over {} primitives, {} deep; built in {ms:.1} ms",
-                    bvh.nodes.len(),
+                    "{} nodes over {} primitives, {} deep, SAH cost {:.3}; built in {ms:.1} ms ({:.1} M primitives/s)",
+                    bvh.node_count(),
                     scene.primitive_count(),
-                    bvh.depth
+                    bvh.depth,
+                    bvh.sah_cost(),
+                    scene.primitive_count() as f64 / ms.max(1e-3) / 1e3
                 )
             });
             (Some(bvh), Some(ms))

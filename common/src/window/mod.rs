@@ -95,8 +95,10 @@ pub struct WindowedRun {
     pub height: u32,
     /// Milliseconds from `started` to the end of the first frame.
     pub setup_ms: f64,
-    /// The first scene's BVH build, where it had one.
+    /// The first scene's BVH build time, where it had one.
     pub bvh_ms: Option<f64>,
+    /// The first scene's BVH node count and SAH cost.
+    pub bvh_figures: Option<(usize, f64)>,
 }
 
 impl WindowedRun {
@@ -108,7 +110,7 @@ impl WindowedRun {
             .path(self.path, self.workgroup)
             .frames(self.frames, self.setup_ms)
             .validation_messages(validation_messages)
-            .bvh_ms(self.bvh_ms)
+            .bvh_figures(self.bvh_ms, self.bvh_figures)
             .build()
     }
 }

@@ -38,6 +38,7 @@ pub fn run<R: Renderer>(
     let size = renderer.window().inner_size();
     let now = Instant::now();
     let bvh_ms = plan.bvh_ms;
+    let bvh_figures = plan.bvh.as_ref().map(|b| (b.node_count(), b.sah_cost()));
     let args = planner.args();
     let mut session = Session {
         program,
@@ -87,6 +88,7 @@ pub fn run<R: Renderer>(
         height: session.size.height,
         setup_ms: session.setup_ms,
         bvh_ms,
+        bvh_figures,
     })
 }
 

@@ -34,6 +34,7 @@
 //! corrected.
 
 use anyhow::{anyhow, bail, Context as _};
+use rayon::prelude::*;
 use std::fmt::Write as _;
 
 /// Number of grid quads per patch along `u` (along a control-point row) used
@@ -175,45 +176,56 @@ pub fn tessellate(patches: &[[[f64; 3]; 16]], nu: u32, nv: u32) -> TeapotMesh {
     );
 
     let flips = inward_facing_patches(patches);
+    let row = nu as usize + 1;
+    let rows = nv as usize + 1;
     let mut mesh = TeapotMesh {
-        positions: Vec::with_capacity(total as usize),
-        normals: Vec::with_capacity(total as usize),
-        triangles: Vec::with_capacity(patches.len() * nu as usize * nv as usize * 2),
+        positions: vec![[0.0; 3]; total as usize],
+        normals: vec![[0.0; 3]; total as usize],
+        triangles: vec![[0; 3]; patches.len() * nu as usize * nv as usize * 2],
     };
-    let row = nu + 1;
-    for (cp, &flip) in patches.iter().zip(&flips) {
-        let base = mesh.positions.len() as u32;
-        for b in 0..=nv {
+    // One task per grid row: a fine tessellation of a few patches still
+    // keeps every core busy, and each row lands where a serial loop would
+    // have put it, so the mesh is the same on any number of threads.
+    mesh.positions
+        .par_chunks_mut(row)
+        .zip(mesh.normals.par_chunks_mut(row))
+        .enumerate()
+        .for_each(|(k, (positions, normals))| {
+            let (patch, b) = (k / rows, k % rows);
+            let (cp, flip) = (&patches[patch], flips[patch]);
             let v = b as f64 / nv as f64;
-            for a in 0..=nu {
+            for (a, (p_out, n_out)) in positions.iter_mut().zip(normals.iter_mut()).enumerate() {
                 let u = a as f64 / nu as f64;
                 let (p, _, _) = eval_patch(cp, u, v);
                 let mut n = surface_normal(cp, u, v);
                 if flip {
                     n = neg(n);
                 }
-                mesh.positions.push(z_up_to_y_up(p));
-                mesh.normals.push(z_up_to_y_up(n));
+                *p_out = z_up_to_y_up(p);
+                *n_out = z_up_to_y_up(n);
             }
-        }
-        for b in 0..nv {
-            for a in 0..nu {
-                let i00 = base + b * row + a;
+        });
+    let quads = nu as usize * 2;
+    mesh.triangles
+        .par_chunks_mut(quads)
+        .enumerate()
+        .for_each(|(k, out)| {
+            let (patch, b) = (k / nv as usize, (k % nv as usize) as u32);
+            let base = (patch * row * rows) as u32;
+            for (a, pair) in (0..nu).zip(out.chunks_exact_mut(2)) {
+                let i00 = base + b * row as u32 + a;
                 let i10 = i00 + 1;
-                let i01 = i00 + row;
+                let i01 = i00 + row as u32;
                 let i11 = i01 + 1;
                 // (p10 - p00) × (p11 - p00) ≈ du·dv · (∂P/∂u × ∂P/∂v): CCW about
                 // the unflipped normal.
-                if flip {
-                    mesh.triangles.push([i00, i11, i10]);
-                    mesh.triangles.push([i00, i01, i11]);
+                if flips[patch] {
+                    pair.copy_from_slice(&[[i00, i11, i10], [i00, i01, i11]]);
                 } else {
-                    mesh.triangles.push([i00, i10, i11]);
-                    mesh.triangles.push([i00, i11, i01]);
+                    pair.copy_from_slice(&[[i00, i10, i11], [i00, i11, i01]]);
                 }
             }
-        }
-    }
+        });
     mesh
 }
 
@@ -506,7 +518,7 @@ fn escape_votes(patches: &[[V3; 16]]) -> Vec<(usize, usize)> {
         .collect();
 
     patches
-        .iter()
+        .par_iter()
         .enumerate()
         .map(|(pi, cp)| {
             let mut votes = (0usize, 0usize);
