@@ -419,11 +419,24 @@ shared uvec2 bvh_stack[BVH_STACK * WG_X * WG_Y];
 #define BVH_PUSH(i, e) bvh_stack[(i) * uint(WG_X * WG_Y) + gl_LocalInvocationIndex] = (e)
 #define BVH_POP(i) bvh_stack[(i) * uint(WG_X * WG_Y) + gl_LocalInvocationIndex]
 #elif defined(BVH_STACK_UNPAIRED)
+#if BVH_STACK < 2
+// At least two elements, for the reason given below.
+#define BVH_STACK_DECLARE uvec2 stack[2]
+#else
 #define BVH_STACK_DECLARE uvec2 stack[BVH_STACK]
+#endif
 #define BVH_PUSH(i, e) stack[i] = (e)
 #define BVH_POP(i) stack[i]
 #else
+#if BVH_STACK <= 2
+// Never a one-element array: Mesa 22.3's GLSL front end (llvmpipe, OpenGL)
+// stores the last component written into every component of `uvec4 s[1]`, so
+// one push and one pop gave (20, 20) for (10, 20) and whole objects went
+// missing with --accel bvh on small trees. Two elements cost one spare slot.
+#define BVH_STACK_DECLARE uvec4 stack[2]
+#else
 #define BVH_STACK_DECLARE uvec4 stack[(BVH_STACK + 1) / 2]
+#endif
 #define BVH_PUSH(i, e) if (((i) & 1u) == 0u) { stack[(i) >> 1u].xy = (e); } else { stack[(i) >> 1u].zw = (e); }
 #define BVH_POP(i) (((i) & 1u) == 0u ? stack[(i) >> 1u].xy : stack[(i) >> 1u].zw)
 #endif
@@ -896,7 +909,14 @@ vec3 trace(vec3 origin, vec3 dir) {
             SPEC(SPEC_GLASS)
             if (kt > 0.0) {
                 float eta = inside ? m.ior : 1.0 / m.ior;
-                float cos_i = -dot(d, ns);
+                // Near a smooth mesh's silhouette the interpolated normal can
+                // face away from the ray (cos_i < 0), where Fresnel's formula
+                // exceeds 1 and glass would send on more than arrived (F = 19.5
+                // on a tilted-normal triangle). There Fresnel and the bend take
+                // the geometric normal, which faces the ray, so F stays in
+                // [0, 1]; the f64 reference does the same.
+                vec3 nt = dot(d, ns) > 0.0 ? ng : ns;
+                float cos_i = -dot(d, nt);
                 float k = 1.0 - eta * eta * (1.0 - cos_i * cos_i);
                 if (k < 0.0) {
                     kr += kt;  // total internal reflection
@@ -906,7 +926,7 @@ vec3 trace(vec3 origin, vec3 dir) {
                     kr += kt * f;
                     float wt = w * kt * (1.0 - f);
                     if (wt >= frame.min_weight && sp < STACK_SIZE) {
-                        vec3 t_dir = normalize(eta * d + (eta * cos_i - cos_t) * ns);
+                        vec3 t_dir = normalize(eta * d + (eta * cos_i - cos_t) * nt);
                         RAY_PUSH(sp, spawn_point(p, -ng, t_dir, scale), t_dir, wt, depth + 1u);
                         sp += 1;
 #ifdef COUNT_RAYS
