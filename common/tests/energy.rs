@@ -18,7 +18,7 @@ const SLACK: f64 = 1e-9;
 fn assert_no_gain(scene: &Scene, width: u32, height: u32) {
     if let Some((x, y, s)) = worst_split(scene, width, height) {
         assert!(
-            s.gain() <= 1.0 + SLACK,
+            s.gain() <= 1.0 + SLACK && s.reflected >= 0.0 && s.refracted >= 0.0,
             "{}: at pixel ({x}, {y}) of {width}x{height} a ray of weight {} sends on {} reflected \
              and {} refracted ({}x what arrived)",
             scene.name,
@@ -59,8 +59,7 @@ material = "glass"
 #[test]
 fn a_tilted_normal_on_glass_makes_no_light() {
     let scene = Scene::from_toml("tilted-glass", TILTED_GLASS, Path::new("."), &[]).unwrap();
-    let (_, _, s) = worst_split(&scene, 33, 33).expect("the triangle is in view");
-    assert!(s.refracted > 0.0, "the centre ray reaches the glass");
+    assert!(worst_split(&scene, 33, 33).is_some(), "the glass is in view");
     assert_no_gain(&scene, 33, 33);
 }
 
@@ -104,13 +103,11 @@ fn random_scenes_with_tilted_glass_normals_make_no_light() {
             let face = (tri.p[1] - tri.p[0]).cross(tri.p[2] - tri.p[0]).normalize();
             for n in &mut tri.n {
                 let lean = DVec3::new(next(&mut state), next(&mut state), next(&mut state));
-                *n = (face + 1.8 * (lean - 0.5)).normalize();
+                *n = (face + 3.0 * (lean - 0.5)).normalize();
             }
         }
-        if let Some((_, _, s)) = worst_split(&scene, 32, 24) {
-            glass_hits += usize::from(s.refracted > 0.0);
-        }
+        glass_hits += usize::from(worst_split(&scene, 32, 24).is_some());
         assert_no_gain(&scene, 32, 24);
     }
-    assert!(glass_hits > 0, "no random scene's rays reached glass");
+    assert!(glass_hits > 0, "no random scene's rays reached glass or a mirror");
 }
