@@ -59,7 +59,10 @@ material = "glass"
 #[test]
 fn a_tilted_normal_on_glass_makes_no_light() {
     let scene = Scene::from_toml("tilted-glass", TILTED_GLASS, Path::new("."), &[]).unwrap();
-    assert!(worst_split(&scene, 33, 33).is_some(), "the glass is in view");
+    assert!(
+        worst_split(&scene, 33, 33).is_some(),
+        "the glass is in view"
+    );
     assert_no_gain(&scene, 33, 33);
 }
 
@@ -69,7 +72,11 @@ fn built_in_and_hard_scenes_make_no_light() {
         assert_no_gain(&Scene::load(name, &[]).unwrap(), 40, 30);
     }
     for case in hard::list(Path::new(hard::SOURCE_DIR)).unwrap() {
-        assert_no_gain(&Scene::load(case.path.to_str().unwrap(), &[]).unwrap(), 32, 32);
+        assert_no_gain(
+            &Scene::load(case.path.to_str().unwrap(), &[]).unwrap(),
+            32,
+            32,
+        );
     }
 }
 
@@ -109,5 +116,8 @@ fn random_scenes_with_tilted_glass_normals_make_no_light() {
         glass_hits += usize::from(worst_split(&scene, 32, 24).is_some());
         assert_no_gain(&scene, 32, 24);
     }
-    assert!(glass_hits > 0, "no random scene's rays reached glass or a mirror");
+    assert!(
+        glass_hits > 0,
+        "no random scene's rays reached glass or a mirror"
+    );
 }

@@ -112,11 +112,17 @@ pub fn worst_split(scene: &Scene, width: u32, height: u32) -> Option<(u32, u32, 
             let (x, y) = (i % width, i / width);
             let mut worst: Option<Split> = None;
             let dir = frame.dir(x as f64, y as f64);
-            trace_with(&tracer, frame.eye, dir, &mut RayKinds::default(), &mut |s| {
-                if worst.is_none_or(|w| s.gain() > w.gain()) {
-                    worst = Some(s);
-                }
-            });
+            trace_with(
+                &tracer,
+                frame.eye,
+                dir,
+                &mut RayKinds::default(),
+                &mut |s| {
+                    if worst.is_none_or(|w| s.gain() > w.gain()) {
+                        worst = Some(s);
+                    }
+                },
+            );
             worst.map(|s| (x, y, s))
         })
         .max_by(|a, b| a.2.gain().total_cmp(&b.2.gain()))
