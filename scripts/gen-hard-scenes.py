@@ -41,6 +41,7 @@ MEASURED = {
     "grazing": m(0.0, 0.0, (0.0, 0.0)),
     "huge-ground": m(0.049, 0.049, (0.049, 0.049)),
     "inside-glass": m(0.0, 0.0, (0.0, 0.0)),
+    "light-inside-glass": m(0.0, 0.0, why="a new case"),
     "light-inside-sphere": m(0.0, 0.0, (0.0, 0.0)),
     "light-on-surface": m(0.0, 0.0, (0.0, 0.0)),
     "nested-glass": m(0.024, 0.024, (0.342, 0.439)),
@@ -350,8 +351,8 @@ simple("light-inside-glass", "a point light inside a glass sphere, near its surf
        lights=BASE_LIGHT + '\n[[lights]]\nposition = [0.52, 1.61, 0.56]\ncolor = [0.8, 0.7, 0.5]\n',
        note="""A second light sits inside a glass sphere of radius 1.07, 0.92 from its centre.
 Shadow rays leave the inner surface towards it over a short distance, where a
-start left on the wrong side of the surface in f32 is hidden by the very
-surface it starts on: speckles inside the sphere, different in each API.""")
+start left on the wrong side of the surface in f32 would be hidden by the very
+surface it starts on: dark speckles inside the sphere.""")
 
 simple("huge-ground", "a sphere of radius 1e6 as the ground, a small sphere resting on it", 1.0,
        '\n[[spheres]]\ncenter = [0.0, -1000000.0, 0.0]\nradius = 1000000.0\nmaterial = "ground"\n'
