@@ -210,6 +210,33 @@ struct Ray {
     depth: u32,
 }
 
+/// The shader's hit record: the hit point (rebuilt from the barycentrics for
+/// the offsets that assume one), the geometric and shading normals as stored,
+/// the material and the offset's scale, for a hit at `p` by a ray from `o`.
+fn surface(scene: &Scene, hit: Hit, o: DVec3, mut p: DVec3) -> (DVec3, DVec3, DVec3, u32, f64) {
+    let max_abs = |v: DVec3| v.abs().max_element();
+    match hit {
+        Hit::Sphere(i) => {
+            let s = &scene.spheres[i];
+            let n = (p - s.center) / s.radius;
+            (p, n, n, s.material, 4.0 * max_abs(o).max(max_abs(p)))
+        }
+        Hit::Triangle(i, u, v) => {
+            let tri = &scene.triangles[i];
+            let (e1, e2) = (tri.p[1] - tri.p[0], tri.p[2] - tri.p[0]);
+            if matches!(scene.numerics.offset, Offset::ScaleAware | Offset::Ulp) {
+                p = tri.p[0] + u * e1 + v * e2;
+            }
+            let ng = e1.cross(e2).normalize();
+            let ns = ((1.0 - u - v) * tri.n[0] + u * tri.n[1] + v * tri.n[2]).normalize();
+            let prim = max_abs(tri.p[0])
+                .max(max_abs(tri.p[1]))
+                .max(max_abs(tri.p[2]));
+            (p, ng, ns, tri.material, max_abs(o).max(prim))
+        }
+    }
+}
+
 /// One pixel: the shader's `trace`, with its stack capacity of max_depth + 1,
 /// adding its rays to `kinds` where the counting variant counts them and
 /// telling `split` how each glass or mirror hit divides its ray's weight.
@@ -236,29 +263,7 @@ fn trace_with(
             color += w * scene.background;
             continue;
         };
-        let mut p = o + t * d;
-        let max_abs = |v: DVec3| v.abs().max_element();
-        let (mut ng, mut ns, mat, scale) = match hit {
-            Hit::Sphere(i) => {
-                let s = &scene.spheres[i];
-                let n = (p - s.center) / s.radius;
-                (n, n, s.material, 4.0 * max_abs(o).max(max_abs(p)))
-            }
-            Hit::Triangle(i, u, v) => {
-                let tri = &scene.triangles[i];
-                let (e1, e2) = (tri.p[1] - tri.p[0], tri.p[2] - tri.p[0]);
-                // The shader's barycentric hit point for the offsets that assume one.
-                if matches!(scene.numerics.offset, Offset::ScaleAware | Offset::Ulp) {
-                    p = tri.p[0] + u * e1 + v * e2;
-                }
-                let ng = e1.cross(e2).normalize();
-                let ns = ((1.0 - u - v) * tri.n[0] + u * tri.n[1] + v * tri.n[2]).normalize();
-                let prim = max_abs(tri.p[0])
-                    .max(max_abs(tri.p[1]))
-                    .max(max_abs(tri.p[2]));
-                (ng, ns, tri.material, max_abs(o).max(prim))
-            }
-        };
+        let (p, mut ng, mut ns, mat, scale) = surface(scene, hit, o, o + t * d);
         let inside = d.dot(ng) > 0.0;
         if inside {
             ng = -ng;
