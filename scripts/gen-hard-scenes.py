@@ -41,6 +41,7 @@ MEASURED = {
     "grazing": m(0.0, 0.0, (0.0, 0.0)),
     "huge-ground": m(0.049, 0.049, (0.049, 0.049)),
     "inside-glass": m(0.0, 0.0, (0.0, 0.0)),
+    "light-inside-glass": m(0.0, 0.0, why="a new case"),
     "light-inside-sphere": m(0.0, 0.0, (0.0, 0.0)),
     "light-on-surface": m(0.0, 0.0, (0.0, 0.0)),
     "nested-glass": m(0.024, 0.024, (0.342, 0.439)),
@@ -328,6 +329,30 @@ simple("light-inside-sphere", "a point light inside a closed opaque sphere: noth
        note="""The only light sits inside an opaque sphere. Every shadow ray from outside must
 hit the sphere: a light leak (a missed sphere test, an offset through the
 shell) lights a floor pixel.""")
+
+# Glass that also scatters a little, so the light inside shows on every inner
+# surface point it reaches, not only in highlights.
+LIT_GLASS = '''
+[[materials]]
+name = "glass"
+diffuse = [0.3, 0.3, 0.3]
+specular = [0.8, 0.8, 0.8]
+shininess = 200.0
+transparency = 0.65
+ior = 1.5
+'''
+
+simple("light-inside-glass", "a point light inside a glass sphere, near its surface: the inner surface towards it is lit, without speckles", 1.0,
+       '\n[[quads]]\ncorners = [[-4.0, 0.0, -4.0], [-4.0, 0.0, 4.0], [4.0, 0.0, 4.0], [4.0, 0.0, -4.0]]\nmaterial = "ground"\n'
+       '\n[[spheres]]\ncenter = [0.0, 1.1, 0.0]\nradius = 1.07\nmaterial = "glass"\n'
+       '\n[[spheres]]\ncenter = [1.8, 0.4, -0.6]\nradius = 0.4\nmaterial = "red"\n',
+       'eye = [0.0, 2.2, 4.2]\nlook_at = [0.0, 1.0, 0.0]\nfov_y = 45.0',
+       materials=MATERIALS + LIT_GLASS,
+       lights=BASE_LIGHT + '\n[[lights]]\nposition = [0.52, 1.61, 0.56]\ncolor = [0.8, 0.7, 0.5]\n',
+       note="""A second light sits inside a glass sphere of radius 1.07, 0.92 from its centre.
+Shadow rays leave the inner surface towards it over a short distance, where a
+start left on the wrong side of the surface in f32 would be hidden by the very
+surface it starts on: dark speckles inside the sphere.""")
 
 simple("huge-ground", "a sphere of radius 1e6 as the ground, a small sphere resting on it", 1.0,
        '\n[[spheres]]\ncenter = [0.0, -1000000.0, 0.0]\nradius = 1000000.0\nmaterial = "ground"\n'

@@ -30,11 +30,24 @@ shared uvec2 bvh_stack[BVH_STACK * WG_X * WG_Y];
 #define BVH_PUSH(i, e) bvh_stack[(i) * uint(WG_X * WG_Y) + gl_LocalInvocationIndex] = (e)
 #define BVH_POP(i) bvh_stack[(i) * uint(WG_X * WG_Y) + gl_LocalInvocationIndex]
 #elif defined(BVH_STACK_UNPAIRED)
+#if BVH_STACK < 2
+// At least two elements, for the reason given below.
+#define BVH_STACK_DECLARE uvec2 stack[2]
+#else
 #define BVH_STACK_DECLARE uvec2 stack[BVH_STACK]
+#endif
 #define BVH_PUSH(i, e) stack[i] = (e)
 #define BVH_POP(i) stack[i]
 #else
+#if BVH_STACK <= 2
+// Never a one-element array: Mesa 22.3's GLSL front end (llvmpipe, OpenGL)
+// stores the last component written into every component of `uvec4 s[1]`, so
+// one push and one pop gave (20, 20) for (10, 20) and whole objects went
+// missing with --accel bvh on small trees. Two elements cost one spare slot.
+#define BVH_STACK_DECLARE uvec4 stack[2]
+#else
 #define BVH_STACK_DECLARE uvec4 stack[(BVH_STACK + 1) / 2]
+#endif
 #define BVH_PUSH(i, e) if (((i) & 1u) == 0u) { stack[(i) >> 1u].xy = (e); } else { stack[(i) >> 1u].zw = (e); }
 #define BVH_POP(i) (((i) & 1u) == 0u ? stack[(i) >> 1u].xy : stack[(i) >> 1u].zw)
 #endif

@@ -149,7 +149,14 @@ vec3 trace(vec3 origin, vec3 dir) {
             SPEC(SPEC_GLASS)
             if (kt > 0.0) {
                 float eta = inside ? m.ior : 1.0 / m.ior;
-                float cos_i = -dot(d, ns);
+                // Near a smooth mesh's silhouette the interpolated normal can
+                // face away from the ray (cos_i < 0), where Fresnel's formula
+                // exceeds 1 and glass would send on more than arrived (F = 19.5
+                // on a tilted-normal triangle). There Fresnel and the bend take
+                // the geometric normal, which faces the ray, so F stays in
+                // [0, 1]; the f64 reference does the same.
+                vec3 nt = dot(d, ns) > 0.0 ? ng : ns;
+                float cos_i = -dot(d, nt);
                 float k = 1.0 - eta * eta * (1.0 - cos_i * cos_i);
                 if (k < 0.0) {
                     kr += kt;  // total internal reflection
@@ -159,7 +166,7 @@ vec3 trace(vec3 origin, vec3 dir) {
                     kr += kt * f;
                     float wt = w * kt * (1.0 - f);
                     if (wt >= frame.min_weight && sp < STACK_SIZE) {
-                        vec3 t_dir = normalize(eta * d + (eta * cos_i - cos_t) * ns);
+                        vec3 t_dir = normalize(eta * d + (eta * cos_i - cos_t) * nt);
                         RAY_PUSH(sp, spawn_point(p, -ng, t_dir, scale), t_dir, wt, depth + 1u);
                         sp += 1;
 #ifdef COUNT_RAYS

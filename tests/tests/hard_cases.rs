@@ -3,7 +3,10 @@
 //! (`# tolerance:` in the file: the share of pixels off by more than 8/255),
 //! never write NaN/Inf before quantisation, pass the extra checks a case names
 //! (`# check: cracks`, `# check: deterministic`), and the validation layer and
-//! GL debug output stay silent.
+//! GL debug output stay silent. Each case also runs through `--accel bvh`, on
+//! the compute path and at a 4x4 workgroup: a per-pixel tracer's image must not
+//! depend on the path, the workgroup or a user's choice of acceleration, and
+//! Mesa once lost whole objects with small BVH trees (a one-element stack).
 
 use std::path::Path;
 use twinray_common::reference;
@@ -14,7 +17,21 @@ use twinray_tests::{render, scratch, App};
 
 const SIZE: &str = "64x64";
 
+/// The runs besides the default that each case must also pass.
+const ALSO: [&[&str]; 5] = [
+    &["--path", "compute"],
+    &["--path", "compute", "--workgroup", "4x4"],
+    &["--accel", "bvh"],
+    &["--accel", "bvh", "--path", "compute"],
+    &["--accel", "bvh", "--path", "compute", "--workgroup", "4x4"],
+];
+
 fn check(name: &str) {
+    check_runs(name, &ALSO);
+}
+
+/// `check` with only the runs of `also` besides the default.
+fn check_runs(name: &str, also: &[&[&str]]) {
     let path = Path::new(hard::SOURCE_DIR).join(format!("{name}.toml"));
     let case: HardCase = hard::parse(&path).unwrap();
     let p = path.to_str().unwrap();
@@ -30,26 +47,12 @@ fn check(name: &str) {
     .to_rgb8();
     let dir = scratch(&format!("hard-{name}"));
     for app in App::BOTH {
+        for extra in also {
+            let (report, img) = render(app, p, SIZE, extra, &dir.join("x.png"));
+            within_tolerance(&case, app, extra, &report, &img, &truth);
+        }
         let (report, img) = render(app, p, SIZE, &[], &dir.join("a.png"));
-        assert_eq!(
-            report.nonfinite_pixels, 0,
-            "{name} {app:?}: NaN/Inf pixels before quantisation"
-        );
-        assert_eq!(
-            report.validation_messages, 0,
-            "{name} {app:?}: validation messages"
-        );
-        let wrong = 100.0 * hard::wrong_share(&img, &truth);
-        println!(
-            "{name} {app:?}: {wrong:.3}% wrong (tolerance {}%)",
-            case.tolerance_pct
-        );
-        assert!(
-            wrong <= case.tolerance_pct,
-            "{name} {app:?}: {wrong:.3}% of pixels wrong, tolerance {}% ({})",
-            case.tolerance_pct,
-            case.checks
-        );
+        within_tolerance(&case, app, &[], &report, &img, &truth);
         if case.extra.iter().any(|e| e == "cracks") {
             let cracks = hard::crack_pixels(&img, &truth, background.get_pixel(0, 0).0);
             assert_eq!(
@@ -68,13 +71,41 @@ fn check(name: &str) {
     std::fs::remove_dir_all(dir).ok();
 }
 
+fn within_tolerance(
+    case: &HardCase,
+    app: App,
+    extra: &[&str],
+    report: &twinray_common::report::RunReport,
+    img: &image::RgbImage,
+    truth: &image::RgbImage,
+) {
+    let name = format!("{} {app:?} {}", case.name, extra.join(" "));
+    assert_eq!(
+        report.nonfinite_pixels, 0,
+        "{name}: NaN/Inf pixels before quantisation"
+    );
+    assert_eq!(report.validation_messages, 0, "{name}: validation messages");
+    let wrong = 100.0 * hard::wrong_share(img, truth);
+    println!(
+        "{name}: {wrong:.3}% wrong (tolerance {}%)",
+        case.tolerance_pct
+    );
+    assert!(
+        wrong <= case.tolerance_pct,
+        "{name}: {wrong:.3}% of pixels wrong, tolerance {}% ({})",
+        case.tolerance_pct,
+        case.checks
+    );
+}
+
 #[test]
 fn every_hard_case_has_a_test() {
     let cases = hard::list(Path::new(hard::SOURCE_DIR)).unwrap();
     let tested = include_str!("hard_cases.rs");
     for c in &cases {
         assert!(
-            tested.contains(&format!("check(\"{}\")", c.name)),
+            tested.contains(&format!("check(\"{}\")", c.name))
+                || tested.contains(&format!("check_runs(\"{}\"", c.name)),
             "scenes/hard/{}.toml has no test here",
             c.name
         );
@@ -158,7 +189,20 @@ fn huge_sphere_as_ground() {
 }
 #[test]
 fn far_tiny_sphere() {
-    check("far-tiny-sphere");
+    check_runs("far-tiny-sphere", &ALSO[..2]);
+}
+/// Open (issue 26, A4): with `--accel bvh` on lavapipe and llvmpipe the wall
+/// is lost where the SIMD vector spans several image rows (the fragment path's
+/// 4x4 blocks, compute workgroups narrower than 8): traversal loops end after
+/// their first turn for some invocations. Not found in the shader yet.
+#[test]
+#[ignore = "issue 26 A4: --accel bvh on Mesa loses the wall in 4x4 blocks"]
+fn far_tiny_sphere_through_the_bvh() {
+    check_runs("far-tiny-sphere", &ALSO[2..]);
+}
+#[test]
+fn light_inside_glass() {
+    check("light-inside-glass");
 }
 
 /// `--set` picks the same numerics in both apps and the reference follows.
