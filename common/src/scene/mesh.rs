@@ -285,6 +285,11 @@ fn scan_obj(what: &str, text: &str, before: usize, limit: &StorageLimit) -> anyh
                 seen[2] += 1;
             }
             Some(kind @ ("f" | "l")) => {
+                // tobj takes a bare `f` or `l` for a polygon and refuses it
+                // without a line number.
+                if words.clone().next().is_none() {
+                    return Err(at(n, &format!("not a valid OBJ file: `{kind}` names no vertex")));
+                }
                 if kind == "f" {
                     // Counted before a single index is parsed: this line may hold millions.
                     triangles = triangles.saturating_add(words.clone().count().saturating_sub(2));
