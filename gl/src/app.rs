@@ -23,7 +23,6 @@ use glow::HasContext;
 use std::time::Instant;
 use twinray_common::cli::{OpenGlKnobs, RenderArgs, Workgroup};
 use twinray_common::explain;
-use twinray_common::lab;
 use twinray_common::plan::requests::Api;
 use twinray_common::plan::{Planner, RunPlan};
 use twinray_common::reference::image_io::FloatImage;
@@ -36,13 +35,9 @@ use twinray_common::shader::post::spirv_for_opengl;
 /// `started` is taken first thing in main, so `setup_ms` includes process,
 /// driver and shader start-up, as in the Vulkan app.
 pub fn run(args: RenderArgs, knobs: &OpenGlKnobs, started: Instant) -> Result<()> {
-    if lab::print_page_if_asked(&args) {
+    let Some(planner) = Planner::start(&args, Api::OpenGl)? else {
         return Ok(());
-    }
-    if args.explain {
-        explain::enable("twinray-gl", "OpenGL");
-    }
-    let planner = Planner::new(&args, Api::OpenGl)?;
+    };
     if !args.headless {
         return run_windowed(&planner, started);
     }

@@ -25,7 +25,6 @@ use std::sync::atomic::Ordering;
 use std::time::Instant;
 use twinray_common::cli::{FrameWait, RenderArgs, SceneMemory, VulkanKnobs, Workgroup};
 use twinray_common::explain;
-use twinray_common::lab;
 use twinray_common::plan::requests::Api;
 use twinray_common::plan::{Planner, RunPlan};
 use twinray_common::reference::image_io::FloatImage;
@@ -33,13 +32,9 @@ use twinray_common::report::{dump_shaders, dump_statistics, timed_frames, FrameT
 use twinray_common::shader::build::{ComputeShader, PathShaders, Shaders};
 
 pub fn run(args: RenderArgs, knobs: &VulkanKnobs, process_start: Instant) -> Result<()> {
-    if lab::print_page_if_asked(&args) {
+    let Some(planner) = Planner::start(&args, Api::Vulkan)? else {
         return Ok(());
-    }
-    if args.explain {
-        explain::enable("twinray-vk", "Vulkan");
-    }
-    let planner = Planner::new(&args, Api::Vulkan)?;
+    };
     if !args.headless {
         return run_windowed(&planner, knobs, process_start);
     }

@@ -59,6 +59,19 @@ pub struct CountingRun<'a> {
 }
 
 impl Planner {
+    /// How every run of either app begins: `--experiments` prints the
+    /// laboratory's page (`None`: nothing more to do), `--explain` turns the
+    /// printout on, and the options are checked once.
+    pub fn start(args: &RenderArgs, api: Api) -> anyhow::Result<Option<Planner>> {
+        if lab::print_page_if_asked(args) {
+            return Ok(None);
+        }
+        if args.explain {
+            explain::enable(api.program(), api.name());
+        }
+        Planner::new(args, api).map(Some)
+    }
+
     /// Checks the options (one sentence and exit 2 for what this run cannot
     /// do) and decides everything that needs no scene.
     pub fn new(args: &RenderArgs, api: Api) -> anyhow::Result<Planner> {

@@ -74,6 +74,14 @@ impl Api {
             Api::OpenGl => "OpenGL",
         }
     }
+
+    /// The app's program name, as its messages begin.
+    pub fn program(&self) -> &'static str {
+        match self {
+            Api::Vulkan => "twinray-vk",
+            Api::OpenGl => "twinray-gl",
+        }
+    }
 }
 
 /// A device's compute limits, under the names its API gives them.

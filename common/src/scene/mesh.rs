@@ -288,7 +288,10 @@ fn scan_obj(what: &str, text: &str, before: usize, limit: &StorageLimit) -> anyh
                 // tobj takes a bare `f` or `l` for a polygon and refuses it
                 // without a line number.
                 if words.clone().next().is_none() {
-                    return Err(at(n, &format!("not a valid OBJ file: `{kind}` names no vertex")));
+                    return Err(at(
+                        n,
+                        &format!("not a valid OBJ file: `{kind}` names no vertex"),
+                    ));
                 }
                 if kind == "f" {
                     // Counted before a single index is parsed: this line may hold millions.
