@@ -1,4 +1,4 @@
-//! Proves that naga's layout of every struct in shaders/trace.glsl equals the
+//! Proves that naga's layout of every struct in shaders/trace/*.glsl equals the
 //! Rust mirror in common/src/gpu/layout.rs: member offsets, struct sizes, array strides.
 
 use std::mem::{offset_of, size_of};

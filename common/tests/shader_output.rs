@@ -2,7 +2,7 @@
 //! (function-local, or private at module scope) keeps
 //! naga's zero initialiser (it costs every pixel a store per element, and on
 //! NVIDIA's OpenGL a trip to local memory), in any variant, for either API,
-//! on either path; and trace.glsl itself gives no array an initialiser, so the
+//! on either path; and the tracer itself gives no array an initialiser, so the
 //! post-passes only ever remove naga's.
 
 use twinray_common::cli::Workgroup;

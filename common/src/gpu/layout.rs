@@ -1,4 +1,4 @@
-//! GPU buffer layouts: the one Rust mirror of every struct in shaders/trace.glsl
+//! GPU buffer layouts: the one Rust mirror of every struct in shaders/trace/*.glsl
 //! (`#[repr(C)]` + bytemuck), the binding numbers, and the flattened BVH as the
 //! shader reads it. A test checks these layouts against naga's view of the GLSL.
 //! The bottom layer of the crate: it imports nothing from it.

@@ -1,6 +1,6 @@
 //! Ray against scene in f64: the sphere and triangle tests of each numerical
 //! choice, the BVH walk, and the closest hit and shadow queries built on them
-//! (trace.glsl's intersection and traversal, step by step).
+//! (the tracer's intersection and traversal, step by step).
 
 use crate::gpu::layout::{child_ref, Bvh, PRIM_SPHERE_BIT};
 use crate::scene::accel::MAX_LEAF;

@@ -1,4 +1,4 @@
-//! The CPU reference: shaders/trace.glsl step by step in f64, one pixel per
+//! The CPU reference: shaders/trace/*.glsl step by step in f64, one pixel per
 //! rayon task. Same ray stack, same push order, same offsets and tests — the
 //! shader's compile-time numerical choices (numerics.rs) are run-time branches
 //! here — so the GPU images differ from it only by f32 arithmetic.

@@ -1,6 +1,6 @@
 //! The numerical choices of the tracer: where secondary rays start, which
 //! ray-triangle test and which ray-sphere test run. Each is a compile-time
-//! define of the one shader (shaders/trace.glsl) and a run-time branch of the
+//! define of the one shader (shaders/trace/*.glsl) and a run-time branch of the
 //! f64 reference (reference.rs), so both always take the same path.
 //!
 //! Scene files set them in `[render]` (`offset`, `triangle`, `sphere`), and both

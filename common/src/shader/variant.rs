@@ -152,7 +152,7 @@ impl Default for Passes {
     }
 }
 
-/// The feature switches trace.glsl declares with `layout(constant_id = N)`
+/// The feature switches the tracer declares with `layout(constant_id = N)`
 /// under SPECIALIZE: name and id (naga's process_overrides wants the id).
 /// A test checks this table against the parsed module.
 pub const SPEC_CONSTANTS: [(&str, u16); 4] = [
@@ -294,7 +294,7 @@ impl Variant {
             }
         };
         // The generic form compiles every feature; the specialised one's
-        // switches are constants (trace.glsl defines every HAS_* under SPECIALIZE).
+        // switches are constants (the tracer defines every HAS_* under SPECIALIZE).
         let f = match self.form {
             Form::Scene => self.features,
             Form::Generic => ALL_FEATURES,
