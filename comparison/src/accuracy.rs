@@ -56,32 +56,64 @@ pub fn run(args: &AccuracyArgs) -> anyhow::Result<()> {
     twinray_common::reference::image_io::prepare_output_dir("--out", &args.out.join("images"))?;
     let frames = if args.quick { 5 } else { 30 };
     let started = std::time::Instant::now();
+    // SIGINT, SIGTERM and SIGHUP stop the run between two renders; what
+    // finished is kept, the reports are written, and they say so.
+    let stop = crate::interrupt::Stop::install()?;
+    let mut stopped_in: Option<&'static str> = None;
+    let mut step = |name: &'static str| {
+        if stop.stopped() && stopped_in.is_none() {
+            stopped_in = Some(name);
+        }
+        stopped_in.is_none()
+    };
     let mut rows: Vec<Row> = Vec::new();
     for (scene_name, size, set) in sweeps::scenes(args.quick) {
+        if !step("the sweeps") {
+            break;
+        }
         rows.extend(sweeps::run_scene(
-            scene_name, size, &set, frames, &args.out,
+            scene_name,
+            size,
+            &set,
+            frames,
+            &args.out,
+            stop.flag(),
         )?);
     }
-    let hard_rows = if args.no_hard {
-        Vec::new()
+    let hard_rows = if step("the sweeps") && !args.no_hard {
+        hard::run_all(&cases, &args.out, stop.flag())?
     } else {
-        hard::run_all(&cases, &args.out)?
+        Vec::new()
     };
     let random_n = args.random.unwrap_or(if args.quick { 10 } else { 100 });
-    let random_rows = if random_n > 0 {
+    let random_rows = if step("the hard cases") && random_n > 0 {
         let size = random::random_size(args.quick);
         eprintln!("twinray accuracy: {random_n} random scenes at {size} x (2 APIs + reference)");
-        let r = random::run_random(random_n, size, &args.out)?;
+        let r = random::run_random(random_n, size, &args.out, stop.flag())?;
         write(&args.out, "random.csv", crate::csv::accuracy::random(&r)?)?;
         r
     } else {
         Vec::new()
     };
-    write_reports(args, &mut rows, &hard_rows, &cases, &random_rows, started)?;
+    step("the random scenes");
+    let interrupted = stop.signal().map(|(signal, _)| {
+        format!(
+            "interrupted by {signal} during {}",
+            stopped_in.unwrap_or("the report")
+        )
+    });
+    let runs = (&mut rows[..], &hard_rows[..], &random_rows[..]);
+    write_reports(args, runs, &cases, interrupted.as_deref(), started)?;
     eprintln!(
-        "twinray accuracy: report: {}",
-        args.out.join("report.md").display()
+        "twinray accuracy: report: {}{}",
+        args.out.join("report.md").display(),
+        interrupted.as_deref().map_or(String::new(), |i| format!(
+            " ({i}: the finished runs are kept)"
+        ))
     );
+    if let Some((_, code)) = stop.signal() {
+        std::process::exit(code);
+    }
     crate::failures::check(&failures(&rows, &hard_rows, &random_rows))
 }
 
@@ -131,10 +163,9 @@ fn write(out: &Path, name: &str, text: String) -> anyhow::Result<()> {
 /// writes hard_cases.csv, accuracy.csv, the plots and report.md.
 fn write_reports(
     args: &AccuracyArgs,
-    rows: &mut [Row],
-    hard_rows: &[HardRow],
+    (rows, hard_rows, random_rows): (&mut [Row], &[HardRow], &[RandomRow]),
     cases: &[HardCase],
-    random_rows: &[RandomRow],
+    interrupted: Option<&str>,
     started: std::time::Instant,
 ) -> anyhow::Result<()> {
     let cpu = crate::report::cpu_model();
@@ -181,6 +212,7 @@ fn write_reports(
         plots: &plots,
         cpu: &cpu,
         secs: started.elapsed().as_secs_f64(),
+        interrupted,
     }
     .markdown();
     write(&args.out, "report.md", md)

@@ -194,3 +194,43 @@ fn sighup_and_sigint_after_the_sweep_are_stated_and_exit_129_and_130() {
         assert!(out.join("results.csv").is_file());
     }
 }
+
+#[test]
+fn sigterm_during_the_accuracy_sweeps_keeps_the_finished_runs_and_exits_143() {
+    let dir = scratch("orch-accuracy-sigterm");
+    let out = dir.join("out");
+    let child = Command::new(bin("twinray"))
+        .args(["accuracy", "--quick", "--no-hard", "--random", "0", "--out"])
+        .arg(&out)
+        .env(
+            "MESA_SHADER_CACHE_DIR",
+            std::env::temp_dir().join("twinray-mesa-cache"),
+        )
+        .stdout(Stdio::null())
+        .stderr(Stdio::piped())
+        .spawn()
+        .expect("starting twinray accuracy");
+    // Two warm-up runs, the default's first timing in both APIs, then the
+    // measured runs: the seventh app started, so at least two rows finished.
+    wait_for(&child, Duration::from_secs(180), |seen| {
+        seen.iter().filter(|c| c.1.contains("twinray-")).count() >= 7
+    });
+    signal(&child, "TERM");
+    let (code, stderr) = finish(child, Duration::from_secs(60));
+    assert_eq!(code, Some(143), "{stderr}");
+    let report = std::fs::read_to_string(out.join("report.md")).unwrap();
+    let title = report.lines().next().unwrap_or_default();
+    assert!(
+        title.contains("(interrupted by SIGTERM during the sweeps)"),
+        "{title}"
+    );
+    assert!(
+        report.contains("The run was interrupted by SIGTERM"),
+        "{report}"
+    );
+    let csv = std::fs::read_to_string(out.join("accuracy.csv")).unwrap();
+    assert!(
+        csv.lines().count() >= 2,
+        "the finished runs are kept:\n{csv}"
+    );
+}

@@ -47,7 +47,11 @@ pub fn cases(dir: Option<&Path>) -> anyhow::Result<Vec<HardCase>> {
 }
 
 /// Every hard case at 64x64 under every strategy.
-pub fn run_all(cases: &[HardCase], out: &Path) -> anyhow::Result<Vec<HardRow>> {
+pub fn run_all(
+    cases: &[HardCase],
+    out: &Path,
+    stop: &std::sync::atomic::AtomicBool,
+) -> anyhow::Result<Vec<HardRow>> {
     let size = Size {
         width: 64,
         height: 64,
@@ -59,6 +63,9 @@ pub fn run_all(cases: &[HardCase], out: &Path) -> anyhow::Result<Vec<HardRow>> {
     );
     let mut rows = Vec::new();
     for case in cases {
+        if stop.load(std::sync::atomic::Ordering::SeqCst) {
+            break;
+        }
         rows.extend(run_hard(case, size, out)?);
     }
     Ok(rows)

@@ -43,9 +43,17 @@ pub fn random_size(quick: bool) -> Size {
 
 /// Renders seeds 0..n with both apps and the reference (the scene's own
 /// numerics, so the three should differ by f32 rounding only).
-pub fn run_random(n: u64, size: Size, out: &Path) -> anyhow::Result<Vec<RandomRow>> {
+pub fn run_random(
+    n: u64,
+    size: Size,
+    out: &Path,
+    stop: &std::sync::atomic::AtomicBool,
+) -> anyhow::Result<Vec<RandomRow>> {
     let mut rows = Vec::new();
     for seed in 0..n {
+        if stop.load(std::sync::atomic::Ordering::SeqCst) {
+            break;
+        }
         let name = format!("{}{seed}", random_scene::PREFIX);
         let scene = Scene::load(&name, &[])?;
         let reference = reference::render(&scene, size.width, size.height);

@@ -34,6 +34,8 @@ pub struct Report<'a> {
     pub cpu: &'a str,
     /// How long the whole run took.
     pub secs: f64,
+    /// "interrupted by SIGTERM during the hard cases", where a signal stopped the run.
+    pub interrupted: Option<&'a str>,
 }
 
 impl Report<'_> {
@@ -59,7 +61,18 @@ impl Report<'_> {
     /// The title, the run, the default and how error and time are measured.
     fn intro(&self) -> String {
         let mut s = String::new();
-        let _ = writeln!(s, "# twinray accuracy — speed against error\n");
+        match self.interrupted {
+            Some(i) => {
+                let _ = writeln!(s, "# twinray accuracy — speed against error ({i})\n");
+                let _ = writeln!(
+                    s,
+                    "**The run was {i}.** The tables hold the runs that finished; what the signal left out is missing from them.\n"
+                );
+            }
+            None => {
+                let _ = writeln!(s, "# twinray accuracy — speed against error\n");
+            }
+        }
         let _ = writeln!(
             s,
             "Preset: {}. CPU: {}. Run time: {:.0} s. Command: `twinray accuracy{} --out {}`.\n",

@@ -244,6 +244,7 @@ pub fn run_scene(
     set: &[String],
     frames: u32,
     out: &Path,
+    stop: &std::sync::atomic::AtomicBool,
 ) -> anyhow::Result<Vec<Row>> {
     let mut rows: Vec<Row> = Vec::new();
     let scene = Scene::load(scene_name, &overrides(set))?;
@@ -284,6 +285,10 @@ pub fn run_scene(
         list.len()
     );
     for (slot, &(k, repeat)) in order.iter().enumerate() {
+        // A signal stops the sweep between runs; the finished rows are kept.
+        if stop.load(std::sync::atomic::Ordering::SeqCst) {
+            break;
+        }
         let c = &list[k];
         for api in if slot % 2 == 0 {
             [Api::Vulkan, Api::Opengl]
