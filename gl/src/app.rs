@@ -21,13 +21,13 @@ use crate::timer::Timer;
 use anyhow::{anyhow, Result};
 use glow::HasContext;
 use std::time::Instant;
-use twinray_common::cli::{OpenGlKnobs, RenderArgs, Workgroup};
+use twinray_common::cli::{OpenGlKnobs, RenderArgs};
 use twinray_common::explain;
 use twinray_common::plan::requests::Api;
 use twinray_common::plan::{Planner, RunPlan};
 use twinray_common::reference::image_io::FloatImage;
 use twinray_common::report::{
-    dump_shaders, dump_statistics, timed_frames, DeviceInfo, FrameTime, RunReport, ShaderStats,
+    dump_shaders, timed_frames, DeviceInfo, FrameTime, RunReport, ShaderStats,
 };
 use twinray_common::shader::build::{ComputeShader, PathShaders, Shaders};
 use twinray_common::shader::post::spirv_for_opengl;
@@ -108,14 +108,10 @@ fn render(
     };
     log.check(gl, "after the frame loop");
     let label = variant_label(&plan, args.gl_spirv);
-    let (mut report, image) = report(
-        args,
-        &plan,
-        &info,
-        (label, planner.workgroup()),
-        rendered,
-        shader_stats,
-    )?;
+    let (frames, setup_ms, pixels) = rendered;
+    let image = FloatImage::from_rgba(width, height, &pixels);
+    let api = ("opengl", info.clone(), label);
+    let mut report = planner.report(&plan, api, (frames, setup_ms), &image, shader_stats)?;
     if args.count_rays {
         let counting = plan.counting(&plan.gpu, planner.pass(), width, height);
         report.add_rays(count_rays(gl, &counting)?);
@@ -268,29 +264,4 @@ fn variant_label(plan: &RunPlan, gl_spirv: bool) -> String {
     } else {
         plan.variant.label()
     }
-}
-
-/// The run's report (device, variant, size, frames, and what the driver said
-/// of the compiled shaders), with the last frame.
-fn report(
-    args: &RenderArgs,
-    plan: &RunPlan,
-    info: &DeviceInfo,
-    (variant_label, workgroup): (String, Workgroup),
-    (frames, setup_ms, pixels): Rendered,
-    shader_stats: Vec<ShaderStats>,
-) -> Result<(RunReport, FloatImage)> {
-    if let Some(dir) = &args.dump_shaders {
-        dump_statistics(dir, &shader_stats)?;
-    }
-    let image = FloatImage::from_rgba(args.size.width, args.size.height, &pixels);
-    let report = RunReport::builder("opengl", info.clone(), plan.scene.stats(), variant_label)
-        .size(args.size.width, args.size.height)
-        .path(args.path, workgroup)
-        .frames(frames, setup_ms)
-        .nonfinite_pixels(image.nonfinite_pixels())
-        .shader_stats(shader_stats)
-        .bvh(plan.bvh.as_ref(), plan.bvh_ms)
-        .build();
-    Ok((report, image))
 }

@@ -34,12 +34,19 @@ fn failing_apps(dir: &Path, slow_s: u32) -> String {
 }
 
 fn compare(out: &Path, bin_dir: Option<&str>, extra: &[&str]) -> Child {
-    let mut cmd = Command::new(bin("twinray"));
+    let mut args = Vec::new();
     if let Some(dir) = bin_dir {
-        cmd.args(["--bin-dir", dir]);
+        args.extend(["--bin-dir", dir]);
     }
-    cmd.args(["compare", "--quick", "--out", out.to_str().unwrap()])
-        .args(extra)
+    args.extend(["compare", "--quick", "--out", out.to_str().unwrap()]);
+    args.extend(extra);
+    orchestrator(&args)
+}
+
+/// `twinray ARGS`, its stderr captured, with the tests' Mesa cache.
+fn orchestrator(args: &[&str]) -> Child {
+    Command::new(bin("twinray"))
+        .args(args)
         .env(
             "MESA_SHADER_CACHE_DIR",
             std::env::temp_dir().join("twinray-mesa-cache"),
@@ -47,7 +54,7 @@ fn compare(out: &Path, bin_dir: Option<&str>, extra: &[&str]) -> Child {
         .stdout(Stdio::null())
         .stderr(Stdio::piped())
         .spawn()
-        .expect("starting twinray compare")
+        .expect("starting twinray")
 }
 
 /// The command lines of `pid`'s children now.
@@ -199,17 +206,16 @@ fn sighup_and_sigint_after_the_sweep_are_stated_and_exit_129_and_130() {
 fn sigterm_during_the_accuracy_sweeps_keeps_the_finished_runs_and_exits_143() {
     let dir = scratch("orch-accuracy-sigterm");
     let out = dir.join("out");
-    let child = Command::new(bin("twinray"))
-        .args(["accuracy", "--quick", "--no-hard", "--random", "0", "--out"])
-        .arg(&out)
-        .env(
-            "MESA_SHADER_CACHE_DIR",
-            std::env::temp_dir().join("twinray-mesa-cache"),
-        )
-        .stdout(Stdio::null())
-        .stderr(Stdio::piped())
-        .spawn()
-        .expect("starting twinray accuracy");
+    let out_dir = out.to_str().unwrap();
+    let child = orchestrator(&[
+        "accuracy",
+        "--quick",
+        "--no-hard",
+        "--random",
+        "0",
+        "--out",
+        out_dir,
+    ]);
     // Two warm-up runs, the default's first timing in both APIs, then the
     // measured runs: the seventh app started, so at least two rows finished.
     wait_for(&child, Duration::from_secs(180), |seen| {

@@ -23,12 +23,12 @@ use crate::window;
 use anyhow::{bail, Result};
 use std::sync::atomic::Ordering;
 use std::time::Instant;
-use twinray_common::cli::{FrameWait, RenderArgs, SceneMemory, VulkanKnobs, Workgroup};
+use twinray_common::cli::{FrameWait, RenderArgs, SceneMemory, VulkanKnobs};
 use twinray_common::explain;
 use twinray_common::plan::requests::Api;
 use twinray_common::plan::{Planner, RunPlan};
 use twinray_common::reference::image_io::FloatImage;
-use twinray_common::report::{dump_shaders, dump_statistics, timed_frames, FrameTime, RunReport};
+use twinray_common::report::{dump_shaders, timed_frames, FrameTime, RunReport};
 use twinray_common::shader::build::{ComputeShader, PathShaders, Shaders};
 
 pub fn run(args: RenderArgs, knobs: &VulkanKnobs, process_start: Instant) -> Result<()> {
@@ -107,8 +107,10 @@ fn render(
     };
     let host_memory = device.scene_memory == SceneMemory::Host;
     let label = variant_label(&plan, host_memory, run.idle_wait);
-    let workgroup = planner.workgroup();
-    let (mut report, image) = report(args, &plan, &device, (label, workgroup), rendered)?;
+    let (frames, setup_ms, image) = rendered;
+    let stats = crate::statistics::captured();
+    let api = ("vulkan", device.info(), label);
+    let mut report = planner.report(&plan, api, (frames, setup_ms), &image, stats)?;
     if args.count_rays {
         let counting = plan.counting(&plan.gpu, planner.pass(), width, height);
         report.add_rays(count_rays(&device, &counting)?);
@@ -224,28 +226,4 @@ fn variant_label(plan: &RunPlan, host_memory: bool, idle_wait: bool) -> String {
         },
         if idle_wait { " (idle wait)" } else { "" }
     )
-}
-
-/// The run's report (device, variant, size, frames, and what the driver said
-/// of the compiled shaders), with the last frame.
-fn report(
-    args: &RenderArgs,
-    plan: &RunPlan,
-    device: &Device,
-    (variant_label, workgroup): (String, Workgroup),
-    (frames, setup_ms, image): Rendered,
-) -> Result<(RunReport, FloatImage)> {
-    let shader_stats = crate::statistics::captured();
-    if let Some(dir) = &args.dump_shaders {
-        dump_statistics(dir, &shader_stats)?;
-    }
-    let report = RunReport::builder("vulkan", device.info(), plan.scene.stats(), variant_label)
-        .size(args.size.width, args.size.height)
-        .path(args.path, workgroup)
-        .frames(frames, setup_ms)
-        .nonfinite_pixels(image.nonfinite_pixels())
-        .shader_stats(shader_stats)
-        .bvh(plan.bvh.as_ref(), plan.bvh_ms)
-        .build();
-    Ok((report, image))
 }

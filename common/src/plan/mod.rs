@@ -16,6 +16,8 @@ use crate::gpu::layout::Bvh;
 use crate::gpu::upload::{check_storage_limit, GpuScene};
 use crate::lab::{self, Changes};
 use crate::limits::StorageLimit;
+use crate::reference::image_io::FloatImage;
+use crate::report::{dump_statistics, DeviceInfo, FrameTime, RunReport, ShaderStats};
 use crate::scene::camera::in_local_frame;
 use crate::scene::Scene;
 use crate::shader::build::PathShaders;
@@ -197,6 +199,35 @@ impl Planner {
             gpu,
             shaders,
         })
+    }
+
+    /// A headless run's `--json` report, the same in both APIs: the device,
+    /// the plan's scene, variant (as `variant_label` names it) and BVH, the
+    /// size and path, the timed frames, the last frame's non-finite pixels
+    /// and what the driver said of the shaders, which `--dump-shaders` also
+    /// writes beside them.
+    pub fn report(
+        &self,
+        plan: &RunPlan,
+        (api, device, variant_label): (&str, DeviceInfo, String),
+        (frames, setup_ms): (Vec<FrameTime>, f64),
+        image: &FloatImage,
+        shader_stats: Vec<ShaderStats>,
+    ) -> anyhow::Result<RunReport> {
+        let args = &self.args;
+        if let Some(dir) = &args.dump_shaders {
+            dump_statistics(dir, &shader_stats)?;
+        }
+        Ok(
+            RunReport::builder(api, device, plan.scene.stats(), variant_label)
+                .size(args.size.width, args.size.height)
+                .path(args.path, self.workgroup)
+                .frames(frames, setup_ms)
+                .nonfinite_pixels(image.nonfinite_pixels())
+                .shader_stats(shader_stats)
+                .bvh(plan.bvh.as_ref(), plan.bvh_ms)
+                .build(),
+        )
     }
 
     /// The variant the apps render for `scene` on `path`: `--generic`,
