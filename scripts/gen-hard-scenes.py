@@ -369,5 +369,8 @@ simple("far-tiny-sphere", "a sphere of radius 1 seen from 1e4 away through a nar
        lights='\n[[lights]]\nposition = [3.0, 4.0, -9990.0]\n',
        note="""From 1e4 away, b^2 and c of the textbook quadratic are about 1e8 and differ by
 r^2 = 1: in f32 (8 units apart at 1e8) the discriminant is noise, while the
-stable form keeps it.""")
+stable form keeps it. The eye stays at the origin: from there, lanes of Mesa
+22.3's SIMD vectors that are no invocation, reading the BVH as zeros, looped in
+the walk until the driver's loop budget ran out, and the wall was lost in 4x4
+blocks (comparison/investigations/mesa-bvh/README.md).""")
 print("wrote", sorted(os.listdir(OUT)))

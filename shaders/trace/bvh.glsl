@@ -118,6 +118,41 @@ bool hit_leaf(inout Hit h, vec3 origin, vec3 dir, TriRay ray, uint first, uint c
     return false;
 }
 
+// Room on a fixed stack (BVH_STACK_FIXED, above) for one more entry; a sized
+// stack always has it, as the tree's depth sizes it.
+#ifdef BVH_STACK_FIXED
+#define BVH_ROOM(i) if ((i) < uint(BVH_STACK))
+#else
+#define BVH_ROOM(i)
+#endif
+
+// One step down from interior node `child`: on to the nearer child whose box
+// the ray enters before h.t, the farther one pushed with its entry t; NO_CHILD
+// if the ray enters neither. A macro, so that the root's step (see `traverse`)
+// is the loop's own code, and a walk's local stack (BVH_STACK_LOCAL) stays
+// its own.
+#define BVH_STEP()                                                                         \
+    {                                                                                      \
+        BvhNode node = bvh_buf.nodes[child];                                               \
+        float tl = enter_box(origin, inv_dir, node.left_min, node.left_max, h.t);          \
+        float tr = enter_box(origin, inv_dir, node.right_min, node.right_max, h.t);        \
+        if (tl >= 0.0 && tr >= 0.0) {                                                      \
+            bool left_first = tl <= tr;                                                    \
+            child = left_first ? node.left : node.right;                                   \
+            BVH_ROOM(sp) {                                                                 \
+                BVH_PUSH(sp, uvec2(left_first ? node.right : node.left,                    \
+                                   floatBitsToUint(left_first ? tr : tl)));                \
+                sp += 1u;                                                                  \
+            }                                                                              \
+        } else if (tl >= 0.0) {                                                            \
+            child = node.left;                                                             \
+        } else if (tr >= 0.0) {                                                            \
+            child = node.right;                                                            \
+        } else {                                                                           \
+            child = NO_CHILD;                                                              \
+        }                                                                                  \
+    }
+
 // Visits the tree near child first and skips subtrees that start beyond the
 // closest hit so far. With `any_hit` (shadow rays) it stops at the first hit
 // before t_max and reports it with kind != 0. The loop within a loop (Aila
@@ -125,6 +160,23 @@ bool hit_leaf(inout Hit h, vec3 origin, vec3 dir, TriRay ray, uint first, uint c
 // same order as one loop taking a node or a leaf per turn, and was faster in
 // both APIs, never slower (measured in
 // comparison/results/nvidia-h100/FINDINGS.md#the-node-layout-investigationnode-layout).
+//
+// The root's step comes before the loops, so that the descent below it goes
+// on only through references > 0 (int(child) > 0: an interior node, never the
+// root, which is no node's child). That costs no instruction: the test is one
+// compare, as LEAF_BIT's was, and the root's step needs none. It makes the walk
+// end even where every read of the tree returns zero, which a tree never does
+// but Mesa 22.3's llvmpipe and lavapipe make happen: they run a SIMD vector's
+// lanes that are no invocation (a compute workgroup narrower than the vector,
+// a fragment block's uncovered pixels) with storage reads of zero, and keep a
+// loop going while such a lane has not left it. A zero node is the root with
+// both boxes at the origin, so a ray from the origin went round it until the
+// driver's budget of 65,535 loop turns per vector ran out, and every later
+// loop of the real pixels was cut to one turn: the wall of hard/far-tiny-sphere
+// was lost in 4x4 blocks. Now such a lane takes reference 0 for a leaf, whose
+// zero primitive is degenerate and never hit, and is done after two turns.
+// comparison/investigations/mesa-bvh/README.md has the driver's side and a
+// reproducer.
 Hit traverse(vec3 origin, vec3 dir, float t_max, bool any_hit) {
     Hit h;
     h.t = t_max;
@@ -138,34 +190,15 @@ Hit traverse(vec3 origin, vec3 dir, float t_max, bool any_hit) {
     BVH_STACK_DECLARE;
 #endif
     uint sp = 0u;
-    // The child reference being visited; the root is interior node 0.
+    // The child reference being visited: first the root, interior node 0.
     uint child = 0u;
+    BVH_STEP();
     while (true) {
         // Down through interior nodes until a leaf, or until nothing is
         // entered (NO_CHILD): the warp's invocations then test their leaves
         // together instead of taking turns between node and leaf steps.
-        while ((child & LEAF_BIT) == 0u) {
-            BvhNode node = bvh_buf.nodes[child];
-            float tl = enter_box(origin, inv_dir, node.left_min, node.left_max, h.t);
-            float tr = enter_box(origin, inv_dir, node.right_min, node.right_max, h.t);
-            if (tl >= 0.0 && tr >= 0.0) {
-                bool left_first = tl <= tr;
-                child = left_first ? node.left : node.right;
-                // sp < BVH_STACK here: the stack is as deep as the tree.
-#ifdef BVH_STACK_FIXED
-                if (sp < uint(BVH_STACK))
-#endif
-                {
-                    BVH_PUSH(sp, uvec2(left_first ? node.right : node.left, floatBitsToUint(left_first ? tr : tl)));
-                    sp += 1u;
-                }
-            } else if (tl >= 0.0) {
-                child = node.left;
-            } else if (tr >= 0.0) {
-                child = node.right;
-            } else {
-                child = NO_CHILD;
-            }
+        while (int(child) > 0) {
+            BVH_STEP();
         }
         if (child != NO_CHILD) {
             uint first = (child & ~LEAF_BIT) >> LEAF_FIRST_SHIFT;
