@@ -475,7 +475,7 @@ impl<P: TypedValueParser> TypedValueParser for NamedInEnv<P> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::lab::experiment::{Experiment, UlpOp};
+    use crate::lab::experiment::Experiment;
     use crate::scene::numerics::{Offset, SphereTest, TriangleTest};
     use crate::scene::OriginMode;
 

@@ -106,7 +106,11 @@ fn markdown(runs: &[Run], baseline: &[(UlpOp, ByClass)], inputs: u32, seconds: f
          multiply-add): what any f32 implementation of a composite operation may lose. \
          Flushed denormals, refract's other branch and non-finite mismatches are counted apart \
          (last table), not as ULPs. `bits` is the transport check: 0 means every result came \
-         back bit for bit. Inputs: {CLASS_TEXT}.\n\n## All inputs\n\n",
+         back bit for bit. Inputs: {CLASS_TEXT}; sqrt, inversesqrt and pow take |x|; pow's \
+         exponent is in [1/8, 128) and refract's eta in [1/2, 2) whatever the class; vectors are \
+         not normalised, so reflect and refract see any lengths. Where a result cancels \
+         (cross, dot, reflect, refract, fma) one absolute rounding is many ULPs of a small \
+         result: compare a driver's column with the CPU's.\n\n## All inputs\n\n",
         machines(runs)
     );
     table(&mut s, runs, baseline, "all");
