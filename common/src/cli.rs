@@ -5,7 +5,7 @@
 //! can set them for every run). Everything is parsed once, in `main`.
 
 use crate::error::bad_input;
-use crate::lab::experiment::Experiment;
+use crate::lab::experiment::{Experiment, UlpOp};
 use crate::scene::accel::Accel;
 use crate::value_name::ValueName;
 use clap::builder::{PossibleValue, TypedValueParser};
@@ -86,6 +86,10 @@ pub struct RenderArgs {
     /// puts back a cost the build removes (or moves one) to measure its effect.
     #[arg(long, value_enum, value_name = "NAME", hide = true)]
     pub experiment: Vec<Experiment>,
+    /// Laboratory, with `--experiment ulp`: the f32 operation the arithmetic
+    /// probe measures (docs/experiments.md).
+    #[arg(long, value_enum, value_name = "OP", hide = true)]
+    pub ulp_op: Option<UlpOp>,
     /// Print the laboratory's page (its experiments and measurement options,
     /// docs/experiments.md) and exit.
     #[arg(long)]
@@ -247,6 +251,7 @@ impl RenderArgs {
             workgroup: None,
             shared_pad: None,
             experiment: Vec::new(),
+            ulp_op: None,
             experiments: false,
             dump_shaders: None,
         }

@@ -143,6 +143,7 @@ pub fn app_args(args: &RenderArgs) -> Vec<String> {
         workgroup,
         shared_pad,
         experiment,
+        ulp_op,
         experiments,
         dump_shaders,
     } = args;
@@ -189,6 +190,9 @@ pub fn app_args(args: &RenderArgs) -> Vec<String> {
     }
     for e in experiment {
         v.extend(["--experiment".into(), e.name()]);
+    }
+    if let Some(op) = ulp_op {
+        v.extend(["--ulp-op".into(), op.name()]);
     }
     if let Some(dir) = dump_shaders {
         v.extend(["--dump-shaders".into(), dir.display().to_string()]);
@@ -338,6 +342,7 @@ fn gpu_only_options(args: &RenderArgs) -> Vec<&'static str> {
         workgroup,
         shared_pad,
         experiment,
+        ulp_op,
         experiments,
         dump_shaders,
     } = args;
@@ -353,6 +358,7 @@ fn gpu_only_options(args: &RenderArgs) -> Vec<&'static str> {
         (workgroup.is_some(), "--workgroup"),
         (shared_pad.is_some(), "--shared-pad"),
         (!experiment.is_empty(), "--experiment"),
+        (ulp_op.is_some(), "--ulp-op"),
         (*experiments, "--experiments"),
         (dump_shaders.is_some(), "--dump-shaders"),
     ]
@@ -455,7 +461,7 @@ mod tests {
     use clap::Parser;
     use std::path::PathBuf;
     use twinray_common::cli::{RenderArgs, RenderPath, Size, VulkanCli, Workgroup};
-    use twinray_common::lab::experiment::Experiment;
+    use twinray_common::lab::experiment::{Experiment, UlpOp};
     use twinray_common::scene::accel::Accel;
 
     /// Every option away from its default, so that one the argv builder drops
@@ -486,6 +492,7 @@ mod tests {
             workgroup: Some(Workgroup { x: 8, y: 4 }),
             shared_pad: Some(24),
             experiment: vec![Experiment::NagaZeroInit, Experiment::UnpairedBvhStack],
+            ulp_op: Some(UlpOp::Refract),
             experiments: true,
             dump_shaders: Some(PathBuf::from("dump")),
         }

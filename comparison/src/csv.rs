@@ -3,7 +3,8 @@
 //! written by the csv crate (which quotes what needs quoting), with the numbers
 //! printed as Rust prints them. The columns of compare's results.csv are in
 //! `results`, those of accuracy's three CSVs in `accuracy`; why.csv's sit with
-//! the verdicts they print (`report::why_table`).
+//! the verdicts they print (`report::why_table`), ulp.csv's with its report
+//! (`ulp::report`).
 
 pub mod accuracy;
 pub mod results;

@@ -6,7 +6,8 @@
 //! `render`); `compare` is `twinray compare`'s plan and steps, `report` its
 //! report.md and plots; `accuracy` is `twinray accuracy` with its own report;
 //! `diff` is `twinray diff`; `csv` writes every CSV file; `failures` and
-//! `interrupt` are how a long run ends when some run failed or a signal came.
+//! `interrupt` are how a long run ends when some run failed or a signal came;
+//! `ulp` is `twinray ulp`, the GPU's f32 arithmetic measured.
 
 mod accuracy;
 mod apps;
@@ -16,6 +17,7 @@ mod diff;
 mod failures;
 mod interrupt;
 mod report;
+mod ulp;
 
 use clap::{Parser, Subcommand};
 use twinray_common::cli::{named_in_env, RenderArgs};
@@ -54,6 +56,8 @@ enum Command {
     Compare(compare::CompareArgs),
     /// Speed against error: sweeps of depth, offset, triangle and sphere tests against the f64 truth, and the hard cases.
     Accuracy(accuracy::AccuracyArgs),
+    /// The GPU's f32 arithmetic: each operation the tracer uses, per API and path, against f64 (ULP error).
+    Ulp(ulp::UlpArgs),
     /// Compare two PNGs: RMSE, PSNR, max abs error, share of pixels above 1/255 and 8/255.
     Diff {
         a: std::path::PathBuf,
@@ -87,6 +91,7 @@ fn main() {
         } => diff::run(&a, &b, json, heatmap.as_deref()),
         Command::Compare(args) => compare::run(&args),
         Command::Accuracy(args) => accuracy::run(&args),
+        Command::Ulp(args) => ulp::run(&args),
     };
     if let Err(e) = result {
         exit_with("twinray", e);

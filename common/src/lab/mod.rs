@@ -152,6 +152,11 @@ pub const REGISTRY: &[Entry] = &[
             c.passes.warp_probe = true
         })
     },
+    Entry {
+        headless: true,
+        // The operation comes from --ulp-op (`changes`), which `check` requires.
+        ..entry(Experiment::Ulp, "The arithmetic probe (shaders/lab/ulp.glsl) in place of the tracer: each pair of pixels holds the 32 bits of one f32 result of the operation `--ulp-op OP` names, on inputs derived from the pixel's index by an integer hash; `twinray ulp` recomputes the inputs and compares each result with the f64 one (docs/architecture.md#the-gpus-arithmetic).", |_| {})
+    },
 ];
 
 /// The registry's entry for `e`.
@@ -211,8 +216,43 @@ pub fn check(args: &RenderArgs, api: Api) -> anyhow::Result<()> {
             ));
         }
     }
+    check_ulp(args)?;
     if args.path == RenderPath::Fragment && args.shared_pad.is_some() {
         return Err(bad_input("--shared-pad applies to --path compute only"));
+    }
+    Ok(())
+}
+
+/// `--experiment ulp` and `--ulp-op` go together, and the probe's image must
+/// reach the PNG as the shader wrote it: an RGBA32F target, no counting frame
+/// (the probe writes no ray counts), an even width (two pixels per result).
+fn check_ulp(args: &RenderArgs) -> anyhow::Result<()> {
+    let probe = args.experiment.contains(&Experiment::Ulp);
+    match (probe, args.ulp_op) {
+        (false, None) => return Ok(()),
+        (false, Some(_)) => return Err(bad_input("--ulp-op applies to --experiment ulp only")),
+        (true, None) => {
+            return Err(bad_input(
+                "--experiment ulp needs --ulp-op OP, the operation to measure",
+            ))
+        }
+        (true, Some(_)) => {}
+    }
+    if args.experiment.contains(&Experiment::Rgba8) {
+        return Err(bad_input(
+            "--experiment ulp with --experiment rgba8: the probe's bytes need the RGBA32F target; drop rgba8",
+        ));
+    }
+    if args.count_rays {
+        return Err(bad_input(
+            "--experiment ulp with --count-rays: the probe traces no rays; drop --count-rays",
+        ));
+    }
+    if args.size.width % 2 != 0 {
+        return Err(bad_input(format!(
+            "--size {}: --experiment ulp needs an even width (two pixels per result)",
+            args.size
+        )));
     }
     Ok(())
 }
@@ -228,6 +268,9 @@ pub fn changes(args: &RenderArgs) -> Changes {
         }
     }
     c.knobs.shared_pad_kib = args.shared_pad;
+    if args.experiment.contains(&Experiment::Ulp) {
+        c.knobs.ulp = args.ulp_op;
+    }
     c
 }
 
@@ -239,6 +282,7 @@ pub const MEASUREMENT_OPTIONS: &[(&str, &str)] = &[
     ("--specialize", "Render with one shader for every scene whose feature switches are specialization constants set to this scene's features (fixed by naga's process_overrides), instead of the scene's own variant of defines."),
     ("--gl-spirv", "OpenGL, headless: load naga's SPIR-V through GL_ARB_gl_spirv instead of naga's GLSL, so that both APIs run the very same shader binary."),
     ("--shared-pad KIB", "Compute path: declare 1-32 KiB of workgroup memory the tracer does not need (each invocation writes and reads one word of it), to see how the driver's split between shared memory and L1, and its occupancy, move the time."),
+    ("--ulp-op OP", "With `--experiment ulp`: the operation the arithmetic probe measures (`twinray ulp --help` lists them)."),
     ("--vk-memory host", "Vulkan (also TWINRAY_VK_MEMORY): the scene's buffers in host-visible memory the GPU reads across the bus, instead of device-local memory filled through a staging buffer."),
     ("--vk-wait idle", "Vulkan, headless (also TWINRAY_VK_WAIT): wait for each frame with vkQueueWaitIdle + vkDeviceWaitIdle, as the 2018 study did, instead of the frame's fence."),
 ];

@@ -59,6 +59,20 @@ pub const TRACE_GLSL: &str = concat!(
 pub const TRACE_FRAG: &str = include_str!("../../../shaders/trace.frag");
 pub const FULLSCREEN_VERT: &str = include_str!("../../../shaders/fullscreen.vert");
 pub const TRACE_COMP: &str = include_str!("../../../shaders/trace.comp");
+/// The laboratory's arithmetic probe (`--experiment ulp`): both entry points.
+pub const ULP_GLSL: &str = include_str!("../../../shaders/lab/ulp.glsl");
+
+/// The entry point's source for `variant`: the tracer's, or, with the
+/// laboratory's arithmetic probe, the probe's main behind the same
+/// declarations (so every binding is the tracer's).
+fn entry_source(variant: &Variant, compute: bool) -> String {
+    match (variant.knobs.ulp, compute) {
+        (None, false) => fragment_source(),
+        (None, true) => compute_source(),
+        (Some(_), false) => format!("#version 450\n{TRACE_GLSL}\n{ULP_GLSL}"),
+        (Some(_), true) => format!("#version 450\n#define ULP_COMPUTE 1\n{TRACE_GLSL}\n{ULP_GLSL}"),
+    }
+}
 
 /// The fragment source as naga sees it (also used by the layout test).
 pub fn fragment_source() -> String {
@@ -220,7 +234,7 @@ pub fn build(variant: &Variant) -> anyhow::Result<Shaders> {
         vertex: compile("vertex", FULLSCREEN_VERT, ShaderStage::Vertex, &variant)?,
         fragment: compile(
             "fragment",
-            &fragment_source(),
+            &entry_source(&variant, false),
             ShaderStage::Fragment,
             &variant,
         )?,
@@ -232,7 +246,12 @@ pub fn build(variant: &Variant) -> anyhow::Result<Shaders> {
 pub fn build_compute(variant: &Variant, workgroup: Workgroup) -> anyhow::Result<ComputeShader> {
     let variant = variant.on(Entry::Compute(workgroup));
     Ok(ComputeShader {
-        stage: compile("compute", &compute_source(), ShaderStage::Compute, &variant)?,
+        stage: compile(
+            "compute",
+            &entry_source(&variant, true),
+            ShaderStage::Compute,
+            &variant,
+        )?,
         workgroup,
         variant,
     })

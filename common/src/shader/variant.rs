@@ -8,6 +8,7 @@
 
 use crate::cli::{RenderPath, Workgroup};
 use crate::gpu::layout::Bvh;
+use crate::lab::experiment::UlpOp;
 use crate::limits::MAX_DEPTH;
 use crate::scene::numerics::Numerics;
 use crate::scene::{Features, Scene};
@@ -107,6 +108,9 @@ pub struct ShaderKnobs {
     pub quad: bool,
     /// Compute: KiB of workgroup memory the tracer does not need.
     pub shared_pad_kib: Option<u32>,
+    /// The arithmetic probe (shaders/lab/ulp.glsl) in place of the tracer's
+    /// entry point, measuring this operation.
+    pub ulp: Option<UlpOp>,
 }
 
 /// The SPIR-V compiler Vulkan's shader comes from.
@@ -339,6 +343,9 @@ impl Variant {
         }
         if let Some(kib) = k.shared_pad_kib {
             d.insert("SHARED_PAD_KIB".into(), kib.to_string());
+        }
+        if let Some(op) = k.ulp {
+            d.insert(op.define(), "1".into());
         }
         // `local_size` must be a constant; a define keeps it out of the
         // specialisation-constant path naga's writers handle poorly.
