@@ -472,8 +472,11 @@ mod tests {
                 .bvh
                 .as_ref()
                 .expect("a BVH above a few primitives");
-            assert!(tree.nodes == gpu.bvh_nodes, "{name}: the nodes differ");
-            let codes: Vec<u32> = gpu.bvh_prims.iter().map(|p| p.code).collect();
+            assert!(tree.nodes == gpu.bvh_nodes(), "{name}: the nodes differ");
+            let prims: Vec<crate::gpu::layout::GpuBvhPrim> = bytemuck::pod_collect_to_vec(
+                &gpu.storage_vec(crate::gpu::layout::binding::BVH_PRIMS),
+            );
+            let codes: Vec<u32> = prims.iter().map(|p| p.code).collect();
             assert_eq!(tree.prims, codes, "{name}: the leaves differ");
         }
     }
