@@ -18,7 +18,7 @@ use crate::lab::{self, Changes};
 use crate::limits::StorageLimit;
 use crate::reference::image_io::FloatImage;
 use crate::report::{dump_statistics, DeviceInfo, FrameTime, RunReport, ShaderStats};
-use crate::scene::camera::in_local_frame;
+use crate::scene::camera::local_origin;
 use crate::scene::Scene;
 use crate::shader::build::PathShaders;
 use crate::shader::variant::{Entry, Variant};
@@ -255,7 +255,7 @@ impl Planner {
 /// The BVH a run traces `scene` through: built over the primitives as the GPU
 /// holds them, relative to the local origin, so its boxes round in that frame.
 pub fn build_bvh(scene: &Scene) -> Bvh {
-    Bvh::build(&in_local_frame(scene))
+    Bvh::build_at(scene, local_origin(scene))
 }
 
 impl RunPlan {
