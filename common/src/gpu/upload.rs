@@ -398,4 +398,38 @@ mod tests {
         // zoom changes the view distance and so the grid, which would move it.
         assert_eq!(local_origin(&s), o);
     }
+
+    #[test]
+    fn chunks_of_any_size_give_the_whole_buffers_bytes() {
+        let s = Scene::load("teapot", &[]).unwrap();
+        let bvh = Bvh::build(&s);
+        let g = GpuScene::new(&s, Some(&bvh), 8, 8);
+        for b in binding::STORAGE {
+            let whole = g.storage_vec(b);
+            assert_eq!(whole.len(), g.storage_len(b));
+            for max in [1, 1000, 1 << 20] {
+                let mut joined = Vec::new();
+                for c in g.chunks(b, max) {
+                    let mut bytes = vec![0; c.len()];
+                    g.write_storage(b, c.start, &mut bytes);
+                    joined.extend(bytes);
+                }
+                assert!(joined == whole, "binding {b}, chunks of {max}");
+            }
+            // A range that cuts elements goes through the copy, to the same bytes.
+            let (start, end) = (7.min(whole.len()), 107.min(whole.len()));
+            let mut bytes = vec![0; end - start];
+            g.write_storage(b, start, &mut bytes);
+            assert!(bytes == whole[start..end], "binding {b}, bytes 7..107");
+        }
+        // The leaves hold the very vertices of the triangle buffer.
+        let prims: Vec<GpuBvhPrim> =
+            bytemuck::pod_collect_to_vec(&g.storage_vec(binding::BVH_PRIMS));
+        let tris: Vec<GpuTriangle> =
+            bytemuck::pod_collect_to_vec(&g.storage_vec(binding::TRIANGLES));
+        for p in prims.iter().filter(|p| p.code & PRIM_SPHERE_BIT == 0) {
+            let t = &tris[p.code as usize];
+            assert_eq!([p.a, p.b, p.c], [t.p0, t.p1, t.p2]);
+        }
+    }
 }
