@@ -33,9 +33,13 @@ impl<'gl> SceneBuffers<'gl> {
         let mut chunk = vec![0u32; chunk_bytes.div_ceil(4)];
         let chunk: &mut [u8] = bytemuck::cast_slice_mut(&mut chunk);
         let (len, ubo) = (frame.len(), glow::UNIFORM_BUFFER);
-        this.upload((ubo, binding::FRAME), len, &[0..len], chunk, |_, bytes| {
-            bytes.copy_from_slice(frame)
-        })?;
+        this.upload(
+            (ubo, binding::FRAME),
+            len,
+            std::slice::from_ref(&(0..len)),
+            chunk,
+            |_, bytes| bytes.copy_from_slice(frame),
+        )?;
         for b in binding::STORAGE {
             let chunks = scene.chunks(b, chunk_bytes);
             let (len, ssbo) = (scene.storage_len(b), glow::SHADER_STORAGE_BUFFER);

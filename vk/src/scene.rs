@@ -88,9 +88,12 @@ pub fn scene_buffers(device: &Device, scene: &GpuScene) -> Result<(Buffer, Vec<(
     let mut uploads = Uploads::new(device, chunk as u64)?;
     // The uniform block first, then the storage buffers in binding order.
     let len = frame_bytes.len();
-    uploads.add(len, (uniform, frame_what), &[0..len], |_, bytes| {
-        bytes.copy_from_slice(frame_bytes)
-    })?;
+    uploads.add(
+        len,
+        (uniform, frame_what),
+        std::slice::from_ref(&(0..len)),
+        |_, bytes| bytes.copy_from_slice(frame_bytes),
+    )?;
     for b in binding::STORAGE {
         let chunks = scene.chunks(b, chunk);
         uploads.add(
