@@ -113,7 +113,8 @@ fn render(
     let api = ("opengl", info.clone(), label);
     let mut report = planner.report(&plan, api, (frames, setup_ms), &image, shader_stats)?;
     if args.count_rays {
-        let counting = plan.counting(&plan.gpu, planner.pass(), width, height);
+        let gpu = plan.gpu();
+        let counting = plan.counting(&gpu, planner.pass(), width, height);
         report.add_rays(count_rays(gl, &counting)?);
         log.check(gl, "after the ray count");
     }
@@ -199,7 +200,7 @@ fn render_fragment(run: &HeadlessRun, shaders: &Shaders) -> Result<(Rendered, Ve
         Program::new(gl, &shaders.vertex.glsl, &shaders.fragment.glsl)?
     };
     let stats = run.dump_binary(program.raw())?;
-    let _buffers = SceneBuffers::new(gl, &run.plan.gpu)?;
+    let _buffers = SceneBuffers::new(gl, &run.plan.gpu())?;
     let pass = run.planner.pass();
     let target = Target::new(gl, width, height, &pass)?;
     let vao = EmptyVertexArray::new(gl)?;
@@ -240,7 +241,7 @@ fn render_compute(
         .then_some(&proc_address as &dyn Fn(&std::ffi::CStr) -> *const std::ffi::c_void);
     let compute = Compute::new(gl, shader, spirv, size.width, size.height)?;
     let stats = run.dump_binary(compute.program())?;
-    let _buffers = SceneBuffers::new(gl, &run.plan.gpu)?;
+    let _buffers = SceneBuffers::new(gl, &run.plan.gpu())?;
     let timer = Timer::new(gl, &run.info.device)?;
     // The barrier before the timer starts, as Vulkan records its barrier
     // before the first timestamp: both time the dispatch alone.

@@ -7,7 +7,7 @@ use anyhow::{anyhow, Context as _};
 use glow::HasContext;
 use twinray_common::explain;
 use twinray_common::gpu::layout::binding;
-use twinray_common::gpu::upload::GpuScene;
+use twinray_common::gpu::upload::{GpuScene, UPLOAD_CHUNK_BYTES};
 
 pub struct SceneBuffers<'gl> {
     gl: &'gl glow::Context,
@@ -18,21 +18,56 @@ pub struct SceneBuffers<'gl> {
 impl<'gl> SceneBuffers<'gl> {
     /// Uploads and binds everything. Bound by number because naga renames
     /// the blocks; UBO and SSBO binding points are separate spaces in GL, so
-    /// the numbers are the Vulkan descriptor bindings unchanged.
+    /// the numbers are the Vulkan descriptor bindings unchanged. A storage
+    /// buffer is allocated whole, then filled a chunk at a time from one
+    /// reused chunk of host memory (`write_storage` converts the scene into
+    /// it), so the host never holds a second full copy of a large scene.
     pub fn new(gl: &'gl glow::Context, scene: &GpuScene) -> anyhow::Result<SceneBuffers<'gl>> {
         let mut this = SceneBuffers {
             gl,
             buffers: Vec::with_capacity(1 + binding::STORAGE.len()),
         };
-        this.upload(glow::UNIFORM_BUFFER, binding::FRAME, scene.frame_bytes())?;
+        let frame = scene.frame_bytes();
+        let chunk_bytes = UPLOAD_CHUNK_BYTES.min(scene.largest_storage().1.max(frame.len()));
+        // u32s: aligned for every GPU struct, which `write_storage` fills in place.
+        let mut chunk = vec![0u32; chunk_bytes.div_ceil(4)];
+        let chunk: &mut [u8] = bytemuck::cast_slice_mut(&mut chunk);
+        let (len, ubo) = (frame.len(), glow::UNIFORM_BUFFER);
+        this.upload(
+            (ubo, binding::FRAME),
+            len,
+            std::slice::from_ref(&(0..len)),
+            chunk,
+            |_, bytes| bytes.copy_from_slice(frame),
+        )?;
         for b in binding::STORAGE {
-            this.upload(glow::SHADER_STORAGE_BUFFER, b, scene.storage_bytes(b))?;
+            let chunks = scene.chunks(b, chunk_bytes);
+            let (len, ssbo) = (scene.storage_len(b), glow::SHADER_STORAGE_BUFFER);
+            this.upload((ssbo, b), len, &chunks, chunk, |offset, bytes| {
+                scene.write_storage(b, offset, bytes)
+            })?;
         }
         Ok(this)
     }
 
-    fn upload(&mut self, target: u32, index: u32, bytes: &[u8]) -> anyhow::Result<()> {
-        // SAFETY: a fresh buffer on the current context; `bytes` is copied by the driver.
+    /// A buffer of `len` bytes at binding `index` of `target`, filled in
+    /// `chunks` (byte ranges, none longer than `chunk`): `write(offset,
+    /// bytes)` writes the contents from `offset` into `bytes`, part of `chunk`.
+    fn upload(
+        &mut self,
+        (target, index): (u32, u32),
+        len: usize,
+        chunks: &[std::ops::Range<usize>],
+        chunk: &mut [u8],
+        write: impl Fn(usize, &mut [u8]),
+    ) -> anyhow::Result<()> {
+        // GL sizes and offsets are signed 32-bit here; the run plan's storage
+        // limit keeps every scene buffer below that.
+        let len =
+            i32::try_from(len).map_err(|_| anyhow!("a {len}-byte buffer is too large for GL"))?;
+        // SAFETY: a fresh buffer on the current context, allocated with
+        // `len` bytes; every chunk lies within it (so its offset fits in i32)
+        // and its bytes are copied by the driver.
         unsafe {
             let buf = self
                 .gl
@@ -42,13 +77,18 @@ impl<'gl> SceneBuffers<'gl> {
             self.buffers.push(buf);
             self.gl.bind_buffer(target, Some(buf));
             // Written once, read every frame: STATIC_DRAW.
-            self.gl
-                .buffer_data_u8_slice(target, bytes, glow::STATIC_DRAW);
+            self.gl.buffer_data_size(target, len, glow::STATIC_DRAW);
+            for c in chunks {
+                let bytes = &mut chunk[..c.len()];
+                write(c.start, bytes);
+                self.gl
+                    .buffer_sub_data_u8_slice(target, c.start as i32, bytes);
+            }
             self.gl.bind_buffer_base(target, index, Some(buf));
         }
         explain::numbered(
             5,
-            &format!("glCreateBuffer + glBufferData + glBindBufferBase (binding {index})"),
+            &format!("glCreateBuffer + glBufferData + glBufferSubData + glBindBufferBase (binding {index})"),
             || {
                 let kind = if target == glow::UNIFORM_BUFFER {
                     "UNIFORM_BUFFER"
@@ -56,8 +96,8 @@ impl<'gl> SceneBuffers<'gl> {
                     "SHADER_STORAGE_BUFFER"
                 };
                 format!(
-                    "{} bytes, {kind}, STATIC_DRAW: the driver picks the memory and uploads",
-                    bytes.len()
+                    "{len} bytes, {kind}, STATIC_DRAW: the driver picks the memory; filled in {} glBufferSubData",
+                    chunks.len()
                 )
             },
         );

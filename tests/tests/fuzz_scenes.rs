@@ -14,6 +14,7 @@ use arbitrary::Unstructured;
 use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
 use twinray_common::error::exit_code_of;
+use twinray_common::gpu::layout::binding;
 use twinray_common::gpu::upload::GpuScene;
 use twinray_common::plan::build_bvh;
 use twinray_common::scene::accel::Accel;
@@ -393,7 +394,10 @@ fn mutated_scenes_and_meshes_never_panic() {
                 check_accepted(s, &scene_text);
                 // As a run with --accel auto prepares it: the BVH where it pays.
                 let bvh = Accel::Auto.wants_bvh(s).then(|| build_bvh(s));
-                GpuScene::new(s, bvh.as_ref(), 8, 8);
+                let gpu = GpuScene::new(s, bvh.as_ref(), 8, 8);
+                for b in binding::STORAGE {
+                    gpu.storage_vec(b);
+                }
             }
             scene.map(|_| ())
         });

@@ -112,7 +112,8 @@ fn render(
     let api = ("vulkan", device.info(), label);
     let mut report = planner.report(&plan, api, (frames, setup_ms), &image, stats)?;
     if args.count_rays {
-        let counting = plan.counting(&plan.gpu, planner.pass(), width, height);
+        let gpu = plan.gpu();
+        let counting = plan.counting(&gpu, planner.pass(), width, height);
         report.add_rays(count_rays(&device, &counting)?);
     }
     Ok((report, image))
@@ -167,7 +168,7 @@ fn render_fragment(run: &HeadlessRun, shaders: &Shaders) -> Result<Rendered> {
     let device = run.device;
     let (width, height) = (run.args.size.width, run.args.size.height);
     let pass = run.planner.pass();
-    let (frame, storage) = scene_buffers(device, &run.plan.gpu)?;
+    let (frame, storage) = scene_buffers(device, &run.plan.gpu())?;
     let descriptors = Descriptors::new(device, &frame, &storage)?;
     let render_pass = RenderPass::offscreen(device, &pass)?;
     let rp = render_pass.render_pass;
@@ -199,7 +200,7 @@ fn render_fragment(run: &HeadlessRun, shaders: &Shaders) -> Result<Rendered> {
 /// compute.rs's pipeline, storage image and commands.
 fn render_compute(run: &HeadlessRun, shader: &ComputeShader) -> Result<Rendered> {
     let size = &run.args.size;
-    let (frame, storage) = scene_buffers(run.device, &run.plan.gpu)?;
+    let (frame, storage) = scene_buffers(run.device, &run.plan.gpu())?;
     let timestamps = Timestamps::new(run.device)?;
     let compute = Compute::new(
         run.device,

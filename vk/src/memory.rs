@@ -122,36 +122,50 @@ impl Buffer {
     /// written directly by the CPU: what a naive app does. The GPU then reads the
     /// scene across the bus on every access; `--vk-memory host` (TWINRAY_VK_MEMORY=host) selects it
     /// to measure that cost.
+    pub fn host_visible(
+        device: &Device,
+        size: usize,
+        usage: vk::BufferUsageFlags,
+        what: &str,
+    ) -> Result<Buffer> {
+        Buffer::new(device, size as u64, usage, &UPLOAD, what)
+    }
+
+    /// A host-visible buffer holding `bytes`.
     pub fn host_visible_with(
         device: &Device,
         bytes: &[u8],
         usage: vk::BufferUsageFlags,
         what: &str,
     ) -> Result<Buffer> {
-        let wishes = [
-            Flags::HOST_VISIBLE | Flags::HOST_COHERENT,
-            Flags::HOST_VISIBLE,
-        ];
-        let buffer = Buffer::new(device, bytes.len() as u64, usage, &wishes, what)?;
+        let buffer = Buffer::host_visible(device, bytes.len(), usage, what)?;
         buffer.write(bytes)?;
         Ok(buffer)
     }
 
     /// Copies `bytes` into a host-visible buffer.
     pub fn write(&self, bytes: &[u8]) -> Result<()> {
-        self.check_mappable(bytes.len() as u64)?;
+        self.fill(bytes.len(), |mapped| mapped.copy_from_slice(bytes))
+    }
+
+    /// Lets `write` fill the first `len` bytes of a host-visible buffer in
+    /// place, through a mapping: the bytes are made where the GPU or the copy
+    /// reads them, with no copy of them in between.
+    pub fn fill(&self, len: usize, write: impl FnOnce(&mut [u8])) -> Result<()> {
+        self.check_mappable(len as u64)?;
         let d = &self.device;
         // SAFETY: the memory is host-visible and not mapped (every map here is
-        // undone before its function returns); only this thread uses it, and no
-        // pending GPU work writes it: a staging or host buffer is written before
-        // any submission that reads it.
+        // undone before its function returns); only this thread maps it, and no
+        // pending GPU work uses it: a staging or host buffer is written before
+        // any submission that reads it, and a staging buffer again only after
+        // the copy that read it has been waited for.
         let ptr =
             unsafe { d.map_memory(self.memory, 0, vk::WHOLE_SIZE, vk::MemoryMapFlags::empty()) }
                 .context("mapping memory")?;
         // SAFETY: the mapping covers the whole allocation, at least `size` bytes,
-        // and check_mappable made sure `bytes` is no longer; a fresh mapping
-        // cannot overlap `bytes`.
-        unsafe { std::ptr::copy_nonoverlapping(bytes.as_ptr(), ptr.cast::<u8>(), bytes.len()) };
+        // and check_mappable made sure `len` is no more; nothing else refers to
+        // the mapping while `write` runs.
+        write(unsafe { std::slice::from_raw_parts_mut(ptr.cast::<u8>(), len) });
         let range = vk::MappedMemoryRange::default()
             .memory(self.memory)
             .size(vk::WHOLE_SIZE);
@@ -161,7 +175,7 @@ impl Buffer {
         } else {
             Ok(())
         };
-        // SAFETY: mapped above; the copy is done and nothing keeps the pointer.
+        // SAFETY: mapped above; `write` has returned and kept no reference.
         unsafe { d.unmap_memory(self.memory) };
         flushed.context("flushing mapped memory")
     }
@@ -197,71 +211,91 @@ impl Buffer {
     }
 }
 
-/// Device-local buffers filled through staging buffers, all in one submit: each
-/// [`Uploads::add`] makes a buffer and its filled staging buffer, and
-/// [`Uploads::submit`] records every copy and one barrier for them all, waits
-/// once, and hands the buffers over. Until then they are only reachable here,
-/// so nothing can use or free one before its copy has run.
+/// Device-local buffers filled through one small staging buffer: each
+/// [`Uploads::add`] makes a buffer and fills it a chunk at a time (the CPU
+/// writes a chunk into the staging buffer, the GPU copies it across, and the
+/// CPU waits before writing the next), so that a scene of any size needs only
+/// a few tens of MiB of host-visible memory. [`Uploads::finish`] records one
+/// barrier for them all and hands the buffers over; until then they are only
+/// reachable here, so nothing can use one before its copies have run.
 pub struct Uploads<'a> {
     device: &'a Device,
-    /// (staging, destination): the staging buffers live until the copies have run.
-    copies: Vec<(Buffer, Buffer)>,
+    staging: Buffer,
+    /// Filled, but not yet made visible to the shaders.
+    filled: Vec<Buffer>,
 }
 
+/// Coherent memory needs no flush after writing, but any mappable type will do.
+const UPLOAD: [Flags; 2] = [
+    Flags::from_raw(Flags::HOST_VISIBLE.as_raw() | Flags::HOST_COHERENT.as_raw()),
+    Flags::HOST_VISIBLE,
+];
+
 impl<'a> Uploads<'a> {
-    pub fn new(device: &'a Device) -> Uploads<'a> {
-        Uploads {
+    /// Uploads whose chunks are at most `chunk` bytes long.
+    pub fn new(device: &'a Device, chunk: u64) -> Result<Uploads<'a>> {
+        let usage = vk::BufferUsageFlags::TRANSFER_SRC;
+        let staging = Buffer::new(device, chunk, usage, &UPLOAD, "staging buffer")?;
+        Ok(Uploads {
             device,
-            copies: Vec::new(),
-        }
+            staging,
+            filled: Vec::new(),
+        })
     }
 
-    /// A device-local buffer that will hold `bytes` once [`Uploads::submit`] has run.
-    pub fn add(&mut self, bytes: &[u8], usage: vk::BufferUsageFlags, what: &str) -> Result<()> {
+    /// A device-local buffer of `size` bytes, filled in `chunks` (byte ranges
+    /// of at most the staging buffer's size): `write(offset, bytes)` writes
+    /// the contents from `offset` into `bytes`, which is the staging buffer.
+    pub fn add(
+        &mut self,
+        size: usize,
+        (usage, what): (vk::BufferUsageFlags, &str),
+        chunks: &[std::ops::Range<usize>],
+        write: impl Fn(usize, &mut [u8]),
+    ) -> Result<()> {
         let device = self.device;
-        let size = bytes.len() as u64;
-        // Coherent memory needs no flush after writing, but any mappable type will do.
-        let upload = [
-            Flags::HOST_VISIBLE | Flags::HOST_COHERENT,
-            Flags::HOST_VISIBLE,
-        ];
-        let staging = Buffer::new(
-            device,
-            size,
-            vk::BufferUsageFlags::TRANSFER_SRC,
-            &upload,
-            &format!("staging buffer for {what}"),
-        )?;
-        staging.write(bytes)?;
+        let d = &device.device;
         let usage = usage | vk::BufferUsageFlags::TRANSFER_DST;
-        let buffer = Buffer::new(
-            device,
-            size,
-            usage,
-            &[Flags::DEVICE_LOCAL, Flags::empty()],
-            what,
-        )?;
+        let wishes = [Flags::DEVICE_LOCAL, Flags::empty()];
+        let buffer = Buffer::new(device, size as u64, usage, &wishes, what)?;
+        for chunk in chunks {
+            let len = chunk.len();
+            self.staging.fill(len, |bytes| write(chunk.start, bytes))?;
+            device.run_once(&format!("uploading the {what}"), |cmd| {
+                let region = vk::BufferCopy::default()
+                    .dst_offset(chunk.start as u64)
+                    .size(len as u64);
+                // SAFETY: `cmd` is run_once's, recording; both buffers are alive
+                // until run_once has waited for the queue; the region lies
+                // within both (a chunk is at most the staging buffer's size and
+                // lies within `size`).
+                unsafe { d.cmd_copy_buffer(cmd, self.staging.buffer, buffer.buffer, &[region]) };
+            })?;
+        }
         explain::numbered(5, &format!("VkBuffer + VkDeviceMemory: {what}"), || {
             format!(
-                "{size} bytes, usage {usage:?}, memory {:?}\nfilled from a HOST_VISIBLE staging buffer: vkCmdCopyBuffer, then a TRANSFER -> FRAGMENT_SHADER barrier",
-                buffer.memory_flags
+                "{size} bytes, usage {usage:?}, memory {:?}\nfilled through a {}-byte HOST_VISIBLE staging buffer: {} vkCmdCopyBuffer, then a TRANSFER -> FRAGMENT_SHADER barrier",
+                buffer.memory_flags,
+                self.staging.size,
+                chunks.len()
             )
         });
-        self.copies.push((staging, buffer));
+        self.filled.push(buffer);
         Ok(())
     }
 
-    /// Runs every copy in one command buffer and waits for it; then the staging
-    /// buffers go. Returns the buffers in the order they were added.
-    pub fn submit(self) -> Result<Vec<Buffer>> {
+    /// Makes every copy visible to the shaders (one barrier for all the
+    /// buffers) and returns the buffers in the order they were added. The
+    /// staging buffer goes: every copy from it has been waited for.
+    pub fn finish(self) -> Result<Vec<Buffer>> {
         let d = &self.device.device;
         // Read after write: the fragment (or compute) shader of every later
         // submission reads what the copies wrote; queue order alone does not
         // order memory.
         let barriers: Vec<_> = self
-            .copies
+            .filled
             .iter()
-            .map(|(_, buffer)| {
+            .map(|buffer| {
                 buffer_barrier(
                     buffer.buffer,
                     vk::AccessFlags::TRANSFER_WRITE,
@@ -276,19 +310,12 @@ impl<'a> Uploads<'a> {
             vk::PipelineStageFlags::COMPUTE_SHADER
         };
         self.device.run_once("uploading the scene", |cmd| {
-            for (staging, buffer) in &self.copies {
-                let region = vk::BufferCopy::default().size(buffer.size);
-                // SAFETY: `cmd` is run_once's, recording; both buffers of each
-                // pair are in `self.copies`, alive until run_once has waited for
-                // the queue, and both are `buffer.size` bytes long.
-                unsafe { d.cmd_copy_buffer(cmd, staging.buffer, buffer.buffer, &[region]) };
-            }
             let transfer = vk::PipelineStageFlags::TRANSFER;
-            // SAFETY: as for the copies.
+            // SAFETY: `cmd` is run_once's, recording; every buffer is in
+            // `self.filled`, alive until run_once has waited for the queue.
             unsafe { pipeline_barrier(d, cmd, transfer, shaders, &barriers, &[]) };
         })?;
-        // The staging buffers drop here: run_once waited for the copies.
-        Ok(self.copies.into_iter().map(|(_, buffer)| buffer).collect())
+        Ok(self.filled)
     }
 }
 

@@ -12,7 +12,7 @@ use anyhow::Result;
 use ash::vk;
 use twinray_common::cli::SceneMemory;
 use twinray_common::gpu::layout::binding;
-use twinray_common::gpu::upload::{storage_name, GpuScene};
+use twinray_common::gpu::upload::{storage_name, GpuScene, UPLOAD_CHUNK_BYTES};
 use twinray_common::shader::build::Shaders;
 
 /// Fields in reverse creation order, so that they drop in the order Vulkan needs:
@@ -56,39 +56,54 @@ impl SceneResources {
 /// The `Frame` uniform buffer and the storage buffers, filled with the scene's
 /// bytes: what both the graphics and the compute pipeline read.
 ///
-/// Device-local memory, filled once through a staging buffer, is the careful
+/// Device-local memory, filled through a staging buffer, is the careful
 /// choice. `--vk-memory host` keeps the scene in host-visible memory instead,
-/// so the comparison can show what a naive placement costs.
+/// so the comparison can show what a naive placement costs. Either way the
+/// bytes are written where the copy or the GPU reads them (`write_storage`
+/// converts the scene a chunk at a time), so the host never holds a second
+/// full copy of a large scene.
 pub fn scene_buffers(device: &Device, scene: &GpuScene) -> Result<(Buffer, Vec<(u32, Buffer)>)> {
     // The run plan checked every buffer against `Device::storage_limit`.
     let host = device.scene_memory == SceneMemory::Host;
-    // The uniform block first, then the storage buffers in binding order.
-    let frame = (
-        scene.frame_bytes(),
+    let frame_bytes = scene.frame_bytes();
+    let (uniform, storage) = (
         vk::BufferUsageFlags::UNIFORM_BUFFER,
-        "frame uniform buffer".to_string(),
+        vk::BufferUsageFlags::STORAGE_BUFFER,
     );
-    let storage = binding::STORAGE.iter().map(|&b| {
-        (
-            scene.storage_bytes(b),
-            vk::BufferUsageFlags::STORAGE_BUFFER,
-            format!("{} storage buffer", storage_name(b)),
-        )
-    });
-    let contents: Vec<_> = std::iter::once(frame).chain(storage).collect();
-    let buffers = if host {
-        contents
-            .iter()
-            .map(|(bytes, usage, what)| Buffer::host_visible_with(device, bytes, *usage, what))
-            .collect::<Result<Vec<_>>>()?
-    } else {
-        let mut uploads = Uploads::new(device);
-        for (bytes, usage, what) in &contents {
-            uploads.add(bytes, *usage, what)?;
+    let frame_what = "frame uniform buffer";
+    let what = |b: u32| format!("{} storage buffer", storage_name(b));
+    if host {
+        let frame = Buffer::host_visible_with(device, frame_bytes, uniform, frame_what)?;
+        let mut buffers = Vec::new();
+        for b in binding::STORAGE {
+            let len = scene.storage_len(b);
+            let buffer = Buffer::host_visible(device, len, storage, &what(b))?;
+            buffer.fill(len, |bytes| scene.write_storage(b, 0, bytes))?;
+            buffers.push((b, buffer));
         }
-        uploads.submit()?
-    };
-    let mut buffers = buffers.into_iter();
+        return Ok((frame, buffers));
+    }
+    // One staging buffer, as large as the largest chunk any buffer needs.
+    let chunk = UPLOAD_CHUNK_BYTES.min(scene.largest_storage().1.max(frame_bytes.len()));
+    let mut uploads = Uploads::new(device, chunk as u64)?;
+    // The uniform block first, then the storage buffers in binding order.
+    let len = frame_bytes.len();
+    uploads.add(
+        len,
+        (uniform, frame_what),
+        std::slice::from_ref(&(0..len)),
+        |_, bytes| bytes.copy_from_slice(frame_bytes),
+    )?;
+    for b in binding::STORAGE {
+        let chunks = scene.chunks(b, chunk);
+        uploads.add(
+            scene.storage_len(b),
+            (storage, &what(b)),
+            &chunks,
+            |offset, bytes| scene.write_storage(b, offset, bytes),
+        )?;
+    }
+    let mut buffers = uploads.finish()?.into_iter();
     let frame = buffers.next().expect("the uniform buffer comes first");
     let storage = binding::STORAGE.iter().copied().zip(buffers).collect();
     Ok((frame, storage))

@@ -145,7 +145,7 @@ pub fn run(
     );
     let drawing = path_resources(
         &device,
-        &plan.gpu,
+        &plan.gpu(),
         &plan.shaders,
         render_pass.render_pass,
         format.format,

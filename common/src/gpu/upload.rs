@@ -1,32 +1,47 @@
 //! The bytes both apps upload: a `Scene` converted into the layouts of
 //! `gpu::layout`, every position relative to the scene's local origin
-//! (`camera::local_origin`), and the checks of those buffers against a device's limits.
+//! (`camera::local_origin`), made a chunk at a time as an upload asks for
+//! them, and the checks of those buffers against a device's limits.
 
 use crate::gpu::layout::{
     binding, Bvh, GpuBvhNode, GpuBvhPrim, GpuFrame, GpuLight, GpuMaterial, GpuSphere, GpuTriangle,
     PRIM_SPHERE_BIT,
 };
 use crate::limits::StorageLimit;
-use crate::scene::camera::{in_local_frame, RayFrame};
-use crate::scene::{Camera, Scene};
+use crate::scene::camera::{local_origin, RayFrame};
+use crate::scene::{Camera, Scene, Triangle};
 use bytemuck::Pod;
+use glam::DVec3;
 use rayon::prelude::*;
 
-/// Everything a frame needs on the GPU, as bytes. Both apps upload exactly these.
+/// Everything a frame needs on the GPU. The small arrays are held as bytes;
+/// the triangles, the BVH's nodes and its leaves' primitives, millions of each
+/// for a fine mesh, are made from the scene and the tree only as an upload
+/// asks for them, a chunk at a time (`write_storage`), so that the host never
+/// holds a second full copy of the scene. Both apps upload exactly these bytes.
 #[derive(Clone, Debug)]
-pub struct GpuScene {
+pub struct GpuScene<'a> {
     pub frame: GpuFrame,
     pub spheres: Vec<GpuSphere>,
-    pub triangles: Vec<GpuTriangle>,
     pub materials: Vec<GpuMaterial>,
     pub lights: Vec<GpuLight>,
-    /// Empty unless the scene traces through a BVH.
-    pub bvh_nodes: Vec<GpuBvhNode>,
-    /// The leaves' primitives, copied from `spheres` and `triangles`.
-    pub bvh_prims: Vec<GpuBvhPrim>,
     /// Spheres, triangles, lights, and a pad word.
     pub counts: [u32; 4],
+    /// The scene's triangles, in world coordinates.
+    triangles: &'a [Triangle],
+    /// Subtracted from every triangle vertex (`camera::local_origin`).
+    origin: DVec3,
+    /// Empty unless the scene traces through a BVH.
+    bvh_nodes: &'a [GpuBvhNode],
+    /// The leaves' primitive codes, expanded into `GpuBvhPrim`s.
+    bvh_codes: &'a [u32],
 }
+
+/// How many bytes of a storage buffer an upload converts at once: a multiple
+/// of every element size (96, 64, 48, 32 and 16 bytes), so that a chunk holds
+/// whole elements; 48 MiB keeps a 16-core conversion and a copy busy without
+/// a full-size staging copy.
+pub const UPLOAD_CHUNK_BYTES: usize = 48 << 20;
 
 fn v3(v: glam::DVec3) -> [f32; 3] {
     v.as_vec3().to_array()
@@ -57,43 +72,27 @@ impl GpuFrame {
     }
 }
 
-impl GpuScene {
-    /// The buffers of `scene` in its local frame: positions have the local origin
-    /// subtracted in f64 before they become f32, and `bvh` (where the run
-    /// traces through one) was built over those translated primitives, so its
-    /// boxes are rounded in the same frame.
-    pub fn new(world: &Scene, bvh: Option<&Bvh>, width: u32, height: u32) -> GpuScene {
-        let scene = &*in_local_frame(world);
-        let empty = Bvh::default();
-        let bvh = bvh.unwrap_or(&empty);
-        let mut gpu = GpuScene {
+impl<'a> GpuScene<'a> {
+    /// The buffers of `world` in its local frame: positions have the local
+    /// origin subtracted in f64 before they become f32 (as `in_local_frame`
+    /// does, element by element, without copying the scene), and `bvh` (where
+    /// the run traces through one) was built over those translated primitives,
+    /// so its boxes are rounded in the same frame.
+    pub fn new(world: &'a Scene, bvh: Option<&'a Bvh>, width: u32, height: u32) -> GpuScene<'a> {
+        let origin = local_origin(world);
+        GpuScene {
             frame: GpuFrame::new(world, &world.camera, width, height),
-            spheres: scene
+            spheres: world
                 .spheres
                 .iter()
                 .map(|s| GpuSphere {
-                    center: v3(s.center),
+                    center: v3(s.center - origin),
                     radius: s.radius as f32,
                     material: s.material,
                     pad: [0; 3],
                 })
                 .collect(),
-            // Millions of triangles for a fine mesh: converted on every core.
-            triangles: scene
-                .triangles
-                .par_iter()
-                .map(|t| GpuTriangle {
-                    p0: v3(t.p[0]),
-                    material: t.material,
-                    p1: v3(t.p[1]),
-                    p2: v3(t.p[2]),
-                    n0: v3(t.n[0]),
-                    n1: v3(t.n[1]),
-                    n2: v3(t.n[2]),
-                    ..Default::default()
-                })
-                .collect(),
-            materials: scene
+            materials: world
                 .materials
                 .iter()
                 .map(|m| GpuMaterial {
@@ -107,35 +106,53 @@ impl GpuScene {
                     pad: [0; 3],
                 })
                 .collect(),
-            lights: scene
+            lights: world
                 .lights
                 .iter()
                 .map(|l| GpuLight {
-                    position: v3(l.position),
+                    position: v3(l.position - origin),
                     color: v3(l.color),
                     ..Default::default()
                 })
                 .collect(),
-            bvh_nodes: bvh.nodes.clone(),
-            bvh_prims: Vec::new(),
             counts: [
-                scene.spheres.len() as u32,
-                scene.triangles.len() as u32,
-                scene.lights.len() as u32,
+                world.spheres.len() as u32,
+                world.triangles.len() as u32,
+                world.lights.len() as u32,
                 0,
             ],
-        };
-        // Copied from the f32 buffers, so a leaf tests exactly the positions
-        // that the brute-force loops and the shading read.
-        gpu.bvh_prims = bvh
-            .prims
-            .par_iter()
-            .map(|&code| gpu.bvh_prim(code))
-            .collect();
-        gpu
+            triangles: &world.triangles,
+            origin,
+            bvh_nodes: bvh.map_or(&[], |b| &b.nodes),
+            bvh_codes: bvh.map_or(&[], |b| &b.prims),
+        }
     }
 
-    fn bvh_prim(&self, code: u32) -> GpuBvhPrim {
+    /// Triangle `i`'s vertices as the GPU holds them.
+    fn positions(&self, i: usize) -> [[f32; 3]; 3] {
+        self.triangles[i].p.map(|p| v3(p - self.origin))
+    }
+
+    /// Triangle `i` as the GPU holds it.
+    pub fn triangle(&self, i: usize) -> GpuTriangle {
+        let t = &self.triangles[i];
+        let [p0, p1, p2] = self.positions(i);
+        GpuTriangle {
+            p0,
+            material: t.material,
+            p1,
+            p2,
+            n0: v3(t.n[0]),
+            n1: v3(t.n[1]),
+            n2: v3(t.n[2]),
+            ..Default::default()
+        }
+    }
+
+    /// The leaf primitive of `code`, from the same f32 values as the sphere
+    /// and triangle buffers, so a leaf tests exactly the positions that the
+    /// brute-force loops and the shading read.
+    pub fn bvh_prim(&self, code: u32) -> GpuBvhPrim {
         if code & PRIM_SPHERE_BIT != 0 {
             let s = &self.spheres[(code & !PRIM_SPHERE_BIT) as usize];
             GpuBvhPrim {
@@ -145,55 +162,131 @@ impl GpuScene {
                 ..Default::default()
             }
         } else {
-            let t = &self.triangles[code as usize];
+            let [a, b, c] = self.positions(code as usize);
             GpuBvhPrim {
-                a: t.p0,
+                a,
                 code,
-                b: t.p1,
-                c: t.p2,
+                b,
+                c,
                 ..Default::default()
             }
         }
+    }
+
+    pub fn bvh_nodes(&self) -> &'a [GpuBvhNode] {
+        self.bvh_nodes
     }
 
     pub fn frame_bytes(&self) -> &[u8] {
         bytemuck::bytes_of(&self.frame)
     }
 
-    /// The bytes of a storage buffer by binding number. An empty array still gets
-    /// one zeroed element: neither API accepts a zero-sized buffer binding, and the
-    /// counts in `Frame` keep the shader from reading it.
-    pub fn storage_bytes(&self, binding: u32) -> &[u8] {
-        // Zeroes for the one element of an empty array (the largest struct is 96 bytes).
-        static ZEROES: [u8; std::mem::size_of::<GpuTriangle>()] =
-            [0; std::mem::size_of::<GpuTriangle>()];
-        fn bytes<T: Pod>(v: &[T]) -> &[u8] {
-            if v.is_empty() {
-                &ZEROES[..std::mem::size_of::<T>()]
-            } else {
-                bytemuck::cast_slice(v)
-            }
-        }
-        match binding {
-            binding::SPHERES => bytes(&self.spheres),
-            binding::TRIANGLES => bytes(&self.triangles),
-            binding::MATERIALS => bytes(&self.materials),
-            binding::LIGHTS => bytes(&self.lights),
-            binding::BVH_NODES => bytes(&self.bvh_nodes),
-            binding::BVH_PRIMS => bytes(&self.bvh_prims),
-            binding::COUNTS => bytes(&self.counts),
+    /// The size in bytes of a storage buffer by binding number. An empty array
+    /// still gets one zeroed element: neither API accepts a zero-sized buffer
+    /// binding, and the counts in `Frame` keep the shader from reading it.
+    pub fn storage_len(&self, binding: u32) -> usize {
+        let (count, size) = match binding {
+            binding::SPHERES => (self.spheres.len(), size_of::<GpuSphere>()),
+            binding::TRIANGLES => (self.triangles.len(), size_of::<GpuTriangle>()),
+            binding::MATERIALS => (self.materials.len(), size_of::<GpuMaterial>()),
+            binding::LIGHTS => (self.lights.len(), size_of::<GpuLight>()),
+            binding::BVH_NODES => (self.bvh_nodes.len(), size_of::<GpuBvhNode>()),
+            binding::BVH_PRIMS => (self.bvh_codes.len(), size_of::<GpuBvhPrim>()),
+            binding::COUNTS => (1, size_of::<[u32; 4]>()),
             _ => panic!("binding {binding} is not a storage buffer"),
+        };
+        count.max(1) * size
+    }
+
+    /// Writes bytes `offset..offset + out.len()` of a storage buffer into
+    /// `out` (a mapped staging buffer, or a chunk the app hands the driver).
+    /// The triangles and the BVH's primitives are converted here, on every
+    /// core; a range that does not start and end on whole elements, or an
+    /// `out` not aligned for them, goes through a small copy.
+    pub fn write_storage(&self, binding: u32, offset: usize, out: &mut [u8]) {
+        assert!(
+            offset + out.len() <= self.storage_len(binding),
+            "bytes {offset}..{} of a {}-byte buffer",
+            offset + out.len(),
+            self.storage_len(binding)
+        );
+        match binding {
+            binding::SPHERES => copy_elements(&self.spheres, offset, out),
+            binding::MATERIALS => copy_elements(&self.materials, offset, out),
+            binding::LIGHTS => copy_elements(&self.lights, offset, out),
+            binding::COUNTS => copy_elements(&self.counts, offset, out),
+            binding::BVH_NODES => copy_elements(self.bvh_nodes, offset, out),
+            binding::TRIANGLES if !self.triangles.is_empty() => {
+                convert(offset, out, |i| self.triangle(i))
+            }
+            binding::BVH_PRIMS if !self.bvh_codes.is_empty() => {
+                convert(offset, out, |i| self.bvh_prim(self.bvh_codes[i]))
+            }
+            // The one zeroed element of an empty array.
+            _ => out.fill(0),
         }
+    }
+
+    /// A whole storage buffer's bytes: for small buffers and tests (an upload
+    /// goes through `write_storage` a chunk at a time).
+    pub fn storage_vec(&self, binding: u32) -> Vec<u8> {
+        let mut bytes = vec![0; self.storage_len(binding)];
+        self.write_storage(binding, 0, &mut bytes);
+        bytes
+    }
+
+    /// The byte ranges, each at most `max_bytes` long (at least one element),
+    /// in which an upload fills a storage buffer: whole elements each.
+    pub fn chunks(&self, binding: u32, max_bytes: usize) -> Vec<std::ops::Range<usize>> {
+        let len = self.storage_len(binding);
+        let step = max_bytes.max(UPLOAD_CHUNK_ALIGN) / UPLOAD_CHUNK_ALIGN * UPLOAD_CHUNK_ALIGN;
+        (0..len)
+            .step_by(step)
+            .map(|start| start..(start + step).min(len))
+            .collect()
     }
 
     /// The largest storage buffer, to check against the device's limit.
     pub fn largest_storage(&self) -> (u32, usize) {
         binding::STORAGE
             .iter()
-            .map(|&b| (b, self.storage_bytes(b).len()))
+            .map(|&b| (b, self.storage_len(b)))
             .max_by_key(|(_, n)| *n)
             .unwrap_or((0, 0))
     }
+}
+
+/// A multiple of every element size, so that chunks hold whole elements.
+const UPLOAD_CHUNK_ALIGN: usize = 192;
+
+/// Bytes `offset..` of `items` (one zeroed element when empty) into `out`.
+fn copy_elements<T: Pod>(items: &[T], offset: usize, out: &mut [u8]) {
+    if items.is_empty() {
+        out.fill(0);
+    } else {
+        out.copy_from_slice(&bytemuck::cast_slice(items)[offset..offset + out.len()]);
+    }
+}
+
+/// Fills `out`, bytes `offset..` of an array whose element `i` is `make(i)`,
+/// in parallel: straight into `out` when the range holds whole, aligned
+/// elements (every chunk an app asks for), through a copy otherwise.
+fn convert<T: Pod + Send>(offset: usize, out: &mut [u8], make: impl Fn(usize) -> T + Sync) {
+    let size = size_of::<T>();
+    let first = offset / size;
+    if offset % size == 0 && out.len() % size == 0 {
+        if let Ok(items) = bytemuck::try_cast_slice_mut::<u8, T>(out) {
+            items
+                .par_iter_mut()
+                .enumerate()
+                .for_each(|(i, x)| *x = make(first + i));
+            return;
+        }
+    }
+    let end = (offset + out.len()).div_ceil(size);
+    let items: Vec<T> = (first..end).into_par_iter().map(&make).collect();
+    let skip = offset - first * size;
+    out.copy_from_slice(&bytemuck::cast_slice(&items)[skip..skip + out.len()]);
 }
 
 pub fn storage_name(binding: u32) -> &'static str {
@@ -234,7 +327,7 @@ pub fn check_storage_limit(gpu: &GpuScene, limit: &StorageLimit) -> anyhow::Resu
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::scene::camera::{local_origin, Orbit, LOCAL_ORIGIN_GRID_VIEWS};
+    use crate::scene::camera::{in_local_frame, local_origin, Orbit, LOCAL_ORIGIN_GRID_VIEWS};
     use crate::scene::OriginMode;
     use glam::DVec3;
     use std::borrow::Cow;
@@ -266,7 +359,7 @@ mod tests {
                 .spheres
                 .iter()
                 .map(|x| x.center)
-                .chain(g.triangles.iter().map(|t| t.p0))
+                .chain((0..g.counts[1] as usize).map(|i| g.triangle(i).p0))
                 .chain(std::iter::once(g.frame.eye))
                 .flat_map(|v| v.map(f32::abs))
                 .fold(0.0f32, f32::max);
@@ -304,5 +397,39 @@ mod tests {
         // The origin comes from the scene's own camera, never the orbit's: a
         // zoom changes the view distance and so the grid, which would move it.
         assert_eq!(local_origin(&s), o);
+    }
+
+    #[test]
+    fn chunks_of_any_size_give_the_whole_buffers_bytes() {
+        let s = Scene::load("teapot", &[]).unwrap();
+        let bvh = Bvh::build(&s);
+        let g = GpuScene::new(&s, Some(&bvh), 8, 8);
+        for b in binding::STORAGE {
+            let whole = g.storage_vec(b);
+            assert_eq!(whole.len(), g.storage_len(b));
+            for max in [1, 1000, 1 << 20] {
+                let mut joined = Vec::new();
+                for c in g.chunks(b, max) {
+                    let mut bytes = vec![0; c.len()];
+                    g.write_storage(b, c.start, &mut bytes);
+                    joined.extend(bytes);
+                }
+                assert!(joined == whole, "binding {b}, chunks of {max}");
+            }
+            // A range that cuts elements goes through the copy, to the same bytes.
+            let (start, end) = (7.min(whole.len()), 107.min(whole.len()));
+            let mut bytes = vec![0; end - start];
+            g.write_storage(b, start, &mut bytes);
+            assert!(bytes == whole[start..end], "binding {b}, bytes 7..107");
+        }
+        // The leaves hold the very vertices of the triangle buffer.
+        let prims: Vec<GpuBvhPrim> =
+            bytemuck::pod_collect_to_vec(&g.storage_vec(binding::BVH_PRIMS));
+        let tris: Vec<GpuTriangle> =
+            bytemuck::pod_collect_to_vec(&g.storage_vec(binding::TRIANGLES));
+        for p in prims.iter().filter(|p| p.code & PRIM_SPHERE_BIT == 0) {
+            let t = &tris[p.code as usize];
+            assert_eq!([p.a, p.b, p.c], [t.p0, t.p1, t.p2]);
+        }
     }
 }

@@ -18,7 +18,7 @@ use crate::lab::{self, Changes};
 use crate::limits::StorageLimit;
 use crate::reference::image_io::FloatImage;
 use crate::report::{dump_statistics, DeviceInfo, FrameTime, RunReport, ShaderStats};
-use crate::scene::camera::in_local_frame;
+use crate::scene::camera::local_origin;
 use crate::scene::Scene;
 use crate::shader::build::PathShaders;
 use crate::shader::variant::{Entry, Variant};
@@ -43,8 +43,8 @@ pub struct RunPlan {
     /// How long the build took.
     pub bvh_ms: Option<f64>,
     pub variant: Variant,
-    /// The buffers' bytes, at the size the plan was prepared for.
-    pub gpu: GpuScene,
+    /// The size the plan was prepared for (the window's may change since).
+    pub size: (u32, u32),
     /// The shaders of the variant's path, compiled.
     pub shaders: PathShaders,
 }
@@ -52,7 +52,7 @@ pub struct RunPlan {
 /// What the untimed ray-counting frame renders (`--count-rays`), in either
 /// app: the plan's scene at a size, with the counting variant of its shader.
 pub struct CountingRun<'a> {
-    pub gpu: &'a GpuScene,
+    pub gpu: &'a GpuScene<'a>,
     /// The counting variant, on the path that is drawing.
     pub variant: Variant,
     pub pass: FragmentPass,
@@ -179,8 +179,7 @@ impl Planner {
             (None, None)
         };
         let variant = self.variant(&scene, bvh.as_ref(), path);
-        let gpu = GpuScene::new(&scene, bvh.as_ref(), width, height);
-        check_storage_limit(&gpu, limit)?;
+        check_storage_limit(&GpuScene::new(&scene, bvh.as_ref(), width, height), limit)?;
         let shaders = PathShaders::build(&variant)?;
         let target = match self.api {
             Api::Vulkan => "SPIR-V",
@@ -196,7 +195,7 @@ impl Planner {
             bvh,
             bvh_ms,
             variant,
-            gpu,
+            size: (width, height),
             shaders,
         })
     }
@@ -256,15 +255,26 @@ impl Planner {
 /// The BVH a run traces `scene` through: built over the primitives as the GPU
 /// holds them, relative to the local origin, so its boxes round in that frame.
 pub fn build_bvh(scene: &Scene) -> Bvh {
-    Bvh::build(&in_local_frame(scene))
+    Bvh::build_at(scene, local_origin(scene))
 }
 
 impl RunPlan {
+    /// The buffers' bytes at the size the plan was prepared for, made from
+    /// the plan's scene and BVH as the upload reads them (`GpuScene`).
+    pub fn gpu(&self) -> GpuScene<'_> {
+        self.gpu_at(self.size.0, self.size.1)
+    }
+
+    /// The same at `width`×`height` (a window that has changed size).
+    pub fn gpu_at(&self, width: u32, height: u32) -> GpuScene<'_> {
+        GpuScene::new(&self.scene, self.bvh.as_ref(), width, height)
+    }
+
     /// The counting frame of this plan on its own path, at `width`×`height`
     /// (the window's size may differ from the plan's), with `gpu` as its buffers.
     pub fn counting<'a>(
         &self,
-        gpu: &'a GpuScene,
+        gpu: &'a GpuScene<'a>,
         pass: FragmentPass,
         width: u32,
         height: u32,

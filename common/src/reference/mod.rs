@@ -463,8 +463,10 @@ mod tests {
         };
         for name in ["teapot".to_string(), far("far-1e6"), far("closed-mesh")] {
             let scene = Scene::load(&name, &[]).unwrap();
-            // As the run plan builds it (plan::build_bvh).
-            let bvh = Bvh::build(&in_local_frame(&scene));
+            // As the run plan builds it (plan::build_bvh): over the world
+            // scene, less its local origin.
+            let origin = crate::scene::camera::local_origin(&scene);
+            let bvh = Bvh::build_at(&scene, origin);
             let gpu = crate::gpu::upload::GpuScene::new(&scene, Some(&bvh), 8, 8);
             let local = in_local_frame(&scene).rounded_to_f32();
             let reference = Tracer::new(&local);
@@ -472,8 +474,11 @@ mod tests {
                 .bvh
                 .as_ref()
                 .expect("a BVH above a few primitives");
-            assert!(tree.nodes == gpu.bvh_nodes, "{name}: the nodes differ");
-            let codes: Vec<u32> = gpu.bvh_prims.iter().map(|p| p.code).collect();
+            assert!(tree.nodes == gpu.bvh_nodes(), "{name}: the nodes differ");
+            let prims: Vec<crate::gpu::layout::GpuBvhPrim> = bytemuck::pod_collect_to_vec(
+                &gpu.storage_vec(crate::gpu::layout::binding::BVH_PRIMS),
+            );
+            let codes: Vec<u32> = prims.iter().map(|p| p.code).collect();
             assert_eq!(tree.prims, codes, "{name}: the leaves differ");
         }
     }

@@ -39,6 +39,36 @@ pub(super) fn line_col(text: &str, offset: usize) -> (usize, usize) {
 
 pub(super) type ObjTriangle = ([DVec3; 3], Option<[DVec3; 3]>);
 
+/// A mesh's faces as its loader gives them: an OBJ's triangles one by one, or
+/// a tessellation's shared vertices and index triples, which take a quarter of
+/// the memory and are expanded only as the scene's triangles are made.
+pub(super) enum Faces {
+    Soup(Vec<ObjTriangle>),
+    Indexed(teapot::TeapotMesh),
+}
+
+impl Faces {
+    pub(super) fn len(&self) -> usize {
+        match self {
+            Faces::Soup(t) => t.len(),
+            Faces::Indexed(m) => m.triangles.len(),
+        }
+    }
+
+    /// Face `f`'s vertices and normals (None: the file gave none).
+    pub(super) fn get(&self, f: usize) -> ObjTriangle {
+        match self {
+            Faces::Soup(t) => t[f],
+            Faces::Indexed(m) => {
+                let t = m.triangles[f];
+                let v = |k: usize| DVec3::from_array(m.positions[t[k] as usize]);
+                let n = |k: usize| DVec3::from_array(m.normals[t[k] as usize]);
+                ([v(0), v(1), v(2)], Some([n(0), n(1), n(2)]))
+            }
+        }
+    }
+}
+
 /// A file's text, refused with a message naming `what` when it is not a regular
 /// file (`/dev/zero`, a pipe, a folder), is larger than `max` bytes, or is not
 /// UTF-8 (with the line and column of the first bad byte).
@@ -130,7 +160,7 @@ pub(super) fn load_bpt(
     [nu, nv]: [u32; 2],
     (before, limit): (usize, &StorageLimit),
     files: &FileSource,
-) -> anyhow::Result<Vec<ObjTriangle>> {
+) -> anyhow::Result<Faces> {
     let max = limits::MAX_TESSELLATION;
     if !(1..=max).contains(&nu) || !(1..=max).contains(&nv) {
         return Err(bad_input(format!(
@@ -151,19 +181,7 @@ pub(super) fn load_bpt(
     );
     limits::check_count(&format!("{what}: triangles"), n, limits::MAX_TRIANGLES)?;
     limit.check(&what, "triangles", n, size_of::<GpuTriangle>())?;
-    let mesh = teapot::tessellate(&patches, nu, nv);
-    let v = |i: u32| DVec3::from_array(mesh.positions[i as usize]);
-    let n = |i: u32| DVec3::from_array(mesh.normals[i as usize]);
-    Ok(mesh
-        .triangles
-        .iter()
-        .map(|t| {
-            (
-                [v(t[0]), v(t[1]), v(t[2])],
-                Some([n(t[0]), n(t[1]), n(t[2])]),
-            )
-        })
-        .collect())
+    Ok(Faces::Indexed(teapot::tessellate(&patches, nu, nv)))
 }
 
 /// An OBJ mesh's triangles. The text is checked line by line first
@@ -174,7 +192,7 @@ pub(super) fn load_obj(
     file: &str,
     (before, limit): (usize, &StorageLimit),
     files: &FileSource,
-) -> anyhow::Result<Vec<ObjTriangle>> {
+) -> anyhow::Result<Faces> {
     let text = read_text(&format!("{at}.obj"), file, files)?;
     let what = format!("{at}.obj '{file}'");
     scan_obj(&what, &text, before, limit)?;
@@ -231,7 +249,7 @@ pub(super) fn load_obj(
             out.push((p, n));
         }
     }
-    Ok(out)
+    Ok(Faces::Soup(out))
 }
 
 /// Checks an OBJ text the way tobj reads it (`v`, `vt`, `vn`, `f` and `l`

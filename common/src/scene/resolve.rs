@@ -12,10 +12,11 @@ use crate::scene::check::{
 use crate::scene::format::{
     CameraDef, LightDef, MaterialDef, MeshDef, QuadDef, RenderDef, SceneFile, TriangleDef,
 };
-use crate::scene::mesh::{load_bpt, load_obj, FileSource};
+use crate::scene::mesh::{load_bpt, load_obj, FileSource, ObjTriangle};
 use crate::scene::numerics::Numerics;
 use crate::scene::{Camera, Light, Material, OriginMode, Scene, Sphere, Triangle};
 use glam::{DMat3, DVec3};
+use rayon::prelude::*;
 use std::collections::{HashMap, HashSet};
 
 /// Names the source of each value in error messages: the scene file and field,
@@ -415,23 +416,32 @@ fn mesh(
         limits::MAX_TRIANGLES,
     )?;
     let before = triangles.len();
-    for (f, (p, n)) in obj.into_iter().enumerate() {
+    let place = |(p, n): ObjTriangle| {
         let p = p.map(|v| rot * (v * scale) + translate);
-        for v in p.iter().filter(|v| !coord_ok(**v)) {
+        let n = match (m.smooth, n) {
+            (true, Some(n)) => n.map(|v| rot * v),
+            _ => [flat_normal(&p); 3],
+        };
+        Triangle {
+            p,
+            n,
+            material: mat,
+        }
+    };
+    // Millions of faces for a fine tessellation: placed on every core, each
+    // written once, straight into its slot of the scene's list.
+    triangles.reserve_exact(obj.len());
+    triangles.par_extend((0..obj.len()).into_par_iter().map(|f| place(obj.get(f))));
+    drop(obj);
+    // The first face (in file order) that scale and translate moved out of range.
+    let bad = |t: &Triangle| t.p.iter().any(|v| !coord_ok(*v));
+    if let Some(f) = triangles[before..].par_iter().position_first(bad) {
+        for v in triangles[before + f].p.iter().filter(|v| !coord_ok(**v)) {
             coord3(
                 &format!("{at}: '{file}' face {} after scale and translate", f + 1),
                 v.to_array(),
             )?;
         }
-        let n = match (m.smooth, n) {
-            (true, Some(n)) => n.map(|v| rot * v),
-            _ => [flat_normal(&p); 3],
-        };
-        triangles.push(Triangle {
-            p,
-            n,
-            material: mat,
-        });
     }
     if triangles.len() == before {
         return Err(bad_input(format!("{at}: '{file}' contains no faces")));

@@ -48,7 +48,7 @@ pub trait Renderer {
     /// A new scene, shader variant or path: rebuild buffers, descriptors and
     /// program (or pipeline) for the path `shaders` belongs to, and draw with
     /// that path from now on.
-    fn load_scene(&mut self, scene: &GpuScene, shaders: &PathShaders) -> anyhow::Result<()>;
+    fn load_scene(&mut self, scene: &GpuScene<'_>, shaders: &PathShaders) -> anyhow::Result<()>;
     /// Renders `frame` at `width`×`height` (the window's size) with the current
     /// path into the RGBA32F image the headless path uses and reads it back, top
     /// row first, so that a screenshot is quantised by `image_io` exactly like

@@ -4,7 +4,6 @@
 use crate::cli::RenderPath;
 use crate::error::bad_input;
 use crate::gpu::layout::GpuFrame;
-use crate::gpu::upload::GpuScene;
 use crate::limits::MAX_DEPTH;
 use crate::plan::{Planner, RunPlan};
 use crate::report::FrameTime;
@@ -249,7 +248,7 @@ impl<R: Renderer> Session<R> {
                 self.orbit = Orbit::new(&plan.scene.camera);
                 self.plan = plan;
                 if let Some(r) = self.renderer.as_mut() {
-                    r.load_scene(&self.plan.gpu, &self.plan.shaders)?;
+                    r.load_scene(&self.plan.gpu_at(w, h), &self.plan.shaders)?;
                 }
                 self.restart_title();
             }
@@ -306,9 +305,8 @@ impl<R: Renderer> Session<R> {
         let plan = &mut self.plan;
         plan.shaders = PathShaders::build(&plan.variant)?;
         let (w, h) = (self.size.width.max(1), self.size.height.max(1));
-        plan.gpu = GpuScene::new(&plan.scene, plan.bvh.as_ref(), w, h);
         if let Some(r) = self.renderer.as_mut() {
-            r.load_scene(&plan.gpu, &plan.shaders)?;
+            r.load_scene(&plan.gpu_at(w, h), &plan.shaders)?;
         }
         Ok(())
     }
@@ -324,7 +322,7 @@ impl<R: Renderer> Session<R> {
         self.rays_stale = false;
         let (width, height) = (self.size.width, self.size.height);
         let plan = &self.plan;
-        let mut gpu = GpuScene::new(&plan.scene, plan.bvh.as_ref(), width, height);
+        let mut gpu = plan.gpu_at(width, height);
         gpu.frame = self.frame_uniform();
         let run = plan.counting(&gpu, self.planner.pass(), width, height);
         if let Some(r) = self.renderer.as_mut() {

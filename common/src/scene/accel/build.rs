@@ -16,6 +16,7 @@
 use super::split::{boxes, split, Box3, Node, PrimRef, BIN_CHUNK, INTERSECT_COST, TRAVERSAL_COST};
 use crate::gpu::layout::{child_ref, Bounds, Bvh, GpuBvhNode, GpuBvhPrim, PRIM_SPHERE_BIT};
 use crate::scene::Scene;
+use glam::DVec3;
 use rayon::prelude::*;
 
 /// A subtree with at least this many primitives builds its two halves as
@@ -59,19 +60,21 @@ fn next_up(f: f32, exact: f64) -> f32 {
     }
 }
 
-fn prim_refs(scene: &Scene) -> Vec<PrimRef> {
+/// The primitives' boxes, every position less `origin` (as `in_local_frame`
+/// subtracts it, element by element, without copying the scene).
+fn prim_refs(scene: &Scene, origin: DVec3) -> Vec<PrimRef> {
     let mut refs = Vec::with_capacity(scene.primitive_count());
     refs.extend(
         scene
             .spheres
             .iter()
             .enumerate()
-            .map(|(i, s)| sphere_ref(s.center, s.radius, PRIM_SPHERE_BIT | i as u32)),
+            .map(|(i, s)| sphere_ref(s.center - origin, s.radius, PRIM_SPHERE_BIT | i as u32)),
     );
     // The vertices rounded to f32 exactly as the upload rounds them: the min
     // and max of f32 values are f32 values, so the box is exact.
     refs.par_extend(scene.triangles.par_iter().enumerate().map(|(i, t)| {
-        let p = t.p.map(|v| v.as_vec3());
+        let p = t.p.map(|v| (v - origin).as_vec3());
         let (lo, hi) = (p[0].min(p[1]).min(p[2]), p[0].max(p[1]).max(p[2]));
         PrimRef {
             min: positive_zero(lo.to_array()),
@@ -85,8 +88,15 @@ fn prim_refs(scene: &Scene) -> Vec<PrimRef> {
 
 impl Bvh {
     pub fn build(scene: &Scene) -> Bvh {
+        Bvh::build_at(scene, DVec3::ZERO)
+    }
+
+    /// The tree of `scene` with `origin` subtracted from every position: the
+    /// tree of `in_local_frame(scene)` when `origin` is its local origin,
+    /// without a copy of the scene.
+    pub fn build_at(scene: &Scene, origin: DVec3) -> Bvh {
         let start = std::time::Instant::now();
-        let mut refs = prim_refs(scene);
+        let mut refs = prim_refs(scene, origin);
         let mut bvh = Bvh::default();
         if !refs.is_empty() {
             let (bounds, centroids) = refs.par_chunks(BIN_CHUNK).map(boxes).reduce(
@@ -106,8 +116,10 @@ impl Bvh {
             // the slots cost about what the tree needs (see `build`).
             let mut slots: Vec<GpuBvhNode> = bytemuck::zeroed_vec(refs.len() - 1);
             let built = build(&mut refs, node, &mut slots);
+            bvh.prims = refs.par_iter().map(|r| r.code).collect();
+            drop(refs);
             bvh.depth = built.depth;
-            bvh.nodes = compact(&slots, &built.runs, built.interior);
+            bvh.nodes = compact(slots, &built.runs, built.interior);
             if let Some((first, count)) = child_ref::as_leaf(built.child) {
                 // Node 0 is always an interior node: a tree that is one leaf
                 // gets a root whose two children are that leaf. The second
@@ -116,7 +128,6 @@ impl Bvh {
                 let leaf = child_ref::leaf(first as u32, count as u32);
                 bvh.nodes.push(GpuBvhNode::new(b, leaf, b, leaf));
             }
-            bvh.prims = refs.par_iter().map(|r| r.code).collect();
         }
         bvh.build_ms = start.elapsed().as_secs_f64() * 1e3;
         bvh
@@ -281,30 +292,31 @@ fn build_serial(
     (RELATIVE, 1 + ldepth.max(rdepth))
 }
 
-/// Copies the written runs of the slots into one array, in order (closing
-/// the gaps at the ends of the windows of `build`), and turns the relative
-/// child references into indices. The runs are copied at once, each by a task.
-fn compact(slots: &[GpuBvhNode], runs: &[(usize, usize)], interior: usize) -> Vec<GpuBvhNode> {
-    let mut nodes: Vec<GpuBvhNode> = bytemuck::zeroed_vec(interior);
-    let mut jobs = Vec::with_capacity(runs.len());
-    let mut rest = nodes.as_mut_slice();
+/// Moves the written runs of the slots to the front, in order (closing the
+/// gaps at the ends of the windows of `build`), in place: no run moves right,
+/// so each is copied over gaps or runs already moved, and the tree never
+/// exists twice. The slots beyond the nodes are freed, and the relative child
+/// references become indices, on every core.
+fn compact(
+    mut slots: Vec<GpuBvhNode>,
+    runs: &[(usize, usize)],
+    interior: usize,
+) -> Vec<GpuBvhNode> {
     let mut at = 0;
     for &(first, n) in runs {
-        let (dst, tail) = rest.split_at_mut(n);
-        jobs.push((at, &slots[first..first + n], dst));
-        rest = tail;
+        debug_assert!(first >= at);
+        slots.copy_within(first..first + n, at);
         at += n;
     }
     debug_assert_eq!(at, interior);
-    jobs.into_par_iter().for_each(|(at, src, dst)| {
-        dst.copy_from_slice(src);
-        for (i, n) in dst.iter_mut().enumerate() {
-            for c in [&mut n.left, &mut n.right] {
-                if child_ref::as_leaf(*c).is_none() {
-                    *c += (at + i) as u32;
-                }
+    slots.truncate(interior);
+    slots.shrink_to_fit();
+    slots.par_iter_mut().enumerate().for_each(|(i, n)| {
+        for c in [&mut n.left, &mut n.right] {
+            if child_ref::as_leaf(*c).is_none() {
+                *c += i as u32;
             }
         }
     });
-    nodes
+    slots
 }
