@@ -125,6 +125,8 @@ bool hit_leaf(inout Hit h, vec3 origin, vec3 dir, TriRay ray, uint first, uint c
 // same order as one loop taking a node or a leaf per turn, and was faster in
 // both APIs, never slower (measured in
 // comparison/results/nvidia-h100/FINDINGS.md#the-node-layout-investigationnode-layout).
+// A wide tree's variant has bvh_wide.glsl's instead, which shares the rest of this file.
+#ifndef USE_BVH_WIDE
 Hit traverse(vec3 origin, vec3 dir, float t_max, bool any_hit) {
     Hit h;
     h.t = t_max;
@@ -190,4 +192,5 @@ Hit traverse(vec3 origin, vec3 dir, float t_max, bool any_hit) {
     }
     return h;
 }
+#endif
 #endif

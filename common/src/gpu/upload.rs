@@ -3,8 +3,8 @@
 //! (`camera::local_origin`), and the checks of those buffers against a device's limits.
 
 use crate::gpu::layout::{
-    binding, Bvh, GpuBvhNode, GpuBvhPrim, GpuFrame, GpuLight, GpuMaterial, GpuSphere, GpuTriangle,
-    PRIM_SPHERE_BIT,
+    binding, Bvh, GpuBvhNode, GpuBvhPrim, GpuBvhWideNode, GpuFrame, GpuLight, GpuMaterial,
+    GpuSphere, GpuTriangle, PRIM_SPHERE_BIT,
 };
 use crate::limits::StorageLimit;
 use crate::scene::camera::{in_local_frame, RayFrame};
@@ -22,6 +22,8 @@ pub struct GpuScene {
     pub lights: Vec<GpuLight>,
     /// Empty unless the scene traces through a BVH.
     pub bvh_nodes: Vec<GpuBvhNode>,
+    /// A wide tree's nodes, bound where `bvh_nodes` is when there are any.
+    pub bvh_wide_nodes: Vec<GpuBvhWideNode>,
     /// The leaves' primitives, copied from `spheres` and `triangles`.
     pub bvh_prims: Vec<GpuBvhPrim>,
     /// Spheres, triangles, lights, and a pad word.
@@ -117,6 +119,7 @@ impl GpuScene {
                 })
                 .collect(),
             bvh_nodes: bvh.nodes.clone(),
+            bvh_wide_nodes: bvh.wide.clone(),
             bvh_prims: Vec::new(),
             counts: [
                 scene.spheres.len() as u32,
@@ -179,6 +182,9 @@ impl GpuScene {
             binding::TRIANGLES => bytes(&self.triangles),
             binding::MATERIALS => bytes(&self.materials),
             binding::LIGHTS => bytes(&self.lights),
+            binding::BVH_NODES if !self.bvh_wide_nodes.is_empty() => {
+                bytemuck::cast_slice(&self.bvh_wide_nodes)
+            }
             binding::BVH_NODES => bytes(&self.bvh_nodes),
             binding::BVH_PRIMS => bytes(&self.bvh_prims),
             binding::COUNTS => bytes(&self.counts),

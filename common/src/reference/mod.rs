@@ -37,27 +37,33 @@ pub fn render(scene: &Scene, width: u32, height: u32) -> FloatImage {
 
 /// Renders `scene` with the given numerical choices instead of the scene's.
 pub fn render_with(scene: &Scene, width: u32, height: u32, numerics: &Numerics) -> FloatImage {
-    render_counting(scene, width, height, numerics, true, &AtomicUsize::new(0))
+    render_counting(
+        scene,
+        width,
+        height,
+        numerics,
+        Some(2),
+        &AtomicUsize::new(0),
+    )
 }
 
-/// `render_with`, through the BVH or (`bvh` false: `--accel none`) testing
-/// every primitive, adding 1 to `rows_done` as each row finishes (for a progress bar).
+/// `render_with`, through the BVH of `bvh_width` children a node or (None:
+/// `--accel none`) testing every primitive, adding 1 to `rows_done` as each row finishes (for a progress bar).
 pub fn render_counting(
     scene: &Scene,
     width: u32,
     height: u32,
     numerics: &Numerics,
-    bvh: bool,
+    bvh_width: Option<u32>,
     rows_done: &AtomicUsize,
 ) -> FloatImage {
     // The GPU's frame: positions relative to the local origin, then rounded to f32.
     let frame = RayFrame::local(scene, &scene.camera, width, height).rounded_to_f32();
     let mut scene = in_local_frame(scene).rounded_to_f32();
     scene.numerics = *numerics;
-    let tracer = if bvh {
-        Tracer::new(&scene)
-    } else {
-        Tracer::brute_force(&scene)
+    let tracer = match bvh_width {
+        Some(width) => Tracer::with_width(&scene, width),
+        None => Tracer::brute_force(&scene),
     };
     let w = width as usize;
     let mut pixels = vec![[0f32; 3]; crate::limits::pixel_count(width, height)];
