@@ -484,7 +484,7 @@ mod tests {
     /// deriving them must keep every spelling.
     #[test]
     fn value_names_keep_their_spelling() {
-        assert_eq!(names::<Accel>(), ["auto", "none", "bvh"]);
+        assert_eq!(names::<Accel>(), ["auto", "none", "bvh", "bvh4", "bvh8"]);
         assert_eq!(names::<RenderPath>(), ["fragment", "compute"]);
         assert_eq!(
             names::<Experiment>(),

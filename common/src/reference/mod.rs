@@ -383,14 +383,20 @@ mod tests {
     use super::*;
     use crate::gpu::layout::Bvh;
 
-    /// Every pixel through the BVH equals brute force, bit for bit.
+    /// Every pixel through the BVH, of each width, equals brute force, bit for bit.
     fn same_as_brute_force(scene: &Scene, width: u32, height: u32) {
+        for w in crate::scene::accel::wide::WIDTHS {
+            same_as_brute_force_through(scene, width, height, w);
+        }
+    }
+
+    fn same_as_brute_force_through(scene: &Scene, width: u32, height: u32, bvh_width: u32) {
         let scene = scene.rounded_to_f32();
         let frame = RayFrame::new(&scene.camera, width, height).rounded_to_f32();
         // A BVH even where `Tracer::new` would not build one (under BVH_FROM primitives).
         let bvh = Tracer {
             scene: &scene,
-            bvh: Some(Bvh::build(&scene)),
+            bvh: Some(Bvh::build(&scene).widen(bvh_width)),
         };
         let brute = Tracer::brute_force(&scene);
         let mismatches = (0..width * height)
@@ -405,7 +411,7 @@ mod tests {
             .count();
         assert_eq!(
             mismatches, 0,
-            "{}: pixels differ from brute force",
+            "{}, {bvh_width}-wide: pixels differ from brute force",
             scene.name
         );
     }
@@ -481,6 +487,17 @@ mod tests {
             assert!(tree.nodes == gpu.bvh_nodes, "{name}: the nodes differ");
             let codes: Vec<u32> = gpu.bvh_prims.iter().map(|p| p.code).collect();
             assert_eq!(tree.prims, codes, "{name}: the leaves differ");
+            for width in [4, 8] {
+                let wide = bvh.clone().widen(width);
+                let gpu = crate::gpu::upload::GpuScene::new(&scene, Some(&wide), 8, 8);
+                let reference = Tracer::with_width(&local, width);
+                let tree = reference.bvh.as_ref().expect("a BVH");
+                assert!(
+                    tree.wide == gpu.bvh_wide_nodes,
+                    "{name}: the {width}-wide nodes differ"
+                );
+                assert!(tree.nodes.is_empty() && gpu.bvh_nodes.is_empty());
+            }
         }
     }
 }
