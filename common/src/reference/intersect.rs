@@ -85,7 +85,8 @@ fn enter_box(min: [f32; 3], max: [f32; 3], o: DVec3, d: DVec3, t_max: f64) -> Op
 /// nearer half's nearest child first, then the rest of the second half near
 /// to far, then the rest of the first.
 fn wide_visits(bvh: &Bvh, index: usize, o: DVec3, d: DVec3, t_max: f64) -> Vec<(u32, f64)> {
-    let (mut near, mut pushed): (Option<(u32, f64)>, Vec<(u32, f64)>) = (None, Vec::new());
+    let mut near: Option<(u32, f64)> = None;
+    let mut pushed: Vec<(u32, f64)> = Vec::new();
     for q in &bvh.wide[index..index + crate::scene::accel::wide::quads(bvh.width)] {
         let mut e: [(u32, f64); 4] = std::array::from_fn(|k| {
             let (min, max) = q.bounds(k);
