@@ -53,8 +53,10 @@ pub struct RenderArgs {
     /// process_overrides), instead of the scene's own variant of defines.
     #[arg(long, conflicts_with = "generic", hide = true)]
     pub specialize: bool,
-    /// Acceleration structure: auto (a BVH for scenes with many primitives), none (test
-    /// every primitive, as the 2018 study did) or bvh.
+    /// Acceleration structure: auto (the two-wide BVH for scenes with many primitives; it
+    /// picks no wider tree yet, as no GPU crossovers are measured), none (test every
+    /// primitive, as the 2018 study did), bvh (two children a node), bvh4 or bvh8 (the same
+    /// tree collapsed to four or eight children a node).
     #[arg(long, value_enum, default_value_t = Accel::Auto)]
     pub accel: Accel,
     /// Laboratory, OpenGL only: load naga's SPIR-V through GL_ARB_gl_spirv instead of naga's GLSL,
@@ -487,7 +489,7 @@ mod tests {
     /// deriving them must keep every spelling.
     #[test]
     fn value_names_keep_their_spelling() {
-        assert_eq!(names::<Accel>(), ["auto", "none", "bvh"]);
+        assert_eq!(names::<Accel>(), ["auto", "none", "bvh", "bvh4", "bvh8"]);
         assert_eq!(names::<RenderPath>(), ["fragment", "compute"]);
         assert_eq!(
             names::<Experiment>(),

@@ -69,6 +69,9 @@ pub struct RunReport {
     pub bvh_nodes: Option<usize>,
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub bvh_sah_cost: Option<f64>,
+    /// The BVH's children per node (2, 4 or 8: `--accel bvh`, `bvh4`, `bvh8`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub bvh_width: Option<u32>,
 }
 
 /// One compiled stage and the figures its driver gives for it, as the driver
@@ -133,6 +136,7 @@ impl RunReport {
                 bvh_ms: None,
                 bvh_nodes: None,
                 bvh_sah_cost: None,
+                bvh_width: None,
             },
         }
     }
@@ -214,6 +218,7 @@ impl RunReportBuilder {
         self.report.bvh_ms = ms;
         self.report.bvh_nodes = bvh.map(|b| b.node_count());
         self.report.bvh_sah_cost = bvh.map(|b| b.sah_cost());
+        self.report.bvh_width = bvh.map(|b| b.width.max(2));
         self
     }
 

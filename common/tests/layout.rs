@@ -201,6 +201,39 @@ fn naga_layout_matches_rust_for_the_bvh() {
     );
 }
 
+/// The wide tree's node (`--accel bvh4`, `bvh8`), which only the wide variants
+/// declare, at the binary node's binding.
+#[test]
+fn naga_layout_matches_rust_for_the_wide_bvh() {
+    for width in [4, 8] {
+        let mut variant = Variant::generic(Default::default());
+        variant.bvh_stack = Some(4);
+        variant.bvh_width = width;
+        let (module, _) = parse(&fragment_source(), naga::ShaderStage::Fragment, &variant).unwrap();
+        let (_, node) = block(&module, binding::BVH_NODES);
+        let (ty, stride) = node.expect("wide BVH nodes are a runtime array");
+        assert_eq!(
+            stride as usize,
+            size_of::<GpuBvhWideNode>(),
+            "BvhWideNode stride"
+        );
+        check(
+            "BvhWideNode",
+            naga_members(&module, ty),
+            rust_offsets!(GpuBvhWideNode {
+                min_x,
+                min_y,
+                min_z,
+                max_x,
+                max_y,
+                max_z,
+                child
+            }),
+            size_of::<GpuBvhWideNode>(),
+        );
+    }
+}
+
 /// The counting variant's per-pixel slots (`--count-rays`), which only it declares.
 #[test]
 fn naga_layout_matches_rust_for_the_ray_counts() {
@@ -244,8 +277,10 @@ fn every_builtin_variant_and_the_generic_one_compile_for_both_apis() {
         }
     }
     let scene = twinray_common::scene::Scene::load("box", &[]).unwrap();
-    let bvh = twinray_common::plan::build_bvh(&scene);
-    variants.push(Variant::for_scene(&scene, Some(&bvh)));
+    for width in [2, 4, 8] {
+        let bvh = twinray_common::plan::build_bvh(&scene).widen(width);
+        variants.push(Variant::for_scene(&scene, Some(&bvh)));
+    }
     for (name, _) in twinray_common::scene::load::BUILTIN_SCENES {
         let scene = twinray_common::scene::Scene::load(name, &[]).unwrap();
         variants.push(Variant::for_scene(&scene, None));

@@ -287,8 +287,10 @@ pub fn render_reference(args: &RenderArgs) -> anyhow::Result<()> {
     let scene = Scene::load(&args.scene, &args.overrides()?)?;
     let (w, h) = (args.size.width, args.size.height);
     let t = Instant::now();
-    // --accel none: brute force, a reference independent of the BVH code.
-    let img = render_with_progress(&scene, w, h, args.accel != Accel::None);
+    // --accel none: brute force, a reference independent of the BVH code;
+    // else through the tree of the width asked for, as the apps trace it.
+    let bvh_width = (args.accel != Accel::None).then(|| args.accel.width());
+    let img = render_with_progress(&scene, w, h, bvh_width);
     let ms = t.elapsed().as_secs_f64() * 1e3;
     if let Some(out) = &args.out {
         img.save_png_for("--out", out)?;
@@ -374,7 +376,7 @@ fn render_with_progress(
     scene: &twinray_common::scene::Scene,
     w: u32,
     h: u32,
-    bvh: bool,
+    bvh_width: Option<u32>,
 ) -> twinray_common::reference::image_io::FloatImage {
     use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
     let rows = AtomicUsize::new(0);
@@ -405,8 +407,14 @@ fn render_with_progress(
                 b.finish_and_clear();
             }
         });
-        let img =
-            twinray_common::reference::render_counting(scene, w, h, &scene.numerics, bvh, &rows);
+        let img = twinray_common::reference::render_counting(
+            scene,
+            w,
+            h,
+            &scene.numerics,
+            bvh_width,
+            &rows,
+        );
         finished.store(true, Ordering::Relaxed);
         img
     })

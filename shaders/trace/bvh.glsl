@@ -177,6 +177,8 @@ bool hit_leaf(inout Hit h, vec3 origin, vec3 dir, TriRay ray, uint first, uint c
 // zero primitive is degenerate and never hit, and is done after two turns.
 // comparison/investigations/mesa-bvh/README.md has the driver's side and a
 // reproducer.
+// A wide tree's variant has bvh_wide.glsl's instead, which shares the rest of this file.
+#ifndef USE_BVH_WIDE
 Hit traverse(vec3 origin, vec3 dir, float t_max, bool any_hit) {
     Hit h;
     h.t = t_max;
@@ -223,4 +225,5 @@ Hit traverse(vec3 origin, vec3 dir, float t_max, bool any_hit) {
     }
     return h;
 }
+#endif
 #endif

@@ -142,9 +142,29 @@ struct BvhNode {
     uint pad1;
 };
 
+#ifdef USE_BVH_WIDE
+// The wide tree's nodes take binding 6 instead (common/src/scene/accel/wide.rs,
+// gpu::layout::GpuBvhWideNode): four children's boxes a struct, one vec4 per
+// corner coordinate; an 8-wide node is two consecutive ones (BVH_WIDE_QUADS).
+// A slot without a child holds NO_CHILD and a box no ray enters.
+struct BvhWideNode {
+    vec4 min_x;
+    vec4 min_y;
+    vec4 min_z;
+    vec4 max_x;
+    vec4 max_y;
+    vec4 max_z;
+    uvec4 child;
+};
+
+layout(std430, set = 0, binding = 6) readonly buffer BvhWideNodes {
+    BvhWideNode nodes[];
+} bvh_wide_buf;
+#else
 layout(std430, set = 0, binding = 6) readonly buffer BvhNodes {
     BvhNode nodes[];
 } bvh_buf;
+#endif
 
 // The leaves' primitives in leaf order, each with only what its test reads
 // (a triangle's corners, or a sphere's centre and radius in b.x), so a leaf

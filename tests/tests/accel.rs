@@ -1,5 +1,5 @@
 //! Model only what a scene needs: the BVH and the per-scene shader variants
-//! change the speed, never the picture. BVH vs brute force, variant vs
+//! change the speed, never the picture. BVH (of each width) vs brute force, variant vs
 //! `--generic` and variant vs `--specialize` agree on ≥ 99.99 % of pixels
 //! within 1/255, in both APIs.
 
@@ -38,6 +38,40 @@ fn bvh_and_brute_force_give_the_same_image() {
             let none: Vec<&str> = set.iter().copied().chain(["--accel", "none"]).collect();
             let bvh: Vec<&str> = set.iter().copied().chain(["--accel", "bvh"]).collect();
             agree(app, scene, size, &none, &bvh, "bvh");
+        }
+    }
+}
+
+/// The 4- and 8-wide trees (`--accel bvh4`, `bvh8`) on both paths: the same
+/// image as brute force, and the variant and the JSON say which width ran.
+#[test]
+fn wide_bvhs_and_brute_force_give_the_same_image() {
+    for app in App::BOTH {
+        for (scene, size, set) in SCENES {
+            let dir = scratch(&format!("accel-wide-{scene}"));
+            let none: Vec<&str> = set.iter().copied().chain(["--accel", "none"]).collect();
+            let (rn, brute) = render(app, scene, size, &none, &dir.join("none.png"));
+            for (accel, width) in [("bvh4", 4), ("bvh8", 8)] {
+                for path in ["fragment", "compute"] {
+                    let args: Vec<&str> = set
+                        .iter()
+                        .copied()
+                        .chain(["--accel", accel, "--path", path])
+                        .collect();
+                    let (r, img) = render(app, scene, size, &args, &dir.join("w.png"));
+                    let what = format!("{app:?} {scene} {accel} {path} ({})", r.variant);
+                    assert!(r.variant.contains(&format!("/wide{width}/bvh")), "{what}");
+                    assert_eq!(r.bvh_width, Some(width), "{what}: the JSON's width");
+                    assert_ne!(r.variant, rn.variant);
+                    let m = compare(&brute, &img).unwrap();
+                    assert!(
+                        m.within_1() >= 0.9999,
+                        "{what}: {:.4}% within 1/255 of brute force",
+                        100.0 * m.within_1()
+                    );
+                }
+            }
+            std::fs::remove_dir_all(dir).ok();
         }
     }
 }

@@ -58,7 +58,9 @@ fn variants() -> Vec<(String, Variant)> {
             .map(|(k, v)| (k.to_string(), v.to_string()))
             .collect();
         let scene = Scene::load("box", &set).unwrap();
-        let bvh = accel.wants_bvh(&scene).then(|| build_bvh(&scene));
+        let bvh = accel
+            .wants_bvh(&scene)
+            .then(|| build_bvh(&scene).widen(accel.width()));
         let args = RenderArgs {
             generic,
             specialize: !generic,
@@ -109,6 +111,23 @@ fn variants() -> Vec<(String, Variant)> {
         "specialize+bvh".into(),
         chosen(d, Accel::Bvh, false, vec![]),
     ));
+    // The wide trees' walk, plain and with the stack experiments.
+    for (label, accel) in [("bvh4", Accel::Bvh4), ("bvh8", Accel::Bvh8)] {
+        v.push((format!("generic+{label}"), chosen(d, accel, true, vec![])));
+        v.push((
+            format!("specialize+{label}"),
+            chosen(d, accel, false, vec![]),
+        ));
+        v.push((
+            format!("generic+{label} unpaired,local stack"),
+            chosen(
+                d,
+                accel,
+                true,
+                vec![Experiment::UnpairedBvhStack, Experiment::LocalBvhStack],
+            ),
+        ));
+    }
     use Experiment::*;
     for experiments in [
         vec![
@@ -137,6 +156,7 @@ fn variants() -> Vec<(String, Variant)> {
     for (label, accel, experiments) in [
         ("generic", Accel::None, vec![]),
         ("generic+bvh", Accel::Bvh, vec![]),
+        ("generic+bvh4", Accel::Bvh4, vec![]),
     ] {
         v.push((
             format!("{label} counting rays"),

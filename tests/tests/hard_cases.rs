@@ -4,10 +4,11 @@
 //! never write NaN/Inf before quantisation, pass the extra checks a case names
 //! (`# check: cracks`, `# check: deterministic`), and the validation layer and
 //! GL debug output stay silent. Each case also runs through `--accel bvh`, on
-//! the compute path and at a 4x4 workgroup: a per-pixel tracer's image must not
-//! depend on the path, the workgroup or a user's choice of acceleration, and
-//! Mesa once lost whole objects with small BVH trees (a one-element stack) and
-//! the wall of far-tiny-sphere where a workgroup is narrower than its vector.
+//! the compute path and at a 4x4 workgroup, and through the 4- and 8-wide
+//! trees: a per-pixel tracer's image must not depend on the path, the
+//! workgroup or a user's choice of acceleration, and Mesa once lost whole
+//! objects with small BVH trees (a one-element stack) and the wall of
+//! far-tiny-sphere where a workgroup is narrower than its vector.
 
 use std::path::Path;
 use twinray_common::reference;
@@ -19,12 +20,15 @@ use twinray_tests::{render, scratch, App};
 const SIZE: &str = "64x64";
 
 /// The runs besides the default that each case must also pass.
-const ALSO: [&[&str]; 5] = [
+const ALSO: [&[&str]; 7] = [
     &["--path", "compute"],
     &["--path", "compute", "--workgroup", "4x4"],
     &["--accel", "bvh"],
     &["--accel", "bvh", "--path", "compute"],
     &["--accel", "bvh", "--path", "compute", "--workgroup", "4x4"],
+    // The wide trees: each width on one path, both paths between them.
+    &["--accel", "bvh4", "--path", "compute", "--workgroup", "4x4"],
+    &["--accel", "bvh8"],
 ];
 
 fn check(name: &str) {

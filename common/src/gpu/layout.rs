@@ -117,6 +117,59 @@ pub struct GpuBvhPrim {
     pub pad1: u32,
 }
 
+/// `BvhWideNode` (std430 array element, binding 6 in the wide variants,
+/// read by shaders/trace/bvh_wide.glsl): four children's boxes, one `vec4`
+/// per corner coordinate, so that the traversal tests all four boxes with
+/// vector arithmetic from seven 16-byte reads. A 4-wide tree has one per
+/// node; an 8-wide tree two consecutive ones per node (children 0-3, then
+/// 4-7), and an interior child reference is the index of its node's first.
+/// A slot without a child holds `child_ref::NO_CHILD` and the box of
+/// `EMPTY_SLOT` corners, which no ray enters.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, Pod, Zeroable, PartialEq)]
+pub struct GpuBvhWideNode {
+    pub min_x: [f32; 4],
+    pub min_y: [f32; 4],
+    pub min_z: [f32; 4],
+    pub max_x: [f32; 4],
+    pub max_y: [f32; 4],
+    pub max_z: [f32; 4],
+    pub child: [u32; 4],
+}
+
+/// Both corners of an empty slot's box: every slab of it lies at infinity,
+/// so its entry distance is +inf or its exit -inf and no ray enters it.
+pub const EMPTY_SLOT: f32 = f32::INFINITY;
+
+impl GpuBvhWideNode {
+    /// A node of empty slots.
+    pub fn empty() -> GpuBvhWideNode {
+        GpuBvhWideNode {
+            min_x: [EMPTY_SLOT; 4],
+            min_y: [EMPTY_SLOT; 4],
+            min_z: [EMPTY_SLOT; 4],
+            max_x: [EMPTY_SLOT; 4],
+            max_y: [EMPTY_SLOT; 4],
+            max_z: [EMPTY_SLOT; 4],
+            child: [child_ref::NO_CHILD; 4],
+        }
+    }
+
+    /// Slot `k`'s box.
+    pub fn bounds(&self, k: usize) -> Bounds {
+        (
+            [self.min_x[k], self.min_y[k], self.min_z[k]],
+            [self.max_x[k], self.max_y[k], self.max_z[k]],
+        )
+    }
+
+    pub fn set(&mut self, k: usize, (min, max): Bounds, child: u32) {
+        [self.min_x[k], self.min_y[k], self.min_z[k]] = min;
+        [self.max_x[k], self.max_y[k], self.max_z[k]] = max;
+        self.child[k] = child;
+    }
+}
+
 /// A child box, as f32 corners rounded outwards.
 pub type Bounds = ([f32; 3], [f32; 3]);
 
@@ -150,6 +203,9 @@ pub mod child_ref {
     pub const MAX_LEAF_COUNT: usize = 1 << LEAF_FIRST_SHIFT;
     /// Primitives a tree can hold: `first` has 29 bits.
     pub const MAX_PRIMS: usize = 1 << (31 - LEAF_FIRST_SHIFT);
+    /// No child: an empty slot of a wide node. A leaf reference no tree has
+    /// (its count bits say 4 and its first primitive is past any limit).
+    pub const NO_CHILD: u32 = u32::MAX;
 
     pub fn leaf(first: u32, count: u32) -> u32 {
         debug_assert!((1..=MAX_LEAF_COUNT as u32).contains(&count) && (first as usize) < MAX_PRIMS);
@@ -223,4 +279,12 @@ pub struct Bvh {
     pub build_ms: f64,
     /// Levels of the tree, leaves included: a single leaf is depth 1.
     pub depth: u32,
+    /// Children per node: 2 (`nodes`), or 4 or 8 (`wide`, with `nodes` empty).
+    pub width: u32,
+    /// The wide tree (`Bvh::widen`, scene/accel/wide.rs): `width / 4`
+    /// `GpuBvhWideNode`s per node, the root first.
+    pub wide: Vec<GpuBvhWideNode>,
+    /// The wide tree's traversal stack: the most entries any path can leave
+    /// pending (every node on it pushes all its children but one).
+    pub wide_stack: u32,
 }

@@ -4,8 +4,8 @@
 //! them, and the checks of those buffers against a device's limits.
 
 use crate::gpu::layout::{
-    binding, Bvh, GpuBvhNode, GpuBvhPrim, GpuFrame, GpuLight, GpuMaterial, GpuSphere, GpuTriangle,
-    PRIM_SPHERE_BIT,
+    binding, Bvh, GpuBvhNode, GpuBvhPrim, GpuBvhWideNode, GpuFrame, GpuLight, GpuMaterial,
+    GpuSphere, GpuTriangle, PRIM_SPHERE_BIT,
 };
 use crate::limits::StorageLimit;
 use crate::scene::camera::{local_origin, RayFrame};
@@ -31,15 +31,16 @@ pub struct GpuScene<'a> {
     triangles: &'a [Triangle],
     /// Subtracted from every triangle vertex (`camera::local_origin`).
     origin: DVec3,
-    /// Empty unless the scene traces through a BVH.
+    /// Empty unless the scene traces through a binary BVH.
     bvh_nodes: &'a [GpuBvhNode],
+    /// A wide tree's nodes, bound where `bvh_nodes` is when there are any.
+    bvh_wide_nodes: &'a [GpuBvhWideNode],
     /// The leaves' primitive codes, expanded into `GpuBvhPrim`s.
     bvh_codes: &'a [u32],
 }
 
-/// How many bytes of a storage buffer an upload converts at once: a multiple
-/// of every element size (96, 64, 48, 32 and 16 bytes), so that a chunk holds
-/// whole elements; 48 MiB keeps a 16-core conversion and a copy busy without
+/// How many bytes of a storage buffer an upload converts at once, at most
+/// (`chunks` rounds it down to whole elements); 48 MiB keeps a 16-core conversion and a copy busy without
 /// a full-size staging copy.
 pub const UPLOAD_CHUNK_BYTES: usize = 48 << 20;
 
@@ -124,6 +125,7 @@ impl<'a> GpuScene<'a> {
             triangles: &world.triangles,
             origin,
             bvh_nodes: bvh.map_or(&[], |b| &b.nodes),
+            bvh_wide_nodes: bvh.map_or(&[], |b| &b.wide),
             bvh_codes: bvh.map_or(&[], |b| &b.prims),
         }
     }
@@ -190,6 +192,9 @@ impl<'a> GpuScene<'a> {
             binding::TRIANGLES => (self.triangles.len(), size_of::<GpuTriangle>()),
             binding::MATERIALS => (self.materials.len(), size_of::<GpuMaterial>()),
             binding::LIGHTS => (self.lights.len(), size_of::<GpuLight>()),
+            binding::BVH_NODES if !self.bvh_wide_nodes.is_empty() => {
+                (self.bvh_wide_nodes.len(), size_of::<GpuBvhWideNode>())
+            }
             binding::BVH_NODES => (self.bvh_nodes.len(), size_of::<GpuBvhNode>()),
             binding::BVH_PRIMS => (self.bvh_codes.len(), size_of::<GpuBvhPrim>()),
             binding::COUNTS => (1, size_of::<[u32; 4]>()),
@@ -215,6 +220,9 @@ impl<'a> GpuScene<'a> {
             binding::MATERIALS => copy_elements(&self.materials, offset, out),
             binding::LIGHTS => copy_elements(&self.lights, offset, out),
             binding::COUNTS => copy_elements(&self.counts, offset, out),
+            binding::BVH_NODES if !self.bvh_wide_nodes.is_empty() => {
+                copy_elements(self.bvh_wide_nodes, offset, out)
+            }
             binding::BVH_NODES => copy_elements(self.bvh_nodes, offset, out),
             binding::TRIANGLES if !self.triangles.is_empty() => {
                 convert(offset, out, |i| self.triangle(i))
@@ -256,8 +264,9 @@ impl<'a> GpuScene<'a> {
     }
 }
 
-/// A multiple of every element size, so that chunks hold whole elements.
-const UPLOAD_CHUNK_ALIGN: usize = 192;
+/// A multiple of every element size (96, 64, 48, 32, 16 and a wide node's
+/// 112 bytes), so that chunks hold whole elements.
+const UPLOAD_CHUNK_ALIGN: usize = 1344;
 
 /// Bytes `offset..` of `items` (one zeroed element when empty) into `out`.
 fn copy_elements<T: Pod>(items: &[T], offset: usize, out: &mut [u8]) {

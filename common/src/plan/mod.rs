@@ -162,12 +162,13 @@ impl Planner {
         });
         let (bvh, bvh_ms) = if self.args.accel.wants_bvh(&scene) {
             let t0 = Instant::now();
-            let bvh = build_bvh(&scene);
+            let bvh = build_bvh(&scene).widen(self.args.accel.width());
             let ms = t0.elapsed().as_secs_f64() * 1e3;
             explain::numbered(0, "BVH (twinray-common)", || {
                 format!(
-                    "{} nodes over {} primitives, {} deep, SAH cost {:.3}; built in {ms:.1} ms ({:.1} M primitives/s)",
+                    "{} {}-wide nodes over {} primitives, {} deep, SAH cost {:.3}; built in {ms:.1} ms ({:.1} M primitives/s)",
                     bvh.node_count(),
+                    bvh.width,
                     scene.primitive_count(),
                     bvh.depth,
                     bvh.sah_cost(),

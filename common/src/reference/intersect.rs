@@ -22,7 +22,13 @@ const BVH_FROM: usize = MAX_LEAF + 1;
 impl<'a> Tracer<'a> {
     /// `scene` as the reference traces it (already rounded to f32, see `render_with`).
     pub fn new(scene: &'a Scene) -> Tracer<'a> {
-        let bvh = (scene.primitive_count() >= BVH_FROM).then(|| Bvh::build(scene));
+        Tracer::with_width(scene, 2)
+    }
+
+    /// `new`, through the BVH collapsed to `width` children a node, as the
+    /// GPU's `--accel bvh4` or `bvh8` traces it.
+    pub fn with_width(scene: &'a Scene, width: u32) -> Tracer<'a> {
+        let bvh = (scene.primitive_count() >= BVH_FROM).then(|| Bvh::build(scene).widen(width));
         Tracer { scene, bvh }
     }
 
@@ -73,6 +79,39 @@ fn enter_box(min: [f32; 3], max: [f32; 3], o: DVec3, d: DVec3, t_max: f64) -> Op
     Some(t0)
 }
 
+/// The children of a node that the ray enters, in the order the shader
+/// (trace/bvh_wide.glsl) visits them: per `GpuBvhWideNode`, sorted by entry
+/// distance with the shader's network; of an 8-wide node's two halves, the
+/// nearer half's nearest child first, then the rest of the second half near
+/// to far, then the rest of the first.
+fn wide_visits(bvh: &Bvh, index: usize, o: DVec3, d: DVec3, t_max: f64) -> Vec<(u32, f64)> {
+    let mut near: Option<(u32, f64)> = None;
+    let mut pushed: Vec<(u32, f64)> = Vec::new();
+    for q in &bvh.wide[index..index + crate::scene::accel::wide::quads(bvh.width)] {
+        let mut e: [(u32, f64); 4] = std::array::from_fn(|k| {
+            let (min, max) = q.bounds(k);
+            let t = (q.child[k] != child_ref::NO_CHILD)
+                .then(|| enter_box(min, max, o, d, t_max))
+                .flatten();
+            (q.child[k], t.unwrap_or(f64::INFINITY))
+        });
+        for (a, b) in [(0, 1), (2, 3), (0, 2), (1, 3), (1, 2)] {
+            if e[b].1 < e[a].1 {
+                e.swap(a, b);
+            }
+        }
+        // Pushed far to near, so that they pop near first.
+        pushed.extend(e[1..].iter().rev().filter(|c| c.1.is_finite()));
+        match near {
+            Some(n) if e[0].1 >= n.1 => pushed.extend(e[0].1.is_finite().then_some(e[0])),
+            _ if e[0].1.is_finite() => pushed.extend(near.replace(e[0])),
+            _ => {}
+        }
+    }
+    pushed.extend(near);
+    pushed
+}
+
 /// Visits the BVH's leaves along a ray, near child first, calling `leaf` with
 /// each leaf's primitive codes and the current bound; `leaf` returns the new
 /// bound (or None to stop: a shadow ray's first hit).
@@ -83,7 +122,7 @@ fn walk(
     mut t_max: f64,
     mut leaf: impl FnMut(&[u32], f64) -> Option<f64>,
 ) {
-    if bvh.nodes.is_empty() {
+    if bvh.nodes.is_empty() && bvh.wide.is_empty() {
         return;
     }
     // (child reference, entry distance); the root is interior node 0.
@@ -98,6 +137,10 @@ fn walk(
                 Some(t) => t_max = t,
                 None => return,
             }
+            continue;
+        }
+        if bvh.width > 2 {
+            stack.extend(wide_visits(bvh, child as usize, o, d, t_max));
             continue;
         }
         let node = &bvh.nodes[child as usize];

@@ -37,27 +37,33 @@ pub fn render(scene: &Scene, width: u32, height: u32) -> FloatImage {
 
 /// Renders `scene` with the given numerical choices instead of the scene's.
 pub fn render_with(scene: &Scene, width: u32, height: u32, numerics: &Numerics) -> FloatImage {
-    render_counting(scene, width, height, numerics, true, &AtomicUsize::new(0))
+    render_counting(
+        scene,
+        width,
+        height,
+        numerics,
+        Some(2),
+        &AtomicUsize::new(0),
+    )
 }
 
-/// `render_with`, through the BVH or (`bvh` false: `--accel none`) testing
-/// every primitive, adding 1 to `rows_done` as each row finishes (for a progress bar).
+/// `render_with`, through the BVH of `bvh_width` children a node or (None:
+/// `--accel none`) testing every primitive, adding 1 to `rows_done` as each row finishes (for a progress bar).
 pub fn render_counting(
     scene: &Scene,
     width: u32,
     height: u32,
     numerics: &Numerics,
-    bvh: bool,
+    bvh_width: Option<u32>,
     rows_done: &AtomicUsize,
 ) -> FloatImage {
     // The GPU's frame: positions relative to the local origin, then rounded to f32.
     let frame = RayFrame::local(scene, &scene.camera, width, height).rounded_to_f32();
     let mut scene = in_local_frame(scene).rounded_to_f32();
     scene.numerics = *numerics;
-    let tracer = if bvh {
-        Tracer::new(&scene)
-    } else {
-        Tracer::brute_force(&scene)
+    let tracer = match bvh_width {
+        Some(width) => Tracer::with_width(&scene, width),
+        None => Tracer::brute_force(&scene),
     };
     let w = width as usize;
     let mut pixels = vec![[0f32; 3]; crate::limits::pixel_count(width, height)];
@@ -377,14 +383,20 @@ mod tests {
     use super::*;
     use crate::gpu::layout::Bvh;
 
-    /// Every pixel through the BVH equals brute force, bit for bit.
+    /// Every pixel through the BVH, of each width, equals brute force, bit for bit.
     fn same_as_brute_force(scene: &Scene, width: u32, height: u32) {
+        for w in crate::scene::accel::wide::WIDTHS {
+            same_as_brute_force_through(scene, width, height, w);
+        }
+    }
+
+    fn same_as_brute_force_through(scene: &Scene, width: u32, height: u32, bvh_width: u32) {
         let scene = scene.rounded_to_f32();
         let frame = RayFrame::new(&scene.camera, width, height).rounded_to_f32();
         // A BVH even where `Tracer::new` would not build one (under BVH_FROM primitives).
         let bvh = Tracer {
             scene: &scene,
-            bvh: Some(Bvh::build(&scene)),
+            bvh: Some(Bvh::build(&scene).widen(bvh_width)),
         };
         let brute = Tracer::brute_force(&scene);
         let mismatches = (0..width * height)
@@ -399,7 +411,7 @@ mod tests {
             .count();
         assert_eq!(
             mismatches, 0,
-            "{}: pixels differ from brute force",
+            "{}, {bvh_width}-wide: pixels differ from brute force",
             scene.name
         );
     }
@@ -480,6 +492,17 @@ mod tests {
             );
             let codes: Vec<u32> = prims.iter().map(|p| p.code).collect();
             assert_eq!(tree.prims, codes, "{name}: the leaves differ");
+            for width in [4, 8] {
+                let wide = bvh.clone().widen(width);
+                let gpu = crate::gpu::upload::GpuScene::new(&scene, Some(&wide), 8, 8);
+                let reference = Tracer::with_width(&local, width);
+                let tree = reference.bvh.as_ref().expect("a BVH");
+                assert!(
+                    tree.wide == gpu.bvh_wide_nodes,
+                    "{name}: the {width}-wide nodes differ"
+                );
+                assert!(tree.nodes.is_empty() && gpu.bvh_nodes.is_empty());
+            }
         }
     }
 }

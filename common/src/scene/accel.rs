@@ -1,9 +1,11 @@
 //! Acceleration: `--accel` and the scene's choice of a BVH; `build` makes the
 //! bounding volume hierarchy itself (`gpu::layout::Bvh`), which
-//! shaders/trace/bvh.glsl walks, and `split` its split of one node.
+//! shaders/trace/bvh.glsl walks, `split` its split of one node, and `wide`
+//! collapses it into the 4- and 8-wide trees that shaders/trace/bvh_wide.glsl walks.
 
 mod build;
 mod split;
+pub mod wide;
 
 pub use split::MAX_LEAF;
 
@@ -14,6 +16,8 @@ pub enum Accel {
     Auto,
     None,
     Bvh,
+    Bvh4,
+    Bvh8,
 }
 
 /// `--accel auto` builds a BVH for scenes with at least this many primitives.
@@ -27,8 +31,18 @@ impl Accel {
     pub fn wants_bvh(self, scene: &Scene) -> bool {
         match self {
             Accel::None => false,
-            Accel::Bvh => scene.primitive_count() > 0,
+            Accel::Bvh | Accel::Bvh4 | Accel::Bvh8 => scene.primitive_count() > 0,
             Accel::Auto => scene.primitive_count() >= AUTO_BVH_MIN_PRIMITIVES,
+        }
+    }
+
+    /// Children per node of the BVH this choice traces through (`auto`
+    /// keeps the binary tree until measured crossovers say otherwise).
+    pub fn width(self) -> u32 {
+        match self {
+            Accel::Bvh4 => 4,
+            Accel::Bvh8 => 8,
+            Accel::Auto | Accel::None | Accel::Bvh => 2,
         }
     }
 }

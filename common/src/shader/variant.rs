@@ -26,6 +26,8 @@ pub struct Variant {
     pub counts: Counts,
     /// The BVH traversal stack's entries, where the variant traces through a BVH.
     pub bvh_stack: Option<u32>,
+    /// The BVH's children per node: 2 (trace/bvh.glsl), 4 or 8 (trace/bvh_wide.glsl).
+    pub bvh_width: u32,
     /// Offset, triangle and sphere tests; the reference can take the same.
     pub numerics: Numerics,
     /// The entry point: the fullscreen pair, or compute with its workgroup.
@@ -201,6 +203,7 @@ impl Variant {
             ray_stack,
             counts: Counts::Uniform,
             bvh_stack: None,
+            bvh_width: 2,
             numerics,
             entry: Entry::Fragment,
             count_rays: false,
@@ -244,6 +247,7 @@ impl Variant {
             lights: scene.lights.len() as u32,
         };
         self.bvh_stack = bvh.map(Bvh::stack_entries);
+        self.bvh_width = bvh.map_or(2, |b| b.width.max(2));
         self
     }
 
@@ -317,6 +321,7 @@ impl Variant {
         let k = self.knobs;
         let bvh = self.bvh_stack.is_some();
         flag(bvh, "USE_BVH");
+        flag(bvh && self.bvh_width > 2, "USE_BVH_WIDE");
         flag(bvh && k.unpaired_bvh_stack, "BVH_STACK_UNPAIRED");
         flag(bvh && k.local_bvh_stack, "BVH_STACK_LOCAL");
         flag(k.split_ray_stack, "RAY_STACK_SPLIT");
@@ -330,6 +335,10 @@ impl Variant {
         d.insert("STACK_SIZE".into(), self.ray_stack.to_string());
         if let Some(n) = self.bvh_stack {
             d.insert("BVH_STACK".into(), n.to_string());
+            if self.bvh_width > 2 {
+                let quads = crate::scene::accel::wide::quads(self.bvh_width);
+                d.insert("BVH_WIDE_QUADS".into(), quads.to_string());
+            }
         }
         if let Counts::Baked {
             spheres,
@@ -386,7 +395,8 @@ impl Variant {
 
     /// A short label such as `spheres+triangles+mirror+glass/stack6/normal-scaled/watertight/stable`
     /// (with `/bvhN` when the variant traces through a BVH with an N-entry
-    /// stack, `/spec` when specialised, then any experiment's name).
+    /// stack, preceded by `/wide4` or `/wide8` for a wide one, `/spec` when
+    /// specialised, then any experiment's name).
     pub fn label(&self) -> String {
         let f = match self.form {
             Form::Generic => ALL_FEATURES,
@@ -405,7 +415,11 @@ impl Variant {
         if parts.is_empty() {
             parts.push("background");
         }
-        let bvh = self.bvh_stack.map_or(String::new(), |n| format!("/bvh{n}"));
+        let bvh = match (self.bvh_stack, self.bvh_width) {
+            (None, _) => String::new(),
+            (Some(n), 2) => format!("/bvh{n}"),
+            (Some(n), w) => format!("/wide{w}/bvh{n}"),
+        };
         let spec = if self.form == Form::Specialized {
             "/spec"
         } else {

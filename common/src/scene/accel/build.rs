@@ -97,7 +97,10 @@ impl Bvh {
     pub fn build_at(scene: &Scene, origin: DVec3) -> Bvh {
         let start = std::time::Instant::now();
         let mut refs = prim_refs(scene, origin);
-        let mut bvh = Bvh::default();
+        let mut bvh = Bvh {
+            width: 2,
+            ..Bvh::default()
+        };
         if !refs.is_empty() {
             let (bounds, centroids) = refs.par_chunks(BIN_CHUNK).map(boxes).reduce(
                 || (Box3::EMPTY, Box3::EMPTY),
@@ -136,13 +139,19 @@ impl Bvh {
     /// The traversal stack this tree needs (the shader's BVH_STACK): the
     /// traversal pushes at most one far child per interior level of the path
     /// it is on, so depth - 1 entries always suffice. At least 1, as GLSL has
-    /// no empty arrays.
+    /// no empty arrays. A wide tree's is `wide_stack`.
     pub fn stack_entries(&self) -> u32 {
+        if self.width > 2 {
+            return self.wide_stack.max(1);
+        }
         self.depth.saturating_sub(1).max(1)
     }
 
     /// Interior nodes (the GPU's node array; leaves live in their parents' child references).
     pub fn node_count(&self) -> usize {
+        if self.width > 2 {
+            return self.wide.len() / super::wide::quads(self.width);
+        }
         self.nodes.len()
     }
 
@@ -152,6 +161,9 @@ impl Bvh {
     /// area over the root's). Lower is a better tree for the same scene;
     /// comparable between builders because it reads only the flattened output.
     pub fn sah_cost(&self) -> f64 {
+        if self.width > 2 {
+            return self.wide_sah_cost();
+        }
         let Some(root) = self.nodes.first() else {
             return 0.0;
         };
@@ -183,6 +195,7 @@ impl Bvh {
     /// Bytes on the GPU: the nodes plus the leaves' primitives (`GpuBvhPrim`).
     pub fn bytes(&self) -> usize {
         std::mem::size_of_val(self.nodes.as_slice())
+            + std::mem::size_of_val(self.wide.as_slice())
             + self.prims.len() * std::mem::size_of::<GpuBvhPrim>()
     }
 }

@@ -124,3 +124,119 @@ fn the_teapot_tree_costs_no_more_than_before() {
     let b = Bvh::build(&Scene::load("teapot", &[]).unwrap());
     assert!(b.sah_cost() < 7.6, "SAH {}", b.sah_cost());
 }
+
+/// The wide tree of `scene`: every primitive in exactly one leaf, every child
+/// box inside its parent's and around its primitives, the leaves those of the
+/// binary tree, the depth no more than the binary tree's, and the stack bound
+/// at least what any path leaves pending (each node pushes all of its
+/// children but one).
+fn check_wide(scene: &Scene, width: u32) -> Bvh {
+    let binary = check(scene);
+    let b = Bvh::build(scene).widen(width);
+    assert_eq!((b.width, b.nodes.len()), (width, 0));
+    assert_eq!(
+        b.prims, binary.prims,
+        "the leaves' primitives are the binary tree's"
+    );
+    let quads = super::wide::quads(width);
+    assert_eq!(b.wide.len() % quads, 0);
+    let mut leaves = Vec::new();
+    let mut reached = vec![false; b.wide.len() / quads];
+    // (node, its box in its parent, depth, entries pending above it)
+    let mut todo = vec![(0usize, None::<Bounds>, 1u32, 0u32)];
+    let (mut depth, mut stack) = (1, 0);
+    while let Some((i, outer, d, pending)) = todo.pop() {
+        assert_eq!(i % quads, 0, "a child points into the middle of a node");
+        assert!(!reached[i / quads], "node {i} is reached twice");
+        reached[i / quads] = true;
+        let kids: Vec<_> = b.wide_children(i).collect();
+        assert!(
+            (1..=width as usize).contains(&kids.len()),
+            "node {i}: {} children",
+            kids.len()
+        );
+        // Occupied slots first: the shader's order needs no gaps.
+        let slots: Vec<u32> = b.wide[i..i + quads].iter().flat_map(|q| q.child).collect();
+        assert!(slots[kids.len()..]
+            .iter()
+            .all(|&c| c == child_ref::NO_CHILD));
+        let here = pending + kids.len() as u32 - 1;
+        stack = stack.max(here);
+        for ((lo, hi), child) in kids {
+            if let Some((olo, ohi)) = outer {
+                for a in 0..3 {
+                    assert!(
+                        lo[a] >= olo[a] && hi[a] <= ohi[a],
+                        "a child of node {i} lies outside it"
+                    );
+                }
+            }
+            match child_ref::as_leaf(child) {
+                Some((first, count)) => {
+                    depth = depth.max(d + 1);
+                    leaves.push((first, count, (lo, hi)));
+                }
+                None => {
+                    assert!(child as usize > i, "node {i} points back to {child}");
+                    todo.push((child as usize, Some((lo, hi)), d + 1, here));
+                }
+            }
+        }
+    }
+    assert!(reached.iter().all(|&r| r), "every node is reached");
+    // Every primitive exactly once, in a leaf whose box holds it (the binary
+    // tree's leaf boxes, checked there against the primitives).
+    leaves.sort_unstable_by_key(|l| l.0);
+    let mut next = 0;
+    for (first, count, _) in &leaves {
+        assert_eq!(
+            *first, next,
+            "the leaves cover the primitives once each, in order"
+        );
+        next += count;
+    }
+    assert_eq!(next, b.prims.len());
+    assert_eq!(depth, b.depth, "the depth it reports");
+    // (A binary tree of one leaf counts 1, its root aside.)
+    assert!(
+        b.depth <= binary.depth.max(2),
+        "wide {} deeper than binary {}",
+        b.depth,
+        binary.depth
+    );
+    assert!(
+        stack <= b.stack_entries(),
+        "a path leaves {stack} pending, the stack holds {}",
+        b.stack_entries()
+    );
+    assert!(b.stack_entries() <= (width - 1) * (b.depth - 1).max(1));
+    b
+}
+
+#[test]
+fn wide_trees_hold_every_primitive_once_inside_their_boxes() {
+    let many = Scene::load("spherelist", &[("extra_spheres".into(), "1000".into())]).unwrap();
+    let mut one = Scene::load("spherelist", &[]).unwrap();
+    one.spheres.truncate(1);
+    one.triangles.clear();
+    for width in [4, 8] {
+        for name in ["box", "teapot"] {
+            check_wide(&Scene::load(name, &[]).unwrap(), width);
+        }
+        check_wide(&many, width);
+        // One primitive: a root with its one leaf.
+        let b = check_wide(&one, width);
+        assert_eq!((b.node_count(), b.depth, b.stack_entries()), (1, 2, 1));
+    }
+    // Wider nodes: fewer of them and a shallower tree than the binary one.
+    let teapot = Scene::load("teapot", &[]).unwrap();
+    let [b2, b4, b8] = [2, 4, 8].map(|w| Bvh::build(&teapot).widen(w));
+    assert!(b4.node_count() * 3 / 2 < b2.node_count() && b8.node_count() < b4.node_count());
+    assert!(
+        b4.depth < b2.depth && b8.depth < b4.depth,
+        "{} {} {}",
+        b2.depth,
+        b4.depth,
+        b8.depth
+    );
+}
