@@ -32,6 +32,51 @@ void wide_order(inout float ta, inout uint ca, inout float tb, inout uint cb) {
 #define WIDE_PUSH(c, t) { BVH_PUSH(sp, uvec2((c), floatBitsToUint(t))); sp += 1u; }
 #endif
 
+// One step down from wide node `child`: on to its nearest entered child, the
+// others pushed; NO_CHILD (which has LEAF_BIT set) if the ray enters none. An
+// empty slot's box is never entered, and its NO_CHILD is checked as well, so
+// that no driver's handling of infinity matters. A macro, like bvh.glsl's
+// BVH_STEP, so that the root's step (see `traverse`) is the loop's own code.
+#define WIDE_STEP()                                                                    \
+    {                                                                                  \
+        uint near = NO_CHILD;                                                          \
+        float near_t = WIDE_MISS;                                                      \
+        for (uint q = 0u; q < uint(BVH_WIDE_QUADS); q++) {                             \
+            BvhWideNode node = bvh_wide_buf.nodes[child + q];                          \
+            vec4 x0 = (node.min_x - origin.x) * inv_dir.x;                             \
+            vec4 x1 = (node.max_x - origin.x) * inv_dir.x;                             \
+            vec4 y0 = (node.min_y - origin.y) * inv_dir.y;                             \
+            vec4 y1 = (node.max_y - origin.y) * inv_dir.y;                             \
+            vec4 z0 = (node.min_z - origin.z) * inv_dir.z;                             \
+            vec4 z1 = (node.max_z - origin.z) * inv_dir.z;                             \
+            vec4 enter = max(max(min(x0, x1), min(y0, y1)), max(min(z0, z1), vec4(0.0))); \
+            vec4 leave = min(min(max(x0, x1), max(y0, y1)), min(max(z0, z1), vec4(h.t))); \
+            uvec4 c = node.child;                                                      \
+            float t0 = (enter.x <= leave.x && c.x != NO_CHILD) ? enter.x : WIDE_MISS;  \
+            float t1 = (enter.y <= leave.y && c.y != NO_CHILD) ? enter.y : WIDE_MISS;  \
+            float t2 = (enter.z <= leave.z && c.z != NO_CHILD) ? enter.z : WIDE_MISS;  \
+            float t3 = (enter.w <= leave.w && c.w != NO_CHILD) ? enter.w : WIDE_MISS;  \
+            uint c0 = c.x;                                                             \
+            uint c1 = c.y;                                                             \
+            uint c2 = c.z;                                                             \
+            uint c3 = c.w;                                                             \
+            wide_order(t0, c0, t1, c1);                                                \
+            wide_order(t2, c2, t3, c3);                                                \
+            wide_order(t0, c0, t2, c2);                                                \
+            wide_order(t1, c1, t3, c3);                                                \
+            wide_order(t1, c1, t2, c2);                                                \
+            if (t3 < WIDE_MISS) WIDE_PUSH(c3, t3)                                      \
+            if (t2 < WIDE_MISS) WIDE_PUSH(c2, t2)                                      \
+            if (t1 < WIDE_MISS) WIDE_PUSH(c1, t1)                                      \
+            if (t0 < near_t) {                                                         \
+                if (near != NO_CHILD) WIDE_PUSH(near, near_t)                          \
+                near = c0;                                                             \
+                near_t = t0;                                                           \
+            } else if (t0 < WIDE_MISS) WIDE_PUSH(c0, t0)                               \
+        }                                                                              \
+        child = near;                                                                  \
+    }
+
 // bvh.glsl's walk for a wide node: the four boxes of a BvhWideNode are tested
 // at once, their entry distances sorted (five compare-and-swaps), the nearest
 // child taken next and the others pushed far to near, so that they pop near
@@ -52,48 +97,13 @@ Hit traverse(vec3 origin, vec3 dir, float t_max, bool any_hit) {
     BVH_STACK_DECLARE;
 #endif
     uint sp = 0u;
+    // The root's step comes first, and the descent below it goes on only
+    // through references > 0, as in bvh.glsl's `traverse` (why: there).
     uint child = 0u;
+    WIDE_STEP();
     while (true) {
-        while ((child & LEAF_BIT) == 0u) {
-            uint near = NO_CHILD;
-            float near_t = WIDE_MISS;
-            for (uint q = 0u; q < uint(BVH_WIDE_QUADS); q++) {
-                BvhWideNode node = bvh_wide_buf.nodes[child + q];
-                vec4 x0 = (node.min_x - origin.x) * inv_dir.x;
-                vec4 x1 = (node.max_x - origin.x) * inv_dir.x;
-                vec4 y0 = (node.min_y - origin.y) * inv_dir.y;
-                vec4 y1 = (node.max_y - origin.y) * inv_dir.y;
-                vec4 z0 = (node.min_z - origin.z) * inv_dir.z;
-                vec4 z1 = (node.max_z - origin.z) * inv_dir.z;
-                vec4 enter = max(max(min(x0, x1), min(y0, y1)), max(min(z0, z1), vec4(0.0)));
-                vec4 leave = min(min(max(x0, x1), max(y0, y1)), min(max(z0, z1), vec4(h.t)));
-                // An empty slot's box is never entered; its NO_CHILD is checked
-                // as well, so that no driver's handling of infinity matters.
-                uvec4 c = node.child;
-                float t0 = (enter.x <= leave.x && c.x != NO_CHILD) ? enter.x : WIDE_MISS;
-                float t1 = (enter.y <= leave.y && c.y != NO_CHILD) ? enter.y : WIDE_MISS;
-                float t2 = (enter.z <= leave.z && c.z != NO_CHILD) ? enter.z : WIDE_MISS;
-                float t3 = (enter.w <= leave.w && c.w != NO_CHILD) ? enter.w : WIDE_MISS;
-                uint c0 = c.x;
-                uint c1 = c.y;
-                uint c2 = c.z;
-                uint c3 = c.w;
-                wide_order(t0, c0, t1, c1);
-                wide_order(t2, c2, t3, c3);
-                wide_order(t0, c0, t2, c2);
-                wide_order(t1, c1, t3, c3);
-                wide_order(t1, c1, t2, c2);
-                if (t3 < WIDE_MISS) WIDE_PUSH(c3, t3)
-                if (t2 < WIDE_MISS) WIDE_PUSH(c2, t2)
-                if (t1 < WIDE_MISS) WIDE_PUSH(c1, t1)
-                if (t0 < near_t) {
-                    if (near != NO_CHILD) WIDE_PUSH(near, near_t)
-                    near = c0;
-                    near_t = t0;
-                } else if (t0 < WIDE_MISS) WIDE_PUSH(c0, t0)
-            }
-            // NO_CHILD (nothing entered) has LEAF_BIT set and ends the descent.
-            child = near;
+        while (int(child) > 0) {
+            WIDE_STEP();
         }
         if (child != NO_CHILD) {
             uint first = (child & ~LEAF_BIT) >> LEAF_FIRST_SHIFT;
