@@ -26,23 +26,21 @@ fn main() -> anyhow::Result<()> {
         .split(',')
         .map(|k| k.parse())
         .collect::<Result<_, _>>()?;
-    let ops: Vec<Option<Op>> = match ops {
-        "all" => Op::ALL.iter().copied().map(Some).collect(),
-        list => list
-            .split(',')
-            .map(|n| {
-                if n == "every" {
-                    return Ok(None);
-                }
+    let mut list: Vec<Option<Op>> = Vec::new();
+    for n in ops.split(',') {
+        match n {
+            "all" => list.extend(Op::ALL.iter().copied().map(Some)),
+            "every" => list.push(None),
+            _ => list.push(Some(
                 Op::ALL
                     .iter()
                     .find(|o| o.name() == n)
                     .copied()
-                    .map(Some)
-                    .ok_or_else(|| anyhow::anyhow!("no operation named {n}"))
-            })
-            .collect::<anyhow::Result<_>>()?,
-    };
+                    .ok_or_else(|| anyhow::anyhow!("no operation named {n}"))?,
+            )),
+        }
+    }
+    let ops = list;
     println!("| scene | size | operation | k (ULPs) | pixels > 8/255 vs f64 truth | > 8/255 vs unperturbed | largest vs truth |");
     println!("|---|---|---|---:|---:|---:|---:|");
     for spec in scenes.split(',') {
@@ -52,7 +50,11 @@ fn main() -> anyhow::Result<()> {
             .ok_or_else(|| anyhow::anyhow!("size {size} is not WxH"))?;
         let (w, h): (u32, u32) = (w.parse()?, h.parse()?);
         let scene = Scene::load(name, &[])?;
-        let short = name.rsplit('/').next().unwrap_or(name).trim_end_matches(".toml");
+        let short = name
+            .rsplit('/')
+            .next()
+            .unwrap_or(name)
+            .trim_end_matches(".toml");
         clear();
         let truth = render_truth(&scene, w, h).to_rgb8();
         let base = render(&scene, w, h).to_rgb8();
@@ -90,7 +92,9 @@ fn main() -> anyhow::Result<()> {
                             m.0 = [255, 0, 255];
                         }
                     }
-                    mask.save(std::path::Path::new(&dir).join(format!("{short}-{label}-{k}-mask.png")))?;
+                    mask.save(
+                        std::path::Path::new(&dir).join(format!("{short}-{label}-{k}-mask.png")),
+                    )?;
                 }
             }
         }

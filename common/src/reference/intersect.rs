@@ -3,7 +3,7 @@
 //! (the tracer's intersection and traversal, step by step).
 
 use crate::gpu::layout::{child_ref, Bvh, PRIM_SPHERE_BIT};
-use crate::reference::perturb::{at, scaled, Op};
+use crate::reference::perturb::{at, Op};
 use crate::scene::accel::MAX_LEAF;
 use crate::scene::numerics::{SphereTest, TriangleTest};
 use crate::scene::{Scene, Sphere, Triangle};
@@ -137,9 +137,12 @@ fn hit_sphere(
             ((-b - sq) / (2.0 * a), (-b + sq) / (2.0 * a))
         }
         SphereTest::Stable => {
-            let d = scaled(Op::SphereDirLength, d);
+            // The shader's: the foot of the perpendicular at b/|d|^2, with
+            // 1/|d|^2 as 2 - |d|^2 (a direction not quite unit must not move
+            // the discriminant by 2 e b^2).
+            let inv_a = 2.0 - d.dot(d);
             let b = at(Op::SphereB, f.dot(d));
-            let l = f - b * d;
+            let l = f - (b * inv_a) * d;
             let disc = r2 - at(Op::SphereDist2, l.dot(l));
             if disc.is_nan() || disc < 0.0 {
                 return None;

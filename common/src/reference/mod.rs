@@ -22,7 +22,7 @@ pub mod perturb;
 use crate::rays::RayKinds;
 use crate::reference::image_io::FloatImage;
 use crate::reference::intersect::{closest_hit, occluded, Hit, Tracer};
-use crate::reference::perturb::{at, at3, Op};
+use crate::reference::perturb::{at, at3, scaled, Op};
 use crate::scene::camera::{in_local_frame, RayFrame};
 use crate::scene::numerics::{Numerics, Offset, SphereTest, TriangleTest};
 use crate::scene::Scene;
@@ -65,7 +65,10 @@ pub fn render_counting(
     let mut pixels = vec![[0f32; 3]; crate::limits::pixel_count(width, height)];
     pixels.par_chunks_mut(w).enumerate().for_each(|(y, row)| {
         for (x, px) in row.iter_mut().enumerate() {
-            let dir = at3(Op::PrimaryDir, frame.dir(x as f64, y as f64));
+            let dir = scaled(
+                Op::DirLength,
+                at3(Op::PrimaryDir, frame.dir(x as f64, y as f64)),
+            );
             let c = tracer.trace(frame.eye, dir);
             *px = [c.x as f32, c.y as f32, c.z as f32];
         }
@@ -246,6 +249,23 @@ fn surface(scene: &Scene, hit: Hit, o: DVec3, mut p: DVec3) -> (DVec3, DVec3, DV
     }
 }
 
+/// The shader's Newton step on a sphere hit's t (|o + t d - c|^2 = r^2),
+/// which takes the test's approximate division and square root out of the
+/// hit point; kept only where the step is below 2^-10 radii, as there.
+fn refine(scene: &Scene, hit: &Hit, o: DVec3, d: DVec3, t: f64) -> f64 {
+    let Hit::Sphere(i) = *hit else {
+        return t;
+    };
+    let s = &scene.spheres[i];
+    let rel = (o - s.center) + t * d;
+    let step = (rel.dot(rel) - s.radius * s.radius) / (2.0 * rel.dot(d));
+    if step.abs() < s.radius / 1024.0 {
+        t - step
+    } else {
+        t
+    }
+}
+
 /// One pixel: the shader's `trace`, with its stack capacity of max_depth + 1,
 /// adding its rays to `kinds` where the counting variant counts them and
 /// telling `split` how each glass or mirror hit divides its ray's weight.
@@ -272,6 +292,7 @@ fn trace_with(
             color += w * scene.background;
             continue;
         };
+        let t = refine(scene, &hit, o, d, t);
         let (p, mut ng, mut ns, mat, scale) = surface(scene, hit, o, at3(Op::HitPoint, o + t * d));
         let inside = d.dot(ng) > 0.0;
         if inside {
@@ -287,7 +308,7 @@ fn trace_with(
             let p_out = spawn_point(scene, p, ng, (light.position - p).normalize(), scale);
             let to_light = light.position - p_out;
             let dist = at(Op::ShadowDir, to_light.length());
-            let l = at3(Op::ShadowDir, to_light / dist);
+            let l = scaled(Op::DirLength, at3(Op::ShadowDir, to_light / dist));
             let ndl = ns.dot(l);
             let faces = ndl > 0.0 && ng.dot(l) > 0.0;
             kinds.shadow += u64::from(faces);
@@ -319,7 +340,8 @@ fn trace_with(
                     let wt = w * kt * (1.0 - f);
                     refracted = wt;
                     if wt >= scene.min_weight && stack.len() < capacity {
-                        let dir = at3(Op::RefractDir, (eta * d + (eta * cos_i - cos_t) * nt).normalize());
+                        let dir = (eta * d + (eta * cos_i - cos_t) * nt).normalize();
+                        let dir = scaled(Op::DirLength, at3(Op::RefractDir, dir));
                         stack.push(Ray {
                             o: spawn_point(scene, p, -ng, dir, scale),
                             d: dir,
@@ -339,7 +361,7 @@ fn trace_with(
                 });
             }
             if wr >= scene.min_weight && stack.len() < capacity {
-                let dir = at3(Op::ReflectDir, reflect(d, ns));
+                let dir = scaled(Op::DirLength, at3(Op::ReflectDir, reflect(d, ns)));
                 stack.push(Ray {
                     o: spawn_point(scene, p, ng, dir, scale),
                     d: dir,

@@ -11,10 +11,11 @@
 pub enum Op {
     /// The primary ray's direction (`primary_dir`), each component.
     PrimaryDir,
-    /// The length of the direction the sphere test gets (a direction from
-    /// `normalize` is unit only to its rounding, and a GPU's `inversesqrt` is
-    /// approximate): the direction scaled by 1 + m 2^-24, |m| <= k.
-    SphereDirLength,
+    /// The length of every ray direction (primary, shadow, reflected,
+    /// refracted): a direction from `normalize` is unit only to its rounding,
+    /// and a GPU's `inversesqrt` is approximate. Each is scaled by
+    /// 1 + m 2^-24, |m| <= k, its direction unchanged.
+    DirLength,
     /// The sphere test's `b = dot(f, dir)`.
     SphereB,
     /// The sphere test's `dot(l, l)`, the squared distance of the centre to
@@ -50,7 +51,7 @@ impl Op {
     /// Every operation, in the order the table lists them.
     pub const ALL: [Op; 16] = [
         Op::PrimaryDir,
-        Op::SphereDirLength,
+        Op::DirLength,
         Op::SphereB,
         Op::SphereDist2,
         Op::SphereC,
@@ -71,7 +72,7 @@ impl Op {
     pub fn name(self) -> &'static str {
         match self {
             Op::PrimaryDir => "primary-dir",
-            Op::SphereDirLength => "sphere-dir-length",
+            Op::DirLength => "dir-length",
             Op::SphereB => "sphere-b",
             Op::SphereDist2 => "sphere-dist2",
             Op::SphereC => "sphere-c",
