@@ -24,21 +24,8 @@ float hit_sphere(vec3 origin, vec3 dir, Sphere s, float t_min, float t_max) {
     // Stable form (Haines et al., Ray Tracing Gems ch. 7): the discriminant is
     // formed from the distance of the centre to the ray, and the two roots as c/q
     // and q, which avoids cancellation for small or far spheres.
-    //
-    // `dir` is unit only to its rounding, and less on a GPU, whose normalize
-    // takes an approximate inversesqrt and whose reflected rays inherit the
-    // length error of a normal. Taken as exactly unit, a length of 1 + e
-    // moves the foot of the perpendicular by e b and the discriminant by about
-    // 2 e b^2: dozens of its ULPs for a sphere a few radii away, enough to
-    // move a hit through nested glass by 14 to 30/255 (the perturbed f64
-    // reference: comparison/investigations/accuracy/README.md). The foot is
-    // therefore taken at b/a, a = |dir|^2, with 1/a as 2 - a (exact to
-    // (a - 1)^2, below f32 rounding; hoisted out of the primitive loops). The
-    // roots keep q and c/q: their error from a is an ULP or two of t, not
-    // magnified, and the closest hit's t is refined in the ray loop.
-    float inv_a = 2.0 - dot(dir, dir);
     float b = dot(f, dir);
-    vec3 l = f - (b * inv_a) * dir;
+    vec3 l = f - b * dir;
     float disc = r2 - dot(l, l);
     if (!(disc >= 0.0)) {
         return -1.0;

@@ -137,12 +137,8 @@ fn hit_sphere(
             ((-b - sq) / (2.0 * a), (-b + sq) / (2.0 * a))
         }
         SphereTest::Stable => {
-            // The shader's: the foot of the perpendicular at b/|d|^2, with
-            // 1/|d|^2 as 2 - |d|^2 (a direction not quite unit must not move
-            // the discriminant by 2 e b^2).
-            let inv_a = 2.0 - d.dot(d);
             let b = at(Op::SphereB, f.dot(d));
-            let l = f - (b * inv_a) * d;
+            let l = f - b * d;
             let disc = r2 - at(Op::SphereDist2, l.dot(l));
             if disc.is_nan() || disc < 0.0 {
                 return None;

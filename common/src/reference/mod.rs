@@ -260,7 +260,7 @@ fn refine(scene: &Scene, hit: &Hit, o: DVec3, d: DVec3, t: f64) -> f64 {
     let rel = (o - s.center) + t * d;
     let step = (rel.dot(rel) - s.radius * s.radius) / (2.0 * rel.dot(d));
     if step.abs() < s.radius / 1024.0 {
-        t - step
+        at(Op::RefinedT, t - step)
     } else {
         t
     }

@@ -25,7 +25,11 @@ pub enum Op {
     SphereC,
     /// Both roots of the sphere test.
     SphereT,
-    /// The watertight triangle test's three edge functions.
+    /// The sphere hit's t after the ray loop's Newton step (its own rounding
+    /// and the error of its residual).
+    RefinedT,
+    /// The triangle test's edge decisions: the watertight test's three edge
+    /// functions, Moller-Trumbore's u and v.
     TriEdge,
     /// The triangle test's t.
     TriT,
@@ -49,13 +53,14 @@ pub enum Op {
 
 impl Op {
     /// Every operation, in the order the table lists them.
-    pub const ALL: [Op; 16] = [
+    pub const ALL: [Op; 17] = [
         Op::PrimaryDir,
         Op::DirLength,
         Op::SphereB,
         Op::SphereDist2,
         Op::SphereC,
         Op::SphereT,
+        Op::RefinedT,
         Op::TriEdge,
         Op::TriT,
         Op::HitPoint,
@@ -77,6 +82,7 @@ impl Op {
             Op::SphereDist2 => "sphere-dist2",
             Op::SphereC => "sphere-c",
             Op::SphereT => "sphere-t",
+            Op::RefinedT => "refined-t",
             Op::TriEdge => "tri-edge",
             Op::TriT => "tri-t",
             Op::HitPoint => "hit-point",
