@@ -3,6 +3,7 @@
 //! (the tracer's intersection and traversal, step by step).
 
 use crate::gpu::layout::{child_ref, Bvh, PRIM_SPHERE_BIT};
+use crate::reference::perturb::{at, Op};
 use crate::scene::accel::MAX_LEAF;
 use crate::scene::numerics::{SphereTest, TriangleTest};
 use crate::scene::{Scene, Sphere, Triangle};
@@ -179,15 +180,15 @@ fn hit_sphere(
             ((-b - sq) / (2.0 * a), (-b + sq) / (2.0 * a))
         }
         SphereTest::Stable => {
-            let b = f.dot(d);
+            let b = at(Op::SphereB, f.dot(d));
             let l = f - b * d;
-            let disc = r2 - l.dot(l);
+            let disc = r2 - at(Op::SphereDist2, l.dot(l));
             if disc.is_nan() || disc < 0.0 {
                 return None;
             }
-            let c = f.dot(f) - r2;
+            let c = at(Op::SphereC, f.dot(f) - r2);
             let q = -b - if b >= 0.0 { 1.0 } else { -1.0 } * disc.sqrt();
-            let (t0, t1) = (c / q, q);
+            let (t0, t1) = (at(Op::SphereT, c / q), at(Op::SphereT, q));
             (t0.min(t1), t0.max(t1))
         }
     };
@@ -258,9 +259,9 @@ fn hit_triangle(
             let (ax, ay) = (a[kx] - r.s.x * a[kz], a[ky] - r.s.y * a[kz]);
             let (bx, by) = (b[kx] - r.s.x * b[kz], b[ky] - r.s.y * b[kz]);
             let (cx, cy) = (c[kx] - r.s.x * c[kz], c[ky] - r.s.y * c[kz]);
-            let eu = cx * by - cy * bx;
-            let ev = ax * cy - ay * cx;
-            let ew = bx * ay - by * ax;
+            let eu = at(Op::TriEdge, cx * by - cy * bx);
+            let ev = at(Op::TriEdge, ax * cy - ay * cx);
+            let ew = at(Op::TriEdge, bx * ay - by * ax);
             if (eu < 0.0 || ev < 0.0 || ew < 0.0) && (eu > 0.0 || ev > 0.0 || ew > 0.0) {
                 return None;
             }
@@ -270,7 +271,7 @@ fn hit_triangle(
             }
             let tz = eu * (r.s.z * a[kz]) + ev * (r.s.z * b[kz]) + ew * (r.s.z * c[kz]);
             let inv = 1.0 / det;
-            let t = tz * inv;
+            let t = at(Op::TriT, tz * inv);
             if !(t > t_min && t < t_max) || is_degenerate(tri) {
                 return None;
             }
@@ -286,16 +287,16 @@ fn hit_triangle(
             }
             let inv = 1.0 / det;
             let tv = r.o - tri.p[0];
-            let u = tv.dot(pv) * inv;
+            let u = at(Op::TriEdge, tv.dot(pv) * inv);
             if !(0.0..=1.0).contains(&u) {
                 return None;
             }
             let qv = tv.cross(e1);
-            let v = r.d.dot(qv) * inv;
+            let v = at(Op::TriEdge, r.d.dot(qv) * inv);
             if !(v >= 0.0 && u + v <= 1.0) {
                 return None;
             }
-            let t = e2.dot(qv) * inv;
+            let t = at(Op::TriT, e2.dot(qv) * inv);
             if !(t > t_min && t < t_max) || is_degenerate(tri) {
                 return None;
             }

@@ -17,10 +17,12 @@
 pub mod image_io;
 mod intersect;
 pub mod metrics;
+pub mod perturb;
 
 use crate::rays::RayKinds;
 use crate::reference::image_io::FloatImage;
 use crate::reference::intersect::{closest_hit, occluded, Hit, Tracer};
+use crate::reference::perturb::{at, at3, scaled, Op};
 use crate::scene::camera::{in_local_frame, RayFrame};
 use crate::scene::numerics::{Numerics, Offset, SphereTest, TriangleTest};
 use crate::scene::Scene;
@@ -69,7 +71,11 @@ pub fn render_counting(
     let mut pixels = vec![[0f32; 3]; crate::limits::pixel_count(width, height)];
     pixels.par_chunks_mut(w).enumerate().for_each(|(y, row)| {
         for (x, px) in row.iter_mut().enumerate() {
-            let c = tracer.trace(frame.eye, frame.dir(x as f64, y as f64));
+            let dir = scaled(
+                Op::DirLength,
+                at3(Op::PrimaryDir, frame.dir(x as f64, y as f64)),
+            );
+            let c = tracer.trace(frame.eye, dir);
             *px = [c.x as f32, c.y as f32, c.z as f32];
         }
         rows_done.fetch_add(1, Ordering::Relaxed);
@@ -185,6 +191,10 @@ const SCALE_AWARE_REL: f64 = 1.0 / 4_194_304.0;
 /// The shader's `spawn_point`: where a secondary ray along `dir` leaves `p`;
 /// `scale` is the largest coordinate of the ray origin (and of a triangle's vertices).
 fn spawn_point(scene: &Scene, p: DVec3, n: DVec3, dir: DVec3, scale: f64) -> DVec3 {
+    at3(Op::Spawn, spawn_at(scene, p, n, dir, scale))
+}
+
+fn spawn_at(scene: &Scene, p: DVec3, n: DVec3, dir: DVec3, scale: f64) -> DVec3 {
     match scene.numerics.offset {
         Offset::ScaleAware => p + n * (SCALE_AWARE_REL * scale.max(p.abs().max_element())),
         Offset::Ray => p + scene.epsilon * dir,
@@ -226,22 +236,39 @@ fn surface(scene: &Scene, hit: Hit, o: DVec3, mut p: DVec3) -> (DVec3, DVec3, DV
     match hit {
         Hit::Sphere(i) => {
             let s = &scene.spheres[i];
-            let n = (p - s.center) / s.radius;
+            let n = at3(Op::Normal, (p - s.center) / s.radius);
             (p, n, n, s.material, 4.0 * max_abs(o).max(max_abs(p)))
         }
         Hit::Triangle(i, u, v) => {
             let tri = &scene.triangles[i];
             let (e1, e2) = (tri.p[1] - tri.p[0], tri.p[2] - tri.p[0]);
             if matches!(scene.numerics.offset, Offset::ScaleAware | Offset::Ulp) {
-                p = tri.p[0] + u * e1 + v * e2;
+                p = at3(Op::HitPoint, tri.p[0] + u * e1 + v * e2);
             }
-            let ng = e1.cross(e2).normalize();
+            let ng = at3(Op::Normal, e1.cross(e2).normalize());
             let ns = ((1.0 - u - v) * tri.n[0] + u * tri.n[1] + v * tri.n[2]).normalize();
             let prim = max_abs(tri.p[0])
                 .max(max_abs(tri.p[1]))
                 .max(max_abs(tri.p[2]));
             (p, ng, ns, tri.material, max_abs(o).max(prim))
         }
+    }
+}
+
+/// The shader's Newton step on a sphere hit's t (|o + t d - c|^2 = r^2),
+/// which takes the test's approximate division and square root out of the
+/// hit point; kept only where the step is below 2^-10 radii, as there.
+fn refine(scene: &Scene, hit: &Hit, o: DVec3, d: DVec3, t: f64) -> f64 {
+    let Hit::Sphere(i) = *hit else {
+        return t;
+    };
+    let s = &scene.spheres[i];
+    let rel = (o - s.center) + t * d;
+    let step = (rel.dot(rel) - s.radius * s.radius) / (2.0 * rel.dot(d));
+    if step.abs() < s.radius / 1024.0 {
+        at(Op::RefinedT, t - step)
+    } else {
+        t
     }
 }
 
@@ -271,7 +298,8 @@ fn trace_with(
             color += w * scene.background;
             continue;
         };
-        let (p, mut ng, mut ns, mat, scale) = surface(scene, hit, o, o + t * d);
+        let t = refine(scene, &hit, o, d, t);
+        let (p, mut ng, mut ns, mat, scale) = surface(scene, hit, o, at3(Op::HitPoint, o + t * d));
         let inside = d.dot(ng) > 0.0;
         if inside {
             ng = -ng;
@@ -285,8 +313,8 @@ fn trace_with(
         for light in &scene.lights {
             let p_out = spawn_point(scene, p, ng, (light.position - p).normalize(), scale);
             let to_light = light.position - p_out;
-            let dist = to_light.length();
-            let l = to_light / dist;
+            let dist = at(Op::ShadowDir, to_light.length());
+            let l = scaled(Op::DirLength, at3(Op::ShadowDir, to_light / dist));
             let ndl = ns.dot(l);
             let faces = ndl > 0.0 && ng.dot(l) > 0.0;
             kinds.shadow += u64::from(faces);
@@ -307,8 +335,8 @@ fn trace_with(
                 // The shader's choice: where the interpolated normal faces away
                 // from the ray, Fresnel and the bend take the geometric normal.
                 let nt = if d.dot(ns) > 0.0 { ng } else { ns };
-                let cos_i = -d.dot(nt);
-                let k = 1.0 - eta * eta * (1.0 - cos_i * cos_i);
+                let cos_i = at(Op::CosI, -d.dot(nt));
+                let k = at(Op::TirK, 1.0 - eta * eta * (1.0 - cos_i * cos_i));
                 if k < 0.0 {
                     kr += kt;
                 } else {
@@ -319,6 +347,7 @@ fn trace_with(
                     refracted = wt;
                     if wt >= scene.min_weight && stack.len() < capacity {
                         let dir = (eta * d + (eta * cos_i - cos_t) * nt).normalize();
+                        let dir = scaled(Op::DirLength, at3(Op::RefractDir, dir));
                         stack.push(Ray {
                             o: spawn_point(scene, p, -ng, dir, scale),
                             d: dir,
@@ -338,7 +367,7 @@ fn trace_with(
                 });
             }
             if wr >= scene.min_weight && stack.len() < capacity {
-                let dir = reflect(d, ns);
+                let dir = scaled(Op::DirLength, at3(Op::ReflectDir, reflect(d, ns)));
                 stack.push(Ray {
                     o: spawn_point(scene, p, ng, dir, scale),
                     d: dir,
