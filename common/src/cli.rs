@@ -513,7 +513,30 @@ mod tests {
                 "dynamic-viewport",
                 "naga-aliasing",
                 "robust-access",
-                "warp-probe"
+                "warp-probe",
+                "ulp"
+            ]
+        );
+        assert_eq!(
+            names::<crate::lab::experiment::UlpOp>(),
+            [
+                "bits",
+                "add",
+                "mul",
+                "div",
+                "sqrt",
+                "inversesqrt",
+                "pow",
+                "fma",
+                "min",
+                "max",
+                "clamp",
+                "dot",
+                "length",
+                "normalize",
+                "cross",
+                "reflect",
+                "refract"
             ]
         );
         assert_eq!(

@@ -98,7 +98,7 @@ fn markdown(runs: &[Run], baseline: &[(UlpOp, ByClass)], inputs: u32, seconds: f
     let mut s = format!(
         "# The GPU's f32 arithmetic: ULP error per operation\n\n\
          Written by `twinray ulp --inputs {inputs}` in {seconds:.0} s; how it measures: \
-         [docs/architecture.md](../../../../docs/architecture.md#the-gpus-arithmetic).\n\n{}\n\n\
+         the section \"The GPU's arithmetic\" of docs/architecture.md.\n\n{}\n\n\
          Each cell is *largest / mean* error in ULPs of f32 at the correctly rounded result, over \
          {inputs} inputs per operation and run (a vector operation's three components are three \
          results). 0.5 or less is correctly rounded. The last column is the same operation done \

@@ -209,6 +209,8 @@ fn cases() -> Vec<Case> {
         opts("path-unknown", &["--path", "warp"], &["--path", "warp"]),
         opts("accel-unknown", &["--accel", "fast"], &["--accel", "fast"]),
         opts("workgroup-on-fragment", &["--workgroup", "8x8"], &["--workgroup", "--path compute"]),
+        opts("ulp-op-unknown", &["--experiment", "ulp", "--ulp-op", "tan"], &["--ulp-op", "tan"]),
+        opts("ulp-op-without-probe", &["--ulp-op", "div"], &["--ulp-op"]),
         // Output paths: refused before any render.
         opts("out-folder", &["--out", "{dir}"], &["--out", "is a folder"]),
         opts("out-missing-folder", &["--out", "{dir}/no/such/x.png"], &["--out", "does not exist"]),
