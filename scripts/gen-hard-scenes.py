@@ -343,16 +343,17 @@ ior = 1.5
 '''
 
 simple("light-inside-glass", "a point light inside a glass sphere, near its surface: the inner surface towards it is lit, without speckles", 1.0,
-       '\n[[quads]]\ncorners = [[-4.0, 0.0, -4.0], [-4.0, 0.0, 4.0], [4.0, 0.0, 4.0], [4.0, 0.0, -4.0]]\nmaterial = "ground"\n'
-       '\n[[spheres]]\ncenter = [0.0, 1.1, 0.0]\nradius = 1.07\nmaterial = "glass"\n'
-       '\n[[spheres]]\ncenter = [1.8, 0.4, -0.6]\nradius = 0.4\nmaterial = "red"\n',
-       'eye = [0.0, 2.2, 4.2]\nlook_at = [0.0, 1.0, 0.0]\nfov_y = 45.0',
+       '\n[[quads]]\ncorners = [[-4.0, -2.0, -3.0], [4.0, -2.0, -3.0], [4.0, 4.0, -3.0], [-4.0, 4.0, -3.0]]\nmaterial = "ground"\n'
+       '\n[[spheres]]\ncenter = [0.0, 1.1, 0.0]\nradius = 1.07\nmaterial = "glass"\n',
+       'eye = [0.0, 1.1, 4.5]\nlook_at = [0.0, 1.1, 0.0]\nfov_y = 40.0',
        materials=MATERIALS + LIT_GLASS,
-       lights=BASE_LIGHT + '\n[[lights]]\nposition = [0.52, 1.61, 0.56]\ncolor = [0.8, 0.7, 0.5]\n',
-       note="""A second light sits inside a glass sphere of radius 1.07, 0.92 from its centre.
-Shadow rays leave the inner surface towards it over a short distance, where a
-start left on the wrong side of the surface in f32 would be hidden by the very
-surface it starts on: dark speckles inside the sphere.""")
+       lights=BASE_LIGHT + '\n[[lights]]\nposition = [0.0, 1.1, 1.0165]\ncolor = [0.8, 0.7, 0.5]\n',
+       note="""A second light sits inside a glass sphere of radius 1.07, 0.95 of the radius from
+its centre towards the eye, in front of a back wall. Shadow rays leave the inner
+surface towards it over a short distance, where a hit point a few ULPs off the
+surface in f32 is hidden by the very surface it starts on: dark speckles inside
+the sphere (OpenGL on llvmpipe: 0.16 % of pixels off by more than 8/255 at
+128x128 before the sphere hit's Newton step, none after).""")
 
 simple("huge-ground", "a sphere of radius 1e6 as the ground, a small sphere resting on it", 1.0,
        '\n[[spheres]]\ncenter = [0.0, -1000000.0, 0.0]\nradius = 1000000.0\nmaterial = "ground"\n'

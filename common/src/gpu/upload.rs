@@ -179,6 +179,10 @@ impl<'a> GpuScene<'a> {
         self.bvh_nodes
     }
 
+    pub fn bvh_wide_nodes(&self) -> &'a [GpuBvhWideNode] {
+        self.bvh_wide_nodes
+    }
+
     pub fn frame_bytes(&self) -> &[u8] {
         bytemuck::bytes_of(&self.frame)
     }

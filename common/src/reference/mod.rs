@@ -527,10 +527,10 @@ mod tests {
                 let reference = Tracer::with_width(&local, width);
                 let tree = reference.bvh.as_ref().expect("a BVH");
                 assert!(
-                    tree.wide == gpu.bvh_wide_nodes,
+                    tree.wide == gpu.bvh_wide_nodes(),
                     "{name}: the {width}-wide nodes differ"
                 );
-                assert!(tree.nodes.is_empty() && gpu.bvh_nodes.is_empty());
+                assert!(tree.nodes.is_empty() && gpu.bvh_nodes().is_empty());
             }
         }
     }
