@@ -1,5 +1,7 @@
 //! Running the two apps as child processes (never in-process, so each API gets
 //! a clean process, as in the study), and the CPU reference in-process.
+//! Long file: its two field-by-field destructurings of the shared options are
+//! kept on purpose, so that a new option does not compile until both place it.
 
 use anyhow::Context;
 use std::path::PathBuf;
