@@ -3,7 +3,9 @@
 # findings are in comparison/results/<device>/FINDINGS.md, which names the
 # script and the files it wrote. The caller sets bin (release binaries), out
 # (the results folder), log (the JSONL file) and errors (where the apps'
-# stderr goes).
+# stderr goes); for two builds against each other, old and new (their
+# release folders) in place of bin.
+# shellcheck shell=bash disable=SC2154 # the caller sets those variables
 
 # run LABEL APP OPTIONS...: one headless run of twinray-APP; appends a line
 # naming the label and the command, then the app's --json report, or a
@@ -21,4 +23,44 @@ run() {
 # missing).
 gpu_info() {
     nvidia-smi --query-gpu=name,driver_version,clocks.max.sm --format=csv > "$out/gpu.txt" 2>&1 || true
+}
+
+# ab_points FRAMES [brute]: sets the array `points` to the study's brute-force
+# points and, unless "brute", the traversal issue's BVH points: FRAMES frames
+# each, a third of them for the brute-force spherelist (the slowest).
+ab_points() {
+    local frames=$1
+    points=(
+        "--scene box --size 1000x1000 --accel none --frames $frames"
+        "--scene spherelist --size 300x300 --set extra_spheres=10000 --accel none --frames $((frames / 3))"
+    )
+    if [ "${2:-all}" != brute ]; then
+        points+=(
+            "--scene teapot --size 1000x1000 --accel bvh --frames $frames"
+            "--scene spherelist --size 300x300 --set extra_spheres=10000 --accel bvh --frames $frames"
+            "--scene box --size 1000x1000 --accel bvh --frames $frames"
+        )
+    fi
+}
+
+# ab_rounds POINT...: builds old and new at each point (a string of options),
+# both paths and both apps, in two rounds of alternating build and API order,
+# so that neither build always runs first or on a warmer GPU.
+ab_rounds() {
+    local round c path app b
+    local -a apps builds
+    for round in 1 2; do
+        if [ "$round" = 1 ]; then apps=(vk gl) builds=(old new); else apps=(gl vk) builds=(new old); fi
+        for c in "$@"; do
+            for path in compute fragment; do
+                for app in "${apps[@]}"; do
+                    for b in "${builds[@]}"; do
+                        if [ "$b" = old ]; then bin=$old; else bin=$new; fi
+                        # shellcheck disable=SC2086
+                        run "$b" "$app" $c --path "$path"
+                    done
+                done
+            done
+        done
+    done
 }

@@ -58,30 +58,11 @@ for path in fragment compute; do
         "$new/twinray" diff "$out/img/box-$path-vk-$b.png" "$out/img/box-$path-gl-$b.png" --json >> "$log" 2>> "$errors"
     done
 done
-# The cost, at the study's points (builds-ab/gpu-ab.sh), two rounds in
-# alternating build and API order.
+# The cost, at the study's points (lib.sh's, as builds-ab/gpu-ab.sh runs
+# them) with half gpu-ab.sh's frames, two rounds in alternating build and API order.
 log="$out/ab.jsonl"
-points=(
-    "--scene box --size 1000x1000 --accel none --frames 30"
-    "--scene spherelist --size 300x300 --set extra_spheres=10000 --accel none --frames 10"
-    "--scene teapot --size 1000x1000 --accel bvh --frames 30"
-    "--scene spherelist --size 300x300 --set extra_spheres=10000 --accel bvh --frames 30"
-    "--scene box --size 1000x1000 --accel bvh --frames 30"
-)
-for round in 1 2; do
-    if [ $round = 1 ]; then apps=(vk gl) builds=(old new); else apps=(gl vk) builds=(new old); fi
-    for c in "${points[@]}"; do
-        for path in compute fragment; do
-            for app in "${apps[@]}"; do
-                for b in "${builds[@]}"; do
-                    if [ $b = old ]; then bin=$old; else bin=$new; fi
-                    # shellcheck disable=SC2086
-                    run $b $app $c --path $path
-                done
-            done
-        done
-    done
-done
+ab_points 30
+ab_rounds "${points[@]}"
 # Only the summaries travel back; the images stay on the machine.
 rm -rf "$out/img"
 touch "$out/done"

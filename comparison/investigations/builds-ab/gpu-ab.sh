@@ -17,32 +17,11 @@ log="$out/ab.jsonl"
 errors="$out/ab.log"
 # shellcheck source=comparison/investigations/lib.sh
 source "$(dirname "$0")/../lib.sh"
-points=(
-    "--scene box --size 1000x1000 --accel none --frames 60"
-    "--scene spherelist --size 300x300 --set extra_spheres=10000 --accel none --frames 20"
-)
+ab_points 60 "$only"
 if [ "$only" != brute ]; then
-    points+=(
-        "--scene teapot --size 1000x1000 --accel bvh --frames 60"
-        "--scene spherelist --size 300x300 --set extra_spheres=10000 --accel bvh --frames 60"
-        "--scene teapot --size 1000x1000 --set tessellation=150x125 --accel bvh --frames 60"
-        "--scene box --size 1000x1000 --accel bvh --frames 60"
-    )
+    points+=("--scene teapot --size 1000x1000 --set tessellation=150x125 --accel bvh --frames 60")
 fi
-for round in 1 2; do
-    if [ $round = 1 ]; then apps=(vk gl) builds=(old new); else apps=(gl vk) builds=(new old); fi
-    for c in "${points[@]}"; do
-        for path in compute fragment; do
-            for app in "${apps[@]}"; do
-                for b in "${builds[@]}"; do
-                    if [ $b = old ]; then bin=$old; else bin=$new; fi
-                    # shellcheck disable=SC2086
-                    run $b $app $c --path $path
-                done
-            done
-        done
-    done
-done
+ab_rounds "${points[@]}"
 for path in compute fragment; do
     for app in vk gl; do
         for b in old new; do
