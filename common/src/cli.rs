@@ -13,6 +13,8 @@ use clap::parser::ValueSource;
 use clap::{Parser, ValueEnum};
 use std::path::PathBuf;
 
+// A hidden option (`hide = true`) is the laboratory's: its doc comment is its
+// row of the laboratory's page (`lab::measurement_options`, docs/experiments.md).
 #[derive(Parser, Debug, Clone, PartialEq)]
 pub struct RenderArgs {
     /// Built-in scene (teapot, box, spherelist) or a path to a scene file (.toml).
@@ -45,7 +47,7 @@ pub struct RenderArgs {
     /// Vulkan: require validation layers and fail on any message. OpenGL: debug context, fail on any error.
     #[arg(long)]
     pub validate: bool,
-    /// Laboratory (docs/experiments.md): the all-features shader instead of the scene's own variant.
+    /// Render with the all-features shader instead of the scene's own variant.
     #[arg(long, hide = true)]
     pub generic: bool,
     /// Render with one shader for every scene whose feature switches are
@@ -59,7 +61,7 @@ pub struct RenderArgs {
     /// tree collapsed to four or eight children a node).
     #[arg(long, value_enum, default_value_t = Accel::Auto)]
     pub accel: Accel,
-    /// Laboratory, OpenGL only: load naga's SPIR-V through GL_ARB_gl_spirv instead of naga's GLSL,
+    /// OpenGL, headless: load naga's SPIR-V through GL_ARB_gl_spirv instead of naga's GLSL,
     /// so that both APIs run the very same shader binary (isolates the compiler path).
     #[arg(long, hide = true)]
     pub gl_spirv: bool,
@@ -78,18 +80,18 @@ pub struct RenderArgs {
     /// Compute path only: the workgroup size WxH (e.g. 8x4, 8x8, 16x8, 16x16) [default: 8x4].
     #[arg(long, value_name = "WxH", value_parser = parse_workgroup)]
     pub workgroup: Option<Workgroup>,
-    /// Measurement only, compute path: declare this many KiB of workgroup
-    /// memory that the tracer does not need (each invocation writes and reads
-    /// one word of it), to see how the driver's split of each multiprocessor's
-    /// memory between shared memory and L1 cache, and its occupancy, move the time.
+    /// Compute path: declare 1-32 KiB of workgroup memory that the tracer does
+    /// not need (each invocation writes and reads one word of it), to see how
+    /// the driver's split of each multiprocessor's memory between shared memory
+    /// and L1 cache, and its occupancy, move the time.
     #[arg(long, value_name = "KIB", value_parser = clap::value_parser!(u32).range(1..=32), hide = true)]
     pub shared_pad: Option<u32>,
-    /// Laboratory (repeatable): one experiment of docs/experiments.md, which
-    /// puts back a cost the build removes (or moves one) to measure its effect.
+    /// Repeatable: one of the experiments (`--experiments` lists them), each of
+    /// which puts back a cost the build removes (or moves one) to measure its effect.
     #[arg(long, value_enum, value_name = "NAME", hide = true)]
     pub experiment: Vec<Experiment>,
-    /// Laboratory, with `--experiment ulp`: the f32 operation the arithmetic
-    /// probe measures (docs/experiments.md).
+    /// With `--experiment ulp`: the f32 operation the arithmetic probe
+    /// measures (`twinray ulp --help` lists them).
     #[arg(long, value_enum, value_name = "OP", hide = true)]
     pub ulp_op: Option<UlpOp>,
     /// Print the laboratory's page (its experiments and measurement options,

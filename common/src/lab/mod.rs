@@ -9,7 +9,7 @@
 
 pub mod experiment;
 
-use crate::cli::{RenderArgs, RenderPath};
+use crate::cli::{OpenGlKnobs, RenderArgs, RenderPath, VulkanKnobs};
 use crate::error::bad_input;
 use crate::plan::requests::{Api, DeviceRequest, FragmentPass};
 use crate::shader::variant::{Counts, Passes, ShaderKnobs, SpirvCompiler};
@@ -274,18 +274,74 @@ pub fn changes(args: &RenderArgs) -> Changes {
     c
 }
 
-/// The measurement options: laboratory switches that are options of their own
-/// (hidden from the default `--help`). (name, what it does.)
-pub const MEASUREMENT_OPTIONS: &[(&str, &str)] = &[
-    ("--experiment NAME", "Repeatable: one of the experiments below."),
-    ("--generic", "Render with the all-features shader instead of the scene's own variant."),
-    ("--specialize", "Render with one shader for every scene whose feature switches are specialization constants set to this scene's features (fixed by naga's process_overrides), instead of the scene's own variant of defines."),
-    ("--gl-spirv", "OpenGL, headless: load naga's SPIR-V through GL_ARB_gl_spirv instead of naga's GLSL, so that both APIs run the very same shader binary."),
-    ("--shared-pad KIB", "Compute path: declare 1-32 KiB of workgroup memory the tracer does not need (each invocation writes and reads one word of it), to see how the driver's split between shared memory and L1, and its occupancy, move the time."),
-    ("--ulp-op OP", "With `--experiment ulp`: the operation the arithmetic probe measures (`twinray ulp --help` lists them)."),
-    ("--vk-memory host", "Vulkan (also TWINRAY_VK_MEMORY): the scene's buffers in host-visible memory the GPU reads across the bus, instead of device-local memory filled through a staging buffer."),
-    ("--vk-wait idle", "Vulkan, headless (also TWINRAY_VK_WAIT): wait for each frame with vkQueueWaitIdle + vkDeviceWaitIdle, as the 2018 study did, instead of the frame's fence."),
-];
+/// The measurement options: laboratory switches that are options of their
+/// own, hidden from the default `--help`. clap's definitions (common/src/cli.rs)
+/// are the one source of their names and texts: (the option as typed, what it does).
+pub fn measurement_options() -> Vec<(String, String)> {
+    use clap::{Args, CommandFactory};
+    let sets = [
+        (None, RenderArgs::command()),
+        (
+            Some(Api::Vulkan),
+            VulkanKnobs::augment_args(clap::Command::new("twinray-vk")),
+        ),
+        (
+            Some(Api::OpenGl),
+            OpenGlKnobs::augment_args(clap::Command::new("twinray-gl")),
+        ),
+    ];
+    let mut options = Vec::new();
+    for (api, command) in sets {
+        for arg in command.get_arguments().filter(|a| a.is_hide_set()) {
+            let Some(long) = arg.get_long() else {
+                continue;
+            };
+            let mut what = arg
+                .get_long_help()
+                .or(arg.get_help())
+                .map(|h| h.to_string())
+                .unwrap_or_default();
+            // clap drops a one-sentence doc comment's full stop; the page is prose.
+            if !what.ends_with('.') {
+                what.push('.');
+            }
+            if let Some(api) = api {
+                let env = arg
+                    .get_env()
+                    .map(|v| format!(" (also {})", v.to_string_lossy()))
+                    .unwrap_or_default();
+                let (first, rest) = what.split_at(what.chars().next().map_or(0, char::len_utf8));
+                what = format!("{}{env}: {}{rest}", api.name(), first.to_lowercase());
+            }
+            options.push((format!("--{long}{}", typed_value(arg)), what));
+        }
+    }
+    options
+}
+
+/// What follows the option as a measurement types it: for a choice with a
+/// default, the choices that change something; else its value's name.
+fn typed_value(arg: &clap::Arg) -> String {
+    if !arg.get_action().takes_values() {
+        return String::new();
+    }
+    let default = arg.get_default_values();
+    if !default.is_empty() {
+        let others: Vec<String> = arg
+            .get_possible_values()
+            .iter()
+            .map(|v| v.get_name().to_string())
+            .filter(|v| !default.iter().any(|d| d.to_str() == Some(v.as_str())))
+            .collect();
+        if !others.is_empty() {
+            return format!(" {}", others.join("|"));
+        }
+    }
+    arg.get_value_names()
+        .and_then(|names| names.first())
+        .map(|n| format!(" {n}"))
+        .unwrap_or_default()
+}
 
 /// `--experiments`: prints the laboratory's page; true when it did (the app then exits).
 pub fn print_page_if_asked(args: &RenderArgs) -> bool {
@@ -307,7 +363,7 @@ pub fn page() -> String {
          report what each one measured.\n\n\
          ## Measurement options\n\n| option | what it does |\n|---|---|\n",
     );
-    for (name, what) in MEASUREMENT_OPTIONS {
+    for (name, what) in measurement_options() {
         s.push_str(&format!("| `{name}` | {what} |\n"));
     }
     s.push_str("\n## Experiments (`--experiment NAME`)\n\n| name | applies to | what it does |\n|---|---|---|\n");
@@ -342,6 +398,35 @@ mod tests {
     fn the_registry_has_every_experiment_once_in_order() {
         let listed: Vec<Experiment> = REGISTRY.iter().map(|r| r.experiment).collect();
         assert_eq!(listed, Experiment::value_variants());
+    }
+
+    /// Every hidden option is on the page, typed as a measurement types it,
+    /// with the text clap holds for it.
+    #[test]
+    fn the_measurement_options_are_the_hidden_options() {
+        let options = measurement_options();
+        let names: Vec<&str> = options.iter().map(|(n, _)| n.as_str()).collect();
+        assert_eq!(
+            names,
+            [
+                "--generic",
+                "--specialize",
+                "--gl-spirv",
+                "--shared-pad KIB",
+                "--experiment NAME",
+                "--ulp-op OP",
+                "--vk-memory host",
+                "--vk-wait idle",
+            ]
+        );
+        for (name, what) in &options {
+            assert!(what.len() > 40, "{name} has no text: {what:?}");
+        }
+        let vk_memory = &options[6].1;
+        assert!(
+            vk_memory.starts_with("Vulkan (also TWINRAY_VK_MEMORY): where"),
+            "{vk_memory}"
+        );
     }
 
     /// docs/experiments.md is the registry's page; TWINRAY_UPDATE_DOCS=1 rewrites it.
