@@ -1,5 +1,6 @@
 // trace/bvh.glsl — the closest-hit and any-hit walks of the BVH that
-// common/src/scene/accel.rs builds; compiled only into the USE_BVH variants.
+// common/src/scene/accel.rs builds, two children a node or collapsed to four or
+// eight (--accel bvh4, bvh8); compiled only into the USE_BVH variants.
 
 #ifdef USE_BVH
 const uint SPHERE_BIT = 0x80000000u;
@@ -153,6 +154,85 @@ bool hit_leaf(inout Hit h, vec3 origin, vec3 dir, TriRay ray, uint first, uint c
         }                                                                                  \
     }
 
+// The wide tree (--accel bvh4, bvh8; USE_BVH_WIDE): common/src/scene/accel/wide.rs
+// collapses the binary tree into nodes of four or eight children with the same
+// leaves. Its step tests the four boxes of a BvhWideNode at once, sorts their
+// entry distances (five compare-and-swaps), takes the nearest child next and
+// pushes the others far to near, so that they pop near first. An 8-wide node
+// does that for each half, keeps the nearer of the two nearest and pushes the
+// other: the pops of such a node come in near-first order within each half.
+// Every node pushes at most its entered children but one, which is what the
+// stack is sized for.
+#ifdef USE_BVH_WIDE
+#ifndef BVH_WIDE_QUADS
+// BvhWideNodes per node: 1 for a 4-wide tree, 2 for an 8-wide one.
+#define BVH_WIDE_QUADS 1
+#endif
+
+// The entry distance of a child the ray does not enter: beyond every t_max.
+const float WIDE_MISS = 3.0e38;
+
+// One step of a sorting network: the two (t, child) pairs in order of t.
+void wide_order(inout float ta, inout uint ca, inout float tb, inout uint cb) {
+    if (tb < ta) {
+        float t = ta;
+        ta = tb;
+        tb = t;
+        uint c = ca;
+        ca = cb;
+        cb = c;
+    }
+}
+
+// Pushes (child, entry t) onto the stack, which is sized for the most entries
+// a walk of this tree leaves pending (Bvh::stack_entries).
+#define WIDE_PUSH(c, t) BVH_ROOM(sp) { BVH_PUSH(sp, uvec2((c), floatBitsToUint(t))); sp += 1u; }
+
+// One step down from wide node `child`: on to its nearest entered child, the
+// others pushed; NO_CHILD (which has LEAF_BIT set) if the ray enters none. An
+// empty slot's box is never entered, and its NO_CHILD is checked as well, so
+// that no driver's handling of infinity matters. A macro, like BVH_STEP.
+#define WIDE_STEP()                                                                    \
+    {                                                                                  \
+        uint near = NO_CHILD;                                                          \
+        float near_t = WIDE_MISS;                                                      \
+        for (uint q = 0u; q < uint(BVH_WIDE_QUADS); q++) {                             \
+            BvhWideNode node = bvh_wide_buf.nodes[child + q];                          \
+            vec4 x0 = (node.min_x - origin.x) * inv_dir.x;                             \
+            vec4 x1 = (node.max_x - origin.x) * inv_dir.x;                             \
+            vec4 y0 = (node.min_y - origin.y) * inv_dir.y;                             \
+            vec4 y1 = (node.max_y - origin.y) * inv_dir.y;                             \
+            vec4 z0 = (node.min_z - origin.z) * inv_dir.z;                             \
+            vec4 z1 = (node.max_z - origin.z) * inv_dir.z;                             \
+            vec4 enter = max(max(min(x0, x1), min(y0, y1)), max(min(z0, z1), vec4(0.0))); \
+            vec4 leave = min(min(max(x0, x1), max(y0, y1)), min(max(z0, z1), vec4(h.t))); \
+            uvec4 c = node.child;                                                      \
+            float t0 = (enter.x <= leave.x && c.x != NO_CHILD) ? enter.x : WIDE_MISS;  \
+            float t1 = (enter.y <= leave.y && c.y != NO_CHILD) ? enter.y : WIDE_MISS;  \
+            float t2 = (enter.z <= leave.z && c.z != NO_CHILD) ? enter.z : WIDE_MISS;  \
+            float t3 = (enter.w <= leave.w && c.w != NO_CHILD) ? enter.w : WIDE_MISS;  \
+            uint c0 = c.x;                                                             \
+            uint c1 = c.y;                                                             \
+            uint c2 = c.z;                                                             \
+            uint c3 = c.w;                                                             \
+            wide_order(t0, c0, t1, c1);                                                \
+            wide_order(t2, c2, t3, c3);                                                \
+            wide_order(t0, c0, t2, c2);                                                \
+            wide_order(t1, c1, t3, c3);                                                \
+            wide_order(t1, c1, t2, c2);                                                \
+            if (t3 < WIDE_MISS) WIDE_PUSH(c3, t3)                                      \
+            if (t2 < WIDE_MISS) WIDE_PUSH(c2, t2)                                      \
+            if (t1 < WIDE_MISS) WIDE_PUSH(c1, t1)                                      \
+            if (t0 < near_t) {                                                         \
+                if (near != NO_CHILD) WIDE_PUSH(near, near_t)                          \
+                near = c0;                                                             \
+                near_t = t0;                                                           \
+            } else if (t0 < WIDE_MISS) WIDE_PUSH(c0, t0)                               \
+        }                                                                              \
+        child = near;                                                                  \
+    }
+#endif
+
 // Visits the tree near child first and skips subtrees that start beyond the
 // closest hit so far. With `any_hit` (shadow rays) it stops at the first hit
 // before t_max and reports it with kind != 0. The loop within a loop (Aila
@@ -177,8 +257,13 @@ bool hit_leaf(inout Hit h, vec3 origin, vec3 dir, TriRay ray, uint first, uint c
 // zero primitive is degenerate and never hit, and is done after two turns.
 // comparison/investigations/mesa-bvh/README.md has the driver's side and a
 // reproducer.
-// A wide tree's variant has bvh_wide.glsl's instead, which shares the rest of this file.
-#ifndef USE_BVH_WIDE
+//
+// NODE_STEP is the step of the tree's width: the one loop walks either tree.
+#ifdef USE_BVH_WIDE
+#define NODE_STEP() WIDE_STEP()
+#else
+#define NODE_STEP() BVH_STEP()
+#endif
 Hit traverse(vec3 origin, vec3 dir, float t_max, bool any_hit) {
     Hit h;
     h.t = t_max;
@@ -194,13 +279,13 @@ Hit traverse(vec3 origin, vec3 dir, float t_max, bool any_hit) {
     uint sp = 0u;
     // The child reference being visited: first the root, interior node 0.
     uint child = 0u;
-    BVH_STEP();
+    NODE_STEP();
     while (true) {
         // Down through interior nodes until a leaf, or until nothing is
         // entered (NO_CHILD): the warp's invocations then test their leaves
         // together instead of taking turns between node and leaf steps.
         while (int(child) > 0) {
-            BVH_STEP();
+            NODE_STEP();
         }
         if (child != NO_CHILD) {
             uint first = (child & ~LEAF_BIT) >> LEAF_FIRST_SHIFT;
@@ -225,5 +310,4 @@ Hit traverse(vec3 origin, vec3 dir, float t_max, bool any_hit) {
     }
     return h;
 }
-#endif
 #endif

@@ -118,7 +118,7 @@ pub struct GpuBvhPrim {
 }
 
 /// `BvhWideNode` (std430 array element, binding 6 in the wide variants,
-/// read by shaders/trace/bvh_wide.glsl): four children's boxes, one `vec4`
+/// read by shaders/trace/bvh.glsl): four children's boxes, one `vec4`
 /// per corner coordinate, so that the traversal tests all four boxes with
 /// vector arithmetic from seven 16-byte reads. A 4-wide tree has one per
 /// node; an 8-wide tree two consecutive ones per node (children 0-3, then

@@ -81,7 +81,7 @@ fn enter_box(min: [f32; 3], max: [f32; 3], o: DVec3, d: DVec3, t_max: f64) -> Op
 }
 
 /// The children of a node that the ray enters, in the order the shader
-/// (trace/bvh_wide.glsl) visits them: per `GpuBvhWideNode`, sorted by entry
+/// (trace/bvh.glsl) visits them: per `GpuBvhWideNode`, sorted by entry
 /// distance with the shader's network; of an 8-wide node's two halves, the
 /// nearer half's nearest child first, then the rest of the second half near
 /// to far, then the rest of the first.

@@ -1,7 +1,7 @@
 //! Acceleration: `--accel` and the scene's choice of a BVH; `build` makes the
 //! bounding volume hierarchy itself (`gpu::layout::Bvh`), which
 //! shaders/trace/bvh.glsl walks, `split` its split of one node, and `wide`
-//! collapses it into the 4- and 8-wide trees that shaders/trace/bvh_wide.glsl walks.
+//! collapses it into the 4- and 8-wide trees that shaders/trace/bvh.glsl walks too.
 
 mod build;
 mod split;

@@ -21,7 +21,7 @@ use naga::{Module, ShaderStage};
 /// The tracer's parts, in reading order (shaders/trace/loop.glsl lists what
 /// each holds). naga has no `#include`, so the build puts them together here,
 /// at compile time: editing a part and rebuilding changes what the apps run.
-pub const TRACE_PARTS: [(&str, &str); 7] = [
+pub const TRACE_PARTS: [(&str, &str); 6] = [
     (
         "inputs.glsl",
         include_str!("../../../shaders/trace/inputs.glsl"),
@@ -31,10 +31,6 @@ pub const TRACE_PARTS: [(&str, &str); 7] = [
         include_str!("../../../shaders/trace/intersect.glsl"),
     ),
     ("bvh.glsl", include_str!("../../../shaders/trace/bvh.glsl")),
-    (
-        "bvh_wide.glsl",
-        include_str!("../../../shaders/trace/bvh_wide.glsl"),
-    ),
     ("hit.glsl", include_str!("../../../shaders/trace/hit.glsl")),
     (
         "secondary.glsl",
@@ -56,7 +52,6 @@ pub const TRACE_GLSL: &str = concat!(
     include_str!("../../../shaders/trace/inputs.glsl"),
     include_str!("../../../shaders/trace/intersect.glsl"),
     include_str!("../../../shaders/trace/bvh.glsl"),
-    include_str!("../../../shaders/trace/bvh_wide.glsl"),
     include_str!("../../../shaders/trace/hit.glsl"),
     include_str!("../../../shaders/trace/secondary.glsl"),
     include_str!("../../../shaders/trace/loop.glsl"),

@@ -26,7 +26,7 @@ pub struct Variant {
     pub counts: Counts,
     /// The BVH traversal stack's entries, where the variant traces through a BVH.
     pub bvh_stack: Option<u32>,
-    /// The BVH's children per node: 2 (trace/bvh.glsl), 4 or 8 (trace/bvh_wide.glsl).
+    /// The BVH's children per node: 2, 4 or 8 (trace/bvh.glsl walks each).
     pub bvh_width: u32,
     /// Offset, triangle and sphere tests; the reference can take the same.
     pub numerics: Numerics,

@@ -1,6 +1,6 @@
 //! The wide BVH (`--accel bvh4`, `bvh8`): the binary SAH tree of `build`
 //! collapsed into nodes of four or eight children (`GpuBvhWideNode`, walked
-//! by shaders/trace/bvh_wide.glsl, and by the f64 reference the same way).
+//! by shaders/trace/bvh.glsl, and by the f64 reference the same way).
 //! A wide node starts from its binary node's two children and keeps opening
 //! the interior child with the largest box, the one a ray is likeliest to
 //! enter, until it has `width` children or only leaves (the greedy collapse
