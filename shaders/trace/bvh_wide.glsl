@@ -36,7 +36,7 @@ void wide_order(inout float ta, inout uint ca, inout float tb, inout uint cb) {
 // others pushed; NO_CHILD (which has LEAF_BIT set) if the ray enters none. An
 // empty slot's box is never entered, and its NO_CHILD is checked as well, so
 // that no driver's handling of infinity matters. A macro, like bvh.glsl's
-// BVH_STEP, so that the root's step (see `traverse`) is the loop's own code.
+// BVH_STEP.
 #define WIDE_STEP()                                                                    \
     {                                                                                  \
         uint near = NO_CHILD;                                                          \
@@ -97,10 +97,9 @@ Hit traverse(vec3 origin, vec3 dir, float t_max, bool any_hit) {
     BVH_STACK_DECLARE;
 #endif
     uint sp = 0u;
-    // The root's step comes first, and the descent below it goes on only
-    // through references > 0, as in bvh.glsl's `traverse` (why: there).
-    uint child = 0u;
-    WIDE_STEP();
+    // The descent goes on only through references > 0, as in bvh.glsl's
+    // `traverse` (why: there).
+    uint child = GPU_ROOT;
     while (true) {
         while (int(child) > 0) {
             WIDE_STEP();
