@@ -327,6 +327,7 @@ fn the_bvh_encodings_match_rust() {
     assert_eq!(constant("SPHERE_BIT"), PRIM_SPHERE_BIT);
     assert_eq!(constant("LEAF_BIT"), child_ref::LEAF_BIT);
     assert_eq!(constant("LEAF_FIRST_SHIFT"), child_ref::LEAF_FIRST_SHIFT);
+    assert_eq!(constant("GPU_ROOT"), child_ref::GPU_ROOT);
     // NO_CHILD decodes to a leaf past the most primitives a tree may hold.
     let (first, _) =
         child_ref::as_leaf(constant("NO_CHILD")).expect("NO_CHILD is a leaf reference");

@@ -68,6 +68,9 @@ const uint LEAF_FIRST_SHIFT = 2u;
 // No child to visit: a leaf reference no tree has (its count bits say 4 and
 // its first primitive is past any limit).
 const uint NO_CHILD = 0xFFFFFFFFu;
+// The root's reference: slot 0 of the GPU's copy is a sentinel no reference
+// names (gpu::layout::child_ref::GPU_ROOT), so 0 is never an interior node.
+const uint GPU_ROOT = 1u;
 
 // Where the ray enters the box, or -1 if it misses it before t_max. Zero
 // direction components are nudged so 0 * inf never makes a NaN.
@@ -129,9 +132,8 @@ bool hit_leaf(inout Hit h, vec3 origin, vec3 dir, TriRay ray, uint first, uint c
 
 // One step down from interior node `child`: on to the nearer child whose box
 // the ray enters before h.t, the farther one pushed with its entry t; NO_CHILD
-// if the ray enters neither. A macro, so that the root's step (see `traverse`)
-// is the loop's own code, and a walk's local stack (BVH_STACK_LOCAL) stays
-// its own.
+// if the ray enters neither. A macro, so that a walk's local stack
+// (BVH_STACK_LOCAL) stays its own.
 #define BVH_STEP()                                                                         \
     {                                                                                      \
         BvhNode node = bvh_buf.nodes[child];                                               \
@@ -241,22 +243,24 @@ void wide_order(inout float ta, inout uint ca, inout float tb, inout uint cb) {
 // both APIs, never slower (measured in
 // comparison/results/nvidia-h100/FINDINGS.md#the-node-layout-investigationnode-layout).
 //
-// The root's step comes before the loops, so that the descent below it goes
-// on only through references > 0 (int(child) > 0: an interior node, never the
-// root, which is no node's child). That costs no instruction: the test is one
-// compare, as LEAF_BIT's was, and the root's step needs none. It makes the walk
-// end even where every read of the tree returns zero, which a tree never does
-// but Mesa 22.3's llvmpipe and lavapipe make happen: they run a SIMD vector's
-// lanes that are no invocation (a compute workgroup narrower than the vector,
-// a fragment block's uncovered pixels) with storage reads of zero, and keep a
-// loop going while such a lane has not left it. A zero node is the root with
-// both boxes at the origin, so a ray from the origin went round it until the
+// The descent goes on only through references > 0 (int(child) > 0: an
+// interior node, as no reference names slot 0, the sentinel before the root;
+// see GPU_ROOT). That costs no instruction: the test is one compare, as
+// LEAF_BIT's was. It makes the walk end even where every read of the tree
+// returns zero, which a tree never does but Mesa 22.3's llvmpipe and lavapipe
+// make happen: they run a SIMD vector's lanes that are no invocation (a
+// compute workgroup narrower than the vector, a fragment block's uncovered
+// pixels) with storage reads of zero, and keep a loop going while such a lane
+// has not left it. When 0 was the root, a zero node was the root with both
+// boxes at the origin, so a ray from the origin went round it until the
 // driver's budget of 65,535 loop turns per vector ran out, and every later
 // loop of the real pixels was cut to one turn: the wall of hard/far-tiny-sphere
 // was lost in 4x4 blocks. Now such a lane takes reference 0 for a leaf, whose
 // zero primitive is degenerate and never hit, and is done after two turns.
-// comparison/investigations/mesa-bvh/README.md has the driver's side and a
-// reproducer.
+// (A first fix took the root's step before the loops instead: it cost up to
+// 5 % in OpenGL, the step's code twice; comparison/results/nvidia-h100/FINDINGS.md,
+// "The BVH's sentinel".) comparison/investigations/mesa-bvh/README.md has the
+// driver's side and a reproducer.
 //
 // NODE_STEP is the step of the tree's width: the one loop walks either tree.
 #ifdef USE_BVH_WIDE
@@ -277,9 +281,8 @@ Hit traverse(vec3 origin, vec3 dir, float t_max, bool any_hit) {
     BVH_STACK_DECLARE;
 #endif
     uint sp = 0u;
-    // The child reference being visited: first the root, interior node 0.
-    uint child = 0u;
-    NODE_STEP();
+    // The child reference being visited: first the root.
+    uint child = GPU_ROOT;
     while (true) {
         // Down through interior nodes until a leaf, or until nothing is
         // entered (NO_CHILD): the warp's invocations then test their leaves

@@ -83,7 +83,8 @@ pub struct GpuLight {
 /// of its children's boxes, so that one 64-byte read gives the traversal
 /// everything it needs to choose its next step (Aila and Laine 2009). With a
 /// box per node instead, every step read the node, then each child's box, the
-/// right child's only once its index had arrived. Node 0 is the root. A child
+/// right child's only once its index had arrived. Node 0 is the root (on the
+/// GPU, slot `child_ref::GPU_ROOT`: the upload shifts the tree). A child
 /// is a reference (`child_ref`): an interior node's index, or a leaf's primitives.
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, Pod, Zeroable, PartialEq)]
@@ -163,6 +164,14 @@ impl GpuBvhWideNode {
         )
     }
 
+    /// This node as the GPU's copy of the tree holds it (`child_ref::GPU_ROOT`).
+    pub fn on_gpu(&self) -> GpuBvhWideNode {
+        GpuBvhWideNode {
+            child: self.child.map(child_ref::on_gpu),
+            ..*self
+        }
+    }
+
     pub fn set(&mut self, k: usize, (min, max): Bounds, child: u32) {
         [self.min_x[k], self.min_y[k], self.min_z[k]] = min;
         [self.max_x[k], self.max_y[k], self.max_z[k]] = max;
@@ -174,6 +183,15 @@ impl GpuBvhWideNode {
 pub type Bounds = ([f32; 3], [f32; 3]);
 
 impl GpuBvhNode {
+    /// This node as the GPU's copy of the tree holds it (`child_ref::GPU_ROOT`).
+    pub fn on_gpu(&self) -> GpuBvhNode {
+        GpuBvhNode {
+            left: child_ref::on_gpu(self.left),
+            right: child_ref::on_gpu(self.right),
+            ..*self
+        }
+    }
+
     pub fn new(
         (left_min, left_max): Bounds,
         left: u32,
@@ -206,6 +224,24 @@ pub mod child_ref {
     /// No child: an empty slot of a wide node. A leaf reference no tree has
     /// (its count bits say 4 and its first primitive is past any limit).
     pub const NO_CHILD: u32 = u32::MAX;
+
+    /// The root's reference in the GPU's copy of the tree, where every node
+    /// sits one slot later than in the tree the host builds: slot 0 is a
+    /// sentinel no reference names, so 0 is never an interior node. A walk
+    /// then descends only through references > 0 (one compare, like
+    /// LEAF_BIT's) and ends even where every read of the tree returns zero,
+    /// as Mesa 22.3's lavapipe and llvmpipe make happen for a SIMD vector's
+    /// lanes that are no invocation (trace/bvh.glsl's `traverse` says more).
+    pub const GPU_ROOT: u32 = 1;
+
+    /// `r` as the GPU's copy holds it: an interior node one slot later.
+    pub fn on_gpu(r: u32) -> u32 {
+        if r & LEAF_BIT == 0 {
+            r + GPU_ROOT
+        } else {
+            r
+        }
+    }
 
     pub fn leaf(first: u32, count: u32) -> u32 {
         debug_assert!((1..=MAX_LEAF_COUNT as u32).contains(&count) && (first as usize) < MAX_PRIMS);

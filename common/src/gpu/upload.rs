@@ -4,8 +4,8 @@
 //! them, and the checks of those buffers against a device's limits.
 
 use crate::gpu::layout::{
-    binding, Bvh, GpuBvhNode, GpuBvhPrim, GpuBvhWideNode, GpuFrame, GpuLight, GpuMaterial,
-    GpuSphere, GpuTriangle, PRIM_SPHERE_BIT,
+    binding, child_ref, Bvh, GpuBvhNode, GpuBvhPrim, GpuBvhWideNode, GpuFrame, GpuLight,
+    GpuMaterial, GpuSphere, GpuTriangle, PRIM_SPHERE_BIT,
 };
 use crate::limits::StorageLimit;
 use crate::scene::camera::{local_origin, RayFrame};
@@ -196,10 +196,14 @@ impl<'a> GpuScene<'a> {
             binding::TRIANGLES => (self.triangles.len(), size_of::<GpuTriangle>()),
             binding::MATERIALS => (self.materials.len(), size_of::<GpuMaterial>()),
             binding::LIGHTS => (self.lights.len(), size_of::<GpuLight>()),
+            // The GPU's copy of a tree starts with a sentinel (`child_ref::GPU_ROOT`).
             binding::BVH_NODES if !self.bvh_wide_nodes.is_empty() => {
-                (self.bvh_wide_nodes.len(), size_of::<GpuBvhWideNode>())
+                (self.bvh_wide_nodes.len() + 1, size_of::<GpuBvhWideNode>())
             }
-            binding::BVH_NODES => (self.bvh_nodes.len(), size_of::<GpuBvhNode>()),
+            binding::BVH_NODES if !self.bvh_nodes.is_empty() => {
+                (self.bvh_nodes.len() + 1, size_of::<GpuBvhNode>())
+            }
+            binding::BVH_NODES => (0, size_of::<GpuBvhNode>()),
             binding::BVH_PRIMS => (self.bvh_codes.len(), size_of::<GpuBvhPrim>()),
             binding::COUNTS => (1, size_of::<[u32; 4]>()),
             _ => panic!("binding {binding} is not a storage buffer"),
@@ -224,10 +228,12 @@ impl<'a> GpuScene<'a> {
             binding::MATERIALS => copy_elements(&self.materials, offset, out),
             binding::LIGHTS => copy_elements(&self.lights, offset, out),
             binding::COUNTS => copy_elements(&self.counts, offset, out),
-            binding::BVH_NODES if !self.bvh_wide_nodes.is_empty() => {
-                copy_elements(self.bvh_wide_nodes, offset, out)
+            binding::BVH_NODES if !self.bvh_wide_nodes.is_empty() => convert(offset, out, |i| {
+                gpu_node(self.bvh_wide_nodes, i, |n| n.on_gpu())
+            }),
+            binding::BVH_NODES if !self.bvh_nodes.is_empty() => {
+                convert(offset, out, |i| gpu_node(self.bvh_nodes, i, |n| n.on_gpu()))
             }
-            binding::BVH_NODES => copy_elements(self.bvh_nodes, offset, out),
             binding::TRIANGLES if !self.triangles.is_empty() => {
                 convert(offset, out, |i| self.triangle(i))
             }
@@ -271,6 +277,15 @@ impl<'a> GpuScene<'a> {
 /// A multiple of every element size (96, 64, 48, 32, 16 and a wide node's
 /// 112 bytes), so that chunks hold whole elements.
 const UPLOAD_CHUNK_ALIGN: usize = 1344;
+
+/// Slot `i` of the GPU's copy of a tree: a zeroed sentinel, then the nodes one
+/// slot later, their interior references moved with them (`child_ref::GPU_ROOT`).
+fn gpu_node<T: Pod>(nodes: &[T], i: usize, on_gpu: impl Fn(&T) -> T) -> T {
+    match i.checked_sub(child_ref::GPU_ROOT as usize) {
+        Some(i) => on_gpu(&nodes[i]),
+        None => T::zeroed(),
+    }
+}
 
 /// Bytes `offset..` of `items` (one zeroed element when empty) into `out`.
 fn copy_elements<T: Pod>(items: &[T], offset: usize, out: &mut [u8]) {

@@ -36,15 +36,21 @@ impl Accel {
         }
     }
 
-    /// Children per node of the BVH this choice traces through. `auto` keeps
-    /// the binary tree: on the H100 the 4-wide one is up to 9 % faster in Vulkan
-    /// on the teapot and 24 % on the 10k sphere list, but up to 12 % slower in
-    /// OpenGL on the teapot, and one tree for both APIs keeps the comparison
-    /// honest (comparison/results/nvidia-h100/FINDINGS.md#the-wide-bvh-investigationwide).
-    pub fn width(self) -> u32 {
+    /// Children per node of the BVH this choice traces through `scene`.
+    /// `auto` takes the 4-wide tree where spheres are at least half of the
+    /// primitives and the binary tree otherwise: the crossover measured on the
+    /// H100 (comparison/results/nvidia-h100/FINDINGS.md#where-the-4-wide-tree-pays-investigationcrossover).
+    /// On sphere lists of 100 to 10,000 spheres the 4-wide tree is 15 to 27 %
+    /// faster in Vulkan and 5 to 17 % in OpenGL (one point excepted: 10,000 at
+    /// 1000² on OpenGL's compute path, 3 % slower); on triangle scenes (the
+    /// teapot, the box) it is 4 to 11 % faster in Vulkan but 2 to 5 % slower in
+    /// OpenGL. One rule for both APIs keeps the comparison honest: both trace
+    /// the same tree.
+    pub fn width(self, scene: &Scene) -> u32 {
         match self {
             Accel::Bvh4 => 4,
             Accel::Bvh8 => 8,
+            Accel::Auto if 2 * scene.spheres.len() >= scene.primitive_count() => 4,
             Accel::Auto | Accel::None | Accel::Bvh => 2,
         }
     }

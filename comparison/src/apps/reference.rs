@@ -32,7 +32,7 @@ pub fn render_reference(args: &RenderArgs) -> anyhow::Result<()> {
     let t = Instant::now();
     // --accel none: brute force, a reference independent of the BVH code;
     // else through the tree of the width asked for, as the apps trace it.
-    let bvh_width = (args.accel != Accel::None).then(|| args.accel.width());
+    let bvh_width = (args.accel != Accel::None).then(|| args.accel.width(&scene));
     let img = render_with_progress(&scene, w, h, bvh_width);
     let ms = t.elapsed().as_secs_f64() * 1e3;
     if let Some(out) = &args.out {

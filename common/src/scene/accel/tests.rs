@@ -240,3 +240,19 @@ fn wide_trees_hold_every_primitive_once_inside_their_boxes() {
         b8.depth
     );
 }
+
+/// `--accel auto`'s width: the 4-wide tree where spheres are at least half of
+/// the primitives (the sphere list), the binary one on meshes (the teapot, the
+/// box), as measured; an explicit width is kept.
+#[test]
+fn auto_picks_the_width_the_crossover_measured() {
+    use crate::scene::accel::Accel;
+    let spheres = Scene::load("spherelist", &[("extra_spheres".into(), "1000".into())]).unwrap();
+    let teapot = Scene::load("teapot", &[]).unwrap();
+    let boxed = Scene::load("box", &[]).unwrap();
+    assert_eq!(Accel::Auto.width(&spheres), 4);
+    assert_eq!(Accel::Auto.width(&teapot), 2);
+    assert_eq!(Accel::Auto.width(&boxed), 2);
+    assert_eq!(Accel::Bvh.width(&spheres), 2);
+    assert_eq!(Accel::Bvh8.width(&teapot), 8);
+}
