@@ -10,9 +10,10 @@ use twinray_common::scene::Scene;
 use twinray_tests::{render, scratch, App};
 
 fn check(scene: &str, size: &str, set: &[(&str, &str)]) {
-    let dir = scratch(&format!("agree-{scene}"));
-    let mut extra = Vec::new();
     let kv: Vec<String> = set.iter().map(|(k, v)| format!("{k}={v}")).collect();
+    // Named by the overrides too: tests of one scene run in parallel.
+    let dir = scratch(&format!("agree-{scene}{}", kv.concat()));
+    let mut extra = Vec::new();
     for s in &kv {
         extra.extend(["--set", s.as_str()]);
     }
