@@ -1,7 +1,15 @@
-//! The scene on the GPU: the `Frame` uniform buffer and the four storage
-//! buffers, uploaded once from the bytes `common` builds for both APIs; and
-//! the storage buffers a shader writes for the app to read back once (the ray
-//! counts, the warp probe).
+//! The scene on the GPU: the `Frame` uniform buffer and the storage buffers,
+//! uploaded once from the bytes `common` builds for both APIs; and the storage
+//! buffers a shader writes for the app to read back once (the ray counts, the
+//! warp probe).
+//!
+//! The scene buffers are immutable (`glBufferStorage`) and filled by the GPU,
+//! the way the Vulkan twin fills its device-local buffers (vk/src/memory.rs):
+//! the CPU writes a chunk into one small mapped staging buffer and
+//! `glCopyBufferSubData` copies it across. A buffer the CPU may neither map
+//! nor rewrite is one the driver need not shadow in system memory. Filled by
+//! `glBufferData` and `glBufferSubData`, the buffers cost NVIDIA's GL driver
+//! about 150 bytes of host memory a triangle more than Vulkan's.
 
 use anyhow::{anyhow, Context as _};
 use glow::HasContext;
@@ -18,96 +26,48 @@ pub struct SceneBuffers<'gl> {
 impl<'gl> SceneBuffers<'gl> {
     /// Uploads and binds everything. Bound by number because naga renames
     /// the blocks; UBO and SSBO binding points are separate spaces in GL, so
-    /// the numbers are the Vulkan descriptor bindings unchanged. A storage
-    /// buffer is allocated whole, then filled a chunk at a time from one
-    /// reused chunk of host memory (`write_storage` converts the scene into
-    /// it), so the host never holds a second full copy of a large scene.
+    /// the numbers are the Vulkan descriptor bindings unchanged. The bytes are
+    /// made in the staging buffer (`write_storage` converts the scene a chunk
+    /// at a time), so the host never holds a second full copy of a large scene.
     pub fn new(gl: &'gl glow::Context, scene: &GpuScene) -> anyhow::Result<SceneBuffers<'gl>> {
-        let mut this = SceneBuffers {
-            gl,
-            buffers: Vec::with_capacity(1 + binding::STORAGE.len()),
-        };
         let frame = scene.frame_bytes();
-        let chunk_bytes = UPLOAD_CHUNK_BYTES.min(scene.largest_storage().1.max(frame.len()));
-        // u32s: aligned for every GPU struct, which `write_storage` fills in place.
-        let mut chunk = vec![0u32; chunk_bytes.div_ceil(4)];
-        let chunk: &mut [u8] = bytemuck::cast_slice_mut(&mut chunk);
-        let (len, ubo) = (frame.len(), glow::UNIFORM_BUFFER);
-        this.upload(
-            (ubo, binding::FRAME),
+        // One staging buffer, as large as the largest chunk any buffer needs.
+        let chunk = UPLOAD_CHUNK_BYTES.min(scene.largest_storage().1.max(frame.len()));
+        let mut uploads = Uploads::new(gl, chunk)?;
+        // The uniform block first: the window rewrites it with glBufferSubData
+        // when the camera moves, which needs DYNAMIC_STORAGE_BIT. Nothing
+        // rewrites the storage buffers: no flags.
+        let len = frame.len();
+        uploads.add(
+            (
+                glow::UNIFORM_BUFFER,
+                binding::FRAME,
+                glow::DYNAMIC_STORAGE_BIT,
+            ),
             len,
             std::slice::from_ref(&(0..len)),
-            chunk,
             |_, bytes| bytes.copy_from_slice(frame),
         )?;
         for b in binding::STORAGE {
-            let chunks = scene.chunks(b, chunk_bytes);
-            let (len, ssbo) = (scene.storage_len(b), glow::SHADER_STORAGE_BUFFER);
-            this.upload((ssbo, b), len, &chunks, chunk, |offset, bytes| {
-                scene.write_storage(b, offset, bytes)
-            })?;
+            let chunks = scene.chunks(b, chunk);
+            uploads.add(
+                (glow::SHADER_STORAGE_BUFFER, b, 0),
+                scene.storage_len(b),
+                &chunks,
+                |offset, bytes| scene.write_storage(b, offset, bytes),
+            )?;
         }
-        Ok(this)
-    }
-
-    /// A buffer of `len` bytes at binding `index` of `target`, filled in
-    /// `chunks` (byte ranges, none longer than `chunk`): `write(offset,
-    /// bytes)` writes the contents from `offset` into `bytes`, part of `chunk`.
-    fn upload(
-        &mut self,
-        (target, index): (u32, u32),
-        len: usize,
-        chunks: &[std::ops::Range<usize>],
-        chunk: &mut [u8],
-        write: impl Fn(usize, &mut [u8]),
-    ) -> anyhow::Result<()> {
-        // GL sizes and offsets are signed 32-bit here; the run plan's storage
-        // limit keeps every scene buffer below that.
-        let len =
-            i32::try_from(len).map_err(|_| anyhow!("a {len}-byte buffer is too large for GL"))?;
-        // SAFETY: a fresh buffer on the current context, allocated with
-        // `len` bytes; every chunk lies within it (so its offset fits in i32)
-        // and its bytes are copied by the driver.
-        unsafe {
-            let buf = self
-                .gl
-                .create_buffer()
-                .map_err(|e| anyhow!(e))
-                .with_context(|| format!("glCreateBuffer (binding {index})"))?;
-            self.buffers.push(buf);
-            self.gl.bind_buffer(target, Some(buf));
-            // Written once, read every frame: STATIC_DRAW.
-            self.gl.buffer_data_size(target, len, glow::STATIC_DRAW);
-            for c in chunks {
-                let bytes = &mut chunk[..c.len()];
-                write(c.start, bytes);
-                self.gl
-                    .buffer_sub_data_u8_slice(target, c.start as i32, bytes);
-            }
-            self.gl.bind_buffer_base(target, index, Some(buf));
-        }
-        explain::numbered(
-            5,
-            &format!("glCreateBuffer + glBufferData + glBufferSubData + glBindBufferBase (binding {index})"),
-            || {
-                let kind = if target == glow::UNIFORM_BUFFER {
-                    "UNIFORM_BUFFER"
-                } else {
-                    "SHADER_STORAGE_BUFFER"
-                };
-                format!(
-                    "{len} bytes, {kind}, STATIC_DRAW: the driver picks the memory; filled in {} glBufferSubData",
-                    chunks.len()
-                )
-            },
-        );
-        Ok(())
+        Ok(SceneBuffers {
+            gl,
+            buffers: uploads.finish(),
+        })
     }
 
     /// Rewrites the `Frame` uniform block (windowed: the camera moves). The
     /// driver orders this after the draws that still read the old contents.
     pub fn update_frame(&self, bytes: &[u8]) {
-        // SAFETY: the buffer holds exactly one Frame, which `bytes` is.
+        // SAFETY: the buffer holds exactly one Frame, which `bytes` is, and
+        // was made with DYNAMIC_STORAGE_BIT.
         unsafe {
             self.gl
                 .bind_buffer(glow::UNIFORM_BUFFER, Some(self.buffers[0]));
@@ -119,11 +79,195 @@ impl<'gl> SceneBuffers<'gl> {
 
 impl Drop for SceneBuffers<'_> {
     fn drop(&mut self) {
-        for &b in self.buffers.iter().rev() {
-            // SAFETY: the buffer was created on this context, which outlives it;
-            // GL keeps it alive for draws already issued.
-            unsafe { self.gl.delete_buffer(b) }
+        delete_buffers(self.gl, &self.buffers);
+    }
+}
+
+/// Deletes `buffers`, newest first. GL keeps a buffer alive for the commands
+/// already issued that use it.
+fn delete_buffers(gl: &glow::Context, buffers: &[glow::Buffer]) {
+    for &b in buffers.iter().rev() {
+        // SAFETY: the buffer was created on this context, which outlives it.
+        unsafe { gl.delete_buffer(b) }
+    }
+}
+
+/// A buffer's size as GL takes it. GL sizes and offsets are signed 32-bit
+/// here; the run plan's storage limit keeps every scene buffer below that.
+fn gl_size(len: usize) -> anyhow::Result<i32> {
+    i32::try_from(len).map_err(|_| anyhow!("a {len}-byte buffer is too large for GL"))
+}
+
+/// Immutable buffers filled through one small staging buffer: each
+/// [`Uploads::add`] makes a buffer and fills it a chunk at a time (the CPU
+/// writes a chunk into the staging buffer, the GPU copies it across, and the
+/// CPU waits for the copy before writing the next), so that a scene of any
+/// size needs only a few tens of MiB of mapped memory. [`Uploads::finish`]
+/// hands the buffers over; until then they are deleted with the uploads on an
+/// error.
+struct Uploads<'gl> {
+    gl: &'gl glow::Context,
+    staging: glow::Buffer,
+    /// The staging buffer's persistent mapping, `len` bytes, write-only.
+    mapped: *mut u8,
+    len: usize,
+    /// Filled and bound, in the order they were added.
+    filled: Vec<glow::Buffer>,
+}
+
+/// How the staging buffer is made and mapped: written by the CPU only, mapped
+/// for its whole life (no map and unmap per chunk), and coherent, so that a
+/// copy issued after a write reads it without a flush.
+const STAGING: u32 = glow::MAP_WRITE_BIT | glow::MAP_PERSISTENT_BIT | glow::MAP_COHERENT_BIT;
+
+impl<'gl> Uploads<'gl> {
+    /// Uploads whose chunks are at most `len` bytes long.
+    fn new(gl: &'gl glow::Context, len: usize) -> anyhow::Result<Uploads<'gl>> {
+        let size = gl_size(len)?;
+        // SAFETY: a fresh buffer on the current context, given `len` bytes of
+        // storage and mapped whole; `Drop` unmaps and deletes it.
+        unsafe {
+            let staging = gl
+                .create_buffer()
+                .map_err(|e| anyhow!(e))
+                .context("glCreateBuffer (staging buffer)")?;
+            let mut uploads = Uploads {
+                gl,
+                staging,
+                mapped: std::ptr::null_mut(),
+                len,
+                filled: Vec::new(),
+            };
+            gl.bind_buffer(glow::COPY_READ_BUFFER, Some(staging));
+            gl.buffer_storage(glow::COPY_READ_BUFFER, size, None, STAGING);
+            uploads.mapped = gl.map_buffer_range(glow::COPY_READ_BUFFER, 0, size, STAGING);
+            if uploads.mapped.is_null() {
+                return Err(anyhow!(
+                    "glMapBufferRange could not map the {len}-byte staging buffer (GL error {:#x})",
+                    gl.get_error()
+                ));
+            }
+            Ok(uploads)
         }
+    }
+
+    /// An immutable buffer of `len` bytes with storage `flags`, bound at
+    /// binding `index` of `target`, filled in `chunks` (byte ranges of at most
+    /// the staging buffer's size): `write(offset, bytes)` writes the contents
+    /// from `offset` into `bytes`, which is the staging buffer.
+    fn add(
+        &mut self,
+        (target, index, flags): (u32, u32, u32),
+        len: usize,
+        chunks: &[std::ops::Range<usize>],
+        write: impl Fn(usize, &mut [u8]),
+    ) -> anyhow::Result<()> {
+        let gl = self.gl;
+        let size = gl_size(len)?;
+        // SAFETY: a fresh buffer on the current context, given `len` bytes of
+        // storage; every chunk lies within it and within the staging buffer
+        // (so its offset and length fit in i32), and the mapping is written
+        // only while no copy that reads it is pending (each copy is waited for).
+        unsafe {
+            let buffer = gl
+                .create_buffer()
+                .map_err(|e| anyhow!(e))
+                .with_context(|| format!("glCreateBuffer (binding {index})"))?;
+            self.filled.push(buffer);
+            gl.bind_buffer(glow::COPY_WRITE_BUFFER, Some(buffer));
+            gl.buffer_storage(glow::COPY_WRITE_BUFFER, size, None, flags);
+            gl.bind_buffer(glow::COPY_READ_BUFFER, Some(self.staging));
+            for c in chunks {
+                if c.len() > self.len {
+                    let n = c.len();
+                    return Err(anyhow!(
+                        "a {n}-byte chunk for a {}-byte staging buffer",
+                        self.len
+                    ));
+                }
+                write(
+                    c.start,
+                    std::slice::from_raw_parts_mut(self.mapped, c.len()),
+                );
+                let (start, n) = (c.start as i32, c.len() as i32);
+                gl.copy_buffer_sub_data(
+                    glow::COPY_READ_BUFFER,
+                    glow::COPY_WRITE_BUFFER,
+                    0,
+                    start,
+                    n,
+                );
+                wait_for_gpu(gl).with_context(|| format!("uploading binding {index}"))?;
+            }
+            // A shader that reads the buffer later sees what the copies wrote:
+            // GL orders its own commands' writes, so unlike Vulkan no barrier.
+            gl.bind_buffer_base(target, index, Some(buffer));
+        }
+        explain::numbered(
+            5,
+            &format!("glCreateBuffer + glBufferStorage + glCopyBufferSubData + glBindBufferBase (binding {index})"),
+            || {
+                let (kind, flags) = if target == glow::UNIFORM_BUFFER {
+                    ("UNIFORM_BUFFER", "DYNAMIC_STORAGE_BIT")
+                } else {
+                    ("SHADER_STORAGE_BUFFER", "no flags: never mapped or rewritten by the CPU")
+                };
+                format!(
+                    "{len} bytes, {kind}, immutable storage, {flags}\nfilled through a {}-byte persistently mapped staging buffer: {} glCopyBufferSubData, each waited for with glFenceSync + glClientWaitSync",
+                    self.len,
+                    chunks.len()
+                )
+            },
+        );
+        Ok(())
+    }
+
+    /// The buffers in the order they were added. Every copy into them has
+    /// been waited for, so the staging buffer can go.
+    fn finish(mut self) -> Vec<glow::Buffer> {
+        std::mem::take(&mut self.filled)
+    }
+}
+
+impl Drop for Uploads<'_> {
+    fn drop(&mut self) {
+        // SAFETY: the staging buffer was created on this context, which
+        // outlives it, and is mapped unless `new` failed to map it; no copy
+        // from it is pending (each was waited for, or never issued).
+        unsafe {
+            if !self.mapped.is_null() {
+                self.gl
+                    .bind_buffer(glow::COPY_READ_BUFFER, Some(self.staging));
+                self.gl.unmap_buffer(glow::COPY_READ_BUFFER);
+            }
+            self.gl.delete_buffer(self.staging);
+        }
+        delete_buffers(self.gl, &self.filled);
+    }
+}
+
+/// Waits until the GPU has run every command issued so far: here, the copy
+/// that read the staging buffer, before the CPU writes the next chunk into it.
+fn wait_for_gpu(gl: &glow::Context) -> anyhow::Result<()> {
+    /// glow takes the timeout in nanoseconds as an i32: wait a second at a time.
+    const SECOND_NS: i32 = 1_000_000_000;
+    // SAFETY: a fence on the current context, deleted before returning.
+    unsafe {
+        let fence = gl
+            .fence_sync(glow::SYNC_GPU_COMMANDS_COMPLETE, 0)
+            .map_err(|e| anyhow!(e))
+            .context("glFenceSync")?;
+        let result = loop {
+            // SYNC_FLUSH_COMMANDS_BIT: the fence must reach the GPU, or the
+            // wait would never end.
+            match gl.client_wait_sync(fence, glow::SYNC_FLUSH_COMMANDS_BIT, SECOND_NS) {
+                glow::TIMEOUT_EXPIRED => continue,
+                glow::ALREADY_SIGNALED | glow::CONDITION_SATISFIED => break Ok(()),
+                status => break Err(anyhow!("glClientWaitSync returned {status:#x}")),
+            }
+        };
+        gl.delete_sync(fence);
+        result
     }
 }
 
