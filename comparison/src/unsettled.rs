@@ -3,7 +3,7 @@
 //! for `twinray diff --exclude`.
 
 use crate::apps::{self, Api};
-use std::path::Path;
+use std::path::{Path, PathBuf};
 use twinray_common::cli::RenderArgs;
 use twinray_common::error::bad_input;
 use twinray_common::reference::image_io::{check_output_file, same_file, write_png};
@@ -22,7 +22,7 @@ pub fn render(api: Api, args: &RenderArgs, mask: Option<&Path>) -> anyhow::Resul
         ));
     }
     check_output_file("--unsettled", mask)?;
-    if args.out.as_deref().is_some_and(|out| same_file(out, mask)) {
+    if args.out.as_deref().is_some_and(|out| one_file(out, mask)) {
         return Err(bad_input(format!(
             "--unsettled '{}' is also --out: the mask would replace the image; choose another file name",
             mask.display()
@@ -36,4 +36,18 @@ pub fn render(api: Api, args: &RenderArgs, mask: Option<&Path>) -> anyhow::Resul
         "--unsettled",
         mask,
     )
+}
+
+/// Whether two output paths name one file, existing or not: the same file, or
+/// the same name in the same folder however the folder is spelt.
+fn one_file(a: &Path, b: &Path) -> bool {
+    let place = |p: &Path| -> Option<PathBuf> {
+        let dir = p.parent().filter(|d| !d.as_os_str().is_empty());
+        Some(
+            std::fs::canonicalize(dir.unwrap_or(Path::new(".")))
+                .ok()?
+                .join(p.file_name()?),
+        )
+    };
+    same_file(a, b) || place(a).is_some_and(|x| Some(x) == place(b))
 }

@@ -84,7 +84,10 @@ fn orchestrator_diff_and_render_errors() {
     // Only the f64 reference names unsettled pixels, and never over its image.
     let mask = dir.join("mask.png");
     let mask_s = mask.to_str().unwrap();
-    for (api, out) in [("vulkan", "x.png"), ("reference", mask_s)] {
+    for (api, out, why) in [
+        ("vulkan", "x.png", "--api reference"),
+        ("reference", mask_s, "--out"),
+    ] {
         let args = [
             "render",
             "--api",
@@ -98,7 +101,7 @@ fn orchestrator_diff_and_render_errors() {
             "--unsettled",
             mask_s,
         ];
-        expect_one(&tw, &args, &[], 2, &["--unsettled"]);
+        expect_one(&tw, &args, &[], 2, &["--unsettled", why]);
     }
     assert!(!mask.exists(), "a refused --unsettled wrote its mask");
 }
