@@ -83,7 +83,7 @@ fn vulkan_opengl_and_the_reference_agree_on_random_scenes() {
 /// Random scene 6 at the size `twinray accuracy --random` renders it: each
 /// app agrees with the f64 reference within 8/255 at every pixel f32 can
 /// settle. Its one pixel off on lavapipe and llvmpipe, (81, 108) at 30/255,
-/// is a ray that bounces seven times inside the mirror teapot, where rounding
+/// is a ray that bounces six times inside the mirror teapot, where rounding
 /// the primary direction to f32 alone changes the colour: the reference's
 /// mask of unsettled pixels names it (comparison/investigations/accuracy/README.md).
 #[test]

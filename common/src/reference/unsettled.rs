@@ -81,7 +81,7 @@ mod tests {
 
     /// Random scene 6's pixel (81, 108) at 160x120 looks into the mirror
     /// teapot's lid, whose reflection enters the pot between lid and body and
-    /// bounces seven times inside: rounding its primary direction to f32 alone
+    /// bounces six times inside: rounding its primary direction to f32 alone
     /// turns it from 32/255 blue to 2/255 (lavapipe and llvmpipe render the
     /// latter, the f64 reference the former). The mask names it, and
     /// leaves the rest of the image alone.
