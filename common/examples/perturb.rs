@@ -44,7 +44,7 @@ fn main() -> anyhow::Result<()> {
     println!("| scene | size | operation | k (ULPs) | pixels > 8/255 vs f64 truth | > 8/255 vs unperturbed | largest vs truth |");
     println!("|---|---|---|---:|---:|---:|---:|");
     for spec in scenes.split(',') {
-        let (name, size) = spec.split_once(':').unwrap_or((spec, "200x200"));
+        let (name, size) = spec.rsplit_once(':').unwrap_or((spec, "200x200"));
         let (w, h) = size
             .split_once('x')
             .ok_or_else(|| anyhow::anyhow!("size {size} is not WxH"))?;

@@ -1,10 +1,18 @@
-//! `twinray diff A.png B.png`: the image metrics of common::metrics, as a table or JSON.
+//! `twinray diff A.png B.png`: the image metrics of common::metrics, as a table or JSON,
+//! over every pixel or (`--exclude`) those a mask does not name.
 
 use std::path::Path;
 use twinray_common::reference::image_io::load_png;
-use twinray_common::reference::metrics::{compare, Metrics};
+use twinray_common::reference::metrics::{compare_outside, Metrics};
+use twinray_common::reference::unsettled::mask_from_image;
 
-pub fn run(a: &Path, b: &Path, json: bool, heatmap: Option<&Path>) -> anyhow::Result<()> {
+pub fn run(
+    a: &Path,
+    b: &Path,
+    json: bool,
+    heatmap: Option<&Path>,
+    exclude: Option<&Path>,
+) -> anyhow::Result<()> {
     // Checked first: a bad --heatmap path is said before any image is read.
     if let Some(path) = heatmap {
         twinray_common::reference::image_io::check_output_file("--heatmap", path)?;
@@ -19,9 +27,27 @@ pub fn run(a: &Path, b: &Path, json: bool, heatmap: Option<&Path>) -> anyhow::Re
         }
     }
     let (ia, ib) = (load_png(a)?, load_png(b)?);
-    let m = compare(&ia, &ib).map_err(|e| {
+    let left_out = match exclude {
+        Some(path) => {
+            let mask = load_png(path)?;
+            if mask.dimensions() != ia.dimensions() {
+                return Err(twinray_common::error::bad_input(format!(
+                    "--exclude '{}' is {}x{}, the images {}x{}: a mask must be of the images' size",
+                    path.display(),
+                    mask.width(),
+                    mask.height(),
+                    ia.width(),
+                    ia.height()
+                )));
+            }
+            mask_from_image(&mask)
+        }
+        None => Vec::new(),
+    };
+    let m = compare_outside(&ia, &ib, &left_out).map_err(|e| {
         twinray_common::error::bad_input(format!("'{}' vs '{}': {e}", a.display(), b.display()))
     })?;
+    let left = left_out.iter().filter(|&&l| l).count();
     if let Some(path) = heatmap {
         let mut out = image::RgbImage::new(ia.width(), ia.height());
         for (x, y, p) in out.enumerate_pixels_mut() {
@@ -37,7 +63,13 @@ pub fn run(a: &Path, b: &Path, json: bool, heatmap: Option<&Path>) -> anyhow::Re
         twinray_common::reference::image_io::write_png(&out, "--heatmap", path)?;
     }
     if json {
-        println!("{}", serde_json::to_string(&m)?);
+        if exclude.is_some() {
+            let mut v = serde_json::to_value(m)?;
+            v["left_out"] = left.into();
+            println!("{v}");
+        } else {
+            println!("{}", serde_json::to_string(&m)?);
+        }
     } else {
         println!(
             "{} vs {} ({}x{})",
@@ -46,6 +78,13 @@ pub fn run(a: &Path, b: &Path, json: bool, heatmap: Option<&Path>) -> anyhow::Re
             m.width,
             m.height
         );
+        if let Some(path) = exclude {
+            println!(
+                "{left} pixels left out (named by {}); the shares are of the other {}",
+                path.display(),
+                (m.width as usize * m.height as usize) - left
+            );
+        }
         print_table(&[("", m)]);
     }
     Ok(())

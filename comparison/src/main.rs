@@ -7,7 +7,8 @@
 //! report.md and plots; `accuracy` is `twinray accuracy` with its own report;
 //! `diff` is `twinray diff`; `csv` writes every CSV file; `failures` and
 //! `interrupt` are how a long run ends when some run failed or a signal came;
-//! `ulp` is `twinray ulp`, the GPU's f32 arithmetic measured.
+//! `ulp` is `twinray ulp`, the GPU's f32 arithmetic measured; `unsettled` is
+//! `render --unsettled`, the reference's mask of pixels f32 cannot settle.
 
 mod accuracy;
 mod apps;
@@ -18,6 +19,7 @@ mod failures;
 mod interrupt;
 mod report;
 mod ulp;
+mod unsettled;
 
 use clap::{Parser, Subcommand};
 use twinray_common::cli::{named_in_env, RenderArgs};
@@ -51,6 +53,9 @@ enum Command {
         api: apps::Api,
         #[command(flatten)]
         args: RenderArgs,
+        /// Reference only: also write a mask (white) of the pixels f32 cannot settle, whose f64 colour moves by more than 8/255 when the primary ray turns by 4 f32 ULPs (for `twinray diff --exclude`).
+        #[arg(long, value_name = "MASK.png")]
+        unsettled: Option<std::path::PathBuf>,
     },
     /// Side-by-side Vulkan vs OpenGL on the study's three experiments: results.csv, report.md, plots.
     Compare(compare::CompareArgs),
@@ -68,6 +73,9 @@ enum Command {
         /// Also write a PNG that shows A dimmed to grey and every pixel off by more than 1/255 in red.
         #[arg(long)]
         heatmap: Option<std::path::PathBuf>,
+        /// Leave out the pixels a mask names (any channel above 127), e.g. `render --api reference --unsettled`'s.
+        #[arg(long, value_name = "MASK.png")]
+        exclude: Option<std::path::PathBuf>,
     },
 }
 
@@ -82,13 +90,18 @@ fn main() {
     };
     apps::set_bin_dir(cli.bin_dir);
     let result = match cli.command {
-        Command::Render { api, args } => apps::render(api, &args),
+        Command::Render {
+            api,
+            args,
+            unsettled,
+        } => unsettled::render(api, &args, unsettled.as_deref()),
         Command::Diff {
             a,
             b,
             json,
             heatmap,
-        } => diff::run(&a, &b, json, heatmap.as_deref()),
+            exclude,
+        } => diff::run(&a, &b, json, heatmap.as_deref(), exclude.as_deref()),
         Command::Compare(args) => compare::run(&args),
         Command::Accuracy(args) => accuracy::run(&args),
         Command::Ulp(args) => ulp::run(&args),

@@ -31,6 +31,16 @@ impl Metrics {
 
 /// Compares two 8-bit RGB images of the same size.
 pub fn compare(a: &image::RgbImage, b: &image::RgbImage) -> anyhow::Result<Metrics> {
+    compare_outside(a, b, &[])
+}
+
+/// `compare` over the pixels `left_out` does not name (row by row, top row
+/// first; empty: none left out): the shares are of the pixels compared.
+pub fn compare_outside(
+    a: &image::RgbImage,
+    b: &image::RgbImage,
+    left_out: &[bool],
+) -> anyhow::Result<Metrics> {
     if a.dimensions() != b.dimensions() {
         return Err(crate::error::bad_input(format!(
             "the images differ in size ({}x{} vs {}x{})",
@@ -40,8 +50,14 @@ pub fn compare(a: &image::RgbImage, b: &image::RgbImage) -> anyhow::Result<Metri
             b.height()
         )));
     }
+    let skip = |i: usize| left_out.get(i).copied().unwrap_or(false);
     let (mut sq, mut max_abs, mut above_1, mut above_8) = (0.0f64, 0u8, 0usize, 0usize);
-    for (pa, pb) in a.pixels().zip(b.pixels()) {
+    let mut n = 0usize;
+    for (i, (pa, pb)) in a.pixels().zip(b.pixels()).enumerate() {
+        if skip(i) {
+            continue;
+        }
+        n += 1;
         let mut worst = 0u8;
         for c in 0..3 {
             let d = pa[c].abs_diff(pb[c]);
@@ -52,7 +68,7 @@ pub fn compare(a: &image::RgbImage, b: &image::RgbImage) -> anyhow::Result<Metri
         above_1 += (worst > 1) as usize;
         above_8 += (worst > 8) as usize;
     }
-    let n = (a.width() as usize * a.height() as usize).max(1);
+    let n = n.max(1);
     let rmse = (sq / (n * 3) as f64).sqrt();
     let psnr_db = if rmse == 0.0 {
         f64::INFINITY
@@ -90,6 +106,21 @@ mod tests {
         assert!((m.above_1 - 0.02).abs() < 1e-12);
         assert!((m.above_8 - 0.01).abs() < 1e-12);
         assert!((m.within_1() - 0.98).abs() < 1e-12);
+    }
+
+    #[test]
+    fn pixels_left_out_are_not_compared() {
+        let a = image::RgbImage::from_pixel(10, 10, image::Rgb([100, 100, 100]));
+        let mut b = a.clone();
+        b.put_pixel(3, 0, image::Rgb([200, 100, 100]));
+        b.put_pixel(4, 0, image::Rgb([102, 100, 100]));
+        let mut left_out = vec![false; 100];
+        left_out[3] = true;
+        let m = compare_outside(&a, &b, &left_out).unwrap();
+        assert_eq!(m.max_abs, 2);
+        assert!((m.above_1 - 1.0 / 99.0).abs() < 1e-12);
+        assert_eq!(m.above_8, 0.0);
+        assert_eq!(compare(&a, &b).unwrap().max_abs, 100);
     }
 
     #[test]

@@ -18,6 +18,7 @@ pub mod image_io;
 mod intersect;
 pub mod metrics;
 pub mod perturb;
+pub mod unsettled;
 
 use crate::rays::RayKinds;
 use crate::reference::image_io::FloatImage;
@@ -26,7 +27,7 @@ use crate::reference::perturb::{at, at3, scaled, Op};
 use crate::scene::camera::{in_local_frame, RayFrame};
 use crate::scene::numerics::{Numerics, Offset, SphereTest, TriangleTest};
 use crate::scene::Scene;
-use glam::DVec3;
+use glam::{DVec2, DVec3};
 use rayon::prelude::*;
 use std::sync::atomic::{AtomicUsize, Ordering};
 
@@ -59,8 +60,32 @@ pub fn render_counting(
     bvh_width: Option<u32>,
     rows_done: &AtomicUsize,
 ) -> FloatImage {
+    render_turned(
+        scene,
+        width,
+        height,
+        numerics,
+        bvh_width,
+        rows_done,
+        DVec2::ZERO,
+    )
+}
+
+/// `render_counting` with every primary ray turned by `turn` radians
+/// towards the image's right (x) and down (y) (`unsettled`); zero leaves
+/// each direction as it is, bit for bit.
+fn render_turned(
+    scene: &Scene,
+    width: u32,
+    height: u32,
+    numerics: &Numerics,
+    bvh_width: Option<u32>,
+    rows_done: &AtomicUsize,
+    turn: DVec2,
+) -> FloatImage {
     // The GPU's frame: positions relative to the local origin, then rounded to f32.
     let frame = RayFrame::local(scene, &scene.camera, width, height).rounded_to_f32();
+    let (right, down) = (frame.step_x.normalize(), frame.step_y.normalize());
     let mut scene = in_local_frame(scene).rounded_to_f32();
     scene.numerics = *numerics;
     let tracer = match bvh_width {
@@ -71,10 +96,11 @@ pub fn render_counting(
     let mut pixels = vec![[0f32; 3]; crate::limits::pixel_count(width, height)];
     pixels.par_chunks_mut(w).enumerate().for_each(|(y, row)| {
         for (x, px) in row.iter_mut().enumerate() {
-            let dir = scaled(
-                Op::DirLength,
-                at3(Op::PrimaryDir, frame.dir(x as f64, y as f64)),
-            );
+            let mut dir = frame.dir(x as f64, y as f64);
+            if turn != DVec2::ZERO {
+                dir = (dir + turn.x * right + turn.y * down).normalize();
+            }
+            let dir = scaled(Op::DirLength, at3(Op::PrimaryDir, dir));
             let c = tracer.trace(frame.eye, dir);
             *px = [c.x as f32, c.y as f32, c.z as f32];
         }

@@ -67,6 +67,43 @@ fn orchestrator_diff_and_render_errors() {
         ];
         expect_one(&tw, &args, &[], 2, &["--heatmap", "input image"]);
     }
+    // A mask of another size cannot say which pixels to leave out.
+    expect_one(
+        &tw,
+        &[
+            "diff",
+            a.to_str().unwrap(),
+            c.to_str().unwrap(),
+            "--exclude",
+            b.to_str().unwrap(),
+        ],
+        &[],
+        2,
+        &["--exclude", "5x4"],
+    );
+    // Only the f64 reference names unsettled pixels, and never over its image.
+    let mask = dir.join("mask.png");
+    let mask_s = mask.to_str().unwrap();
+    for (api, out, why) in [
+        ("vulkan", "x.png", "--api reference"),
+        ("reference", mask_s, "--out"),
+    ] {
+        let args = [
+            "render",
+            "--api",
+            api,
+            "--scene",
+            "box",
+            "--size",
+            "8x8",
+            "--out",
+            out,
+            "--unsettled",
+            mask_s,
+        ];
+        expect_one(&tw, &args, &[], 2, &["--unsettled", why]);
+    }
+    assert!(!mask.exists(), "a refused --unsettled wrote its mask");
 }
 
 /// A folder that exists but lacks the apps is refused the same way from the

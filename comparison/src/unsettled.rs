@@ -1,0 +1,53 @@
+//! `twinray render --api reference --unsettled MASK.png`: besides the image,
+//! the mask of the pixels f32 cannot settle (common's `reference::unsettled`),
+//! for `twinray diff --exclude`.
+
+use crate::apps::{self, Api};
+use std::path::{Path, PathBuf};
+use twinray_common::cli::RenderArgs;
+use twinray_common::error::bad_input;
+use twinray_common::reference::image_io::{check_output_file, same_file, write_png};
+use twinray_common::reference::unsettled::{mask_image, unsettled};
+use twinray_common::scene::Scene;
+
+/// `twinray render`, and with `mask` (reference only) the mask written there too.
+pub fn render(api: Api, args: &RenderArgs, mask: Option<&Path>) -> anyhow::Result<()> {
+    let Some(mask) = mask else {
+        return apps::render(api, args);
+    };
+    // Said before anything renders.
+    if api != Api::Reference {
+        return Err(bad_input(
+            "--unsettled is the f64 reference's: use it with --api reference",
+        ));
+    }
+    check_output_file("--unsettled", mask)?;
+    if args.out.as_deref().is_some_and(|out| one_file(out, mask)) {
+        return Err(bad_input(format!(
+            "--unsettled '{}' is also --out: the mask would replace the image; choose another file name",
+            mask.display()
+        )));
+    }
+    apps::render(api, args)?;
+    let scene = Scene::load(&args.scene, &args.overrides()?)?;
+    let (w, h) = (args.size.width, args.size.height);
+    write_png(
+        &mask_image(&unsettled(&scene, w, h), w, h),
+        "--unsettled",
+        mask,
+    )
+}
+
+/// Whether two output paths name one file, existing or not: the same file, or
+/// the same name in the same folder however the folder is spelt.
+fn one_file(a: &Path, b: &Path) -> bool {
+    let place = |p: &Path| -> Option<PathBuf> {
+        let dir = p.parent().filter(|d| !d.as_os_str().is_empty());
+        Some(
+            std::fs::canonicalize(dir.unwrap_or(Path::new(".")))
+                .ok()?
+                .join(p.file_name()?),
+        )
+    };
+    same_file(a, b) || place(a).is_some_and(|x| Some(x) == place(b))
+}
