@@ -5,11 +5,14 @@
 //!
 //! The scene buffers are immutable (`glBufferStorage`) and filled by the GPU,
 //! the way the Vulkan twin fills its device-local buffers (vk/src/memory.rs):
-//! the CPU writes a chunk into one small mapped staging buffer and
-//! `glCopyBufferSubData` copies it across. A buffer the CPU may neither map
-//! nor rewrite is one the driver need not shadow in system memory. Filled by
-//! `glBufferData` and `glBufferSubData`, the buffers cost NVIDIA's GL driver
-//! about 150 bytes of host memory a triangle more than Vulkan's.
+//! the CPU makes a chunk in host memory, `glBufferSubData` puts it in one
+//! small staging buffer and `glCopyBufferSubData` copies it across. A buffer
+//! the CPU may neither map nor rewrite is one the driver need not shadow in
+//! system memory. Filled by `glBufferData` and `glBufferSubData` directly,
+//! the buffers cost NVIDIA's GL driver about 150 bytes of host memory a
+//! triangle more than Vulkan's. (A persistently mapped staging buffer, written
+//! in place, gave NVIDIA's GL driver wrong BVH buffers: comparison/results/
+//! nvidia-h100/FINDINGS.md, "OpenGL's upload, after".)
 
 use anyhow::{anyhow, Context as _};
 use glow::HasContext;
@@ -102,52 +105,45 @@ fn gl_size(len: usize) -> anyhow::Result<i32> {
 /// [`Uploads::add`] makes a buffer and fills it a chunk at a time (the CPU
 /// writes a chunk into the staging buffer, the GPU copies it across, and the
 /// CPU waits for the copy before writing the next), so that a scene of any
-/// size needs only a few tens of MiB of mapped memory. [`Uploads::finish`]
+/// size needs only a few tens of MiB of host memory. [`Uploads::finish`]
 /// hands the buffers over; until then they are deleted with the uploads on an
 /// error.
 struct Uploads<'gl> {
     gl: &'gl glow::Context,
     staging: glow::Buffer,
-    /// The staging buffer's persistent mapping, `len` bytes, write-only.
-    mapped: *mut u8,
+    /// Host memory for one chunk (u32s: aligned for every GPU struct, which
+    /// `write_storage` fills in place), `len` bytes.
+    chunk: Vec<u32>,
     len: usize,
     /// Filled and bound, in the order they were added.
     filled: Vec<glow::Buffer>,
 }
-
-/// How the staging buffer is made and mapped: written by the CPU only, mapped
-/// for its whole life (no map and unmap per chunk), and coherent, so that a
-/// copy issued after a write reads it without a flush.
-const STAGING: u32 = glow::MAP_WRITE_BIT | glow::MAP_PERSISTENT_BIT | glow::MAP_COHERENT_BIT;
 
 impl<'gl> Uploads<'gl> {
     /// Uploads whose chunks are at most `len` bytes long.
     fn new(gl: &'gl glow::Context, len: usize) -> anyhow::Result<Uploads<'gl>> {
         let size = gl_size(len)?;
         // SAFETY: a fresh buffer on the current context, given `len` bytes of
-        // storage and mapped whole; `Drop` unmaps and deletes it.
+        // storage that glBufferSubData may rewrite; `Drop` deletes it.
         unsafe {
             let staging = gl
                 .create_buffer()
                 .map_err(|e| anyhow!(e))
                 .context("glCreateBuffer (staging buffer)")?;
-            let mut uploads = Uploads {
+            gl.bind_buffer(glow::COPY_READ_BUFFER, Some(staging));
+            gl.buffer_storage(
+                glow::COPY_READ_BUFFER,
+                size,
+                None,
+                glow::DYNAMIC_STORAGE_BIT,
+            );
+            Ok(Uploads {
                 gl,
                 staging,
-                mapped: std::ptr::null_mut(),
+                chunk: vec![0; len.div_ceil(4)],
                 len,
                 filled: Vec::new(),
-            };
-            gl.bind_buffer(glow::COPY_READ_BUFFER, Some(staging));
-            gl.buffer_storage(glow::COPY_READ_BUFFER, size, None, STAGING);
-            uploads.mapped = gl.map_buffer_range(glow::COPY_READ_BUFFER, 0, size, STAGING);
-            if uploads.mapped.is_null() {
-                return Err(anyhow!(
-                    "glMapBufferRange could not map the {len}-byte staging buffer (GL error {:#x})",
-                    gl.get_error()
-                ));
-            }
-            Ok(uploads)
+            })
         }
     }
 
@@ -166,8 +162,8 @@ impl<'gl> Uploads<'gl> {
         let size = gl_size(len)?;
         // SAFETY: a fresh buffer on the current context, given `len` bytes of
         // storage; every chunk lies within it and within the staging buffer
-        // (so its offset and length fit in i32), and the mapping is written
-        // only while no copy that reads it is pending (each copy is waited for).
+        // (so its offset and length fit in i32); each copy is waited for
+        // before the staging buffer is rewritten.
         unsafe {
             let buffer = gl
                 .create_buffer()
@@ -185,10 +181,9 @@ impl<'gl> Uploads<'gl> {
                         self.len
                     ));
                 }
-                write(
-                    c.start,
-                    std::slice::from_raw_parts_mut(self.mapped, c.len()),
-                );
+                let bytes = &mut bytemuck::cast_slice_mut(&mut self.chunk)[..c.len()];
+                write(c.start, bytes);
+                gl.buffer_sub_data_u8_slice(glow::COPY_READ_BUFFER, 0, bytes);
                 let (start, n) = (c.start as i32, c.len() as i32);
                 gl.copy_buffer_sub_data(
                     glow::COPY_READ_BUFFER,
@@ -213,7 +208,7 @@ impl<'gl> Uploads<'gl> {
                     ("SHADER_STORAGE_BUFFER", "no flags: never mapped or rewritten by the CPU")
                 };
                 format!(
-                    "{len} bytes, {kind}, immutable storage, {flags}\nfilled through a {}-byte persistently mapped staging buffer: {} glCopyBufferSubData, each waited for with glFenceSync + glClientWaitSync",
+                    "{len} bytes, {kind}, immutable storage, {flags}\nfilled through a {}-byte staging buffer: {} glBufferSubData + glCopyBufferSubData, each waited for with glFenceSync + glClientWaitSync",
                     self.len,
                     chunks.len()
                 )
@@ -232,16 +227,8 @@ impl<'gl> Uploads<'gl> {
 impl Drop for Uploads<'_> {
     fn drop(&mut self) {
         // SAFETY: the staging buffer was created on this context, which
-        // outlives it, and is mapped unless `new` failed to map it; no copy
-        // from it is pending (each was waited for, or never issued).
-        unsafe {
-            if !self.mapped.is_null() {
-                self.gl
-                    .bind_buffer(glow::COPY_READ_BUFFER, Some(self.staging));
-                self.gl.unmap_buffer(glow::COPY_READ_BUFFER);
-            }
-            self.gl.delete_buffer(self.staging);
-        }
+        // outlives it; GL keeps it alive for any copy still reading it.
+        unsafe { self.gl.delete_buffer(self.staging) }
         delete_buffers(self.gl, &self.filled);
     }
 }
