@@ -51,6 +51,10 @@ enum Command {
         api: apps::Api,
         #[command(flatten)]
         args: RenderArgs,
+        /// With --api reference: the f64 truth the hard cases are measured
+        /// against (the truth numerics, whatever the scene's own).
+        #[arg(long, hide = true)]
+        truth: bool,
     },
     /// Side-by-side Vulkan vs OpenGL on the study's three experiments: results.csv, report.md, plots.
     Compare(compare::CompareArgs),
@@ -69,6 +73,10 @@ enum Command {
         #[arg(long)]
         heatmap: Option<std::path::PathBuf>,
     },
+    /// The app options of each run every hard case must pass besides the
+    /// default, one run a line (for the tolerance measurement script).
+    #[command(hide = true)]
+    HardRuns,
 }
 
 fn main() {
@@ -82,7 +90,7 @@ fn main() {
     };
     apps::set_bin_dir(cli.bin_dir);
     let result = match cli.command {
-        Command::Render { api, args } => apps::render(api, &args),
+        Command::Render { api, args, truth } => apps::render(api, &args, truth),
         Command::Diff {
             a,
             b,
@@ -92,6 +100,12 @@ fn main() {
         Command::Compare(args) => compare::run(&args),
         Command::Accuracy(args) => accuracy::run(&args),
         Command::Ulp(args) => ulp::run(&args),
+        Command::HardRuns => {
+            for run in twinray_common::scene::hard::RUNS {
+                println!("{}", run.join(" "));
+            }
+            Ok(())
+        }
     };
     if let Err(e) = result {
         exit_with("twinray", e);
