@@ -25,7 +25,9 @@ mkdir -p "$out/img"
 csv="$out/tolerances.csv"
 errors="$out/tolerances.log"
 : > "$errors"
-nvidia-smi --query-gpu=name,driver_version --format=csv > "$out/gpu.txt" 2>&1 || true
+# shellcheck source=comparison/investigations/lib.sh
+source "$here/comparison/investigations/lib.sh"
+gpu_info
 mapfile -t runs < <("$bin/twinray" hard-runs)
 if [ ${#runs[@]} -eq 0 ]; then
     echo "$bin/twinray hard-runs printed no runs" >&2
@@ -42,11 +44,11 @@ for scene in "$here"/scenes/hard/*.toml; do
     fi
     for app in vk gl; do
         if [ $app = vk ]; then api=vulkan; else api=opengl; fi
-        for run in "${runs[@]}"; do
-            label=${run:-default}
+        for opts in "${runs[@]}"; do
+            label=${opts:-default}
             img="$out/img/$case-$app-$(echo "$label" | tr ' ' '_' | tr -d -).png"
             # shellcheck disable=SC2086 # a run is a list of options
-            if report=$(timeout 120 "$bin/twinray-$app" --headless --json --scene "$scene" --size $size --out "$img" $run 2>> "$errors") &&
+            if report=$(timeout 120 "$bin/twinray-$app" --headless --json --scene "$scene" --size $size --out "$img" $opts 2>> "$errors") &&
                 diff=$("$bin/twinray" diff "$truth" "$img" --json 2>> "$errors"); then
                 share=$(echo "$diff" | sed -n 's/.*"above_8":\([-0-9.eE+]*\).*/\1/p')
                 nan=$(echo "$report" | sed -n 's/.*"nonfinite_pixels":\([0-9]*\).*/\1/p' | tail -1)
