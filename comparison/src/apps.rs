@@ -199,8 +199,15 @@ pub fn app_args(args: &RenderArgs) -> Vec<String> {
     v
 }
 
-/// Runs an app, passing its output through, and exits with its exit code on failure.
-pub fn render(api: Api, args: &RenderArgs) -> anyhow::Result<()> {
+/// Runs an app, passing its output through, and exits with its exit code on
+/// failure; `truth` (reference only) renders the f64 truth.
+pub fn render(api: Api, args: &RenderArgs, truth: bool) -> anyhow::Result<()> {
+    if truth && api != Api::Reference {
+        return Err(twinray_common::error::bad_input(format!(
+            "render --truth is the f64 truth of the reference only; --api {} cannot render it",
+            api_name(api)
+        )));
+    }
     match api.binary() {
         Some(bin) => {
             let mut args = args.clone();
@@ -215,7 +222,7 @@ pub fn render(api: Api, args: &RenderArgs) -> anyhow::Result<()> {
             }
             Ok(())
         }
-        None => reference::render_reference(args),
+        None => reference::render_reference(args, truth),
     }
 }
 

@@ -56,6 +56,10 @@ enum Command {
         /// Reference only: also write a mask (white) of the pixels f32 cannot settle, whose f64 colour moves by more than 8/255 when the primary ray turns by 4 f32 ULPs (for `twinray diff --exclude`).
         #[arg(long, value_name = "MASK.png")]
         unsettled: Option<std::path::PathBuf>,
+        /// With --api reference: the f64 truth the hard cases are measured
+        /// against (the truth numerics, whatever the scene's own).
+        #[arg(long, hide = true)]
+        truth: bool,
     },
     /// Side-by-side Vulkan vs OpenGL on the study's three experiments: results.csv, report.md, plots.
     Compare(compare::CompareArgs),
@@ -77,6 +81,10 @@ enum Command {
         #[arg(long, value_name = "MASK.png")]
         exclude: Option<std::path::PathBuf>,
     },
+    /// The app options of each run every hard case must pass besides the
+    /// default, one run a line (for the tolerance measurement script).
+    #[command(hide = true)]
+    HardRuns,
 }
 
 fn main() {
@@ -94,7 +102,8 @@ fn main() {
             api,
             args,
             unsettled,
-        } => unsettled::render(api, &args, unsettled.as_deref()),
+            truth,
+        } => unsettled::render(api, &args, truth, unsettled.as_deref()),
         Command::Diff {
             a,
             b,
@@ -105,6 +114,12 @@ fn main() {
         Command::Compare(args) => compare::run(&args),
         Command::Accuracy(args) => accuracy::run(&args),
         Command::Ulp(args) => ulp::run(&args),
+        Command::HardRuns => {
+            for run in twinray_common::scene::hard::RUNS {
+                println!("{}", run.join(" "));
+            }
+            Ok(())
+        }
     };
     if let Err(e) = result {
         exit_with("twinray", e);

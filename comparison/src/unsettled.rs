@@ -10,10 +10,11 @@ use twinray_common::reference::image_io::{check_output_file, same_file, write_pn
 use twinray_common::reference::unsettled::{mask_image, unsettled};
 use twinray_common::scene::Scene;
 
-/// `twinray render`, and with `mask` (reference only) the mask written there too.
-pub fn render(api: Api, args: &RenderArgs, mask: Option<&Path>) -> anyhow::Result<()> {
+/// `twinray render` (`truth`: the reference's f64 truth), and with `mask`
+/// (reference only) the mask written there too.
+pub fn render(api: Api, args: &RenderArgs, truth: bool, mask: Option<&Path>) -> anyhow::Result<()> {
     let Some(mask) = mask else {
-        return apps::render(api, args);
+        return apps::render(api, args, truth);
     };
     // Said before anything renders.
     if api != Api::Reference {
@@ -28,7 +29,7 @@ pub fn render(api: Api, args: &RenderArgs, mask: Option<&Path>) -> anyhow::Resul
             mask.display()
         )));
     }
-    apps::render(api, args)?;
+    apps::render(api, args, truth)?;
     let scene = Scene::load(&args.scene, &args.overrides()?)?;
     let (w, h) = (args.size.width, args.size.height);
     write_png(

@@ -19,18 +19,6 @@ use twinray_tests::{render, scratch, App};
 
 const SIZE: &str = "64x64";
 
-/// The runs besides the default that each case must also pass.
-const ALSO: [&[&str]; 7] = [
-    &["--path", "compute"],
-    &["--path", "compute", "--workgroup", "4x4"],
-    &["--accel", "bvh"],
-    &["--accel", "bvh", "--path", "compute"],
-    &["--accel", "bvh", "--path", "compute", "--workgroup", "4x4"],
-    // The wide trees: each width on one path, both paths between them.
-    &["--accel", "bvh4", "--path", "compute", "--workgroup", "4x4"],
-    &["--accel", "bvh8"],
-];
-
 fn check(name: &str) {
     let path = Path::new(hard::SOURCE_DIR).join(format!("{name}.toml"));
     let case: HardCase = hard::parse(&path).unwrap();
@@ -47,7 +35,7 @@ fn check(name: &str) {
     .to_rgb8();
     let dir = scratch(&format!("hard-{name}"));
     for app in App::BOTH {
-        for extra in ALSO {
+        for extra in hard::RUNS {
             let (report, img) = render(app, p, SIZE, extra, &dir.join("x.png"));
             within_tolerance(&case, app, extra, &report, &img, &truth);
         }

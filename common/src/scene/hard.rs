@@ -14,6 +14,25 @@ pub const WRONG_ABOVE: u8 = 8;
 /// Where the hard cases live in this source tree (the default for tools).
 pub const SOURCE_DIR: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/../scenes/hard");
 
+/// The runs besides the default that every hard case must also pass, as app
+/// options: a per-pixel tracer's image must not depend on the path, the
+/// workgroup or a user's choice of acceleration, and Mesa once lost whole
+/// objects with small BVH trees (a one-element stack) and a wall where a
+/// workgroup is narrower than its vector. tests/tests/hard_cases.rs renders
+/// them, and `twinray hard-runs` prints them for
+/// comparison/investigations/accuracy/gpu-tolerances.sh, which measures the
+/// tolerances on each driver.
+pub const RUNS: [&[&str]; 7] = [
+    &["--path", "compute"],
+    &["--path", "compute", "--workgroup", "4x4"],
+    &["--accel", "bvh"],
+    &["--accel", "bvh", "--path", "compute"],
+    &["--accel", "bvh", "--path", "compute", "--workgroup", "4x4"],
+    // The wide trees: each width on one path, both paths between them.
+    &["--accel", "bvh4", "--path", "compute", "--workgroup", "4x4"],
+    &["--accel", "bvh8"],
+];
+
 #[derive(Debug, Clone, PartialEq)]
 pub struct HardCase {
     pub name: String,

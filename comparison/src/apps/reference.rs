@@ -9,8 +9,10 @@ use twinray_common::scene::accel::Accel;
 use twinray_common::scene::Scene;
 
 /// The f64 CPU reference, in-process. With `--json` it prints a report in the
-/// apps' format (api "reference", CPU time as wall time).
-pub fn render_reference(args: &RenderArgs) -> anyhow::Result<()> {
+/// apps' format (api "reference", CPU time as wall time). With `truth`, the
+/// f64 truth (`reference::render_truth`, what the hard cases are measured
+/// against) instead of the scene's own numerics.
+pub fn render_reference(args: &RenderArgs, truth: bool) -> anyhow::Result<()> {
     let start = Instant::now();
     if !args.json && args.out.is_none() {
         return Err(bad_input(
@@ -26,6 +28,13 @@ pub fn render_reference(args: &RenderArgs) -> anyhow::Result<()> {
             ignored.join(", ")
         )));
     }
+    // The truth always traces every primitive with its own numerics: a tree
+    // asked for, or rays counted with the scene's numerics, would not be it.
+    if truth && (args.accel != Accel::Auto || args.count_rays) {
+        return Err(bad_input(
+            "render --truth takes neither --accel nor --count-rays: the f64 truth tests every primitive with its own numerics",
+        ));
+    }
     args.check_outputs()?;
     let scene = Scene::load(&args.scene, &args.overrides()?)?;
     let (w, h) = (args.size.width, args.size.height);
@@ -33,7 +42,11 @@ pub fn render_reference(args: &RenderArgs) -> anyhow::Result<()> {
     // --accel none: brute force, a reference independent of the BVH code;
     // else through the tree of the width asked for, as the apps trace it.
     let bvh_width = (args.accel != Accel::None).then(|| args.accel.width(&scene));
-    let img = render_with_progress(&scene, w, h, bvh_width);
+    let img = if truth {
+        twinray_common::reference::render_truth(&scene, w, h)
+    } else {
+        render_with_progress(&scene, w, h, bvh_width)
+    };
     let ms = t.elapsed().as_secs_f64() * 1e3;
     if let Some(out) = &args.out {
         img.save_png_for("--out", out)?;

@@ -54,6 +54,30 @@ fn orchestrator_diff_and_render_errors() {
         args.extend(value);
         expect_one(&tw, &args, &[], 2, &["--api reference", option]);
     }
+    // The hidden --truth is the reference's alone, and renders the truth only
+    // as the hard-case tests take it: no tree, no ray counts.
+    for (api, extra) in [
+        ("vulkan", None),
+        ("opengl", None),
+        ("reference", Some("--accel")),
+        ("reference", Some("--count-rays")),
+    ] {
+        let mut args = vec![
+            "render", "--truth", "--api", api, "--scene", "box", "--json",
+        ];
+        let named = match extra {
+            Some("--accel") => {
+                args.extend(["--accel", "bvh"]);
+                "--accel"
+            }
+            Some(option) => {
+                args.push(option);
+                option
+            }
+            None => api,
+        };
+        expect_one(&tw, &args, &[], 2, &["--truth", named]);
+    }
     // Neither may the heatmap replace an image it compares.
     let c = dir.join("c.png");
     image::RgbImage::new(4, 4).save(&c).unwrap();
