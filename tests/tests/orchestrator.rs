@@ -62,3 +62,45 @@ fn render_through_the_orchestrator_matches_the_app() {
     let img = twinray_common::reference::image_io::load_png(&out).unwrap();
     assert_eq!(img.dimensions(), (48, 32));
 }
+
+/// The hidden `render --truth` and `hard-runs` that
+/// comparison/investigations/accuracy/gpu-tolerances.sh measures with: the
+/// truth is the very image tests/tests/hard_cases.rs compares against (not the
+/// reference with the scene's own numerics, which on coplanar differs from it),
+/// and the runs are the test's.
+#[test]
+fn the_tolerance_script_gets_the_hard_cases_truth_and_runs() {
+    use twinray_common::scene::{hard, Scene};
+    let dir = scratch("truth");
+    let scene = format!("{}/coplanar.toml", hard::SOURCE_DIR);
+    let render = |extra: &[&str], name: &str| {
+        let out = dir.join(name);
+        let mut args = vec!["render", "--api", "reference", "--scene", &scene];
+        args.extend(["--size", "64x64", "--out", out.to_str().unwrap()]);
+        args.extend(extra);
+        let o = run(&bin("twinray"), &args, &[]);
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+        twinray_common::reference::image_io::load_png(&out).unwrap()
+    };
+    let truth = render(&["--truth"], "truth.png");
+    let own = render(&[], "own.png");
+    let expected =
+        twinray_common::reference::render_truth(&Scene::load(&scene, &[]).unwrap(), 64, 64)
+            .to_rgb8();
+    assert!(
+        truth == expected,
+        "render --truth is not reference::render_truth"
+    );
+    assert!(
+        truth != own,
+        "coplanar's truth equals its own numerics' render"
+    );
+    let o = run(&bin("twinray"), &["hard-runs"], &[]);
+    let printed: Vec<String> = String::from_utf8_lossy(&o.stdout)
+        .lines()
+        .map(String::from)
+        .collect();
+    let runs: Vec<String> = hard::RUNS.iter().map(|r| r.join(" ")).collect();
+    assert_eq!(printed, runs);
+    std::fs::remove_dir_all(dir).ok();
+}
