@@ -105,7 +105,13 @@ fn orchestrator_diff_and_render_errors() {
         2,
         &["--exclude", "5x4"],
     );
-    // Only the f64 reference names unsettled pixels, and never over its image.
+}
+
+/// Only the f64 reference names unsettled pixels, and never over its image.
+#[test]
+fn unsettled_masks_are_the_references_alone() {
+    let dir = scratch("unsettled");
+    let tw = bin("twinray");
     let mask = dir.join("mask.png");
     let mask_s = mask.to_str().unwrap();
     for (api, out, why) in [
