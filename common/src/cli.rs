@@ -517,7 +517,8 @@ mod tests {
                 "naga-aliasing",
                 "robust-access",
                 "warp-probe",
-                "ulp"
+                "ulp",
+                "per-light-shadows"
             ]
         );
         assert_eq!(

@@ -313,4 +313,157 @@ Hit traverse(vec3 origin, vec3 dir, float t_max, bool any_hit) {
     }
     return h;
 }
+// The shadow rays of one hit point, walked together (SHADOW_PACKET, set by
+// common/src/shader/variant.rs to the number of rays a packet holds, 2 to 4,
+// where a scene has two lights or more, the tree is binary and the offset
+// takes no direction, so that every light's ray starts at the same point).
+// A packet is one component of a PVEC per ray: one walk, one node read and
+// one stack for them all instead of a walk each, which the teapot's three
+// lights made three dependent walks per pixel. Each ray goes into a subtree
+// only if its own box test there says so, and tests its leaves with the same
+// tests and the same reach as traverse(origin, dir, reach, true), so it
+// reaches exactly the leaves its own walk would and is blocked exactly when
+// that walk would have found a hit. Only the order in
+// which the rays' leaves come may differ, which an any-hit query does not see.
+// `--experiment per-light-shadows` puts back a walk per light.
+#ifdef SHADOW_PACKET
+#if SHADOW_PACKET == 2
+#define PVEC vec2
+#define PACKET_BITS(b) ((b.x ? 1u : 0u) | (b.y ? 2u : 0u))
+#define PACKET_MIN(t, m) min(((m) & 1u) != 0u ? t.x : WIDE_MISS_T, ((m) & 2u) != 0u ? t.y : WIDE_MISS_T)
+#elif SHADOW_PACKET == 3
+#define PVEC vec3
+#define PACKET_BITS(b) ((b.x ? 1u : 0u) | (b.y ? 2u : 0u) | (b.z ? 4u : 0u))
+#define PACKET_MIN(t, m) min(min(((m) & 1u) != 0u ? t.x : WIDE_MISS_T, ((m) & 2u) != 0u ? t.y : WIDE_MISS_T), ((m) & 4u) != 0u ? t.z : WIDE_MISS_T)
+#else
+#define PVEC vec4
+#define PACKET_BITS(b) ((b.x ? 1u : 0u) | (b.y ? 2u : 0u) | (b.z ? 4u : 0u) | (b.w ? 8u : 0u))
+#define PACKET_MIN(t, m) min(min(((m) & 1u) != 0u ? t.x : WIDE_MISS_T, ((m) & 2u) != 0u ? t.y : WIDE_MISS_T), min(((m) & 4u) != 0u ? t.z : WIDE_MISS_T, ((m) & 8u) != 0u ? t.w : WIDE_MISS_T))
+#endif
+// Beyond every entry t (the packet's own, as WIDE_MISS belongs to the wide tree).
+const float WIDE_MISS_T = 3.0e38;
+
+// inverse_dir's formula for one axis of every ray of the packet.
+PVEC inverse_axis(PVEC a) {
+    PVEC m = mix(PVEC(1.0e-30), abs(a), greaterThan(abs(a), PVEC(1.0e-30)));
+    return sign(a + PVEC(1.0e-38)) / m;
+}
+
+// enter_box for every ray of the packet, in the same operations and order per
+// ray: where each enters the box, or -1 where it misses it before its reach.
+PVEC enter_box_packet(vec3 o, PVEC ix, PVEC iy, PVEC iz, vec3 bmin, vec3 bmax, PVEC reach) {
+    PVEC x0 = (bmin.x - o.x) * ix;
+    PVEC x1 = (bmax.x - o.x) * ix;
+    PVEC y0 = (bmin.y - o.y) * iy;
+    PVEC y1 = (bmax.y - o.y) * iy;
+    PVEC z0 = (bmin.z - o.z) * iz;
+    PVEC z1 = (bmax.z - o.z) * iz;
+    PVEC enter = max(max(min(x0, x1), min(y0, y1)), max(min(z0, z1), PVEC(0.0)));
+    PVEC leave = min(min(max(x0, x1), max(y0, y1)), min(max(z0, z1), reach));
+    return mix(PVEC(-1.0), enter, lessThanEqual(enter, leave));
+}
+
+// Whether primitive p blocks ray `bit` of the packet before its reach: the
+// tests hit_leaf makes, with the reach as t_max as an any-hit walk has it.
+#define PACKET_TEST(bit, CC)                                                                 \
+    if ((mask & (bit)) != 0u) {                                                             \
+        vec3 pd = vec3(dx.CC, dy.CC, dz.CC);                                                   \
+        bool hit;                                                                           \
+        if ((p.code & SPHERE_BIT) != 0u) {                                                  \
+            hit = hit_sphere(origin, pd, Sphere(p.a, p.b.x, 0u, 0u, 0u, 0u), 0.0, reach.CC) > 0.0; \
+        } else {                                                                            \
+            Triangle tri = Triangle(p.a, 0u, p.b, 0u, p.c, 0u, vec3(0.0), 0u, vec3(0.0), 0u, vec3(0.0), 0u); \
+            hit = hit_triangle(tri_ray(origin, pd), tri, 0.0, reach.CC).x > 0.0;             \
+        }                                                                                   \
+        if (hit) {                                                                          \
+            blocked |= (bit);                                                               \
+        }                                                                                   \
+    }
+
+// The rays with reach > 0 are cast; returns a bit per ray (1 << its component)
+// set where something lies between the origin and its reach.
+uint traverse_shadows(vec3 origin, PVEC dx, PVEC dy, PVEC dz, PVEC reach) {
+#ifdef BVH_STACK_LOCAL
+    BVH_STACK_DECLARE;
+#endif
+    PVEC ix = inverse_axis(dx);
+    PVEC iy = inverse_axis(dy);
+    PVEC iz = inverse_axis(dz);
+    // The rays still looking for a blocker, and those of them that entered
+    // the subtree being visited.
+    uint alive = PACKET_BITS(greaterThan(reach, PVEC(0.0)));
+    uint mask = alive;
+    uint blocked = 0u;
+    uint sp = 0u;
+    uint child = alive != 0u ? GPU_ROOT : NO_CHILD;
+    while (true) {
+        while (int(child) > 0) {
+            BvhNode node = bvh_buf.nodes[child];
+            PVEC tl = enter_box_packet(origin, ix, iy, iz, node.left_min, node.left_max, reach);
+            PVEC tr = enter_box_packet(origin, ix, iy, iz, node.right_min, node.right_max, reach);
+            // As BVH_STEP for each ray: a child it enters is visited if it is
+            // the ray's nearer one (the left on a tie), or the only one it
+            // enters, or starts before its reach (BVH_STEP pushes it and its
+            // pop checks that).
+            uint el = PACKET_BITS(greaterThanEqual(tl, PVEC(0.0)));
+            uint er = PACKET_BITS(greaterThanEqual(tr, PVEC(0.0)));
+            uint left_near = PACKET_BITS(lessThanEqual(tl, tr));
+            uint ml = mask & el & (~er | left_near | PACKET_BITS(lessThan(tl, reach)));
+            uint mr = mask & er & (~el | ~left_near | PACKET_BITS(lessThan(tr, reach)));
+            if (ml != 0u && mr != 0u) {
+                bool left_first = PACKET_MIN(tl, ml) <= PACKET_MIN(tr, mr);
+                child = left_first ? node.left : node.right;
+                mask = left_first ? ml : mr;
+                BVH_ROOM(sp) {
+                    BVH_PUSH(sp, uvec2(left_first ? node.right : node.left, left_first ? mr : ml));
+                    sp += 1u;
+                }
+            } else if (ml != 0u) {
+                child = node.left;
+                mask = ml;
+            } else if (mr != 0u) {
+                child = node.right;
+                mask = mr;
+            } else {
+                child = NO_CHILD;
+            }
+        }
+        if (child != NO_CHILD) {
+            uint first = (child & ~LEAF_BIT) >> LEAF_FIRST_SHIFT;
+            uint count = (child & ((1u << LEAF_FIRST_SHIFT) - 1u)) + 1u;
+            for (uint k = 0u; k < count && mask != 0u; k++) {
+                BvhPrim p = prim_buf.prims[first + k];
+                PACKET_TEST(1u, x)
+                PACKET_TEST(2u, y)
+#if SHADOW_PACKET >= 3
+                PACKET_TEST(4u, z)
+#endif
+#if SHADOW_PACKET >= 4
+                PACKET_TEST(8u, w)
+#endif
+                mask &= ~blocked;
+            }
+            alive &= ~blocked;
+            if (alive == 0u) {
+                return blocked;
+            }
+        }
+        // Pop the next pending subtree that a ray still looking entered.
+        bool found = false;
+        while (sp > 0u && !found) {
+            sp -= 1u;
+            uvec2 entry = BVH_POP(sp);
+            if ((entry.y & alive) != 0u) {
+                child = entry.x;
+                mask = entry.y & alive;
+                found = true;
+            }
+        }
+        if (!found) {
+            break;
+        }
+    }
+    return blocked;
+}
+#endif
 #endif

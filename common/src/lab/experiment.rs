@@ -30,6 +30,7 @@ pub enum Experiment {
     RobustAccess,
     WarpProbe,
     Ulp,
+    PerLightShadows,
 }
 
 /// One f32 operation the arithmetic probe (`--experiment ulp --ulp-op OP`)
