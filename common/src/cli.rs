@@ -517,8 +517,7 @@ mod tests {
                 "naga-aliasing",
                 "robust-access",
                 "warp-probe",
-                "ulp",
-                "per-light-shadows"
+                "ulp"
             ]
         );
         assert_eq!(

@@ -41,40 +41,6 @@
 #define RAY_POP(i) o = st_origin_weight[i].xyz; w = st_origin_weight[i].w; d = st_dir_depth[i].xyz; depth = uint(st_dir_depth[i].w)
 #endif
 
-#ifdef SHADOW_PACKET
-// Light `li` of a packet, component c: its shadow ray (direction and reach)
-// and its terms, where it lights the point; the same operations as the loop
-// of one walk per light in trace() below.
-#define SHADOW_SETUP(li, CC)                                                   \
-    if ((li) < LIGHT_COUNT) {                                                 \
-        vec3 to_light = light_buf.lights[li].position - p_out;               \
-        float dist = length(to_light);                                        \
-        vec3 l = to_light / dist;                                             \
-        float ndl = dot(ns, l);                                               \
-        if (ndl > 0.0 && dot(ng, l) > 0.0) {                                  \
-            dx.CC = l.x;                                                       \
-            dy.CC = l.y;                                                       \
-            dz.CC = l.z;                                                       \
-            reach.CC = dist * SHADOW_REACH;                                    \
-            ndls.CC = ndl;                                                     \
-            vec3 r = reflect(-l, ns);                                         \
-            specs.CC = pow(max(dot(r, -d), 0.0), m.shininess);                 \
-            SHADOW_COUNT                                                      \
-        }                                                                     \
-    }
-// Adds light `li` (component c, bit `bit` of the walk's answer) if its ray
-// was cast and nothing blocked it.
-#define SHADOW_ADD(li, CC, bit)                                                \
-    if (reach.CC > 0.0 && (blocked & (bit)) == 0u) {                           \
-        local += light_buf.lights[li].color * (m.diffuse * ndls.CC + m.specular * specs.CC); \
-    }
-#ifdef COUNT_RAYS
-#define SHADOW_COUNT rays_traced.shadow += 1u;
-#else
-#define SHADOW_COUNT
-#endif
-#endif
-
 vec3 trace(vec3 origin, vec3 dir) {
     RAY_STACK_DECLARE;
 #ifdef HAS_GLASS
@@ -164,39 +130,6 @@ vec3 trace(vec3 origin, vec3 dir) {
         Material m = material_buf.materials[mat_index];
 
         vec3 local = m.ambient;
-#ifdef SHADOW_PACKET
-        // The lights' shadow rays walk the BVH together, SHADOW_PACKET at a
-        // time (trace/bvh.glsl, traverse_shadows). The offset here takes no
-        // direction, so every light's ray starts from the same point. Each
-        // light's terms are kept (ndl, spec) and its light added afterwards
-        // in light order, with the same expression as the loop below.
-        vec3 p_out = spawn_point(p, ng, ng, scale);
-        for (uint l0 = 0u; l0 < LIGHT_COUNT; l0 += uint(SHADOW_PACKET)) {
-            PVEC dx = PVEC(0.0);
-            PVEC dy = PVEC(0.0);
-            PVEC dz = PVEC(0.0);
-            PVEC reach = PVEC(-1.0);
-            PVEC ndls = PVEC(0.0);
-            PVEC specs = PVEC(0.0);
-            SHADOW_SETUP(l0, x)
-            SHADOW_SETUP(l0 + 1u, y)
-#if SHADOW_PACKET >= 3
-            SHADOW_SETUP(l0 + 2u, z)
-#endif
-#if SHADOW_PACKET >= 4
-            SHADOW_SETUP(l0 + 3u, w)
-#endif
-            uint blocked = traverse_shadows(p_out, dx, dy, dz, reach);
-            SHADOW_ADD(l0, x, 1u)
-            SHADOW_ADD(l0 + 1u, y, 2u)
-#if SHADOW_PACKET >= 3
-            SHADOW_ADD(l0 + 2u, z, 4u)
-#endif
-#if SHADOW_PACKET >= 4
-            SHADOW_ADD(l0 + 3u, w, 8u)
-#endif
-        }
-#else
         for (uint li = 0u; li < LIGHT_COUNT; li++) {
             Light light = light_buf.lights[li];
             // The offset may depend on the direction (OFFSET_RAY): aim from p first.
@@ -217,7 +150,6 @@ vec3 trace(vec3 origin, vec3 dir) {
                 local += light.color * (m.diffuse * ndl + m.specular * spec);
             }
         }
-#endif
         color += w * local;
 
 #if defined(HAS_MIRROR) || defined(HAS_GLASS)

@@ -30,7 +30,6 @@ pub enum Experiment {
     RobustAccess,
     WarpProbe,
     Ulp,
-    PerLightShadows,
 }
 
 /// One f32 operation the arithmetic probe (`--experiment ulp --ulp-op OP`)

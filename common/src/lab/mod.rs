@@ -157,9 +157,6 @@ pub const REGISTRY: &[Entry] = &[
         // The operation comes from --ulp-op (`changes`), which `check` requires.
         ..entry(Experiment::Ulp, "The arithmetic probe (shaders/lab/ulp.glsl) in place of the tracer: each pair of pixels holds the 32 bits of one f32 result of the operation `--ulp-op OP` names, on inputs derived from the pixel's index by an integer hash; `twinray ulp` recomputes the inputs and compares each result with the f64 one (docs/architecture.md#the-gpus-arithmetic).", |_| {})
     },
-    entry(Experiment::PerLightShadows, "A BVH walk for each light's shadow ray instead of one walk for the lights' rays together (scenes of two lights or more, binary BVH).", |c| {
-        c.knobs.per_light_shadows = true
-    }),
 ];
 
 /// The registry's entry for `e`.

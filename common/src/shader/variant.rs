@@ -106,8 +106,6 @@ pub struct ShaderKnobs {
     pub shared_bvh_stack: bool,
     /// The ray stack as four arrays instead of two of vec4 pairs.
     pub split_ray_stack: bool,
-    /// A BVH walk per light's shadow ray instead of one per packet of them.
-    pub per_light_shadows: bool,
     /// The fullscreen pass as two triangles.
     pub quad: bool,
     /// Compute: KiB of workgroup memory the tracer does not need.
@@ -281,20 +279,6 @@ impl Variant {
         self.knobs.shared_bvh_stack && bytes <= SHARED_BVH_STACK_BUDGET
     }
 
-    /// How many shadow rays walk the BVH together (trace/bvh.glsl,
-    /// traverse_shadows): every light's, up to four at a time, where the scene
-    /// has two lights or more, the tree is binary and the offset takes no
-    /// direction, so that they share an origin. `None`: a walk per light.
-    pub fn shadow_packet(&self) -> Option<u32> {
-        let Counts::Baked { lights, .. } = self.counts else {
-            return None;
-        };
-        let shared_origin = self.numerics.offset != crate::scene::numerics::Offset::Ray;
-        let binary = self.bvh_stack.is_some() && self.bvh_width == 2;
-        (lights >= 2 && shared_origin && binary && !self.knobs.per_light_shadows)
-            .then(|| lights.min(4))
-    }
-
     /// The specialization constants (`Form::Specialized` only).
     pub fn constants(&self) -> BTreeMap<String, bool> {
         if self.form != Form::Specialized {
@@ -365,9 +349,6 @@ impl Variant {
             d.insert("SPHERE_COUNT".into(), format!("{spheres}u"));
             d.insert("TRIANGLE_COUNT".into(), format!("{triangles}u"));
             d.insert("LIGHT_COUNT".into(), format!("{lights}u"));
-        }
-        if let Some(n) = self.shadow_packet() {
-            d.insert("SHADOW_PACKET".into(), n.to_string());
         }
         if let Some(kib) = k.shared_pad_kib {
             d.insert("SHARED_PAD_KIB".into(), kib.to_string());

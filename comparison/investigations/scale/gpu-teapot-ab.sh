@@ -1,0 +1,53 @@
+#!/usr/bin/env bash
+# Two builds at the teapot's points (three lights, two-wide BVH): the compute
+# path at 1080p and 4K with Grays/s, at 1000x1000 at four tessellations (the
+# growth), and the fragment path at 19.2k and 1.2M triangles; both APIs, two
+# rounds in alternating API and build order. Then what each driver made of the
+# teapot's compute shader in each build (--dump-shaders: Vulkan's register
+# count, OpenGL's program binary). About 3 minutes on an H100.
+# OUT_DIR/teapot-ab.jsonl: a label line (point|build|round), then the app's
+# --json report.
+# Usage: comparison/investigations/scale/gpu-teapot-ab.sh OLD_BIN_DIR NEW_BIN_DIR OUT_DIR
+set -uo pipefail
+old=$1
+new=$2
+out=$3
+mkdir -p "$out"
+log=$out/teapot-ab.jsonl
+errors=$out/teapot-ab.log
+: > "$log"
+# shellcheck source=comparison/investigations/lib.sh
+source "$(dirname "$0")/../lib.sh"
+gpu_info
+points=(
+    "teapot-1080p|--scene teapot --size 1920x1080 --frames 60 --count-rays --path compute"
+    "teapot-4k|--scene teapot --size 3840x2160 --frames 60 --count-rays --path compute"
+    "teapot-19.2k|--scene teapot --size 1000x1000 --frames 60 --path compute"
+    "teapot-307k|--scene teapot --set tessellation=80x60 --size 1000x1000 --frames 60 --path compute"
+    "teapot-1.2m|--scene teapot --set tessellation=160x120 --size 1000x1000 --frames 60 --path compute"
+    "teapot-4.9m|--scene teapot --set tessellation=320x240 --size 1000x1000 --frames 30 --path compute"
+    "teapot-fragment|--scene teapot --size 1000x1000 --frames 30 --path fragment"
+    "teapot-1.2m-fragment|--scene teapot --set tessellation=160x120 --size 1000x1000 --frames 20 --path fragment"
+)
+for round in 1 2; do
+    if [ $round = 1 ]; then apps=(vk gl) builds=(old new); else apps=(gl vk) builds=(new old); fi
+    for p in "${points[@]}"; do
+        name=${p%%|*}
+        args=${p#*|}
+        for app in "${apps[@]}"; do
+            for b in "${builds[@]}"; do
+                if [ "$b" = old ]; then bin=$old; else bin=$new; fi
+                # shellcheck disable=SC2086
+                run "$name|$b|$round" $app $args --accel bvh
+            done
+        done
+    done
+done
+for app in vk gl; do
+    for b in old new; do
+        if [ "$b" = old ]; then bin=$old; else bin=$new; fi
+        "$bin/twinray-$app" --headless --scene teapot --size 64x64 --path compute --accel bvh \
+            --dump-shaders "$out/shaders-$app-$b" > /dev/null 2>> "$errors"
+    done
+done
+touch "$out/done"
