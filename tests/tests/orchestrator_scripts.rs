@@ -1,7 +1,8 @@
 //! The tracked shell scripts against the apps they drive: every
 //! `--experiment NAME` a script passes is a name both apps accept today, so an
 //! investigation cannot record an app's refusal as its data and look as if it
-//! ran (as `gpu-lmem.sh` did with the retired `global-bvh-stack`).
+//! ran (as `gpu-lmem.sh` did with the retired `global-bvh-stack`); and every
+//! script passes shellcheck at its warning level.
 
 use std::collections::BTreeSet;
 use std::path::{Path, PathBuf};
@@ -123,5 +124,27 @@ fn every_experiment_a_tracked_script_passes_is_one_the_apps_accept() {
         unknown.is_empty(),
         "scripts pass experiments the apps refuse (rename or retire them):\n{}",
         unknown.join("\n")
+    );
+}
+
+/// Every tracked script passes shellcheck at its warning level: a quoting slip
+/// or a variable set and never used in an investigation script shows here,
+/// not on a borrowed GPU.
+#[test]
+fn every_tracked_script_passes_shellcheck() {
+    let scripts = tracked_scripts();
+    let out = std::process::Command::new("shellcheck")
+        .args(["-x", "-S", "warning", "-f", "gcc"])
+        .args(&scripts)
+        .current_dir(root())
+        .output()
+        .unwrap_or_else(|e| {
+            panic!("shellcheck could not run ({e}): install Debian's shellcheck (scripts/setup.sh does)")
+        });
+    assert!(
+        out.status.success(),
+        "shellcheck finds problems in the tracked scripts:\n{}{}",
+        String::from_utf8_lossy(&out.stdout),
+        String::from_utf8_lossy(&out.stderr)
     );
 }

@@ -12,7 +12,6 @@ set -uo pipefail
 bin=$1
 out=$2
 mkdir -p "$out"
-log="$out/ulp.jsonl"
 errors="$out/ulp.log"
 source "$(dirname "$0")/../lib.sh"
 gpu_info

@@ -25,7 +25,7 @@ for s in "${scenes[@]}"; do
     name=${s%% *}
     for path in fragment compute; do
         for e in none no-contraction glslang float-controls strict; do
-            x=(); [ $e != none ] && x=(--experiment $e)
+            x=(); [ $e != none ] && x=(--experiment "$e")
             [ $e = strict ] && x=(--experiment no-contraction --experiment float-controls)
             for app in vk gl; do
                 [ $app = gl ] && [ $e != none ] && [ $e != no-contraction ] && continue
