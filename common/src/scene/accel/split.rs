@@ -10,6 +10,9 @@ use rayon::prelude::*;
 
 /// Primitives per leaf at most; SAH may stop splitting earlier.
 pub const MAX_LEAF: usize = child_ref::MAX_LEAF_COUNT;
+/// Bins per axis. Finer is not better for this greedy top-down build: 8, 32
+/// and 64 gave the teapot's tree a 1.6-4 % higher SAH cost than 16 (19.2k and
+/// 1.2M triangles; `bvh_sah_cost` in `--json`).
 const BINS: usize = 16;
 /// Relative cost of one node visit vs one primitive test, for SAH.
 pub(super) const TRAVERSAL_COST: f64 = 1.0;
