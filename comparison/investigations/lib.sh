@@ -64,3 +64,18 @@ ab_rounds() {
         done
     done
 }
+
+# teapot_points: sets the array `points` to the teapot's traversal points as
+# "label|options": 1080p and 4K with their rays counted (Grays/s), and four
+# tessellations at 1000x1000 (the growth from 19.2k to 4.9M triangles). The
+# labels are those of the committed results (gpu-teapot-ab.sh, gpu-cw8.sh).
+teapot_points() {
+    points=(
+        "teapot-1080p|--scene teapot --size 1920x1080 --frames 60 --count-rays"
+        "teapot-4k|--scene teapot --size 3840x2160 --frames 60 --count-rays"
+        "teapot-19.2k|--scene teapot --size 1000x1000 --frames 60"
+        "teapot-307k|--scene teapot --set tessellation=80x60 --size 1000x1000 --frames 60"
+        "teapot-1.2m|--scene teapot --set tessellation=160x120 --size 1000x1000 --frames 60"
+        "teapot-4.9m|--scene teapot --set tessellation=320x240 --size 1000x1000 --frames 30"
+    )
+}

@@ -20,13 +20,8 @@ errors=$out/cw8.log
 # shellcheck source=comparison/investigations/lib.sh
 source "$(dirname "$0")/../lib.sh"
 gpu_info
-points=(
-    "teapot-1080p|--scene teapot --size 1920x1080 --frames 60 --count-rays"
-    "teapot-4k|--scene teapot --size 3840x2160 --frames 60 --count-rays"
-    "teapot-19.2k|--scene teapot --size 1000x1000 --frames 60"
-    "teapot-307k|--scene teapot --set tessellation=80x60 --size 1000x1000 --frames 60"
-    "teapot-1.2m|--scene teapot --set tessellation=160x120 --size 1000x1000 --frames 60"
-    "teapot-4.9m|--scene teapot --set tessellation=320x240 --size 1000x1000 --frames 30"
+teapot_points
+points+=(
     "sl-10k|--scene spherelist --set extra_spheres=10000 --size 300x300 --frames 60"
     "box|--scene box --size 1000x1000 --frames 60"
 )

@@ -19,13 +19,11 @@ errors=$out/teapot-ab.log
 # shellcheck source=comparison/investigations/lib.sh
 source "$(dirname "$0")/../lib.sh"
 gpu_info
-points=(
-    "teapot-1080p|--scene teapot --size 1920x1080 --frames 60 --count-rays --path compute"
-    "teapot-4k|--scene teapot --size 3840x2160 --frames 60 --count-rays --path compute"
-    "teapot-19.2k|--scene teapot --size 1000x1000 --frames 60 --path compute"
-    "teapot-307k|--scene teapot --set tessellation=80x60 --size 1000x1000 --frames 60 --path compute"
-    "teapot-1.2m|--scene teapot --set tessellation=160x120 --size 1000x1000 --frames 60 --path compute"
-    "teapot-4.9m|--scene teapot --set tessellation=320x240 --size 1000x1000 --frames 30 --path compute"
+teapot_points
+for i in "${!points[@]}"; do
+    points[i]+=" --path compute"
+done
+points+=(
     "teapot-fragment|--scene teapot --size 1000x1000 --frames 30 --path fragment"
     "teapot-1.2m-fragment|--scene teapot --set tessellation=160x120 --size 1000x1000 --frames 20 --path fragment"
 )
