@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Two builds at the teapot's points (three lights, two-wide BVH): the compute
+# Two builds at the teapot's points (three lights, the two-wide BVH unless ACCEL): the compute
 # path at 1080p and 4K with Grays/s, at 1000x1000 at four tessellations (the
 # growth), and the fragment path at 19.2k and 1.2M triangles; both APIs, two
 # rounds in alternating API and build order. Then what each driver made of the
@@ -7,11 +7,13 @@
 # count, OpenGL's program binary). About 3 minutes on an H100.
 # OUT_DIR/teapot-ab.jsonl: a label line (point|build|round), then the app's
 # --json report.
-# Usage: comparison/investigations/scale/gpu-teapot-ab.sh OLD_BIN_DIR NEW_BIN_DIR OUT_DIR
+# Usage: comparison/investigations/scale/gpu-teapot-ab.sh OLD_BIN_DIR NEW_BIN_DIR OUT_DIR [ACCEL]
+#   ACCEL: the --accel of every run, default bvh
 set -uo pipefail
 old=$1
 new=$2
 out=$3
+accel=${4:-bvh}
 mkdir -p "$out"
 log=$out/teapot-ab.jsonl
 errors=$out/teapot-ab.log
@@ -36,7 +38,7 @@ for round in 1 2; do
             for b in "${builds[@]}"; do
                 if [ "$b" = old ]; then bin=$old; else bin=$new; fi
                 # shellcheck disable=SC2086
-                run "$name|$b|$round" $app $args --accel bvh
+                run "$name|$b|$round" $app $args --accel "$accel"
             done
         done
     done
@@ -44,7 +46,7 @@ done
 for app in vk gl; do
     for b in old new; do
         if [ "$b" = old ]; then bin=$old; else bin=$new; fi
-        "$bin/twinray-$app" --headless --scene teapot --size 64x64 --path compute --accel bvh \
+        "$bin/twinray-$app" --headless --scene teapot --size 64x64 --path compute --accel "$accel" \
             --dump-shaders "$out/shaders-$app-$b" > /dev/null 2>> "$errors"
     done
 done

@@ -1,0 +1,55 @@
+#!/usr/bin/env bash
+# Two builds at the teapot's compute points under several workgroups: 1080p
+# (two-wide and 4-wide BVH) and 4K with Grays/s, and 1000x1000 at 19.2k and
+# 1.2M triangles; both APIs, two rounds in alternating API and build order.
+# Then each build's Vulkan statistics per workgroup (--dump-shaders: registers,
+# shared memory). Written for the shadow-ray compaction experiment
+# (comparison/results/nvidia-h100/investigation/compact/per-light.patch), whose
+# shader changes with the workgroup. About 2 minutes on an H100.
+# OUT_DIR/wg.jsonl: a label line (point@workgroup|build|round), then the app's
+# --json report.
+# Usage: comparison/investigations/scale/gpu-compact.sh OLD_BIN_DIR NEW_BIN_DIR OUT_DIR [WORKGROUPS]
+#   WORKGROUPS: space-separated, default "8x4 8x8 16x8"
+set -uo pipefail
+old=$1
+new=$2
+out=$3
+read -r -a workgroups <<< "${4:-8x4 8x8 16x8}"
+mkdir -p "$out"
+log=$out/wg.jsonl
+errors=$out/wg.log
+: > "$log"
+# shellcheck source=comparison/investigations/lib.sh
+source "$(dirname "$0")/../lib.sh"
+gpu_info
+points=(
+    "teapot-1080p|--scene teapot --size 1920x1080 --frames 60 --count-rays --accel bvh"
+    "teapot-1080p-bvh4|--scene teapot --size 1920x1080 --frames 60 --count-rays --accel bvh4"
+    "teapot-4k|--scene teapot --size 3840x2160 --frames 60 --count-rays --accel bvh"
+    "teapot-19.2k|--scene teapot --size 1000x1000 --frames 60 --accel bvh"
+    "teapot-1.2m|--scene teapot --set tessellation=160x120 --size 1000x1000 --frames 60 --accel bvh"
+)
+for round in 1 2; do
+    if [ $round = 1 ]; then apps=(vk gl) builds=(old new); else apps=(gl vk) builds=(new old); fi
+    for p in "${points[@]}"; do
+        name=${p%%|*}
+        args=${p#*|}
+        for wg in "${workgroups[@]}"; do
+            for app in "${apps[@]}"; do
+                for b in "${builds[@]}"; do
+                    if [ "$b" = old ]; then bin=$old; else bin=$new; fi
+                    # shellcheck disable=SC2086
+                    run "$name@$wg|$b|$round" $app $args --path compute --workgroup "$wg"
+                done
+            done
+        done
+    done
+done
+for wg in "${workgroups[@]}"; do
+    for b in old new; do
+        if [ "$b" = old ]; then bin=$old; else bin=$new; fi
+        "$bin/twinray-vk" --headless --scene teapot --size 64x64 --path compute --workgroup "$wg" \
+            --dump-shaders "$out/shaders-vk-$b-$wg" > /dev/null 2>> "$errors"
+    done
+done
+touch "$out/done"
