@@ -4,7 +4,8 @@
 //! and where it names a heading (`page.md#anchor`) that page has the heading;
 //! and every `page.md#anchor` a code comment cites (a FINDINGS section instead
 //! of a timing that would go stale, the module map in docs/architecture.md)
-//! names a heading that is there.
+//! names a heading that is there; and the Rust version the pages ask a
+//! newcomer to install is the one cargo enforces.
 
 use std::path::{Path, PathBuf};
 
@@ -248,4 +249,34 @@ fn anchors_are_githubs() {
         cited_anchors("// (see docs/architecture.md#the-tracers-parts)."),
         ["docs/architecture.md#the-tracers-parts"]
     );
+}
+
+/// The Rust a newcomer must install is the `rust-version` that cargo enforces:
+/// README.md and CONTRIBUTING.md name it, and said 1.85 after the workspace
+/// had moved to 1.86.
+#[test]
+fn the_pages_name_the_rust_version_cargo_enforces() {
+    let manifest = read(&root().join("Cargo.toml"));
+    let version = manifest
+        .lines()
+        .find_map(|l| l.trim().strip_prefix("rust-version = "))
+        .map(|v| v.trim_matches('"'))
+        .expect("Cargo.toml sets rust-version");
+    for page in ["README.md", "CONTRIBUTING.md"] {
+        let text = read(&root().join(page));
+        let named: Vec<&str> = text
+            .split("Rust ")
+            .skip(1)
+            .filter_map(|rest| rest.split_once(" or newer").map(|(v, _)| v))
+            .filter(|v| !v.is_empty() && v.chars().all(|c| c.is_ascii_digit() || c == '.'))
+            .collect();
+        assert!(
+            !named.is_empty(),
+            "{page} does not say which Rust to install (\"Rust {version} or newer\")"
+        );
+        assert!(
+            named.iter().all(|v| *v == version),
+            "{page} names Rust {named:?}, but Cargo.toml's rust-version is {version}"
+        );
+    }
 }
