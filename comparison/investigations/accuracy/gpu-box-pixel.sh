@@ -2,8 +2,9 @@
 # Where OpenGL's one wrong pixel of the box at 1000x1000 comes from: both apps
 # against the f64 reference as they are, then OpenGL with one thing changed at
 # a time: naga's SPIR-V instead of its GLSL (--gl-spirv, the binary Vulkan
-# runs), no contraction, no BVH, and the watertight triangle test (against a
-# reference with the same test). Prints one `NAME {diff --json}` line a run.
+# runs), no contraction, and the watertight triangle test (against a reference
+# with the same test); and --accel none, a control (the box's 32 primitives
+# are below auto's 64, so it is the default's shader). Prints one `NAME {diff --json}` line a run.
 # Usage: comparison/investigations/accuracy/gpu-box-pixel.sh BIN_DIR OUT_DIR
 set -uo pipefail
 bin=$1
