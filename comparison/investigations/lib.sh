@@ -65,6 +65,29 @@ ab_rounds() {
     done
 }
 
+# labelled_rounds OPTIONS...: every entry of the array `points` ("label|options")
+# with the old and new builds and both apps, OPTIONS added to each run, in two
+# rounds of alternating build and API order (as ab_rounds); each run is
+# labelled "label|build|round".
+labelled_rounds() {
+    local round p name args app b
+    local -a apps builds
+    for round in 1 2; do
+        if [ "$round" = 1 ]; then apps=(vk gl) builds=(old new); else apps=(gl vk) builds=(new old); fi
+        for p in "${points[@]}"; do
+            name=${p%%|*}
+            args=${p#*|}
+            for app in "${apps[@]}"; do
+                for b in "${builds[@]}"; do
+                    if [ "$b" = old ]; then bin=$old; else bin=$new; fi
+                    # shellcheck disable=SC2086
+                    run "$name|$b|$round" "$app" $args "$@"
+                done
+            done
+        done
+    done
+}
+
 # teapot_points: sets the array `points` to the teapot's traversal points as
 # "label|options": 1080p and 4K with their rays counted (Grays/s), and four
 # tessellations at 1000x1000 (the growth from 19.2k to 4.9M triangles). The

@@ -22,29 +22,18 @@ errors=$out/wg.log
 # shellcheck source=comparison/investigations/lib.sh
 source "$(dirname "$0")/../lib.sh"
 gpu_info
-points=(
-    "teapot-1080p|--scene teapot --size 1920x1080 --frames 60 --count-rays --accel bvh"
-    "teapot-1080p-bvh4|--scene teapot --size 1920x1080 --frames 60 --count-rays --accel bvh4"
-    "teapot-4k|--scene teapot --size 3840x2160 --frames 60 --count-rays --accel bvh"
-    "teapot-19.2k|--scene teapot --size 1000x1000 --frames 60 --accel bvh"
-    "teapot-1.2m|--scene teapot --set tessellation=160x120 --size 1000x1000 --frames 60 --accel bvh"
-)
-for round in 1 2; do
-    if [ $round = 1 ]; then apps=(vk gl) builds=(old new); else apps=(gl vk) builds=(new old); fi
-    for p in "${points[@]}"; do
-        name=${p%%|*}
-        args=${p#*|}
-        for wg in "${workgroups[@]}"; do
-            for app in "${apps[@]}"; do
-                for b in "${builds[@]}"; do
-                    if [ "$b" = old ]; then bin=$old; else bin=$new; fi
-                    # shellcheck disable=SC2086
-                    run "$name@$wg|$b|$round" $app $args --path compute --workgroup "$wg"
-                done
-            done
-        done
+points=()
+for p in \
+    "teapot-1080p|--scene teapot --size 1920x1080 --frames 60 --count-rays --accel bvh" \
+    "teapot-1080p-bvh4|--scene teapot --size 1920x1080 --frames 60 --count-rays --accel bvh4" \
+    "teapot-4k|--scene teapot --size 3840x2160 --frames 60 --count-rays --accel bvh" \
+    "teapot-19.2k|--scene teapot --size 1000x1000 --frames 60 --accel bvh" \
+    "teapot-1.2m|--scene teapot --set tessellation=160x120 --size 1000x1000 --frames 60 --accel bvh"; do
+    for wg in "${workgroups[@]}"; do
+        points+=("${p%%|*}@$wg|${p#*|} --workgroup $wg")
     done
 done
+labelled_rounds --path compute
 for wg in "${workgroups[@]}"; do
     for b in old new; do
         if [ "$b" = old ]; then bin=$old; else bin=$new; fi

@@ -29,20 +29,7 @@ points+=(
     "teapot-fragment|--scene teapot --size 1000x1000 --frames 30 --path fragment"
     "teapot-1.2m-fragment|--scene teapot --set tessellation=160x120 --size 1000x1000 --frames 20 --path fragment"
 )
-for round in 1 2; do
-    if [ $round = 1 ]; then apps=(vk gl) builds=(old new); else apps=(gl vk) builds=(new old); fi
-    for p in "${points[@]}"; do
-        name=${p%%|*}
-        args=${p#*|}
-        for app in "${apps[@]}"; do
-            for b in "${builds[@]}"; do
-                if [ "$b" = old ]; then bin=$old; else bin=$new; fi
-                # shellcheck disable=SC2086
-                run "$name|$b|$round" $app $args --accel "$accel"
-            done
-        done
-    done
-done
+labelled_rounds --accel "$accel"
 for app in vk gl; do
     for b in old new; do
         if [ "$b" = old ]; then bin=$old; else bin=$new; fi
