@@ -18,6 +18,11 @@ run() {
         echo "{\"failed\":\"twinray-$app $*\"}" >> "$log"
 }
 
+# use_build old|new: points `bin` (what `run` starts) at that build's folder.
+use_build() {
+    if [ "$1" = old ]; then bin=$old; else bin=$new; fi
+}
+
 # gpu_info: the GPU's name, driver and top clock into $out/gpu.txt, so that a
 # results folder says which machine it came from (nothing where nvidia-smi is
 # missing).
@@ -55,7 +60,7 @@ ab_rounds() {
             for path in compute fragment; do
                 for app in "${apps[@]}"; do
                     for b in "${builds[@]}"; do
-                        if [ "$b" = old ]; then bin=$old; else bin=$new; fi
+                        use_build "$b"
                         # shellcheck disable=SC2086
                         run "$b" "$app" $c --path "$path"
                     done
@@ -79,7 +84,7 @@ labelled_rounds() {
             args=${p#*|}
             for app in "${apps[@]}"; do
                 for b in "${builds[@]}"; do
-                    if [ "$b" = old ]; then bin=$old; else bin=$new; fi
+                    use_build "$b"
                     # shellcheck disable=SC2086
                     run "$name|$b|$round" "$app" $args "$@"
                 done

@@ -36,7 +36,7 @@ done
 labelled_rounds --path compute
 for wg in "${workgroups[@]}"; do
     for b in old new; do
-        if [ "$b" = old ]; then bin=$old; else bin=$new; fi
+        use_build "$b"
         "$bin/twinray-vk" --headless --scene teapot --size 64x64 --path compute --workgroup "$wg" \
             --dump-shaders "$out/shaders-vk-$b-$wg" > /dev/null 2>> "$errors"
     done

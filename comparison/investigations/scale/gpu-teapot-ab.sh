@@ -32,7 +32,7 @@ points+=(
 labelled_rounds --accel "$accel"
 for app in vk gl; do
     for b in old new; do
-        if [ "$b" = old ]; then bin=$old; else bin=$new; fi
+        use_build "$b"
         "$bin/twinray-$app" --headless --scene teapot --size 64x64 --path compute --accel "$accel" \
             --dump-shaders "$out/shaders-$app-$b" > /dev/null 2>> "$errors"
     done
