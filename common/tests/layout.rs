@@ -20,6 +20,28 @@ fn naga_members(module: &naga::Module, ty: naga::Handle<naga::Type>) -> (Vec<(St
     }
 }
 
+/// As `naga_members`, with each member that is a fixed-size array spelled out
+/// element by element (`bounds[0]`, `bounds[1]`, ...), for a GLSL array that
+/// stands for consecutive Rust fields.
+fn naga_elements(module: &naga::Module, ty: naga::Handle<naga::Type>) -> (Vec<(String, u32)>, u32) {
+    let naga::TypeInner::Struct { members, span } = &module.types[ty].inner else {
+        panic!("expected a struct");
+    };
+    let mut out = Vec::new();
+    for m in members {
+        let name = m.name.clone().unwrap_or_default();
+        match &module.types[m.ty].inner {
+            naga::TypeInner::Array {
+                size: naga::ArraySize::Constant(n),
+                stride,
+                ..
+            } => out.extend((0..n.get()).map(|i| (format!("{name}[{i}]"), m.offset + i * stride))),
+            _ => out.push((name, m.offset)),
+        }
+    }
+    (out, *span)
+}
+
 /// The block bound at `binding` and, for storage buffers, its runtime-array element type and stride.
 fn block(
     module: &naga::Module,
@@ -217,9 +239,10 @@ fn naga_layout_matches_rust_for_the_wide_bvh() {
             size_of::<GpuBvhWideNode>(),
             "BvhWideNode stride"
         );
+        // The GLSL's `vec4 bounds[6]` is the six corner fields, in their order.
         check(
             "BvhWideNode",
-            naga_members(&module, ty),
+            naga_elements(&module, ty),
             rust_offsets!(GpuBvhWideNode {
                 min_x,
                 min_y,

@@ -148,12 +148,10 @@ struct BvhNode {
 // corner coordinate; an 8-wide node is two consecutive ones (BVH_WIDE_QUADS).
 // A slot without a child holds NO_CHILD and a box no ray enters.
 struct BvhWideNode {
-    vec4 min_x;
-    vec4 min_y;
-    vec4 min_z;
-    vec4 max_x;
-    vec4 max_y;
-    vec4 max_z;
+    // min_x, min_y, min_z, max_x, max_y, max_z (the Rust struct's fields), as
+    // an array so that the walk reads each axis's near and far planes by the
+    // sign of the ray's direction.
+    vec4 bounds[6];
     uvec4 child;
 };
 

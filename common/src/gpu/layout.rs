@@ -125,7 +125,9 @@ pub struct GpuBvhPrim {
 /// node; an 8-wide tree two consecutive ones per node (children 0-3, then
 /// 4-7), and an interior child reference is the index of its node's first.
 /// A slot without a child holds `child_ref::NO_CHILD` and the box of
-/// `EMPTY_SLOT` corners, which no ray enters.
+/// `EMPTY_SLOT` corners, which no ray enters. The GLSL declares the six
+/// corner fields as one array, `vec4 bounds[6]`, in this order, so that a
+/// ray reads each axis's near and far planes by the sign of its direction.
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, Pod, Zeroable, PartialEq)]
 pub struct GpuBvhWideNode {

@@ -84,7 +84,9 @@ fn enter_box(min: [f32; 3], max: [f32; 3], o: DVec3, d: DVec3, t_max: f64) -> Op
 /// (trace/bvh.glsl) visits them: per `GpuBvhWideNode`, sorted by entry
 /// distance with the shader's network; of an 8-wide node's two halves, the
 /// nearer half's nearest child first, then the rest of the second half near
-/// to far, then the rest of the first.
+/// to far, then the rest of the first. (The shader's shadow rays sort only
+/// the nearest child first; whether anything blocks a ray does not depend
+/// on the order, so the reference keeps one order for both.)
 fn wide_visits(bvh: &Bvh, index: usize, o: DVec3, d: DVec3, t_max: f64) -> Vec<(u32, f64)> {
     let mut near: Option<(u32, f64)> = None;
     let mut pushed: Vec<(u32, f64)> = Vec::new();
