@@ -55,9 +55,8 @@ pub struct RenderArgs {
     /// process_overrides), instead of the scene's own variant of defines.
     #[arg(long, conflicts_with = "generic", hide = true)]
     pub specialize: bool,
-    /// Acceleration structure: auto (for scenes with many primitives a BVH: 4-wide where
-    /// spheres are at least half of them, two-wide otherwise, the crossover measured on
-    /// the H100 in both APIs), none (test every
+    /// Acceleration structure: auto (for scenes with many primitives a BVH, 4-wide: the
+    /// faster tree on the H100 in both APIs but at a million triangles in OpenGL), none (test every
     /// primitive, as the 2018 study did), bvh (two children a node), bvh4 or bvh8 (the same
     /// tree collapsed to four or eight children a node).
     #[arg(long, value_enum, default_value_t = Accel::Auto)]

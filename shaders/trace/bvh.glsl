@@ -160,21 +160,22 @@ bool hit_leaf(inout Hit h, vec3 origin, vec3 dir, TriRay ray, uint first, uint c
 // collapses the binary tree into nodes of four or eight children with the same
 // leaves. Its step tests the four boxes of a BvhWideNode at once, sorts their
 // entry distances (five compare-and-swaps), takes the nearest child next and
-// pushes the others far to near, so that they pop near first. A shadow ray
-// (any hit) only needs the nearest first (three compare-and-swaps): it stops at
-// any blocker, so the order of the rest cannot change its answer.
+// pushes the others far to near, so that they pop near first. An 8-wide node
+// does that for each half, keeps the nearer of the two nearest and pushes the
+// other: the pops of such a node come in near-first order within each half.
+// Every node pushes at most its entered children but one, which is what the
+// stack is sized for. A shadow ray (any hit) only needs the nearest first
+// (three compare-and-swaps): it stops at any blocker, so the order of the rest
+// cannot change its answer.
 //
 // The slab test reads each axis's near and far planes by the sign of the ray's
 // direction (near_k, far_k in traverse), so each entry and exit distance is
 // already the smaller and the larger: no min and max per axis, the same
 // values as taking both planes and sorting them, since a positive inverse
 // direction keeps (min - o) * inv <= (max - o) * inv under rounding. That
-// took Vulkan's 1080p teapot from 0.259 to 0.230 ms and OpenGL's from 0.316
-// to 0.294 (comparison/results/nvidia-h100/FINDINGS.md#the-wide-steps-arithmetic-investigationoctant). An 8-wide node
-// does that for each half, keeps the nearer of the two nearest and pushes the
-// other: the pops of such a node come in near-first order within each half.
-// Every node pushes at most its entered children but one, which is what the
-// stack is sized for.
+// took Vulkan's 1080p teapot from 0.259 to 0.232 ms and OpenGL's from 0.319
+// to 0.294
+// (comparison/results/nvidia-h100/FINDINGS.md#the-wide-steps-arithmetic-investigationoctant).
 #ifdef USE_BVH_WIDE
 #ifndef BVH_WIDE_QUADS
 // BvhWideNodes per node: 1 for a 4-wide tree, 2 for an 8-wide one.
@@ -202,8 +203,9 @@ void wide_order(inout float ta, inout uint ca, inout float tb, inout uint cb) {
 
 // One step down from wide node `child`: on to its nearest entered child, the
 // others pushed; NO_CHILD (which has LEAF_BIT set) if the ray enters none. An
-// empty slot's box is never entered, and its NO_CHILD is checked as well, so
-// that no driver's handling of infinity matters. A macro, like BVH_STEP.
+// empty slot's box is inside out (gpu::layout::EMPTY_SLOT_MIN), so its entry
+// distance exceeds its exit in any rounding and its NO_CHILD need not be
+// tested (that test cost 1-3 %). A macro, like BVH_STEP.
 #define WIDE_STEP()                                                                    \
     {                                                                                  \
         uint near = NO_CHILD;                                                          \
@@ -219,10 +221,10 @@ void wide_order(inout float ta, inout uint ca, inout float tb, inout uint cb) {
             vec4 enter = max(max(xn, yn), max(zn, vec4(0.0)));                         \
             vec4 leave = min(min(xf, yf), min(zf, vec4(h.t)));                         \
             uvec4 c = bvh_wide_buf.nodes[n].child;                                     \
-            float t0 = (enter.x <= leave.x && c.x != NO_CHILD) ? enter.x : WIDE_MISS;  \
-            float t1 = (enter.y <= leave.y && c.y != NO_CHILD) ? enter.y : WIDE_MISS;  \
-            float t2 = (enter.z <= leave.z && c.z != NO_CHILD) ? enter.z : WIDE_MISS;  \
-            float t3 = (enter.w <= leave.w && c.w != NO_CHILD) ? enter.w : WIDE_MISS;  \
+            float t0 = enter.x <= leave.x ? enter.x : WIDE_MISS;                       \
+            float t1 = enter.y <= leave.y ? enter.y : WIDE_MISS;                       \
+            float t2 = enter.z <= leave.z ? enter.z : WIDE_MISS;                       \
+            float t3 = enter.w <= leave.w ? enter.w : WIDE_MISS;                       \
             uint c0 = c.x;                                                             \
             uint c1 = c.y;                                                             \
             uint c2 = c.z;                                                             \

@@ -207,14 +207,15 @@ fn a_bvh_deeper_than_the_small_fixed_stacks_renders_every_primitive() {
 }
 
 /// `--accel auto` runs the width its rule picks, in both apps: the 4-wide
-/// tree on a sphere list, the binary one on the teapot.
+/// tree, on a sphere list and on the teapot; `--accel bvh` the binary one.
 #[test]
 fn auto_runs_the_width_it_picks() {
     for app in App::BOTH {
         let dir = scratch("accel-auto-width");
         for (scene, set, width) in [
             ("spherelist", &["--set", "extra_spheres=1000"][..], 4),
-            ("teapot", &[][..], 2),
+            ("teapot", &[][..], 4),
+            ("teapot", &["--accel", "bvh"][..], 2),
         ] {
             let (r, _) = render(app, scene, "64x64", set, &dir.join("a.png"));
             assert_eq!(r.bvh_width, Some(width), "{app:?} {scene}: auto's width");

@@ -60,7 +60,7 @@ fn variants() -> Vec<(String, Variant)> {
         let scene = Scene::load("box", &set).unwrap();
         let bvh = accel
             .wants_bvh(&scene)
-            .then(|| build_bvh(&scene).widen(accel.width(&scene)));
+            .then(|| build_bvh(&scene).widen(accel.width()));
         let args = RenderArgs {
             generic,
             specialize: !generic,

@@ -124,10 +124,11 @@ pub struct GpuBvhPrim {
 /// vector arithmetic from seven 16-byte reads. A 4-wide tree has one per
 /// node; an 8-wide tree two consecutive ones per node (children 0-3, then
 /// 4-7), and an interior child reference is the index of its node's first.
-/// A slot without a child holds `child_ref::NO_CHILD` and the box of
-/// `EMPTY_SLOT` corners, which no ray enters. The GLSL declares the six
-/// corner fields as one array, `vec4 bounds[6]`, in this order, so that a
-/// ray reads each axis's near and far planes by the sign of its direction.
+/// A slot without a child holds `child_ref::NO_CHILD` and the inside-out
+/// box of `EMPTY_SLOT_MIN` and `EMPTY_SLOT_MAX`, which no ray enters. The
+/// GLSL declares the six corner fields as one array, `vec4 bounds[6]`, in
+/// this order, so that a ray reads each axis's near and far planes by the
+/// sign of its direction.
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, Pod, Zeroable, PartialEq)]
 pub struct GpuBvhWideNode {
@@ -140,20 +141,26 @@ pub struct GpuBvhWideNode {
     pub child: [u32; 4],
 }
 
-/// Both corners of an empty slot's box: every slab of it lies at infinity,
-/// so its entry distance is +inf or its exit -inf and no ray enters it.
-pub const EMPTY_SLOT: f32 = f32::INFINITY;
+/// An empty slot's box, its min corner at +`f32::MAX` and its max corner at
+/// -`f32::MAX`: inside out on every axis. The walk reads the near plane by
+/// the ray's sign, and for an inside-out box that plane lies beyond the far
+/// one (the two distances even have opposite signs), so the box's entry
+/// exceeds its exit and no ray enters it, in any rounding and without
+/// infinities; the walk needs no test of the slot's reference.
+pub const EMPTY_SLOT_MIN: f32 = f32::MAX;
+/// The max corner of an empty slot's box (`EMPTY_SLOT_MIN`).
+pub const EMPTY_SLOT_MAX: f32 = -f32::MAX;
 
 impl GpuBvhWideNode {
     /// A node of empty slots.
     pub fn empty() -> GpuBvhWideNode {
         GpuBvhWideNode {
-            min_x: [EMPTY_SLOT; 4],
-            min_y: [EMPTY_SLOT; 4],
-            min_z: [EMPTY_SLOT; 4],
-            max_x: [EMPTY_SLOT; 4],
-            max_y: [EMPTY_SLOT; 4],
-            max_z: [EMPTY_SLOT; 4],
+            min_x: [EMPTY_SLOT_MIN; 4],
+            min_y: [EMPTY_SLOT_MIN; 4],
+            min_z: [EMPTY_SLOT_MIN; 4],
+            max_x: [EMPTY_SLOT_MAX; 4],
+            max_y: [EMPTY_SLOT_MAX; 4],
+            max_z: [EMPTY_SLOT_MAX; 4],
             child: [child_ref::NO_CHILD; 4],
         }
     }

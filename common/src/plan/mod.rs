@@ -162,7 +162,7 @@ impl Planner {
         });
         let (bvh, bvh_ms) = if self.args.accel.wants_bvh(&scene) {
             let t0 = Instant::now();
-            let bvh = build_bvh(&scene).widen(self.args.accel.width(&scene));
+            let bvh = build_bvh(&scene).widen(self.args.accel.width());
             let ms = t0.elapsed().as_secs_f64() * 1e3;
             explain::numbered(0, "BVH (twinray-common)", || {
                 format!(

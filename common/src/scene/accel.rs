@@ -37,21 +37,20 @@ impl Accel {
     }
 
     /// Children per node of the BVH this choice traces through `scene`.
-    /// `auto` takes the 4-wide tree where spheres are at least half of the
-    /// primitives and the binary tree otherwise: the crossover measured on the
-    /// H100 (comparison/results/nvidia-h100/FINDINGS.md#where-the-4-wide-tree-pays-investigationcrossover).
-    /// On sphere lists of 100 to 10,000 spheres the 4-wide tree is 15 to 27 %
-    /// faster in Vulkan and 5 to 17 % in OpenGL (one point excepted: 10,000 at
-    /// 1000² on OpenGL's compute path, 3 % slower); on triangle scenes (the
-    /// teapot, the box) it is 4 to 11 % faster in Vulkan but 2 to 5 % slower in
+    /// `auto` takes the 4-wide tree: since its step reads each axis's near
+    /// and far planes by the ray's signs, it is the faster tree at every
+    /// point measured on the H100 in both APIs but one: OpenGL's compute
+    /// path on the teapot tessellated past a million triangles, where the
+    /// binary tree is 4 to 9 % faster and the 4-wide one 6 to 10 % faster in
+    /// Vulkan (comparison/results/nvidia-h100/FINDINGS.md#the-wide-steps-arithmetic-investigationoctant).
+    /// On the 19.2k teapot at 1080p it is 17 % faster in Vulkan and 8 % in
     /// OpenGL. One rule for both APIs keeps the comparison honest: both trace
-    /// the same tree.
-    pub fn width(self, scene: &Scene) -> u32 {
+    /// the same tree; `--accel bvh` still gives the binary one.
+    pub fn width(self) -> u32 {
         match self {
-            Accel::Bvh4 => 4,
+            Accel::Auto | Accel::Bvh4 => 4,
             Accel::Bvh8 => 8,
-            Accel::Auto if 2 * scene.spheres.len() >= scene.primitive_count() => 4,
-            Accel::Auto | Accel::None | Accel::Bvh => 2,
+            Accel::None | Accel::Bvh => 2,
         }
     }
 }

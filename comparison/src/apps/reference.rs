@@ -41,7 +41,7 @@ pub fn render_reference(args: &RenderArgs, truth: bool) -> anyhow::Result<()> {
     let t = Instant::now();
     // --accel none: brute force, a reference independent of the BVH code;
     // else through the tree of the width asked for, as the apps trace it.
-    let bvh_width = (args.accel != Accel::None).then(|| args.accel.width(&scene));
+    let bvh_width = (args.accel != Accel::None).then(|| args.accel.width());
     let img = if truth {
         twinray_common::reference::render_truth(&scene, w, h)
     } else {
