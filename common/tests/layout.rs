@@ -356,3 +356,30 @@ fn the_bvh_encodings_match_rust() {
         child_ref::as_leaf(constant("NO_CHILD")).expect("NO_CHILD is a leaf reference");
     assert!(first >= twinray_common::limits::MAX_BVH_PRIMITIVES);
 }
+
+/// The wide step's per-ray origin term, origin * inverse direction (padded by
+/// 2^-22 of itself), stays finite for every coordinate a scene may hold: the
+/// shader's MIN_DIR bounds the inverse, limits::MAX_COORDINATE the origin.
+#[test]
+fn the_wide_steps_origin_term_stays_finite() {
+    let mut variant = Variant::generic(Default::default());
+    variant.bvh_stack = Some(4);
+    let module = parse(&fragment_source(), naga::ShaderStage::Fragment, &variant)
+        .unwrap()
+        .0;
+    let (_, c) = module
+        .constants
+        .iter()
+        .find(|(_, c)| c.name.as_deref() == Some("MIN_DIR"))
+        .expect("the shader has no constant MIN_DIR");
+    let min_dir = match module.global_expressions[c.init] {
+        naga::Expression::Literal(naga::Literal::F32(v)) => v,
+        ref other => panic!("MIN_DIR is {other:?}, not an f32 literal"),
+    };
+    let largest = twinray_common::limits::MAX_COORDINATE as f32 * (1.0 / min_dir);
+    let padded = largest + largest * (1.0 / 4_194_304.0);
+    assert!(
+        padded.is_finite() && padded < f32::MAX / 1.5,
+        "MAX_COORDINATE / MIN_DIR = {largest:e} leaves no room below f32::MAX"
+    );
+}

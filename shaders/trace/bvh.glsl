@@ -73,7 +73,7 @@ const uint NO_CHILD = 0xFFFFFFFFu;
 const uint GPU_ROOT = 1u;
 
 // Where the ray enters the box, or -1 if it misses it before t_max. Zero
-// direction components are nudged so 0 * inf never makes a NaN.
+// direction components are nudged (inverse_dir) so 0 * inf never makes a NaN.
 float enter_box(vec3 origin, vec3 inv_dir, vec3 bmin, vec3 bmax, float t_max) {
     vec3 t0 = (bmin - origin) * inv_dir;
     vec3 t1 = (bmax - origin) * inv_dir;
@@ -84,8 +84,16 @@ float enter_box(vec3 origin, vec3 inv_dir, vec3 bmin, vec3 bmax, float t_max) {
     return enter <= leave ? enter : -1.0;
 }
 
+// The smallest direction component the slab tests divide by: a zero one would
+// make 0 * inf a NaN. At 2e-20 the inverse stays below 5e19, so the wide step's
+// origin * inverse stays finite for any coordinate the scene checks allow
+// (limits::MAX_COORDINATE, 4e18: 2e38 < 3.4e38; a test holds the two together),
+// and a slab it makes of a direction this small is off by under 1e-19 of the
+// distance travelled, far below f32's rounding.
+const float MIN_DIR = 2.0e-20;
+
 vec3 inverse_dir(vec3 dir) {
-    vec3 d = mix(vec3(1.0e-30), abs(dir), greaterThan(abs(dir), vec3(1.0e-30)));
+    vec3 d = mix(vec3(MIN_DIR), abs(dir), greaterThan(abs(dir), vec3(MIN_DIR)));
     return sign(dir + vec3(1.0e-38)) / d;
 }
 
@@ -170,12 +178,13 @@ bool hit_leaf(inout Hit h, vec3 origin, vec3 dir, TriRay ray, uint first, uint c
 //
 // The slab test reads each axis's near and far planes by the sign of the ray's
 // direction (near_k, far_k in traverse), so each entry and exit distance is
-// already the smaller and the larger: no min and max per axis, the same
-// values as taking both planes and sorting them, since a positive inverse
-// direction keeps (min - o) * inv <= (max - o) * inv under rounding. That
-// took Vulkan's 1080p teapot from 0.259 to 0.232 ms and OpenGL's from 0.319
-// to 0.294
+// already the smaller and the larger: no min and max per axis, since a
+// positive inverse direction keeps min * inv - a <= max * inv - b for a >= b
+// under rounding. That took Vulkan's 1080p teapot from 0.259 to 0.232 ms and
+// OpenGL's from 0.319 to 0.294
 // (comparison/results/nvidia-h100/FINDINGS.md#the-wide-steps-arithmetic-investigationoctant).
+// Each distance is one fma against a per-ray origin term, padded so that no
+// box is missed for its rounding (traverse has why).
 #ifdef USE_BVH_WIDE
 #ifndef BVH_WIDE_QUADS
 // BvhWideNodes per node: 1 for a 4-wide tree, 2 for an 8-wide one.
@@ -212,12 +221,12 @@ void wide_order(inout float ta, inout uint ca, inout float tb, inout uint cb) {
         float near_t = WIDE_MISS;                                                      \
         for (uint q = 0u; q < uint(BVH_WIDE_QUADS); q++) {                             \
             uint n = child + q;                                                        \
-            vec4 xn = (bvh_wide_buf.nodes[n].bounds[near_k.x] - origin.x) * inv_dir.x; \
-            vec4 xf = (bvh_wide_buf.nodes[n].bounds[far_k.x] - origin.x) * inv_dir.x;  \
-            vec4 yn = (bvh_wide_buf.nodes[n].bounds[near_k.y] - origin.y) * inv_dir.y; \
-            vec4 yf = (bvh_wide_buf.nodes[n].bounds[far_k.y] - origin.y) * inv_dir.y;  \
-            vec4 zn = (bvh_wide_buf.nodes[n].bounds[near_k.z] - origin.z) * inv_dir.z; \
-            vec4 zf = (bvh_wide_buf.nodes[n].bounds[far_k.z] - origin.z) * inv_dir.z;  \
+            vec4 xn = fma(bvh_wide_buf.nodes[n].bounds[near_k.x], vec4(inv_dir.x), -oi_near.xxxx); \
+            vec4 xf = fma(bvh_wide_buf.nodes[n].bounds[far_k.x], vec4(inv_dir.x), -oi_far.xxxx);   \
+            vec4 yn = fma(bvh_wide_buf.nodes[n].bounds[near_k.y], vec4(inv_dir.y), -oi_near.yyyy); \
+            vec4 yf = fma(bvh_wide_buf.nodes[n].bounds[far_k.y], vec4(inv_dir.y), -oi_far.yyyy);   \
+            vec4 zn = fma(bvh_wide_buf.nodes[n].bounds[near_k.z], vec4(inv_dir.z), -oi_near.zzzz); \
+            vec4 zf = fma(bvh_wide_buf.nodes[n].bounds[far_k.z], vec4(inv_dir.z), -oi_far.zzzz);   \
             vec4 enter = max(max(xn, yn), max(zn, vec4(0.0)));                         \
             vec4 leave = min(min(xf, yf), min(zf, vec4(h.t)));                         \
             uvec4 c = bvh_wide_buf.nodes[n].child;                                     \
@@ -300,6 +309,21 @@ Hit traverse(vec3 origin, vec3 dir, float t_max, bool any_hit) {
     // 3-5) by the direction's sign, and its far plane (WIDE_STEP).
     uvec3 near_k = uvec3(inv_dir.x < 0.0 ? 3u : 0u, inv_dir.y < 0.0 ? 4u : 1u, inv_dir.z < 0.0 ? 5u : 2u);
     uvec3 far_k = uvec3(3u, 5u, 7u) - near_k;
+    // Each slab distance (plane - o) * inv is one fma, plane * inv - o * inv,
+    // with o * inv taken once per ray. That product's rounding is relative to
+    // the origin's distance from the world's origin, not to the box, so it
+    // is taken 2^-22 of itself too large for the near planes and too small for
+    // the far ones: more than the 2^-24 it can be off by, so every entry
+    // distance is no later and every exit no earlier than the exact one's
+    // rounding. A box is never missed for it; far from the origin a few more
+    // are entered (MIN_DIR keeps o * inv finite). The 1080p teapot: Vulkan
+    // -4 %, OpenGL -2 %; OpenGL's compute path loses 7-8 % from a million
+    // triangles up
+    // (comparison/results/nvidia-h100/FINDINGS.md#the-slab-distance-as-one-padded-fma-investigationfma-pad).
+    vec3 oi = origin * inv_dir;
+    vec3 oi_pad = abs(oi) * (1.0 / 4194304.0);
+    vec3 oi_near = oi + oi_pad;
+    vec3 oi_far = oi - oi_pad;
 #endif
 #ifdef BVH_STACK_LOCAL
     BVH_STACK_DECLARE;
