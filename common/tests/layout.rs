@@ -327,24 +327,37 @@ fn every_builtin_variant_and_the_generic_one_compile_for_both_apis() {
     }
 }
 
+/// The generic fragment shader with the BVH compiled in, as naga reads it.
+fn bvh_module() -> naga::Module {
+    let mut variant = Variant::generic(Default::default());
+    variant.bvh_stack = Some(4);
+    parse(&fragment_source(), naga::ShaderStage::Fragment, &variant)
+        .unwrap()
+        .0
+}
+
+/// The literal that the shader's constant `name` is.
+fn shader_constant(module: &naga::Module, name: &str) -> naga::Literal {
+    let (_, c) = module
+        .constants
+        .iter()
+        .find(|(_, c)| c.name.as_deref() == Some(name))
+        .unwrap_or_else(|| panic!("the shader has no constant {name}"));
+    match module.global_expressions[c.init] {
+        naga::Expression::Literal(literal) => literal,
+        ref other => panic!("{name} is {other:?}, not a literal"),
+    }
+}
+
 /// The shader's own constants for what the BVH's words encode (trace/bvh.glsl)
 /// equal the Rust ones that write those words.
 #[test]
 fn the_bvh_encodings_match_rust() {
-    let mut variant = Variant::generic(Default::default());
-    variant.bvh_stack = Some(4);
-    let module = parse(&fragment_source(), naga::ShaderStage::Fragment, &variant)
-        .unwrap()
-        .0;
+    let module = bvh_module();
     let constant = |name: &str| -> u32 {
-        let (_, c) = module
-            .constants
-            .iter()
-            .find(|(_, c)| c.name.as_deref() == Some(name))
-            .unwrap_or_else(|| panic!("the shader has no constant {name}"));
-        match module.global_expressions[c.init] {
-            naga::Expression::Literal(naga::Literal::U32(v)) => v,
-            ref other => panic!("{name} is {other:?}, not a u32 literal"),
+        match shader_constant(&module, name) {
+            naga::Literal::U32(v) => v,
+            other => panic!("{name} is {other:?}, not a u32"),
         }
     };
     assert_eq!(constant("SPHERE_BIT"), PRIM_SPHERE_BIT);
@@ -362,19 +375,9 @@ fn the_bvh_encodings_match_rust() {
 /// shader's MIN_DIR bounds the inverse, limits::MAX_COORDINATE the origin.
 #[test]
 fn the_wide_steps_origin_term_stays_finite() {
-    let mut variant = Variant::generic(Default::default());
-    variant.bvh_stack = Some(4);
-    let module = parse(&fragment_source(), naga::ShaderStage::Fragment, &variant)
-        .unwrap()
-        .0;
-    let (_, c) = module
-        .constants
-        .iter()
-        .find(|(_, c)| c.name.as_deref() == Some("MIN_DIR"))
-        .expect("the shader has no constant MIN_DIR");
-    let min_dir = match module.global_expressions[c.init] {
-        naga::Expression::Literal(naga::Literal::F32(v)) => v,
-        ref other => panic!("MIN_DIR is {other:?}, not an f32 literal"),
+    let min_dir = match shader_constant(&bvh_module(), "MIN_DIR") {
+        naga::Literal::F32(v) => v,
+        other => panic!("MIN_DIR is {other:?}, not an f32"),
     };
     let largest = twinray_common::limits::MAX_COORDINATE as f32 * (1.0 / min_dir);
     let padded = largest + largest * (1.0 / 4_194_304.0);
