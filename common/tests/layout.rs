@@ -371,16 +371,20 @@ fn the_bvh_encodings_match_rust() {
 }
 
 /// The wide step's per-ray origin term, origin * inverse direction (padded by
-/// 2^-22 of itself), stays finite for every coordinate a scene may hold: the
+/// ORIGIN_PAD, 2^-22, of itself), stays finite for every coordinate a scene may hold: the
 /// shader's MIN_DIR bounds the inverse, limits::MAX_COORDINATE the origin.
 #[test]
 fn the_wide_steps_origin_term_stays_finite() {
-    let min_dir = match shader_constant(&bvh_module(), "MIN_DIR") {
-        naga::Literal::F32(v) => v,
-        other => panic!("MIN_DIR is {other:?}, not an f32"),
+    let module = bvh_module();
+    let constant = |name: &str| -> f32 {
+        match shader_constant(&module, name) {
+            naga::Literal::F32(v) => v,
+            other => panic!("{name} is {other:?}, not an f32"),
+        }
     };
-    let largest = twinray_common::limits::MAX_COORDINATE as f32 * (1.0 / min_dir);
-    let padded = largest + largest * (1.0 / 4_194_304.0);
+    assert_eq!(constant("ORIGIN_PAD"), 2f32.powi(-22));
+    let largest = twinray_common::limits::MAX_COORDINATE as f32 * (1.0 / constant("MIN_DIR"));
+    let padded = largest + largest * constant("ORIGIN_PAD");
     assert!(
         padded.is_finite() && padded < f32::MAX / 1.5,
         "MAX_COORDINATE / MIN_DIR = {largest:e} leaves no room below f32::MAX"

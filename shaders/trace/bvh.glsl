@@ -92,6 +92,10 @@ float enter_box(vec3 origin, vec3 inv_dir, vec3 bmin, vec3 bmax, float t_max) {
 // distance travelled, far below f32's rounding.
 const float MIN_DIR = 2.0e-20;
 
+// How far the wide step pads its per-ray origin term, as a share of it: 2^-22,
+// four times the 2^-24 that term's rounding can be off by (traverse has why).
+const float ORIGIN_PAD = 2.384185791015625e-7;
+
 vec3 inverse_dir(vec3 dir) {
     vec3 d = mix(vec3(MIN_DIR), abs(dir), greaterThan(abs(dir), vec3(MIN_DIR)));
     return sign(dir + vec3(1.0e-38)) / d;
@@ -321,7 +325,7 @@ Hit traverse(vec3 origin, vec3 dir, float t_max, bool any_hit) {
     // triangles up
     // (comparison/results/nvidia-h100/FINDINGS.md#the-slab-distance-as-one-padded-fma-investigationfma-pad).
     vec3 oi = origin * inv_dir;
-    vec3 oi_pad = abs(oi) * (1.0 / 4194304.0);
+    vec3 oi_pad = abs(oi) * ORIGIN_PAD;
     vec3 oi_near = oi + oi_pad;
     vec3 oi_far = oi - oi_pad;
 #endif
