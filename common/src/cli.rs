@@ -77,7 +77,7 @@ pub struct RenderArgs {
     /// tracer as a compute shader writing a storage image.
     #[arg(long, value_enum, default_value_t = RenderPath::Fragment)]
     pub path: RenderPath,
-    /// Compute path only: the workgroup size WxH (e.g. 8x4, 8x8, 16x8, 16x16) [default: 8x4].
+    /// Compute path only: the workgroup size WxH (e.g. 8x4, 4x8, 8x16) [default: Vulkan 8x16, OpenGL 4x8].
     #[arg(long, value_name = "WxH", value_parser = parse_workgroup)]
     pub workgroup: Option<Workgroup>,
     /// Compute path: declare 1-32 KiB of workgroup memory that the tracer does
@@ -140,16 +140,12 @@ pub struct Workgroup {
 }
 
 impl Workgroup {
-    /// The default, chosen by measurement: one warp. On NVIDIA it was as fast
-    /// as 16x8 or faster in Vulkan, and faster in OpenGL, whose driver keeps
-    /// more one-warp workgroups resident on each multiprocessor; on lavapipe and
-    /// llvmpipe it ties with 16x8. The figures:
-    /// comparison/results/nvidia-h100/FINDINGS.md#local-memory-and-opengls-multiprocessors-investigationgl-multiprocessors
-    pub const DEFAULT: Workgroup = Workgroup { x: 8, y: 4 };
     /// The sizes the comparison measures.
-    pub const MEASURED: [Workgroup; 4] = [
+    pub const MEASURED: [Workgroup; 6] = [
         Workgroup { x: 8, y: 4 },
+        Workgroup { x: 4, y: 8 },
         Workgroup { x: 8, y: 8 },
+        Workgroup { x: 8, y: 16 },
         Workgroup { x: 16, y: 8 },
         Workgroup { x: 16, y: 16 },
     ];
@@ -261,16 +257,17 @@ impl RenderArgs {
         }
     }
 
-    /// The workgroup of a compute run (`--workgroup` or the default). A
-    /// `--workgroup` with the fragment path is a mistake worth saying, not ignoring.
-    pub fn compute_workgroup(&self) -> anyhow::Result<Workgroup> {
+    /// The `--workgroup` of a compute run, None for the app's default
+    /// (`Api::default_workgroup`). A `--workgroup` with the fragment path is a
+    /// mistake worth saying, not ignoring.
+    pub fn compute_workgroup(&self) -> anyhow::Result<Option<Workgroup>> {
         if self.path == RenderPath::Fragment && self.workgroup.is_some() {
             return Err(bad_input("--workgroup applies to --path compute only"));
         }
         if self.path == RenderPath::Fragment && self.shared_pad.is_some() {
             return Err(bad_input("--shared-pad applies to --path compute only"));
         }
-        Ok(self.workgroup.unwrap_or(Workgroup::DEFAULT))
+        Ok(self.workgroup)
     }
 
     pub fn frame_count(&self) -> u32 {

@@ -5,8 +5,8 @@
 //! on either path; and the tracer itself gives no array an initialiser, so the
 //! post-passes only ever remove naga's.
 
-use twinray_common::cli::Workgroup;
 use twinray_common::plan::build_bvh;
+use twinray_common::plan::requests::Api;
 use twinray_common::scene::load::BUILTIN_SCENES;
 use twinray_common::scene::numerics::{Numerics, Offset, SphereTest, TriangleTest};
 use twinray_common::scene::Scene;
@@ -90,7 +90,7 @@ fn no_local_array_keeps_an_initialiser() {
     let mut arrays_seen = 0;
     for v in &variants {
         let s = build::build(v).unwrap_or_else(|e| panic!("{}: {e:#}", v.label()));
-        let c = build::build_compute(v, Workgroup::DEFAULT).unwrap();
+        let c = build::build_compute(v, Api::Vulkan.default_workgroup()).unwrap();
         for (what, words, glsl) in [
             ("fragment", &s.fragment.spirv, &s.fragment.glsl),
             ("compute", &c.stage.spirv, &c.stage.glsl),

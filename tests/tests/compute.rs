@@ -68,7 +68,7 @@ fn every_measured_workgroup_covers_an_odd_sized_image() {
     let dir = scratch("compute-workgroups");
     for app in App::BOTH {
         let (_, fragment) = render(app, "box", "61x37", &[], &dir.join("f.png"));
-        for wg in ["8x4", "8x8", "16x8", "16x16"] {
+        for wg in ["8x4", "4x8", "8x8", "8x16", "16x8", "16x16"] {
             let (report, img) = render(
                 app,
                 "box",

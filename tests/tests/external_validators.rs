@@ -11,7 +11,7 @@
 use std::path::{Path, PathBuf};
 use std::process::Command;
 use std::sync::Mutex;
-use twinray_common::cli::{RenderArgs, RenderPath, Size, Workgroup};
+use twinray_common::cli::{RenderArgs, RenderPath, Size};
 use twinray_common::lab::experiment::Experiment;
 use twinray_common::plan::build_bvh;
 use twinray_common::plan::requests::Api;
@@ -224,7 +224,7 @@ fn glslang_and_spirv_val_accept_every_variant() {
                     s.fragment.glsl,
                 )
             } else {
-                let s = build_compute(variant, Workgroup::DEFAULT)
+                let s = build_compute(variant, Api::Vulkan.default_workgroup())
                     .unwrap_or_else(|e| panic!("{label} compute: {e:#}"));
                 compute_sources += 1;
                 // The compute variant adds WG_X, WG_Y (and BVH_STACK_SHARED).

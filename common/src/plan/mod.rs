@@ -78,7 +78,7 @@ impl Planner {
     /// do) and decides everything that needs no scene.
     pub fn new(args: &RenderArgs, api: Api) -> anyhow::Result<Planner> {
         lab::check(args, api)?;
-        let workgroup = args.compute_workgroup()?;
+        let workgroup = args.compute_workgroup()?.unwrap_or(api.default_workgroup());
         args.check_outputs()?;
         let mut changes = lab::changes(args);
         changes.device.count_rays = args.count_rays;

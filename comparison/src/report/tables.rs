@@ -33,6 +33,28 @@ pub fn machine(outcomes: &[Outcome], cpu: &str) -> String {
             field(Api::Opengl, g)
         );
     }
+    // Each app has its own default workgroup (Api::default_workgroup), so
+    // the table says which shapes the compute rows ran at.
+    let workgroups = |api: Api| {
+        let mut shapes: Vec<&str> = outcomes
+            .iter()
+            .filter(|o| o.api == api)
+            .filter_map(|o| o.result.as_ref().ok()?.workgroup.as_deref())
+            .collect();
+        shapes.sort_unstable();
+        shapes.dedup();
+        if shapes.is_empty() {
+            "–".to_string()
+        } else {
+            shapes.join(", ")
+        }
+    };
+    let _ = writeln!(
+        s,
+        "| compute workgroup | {} | {} |",
+        workgroups(Api::Vulkan),
+        workgroups(Api::Opengl)
+    );
     let _ = writeln!(s, "| CPU | {cpu} | {cpu} |\n");
     s
 }

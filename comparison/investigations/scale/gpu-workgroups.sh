@@ -1,0 +1,54 @@
+#!/usr/bin/env bash
+# One build at several compute workgroup shapes (investigation/workgroups/):
+# the teapot at 1080p and 4K with Grays/s and at 1000x1000, the 10k sphere
+# list at 300x300 through its default tree, and the study's two brute-force
+# points (the box at 1000x1000, the 10k sphere list at 300x300); both APIs,
+# two rounds in alternating shape and API order, after one untimed run of
+# each app so that neither round meets a cold shader cache. Then what each
+# driver made of the teapot's compute shader at each shape (Vulkan's
+# registers, OpenGL's local memory). About three minutes for six shapes on an H100.
+# OUT_DIR/workgroups.jsonl: a label line (point|shape|round), then the app's
+# --json report.
+# Usage: comparison/investigations/scale/gpu-workgroups.sh BIN_DIR OUT_DIR SHAPE...
+#   SHAPE: a --workgroup, e.g. 8x4 8x8 16x8
+set -uo pipefail
+bin=$1
+out=$2
+shift 2
+mkdir -p "$out"
+log=$out/workgroups.jsonl
+errors=$out/workgroups.log
+: > "$log"
+# shellcheck source=comparison/investigations/lib.sh
+source "$(dirname "$0")/../lib.sh"
+gpu_info
+points=(
+    "teapot-1080p|--scene teapot --size 1920x1080 --frames 60 --count-rays"
+    "teapot-4k|--scene teapot --size 3840x2160 --frames 60 --count-rays"
+    "teapot-19.2k|--scene teapot --size 1000x1000 --frames 60"
+    "spherelist-10k|--scene spherelist --set extra_spheres=10000 --size 300x300 --frames 60"
+    "box-brute|--scene box --size 1000x1000 --accel none --frames 60"
+    "spherelist-10k-brute|--scene spherelist --set extra_spheres=10000 --size 300x300 --accel none --frames 20"
+)
+shapes=("$@")
+for app in vk gl; do
+    "$bin/twinray-$app" --headless --scene teapot --size 1920x1080 --frames 10 --path compute > /dev/null 2>> "$errors"
+done
+for round in 1 2; do
+    if [ "$round" = 1 ]; then apps=(vk gl); order=("${shapes[@]}"); else apps=(gl vk); order=(); for ((i = ${#shapes[@]} - 1; i >= 0; i--)); do order+=("${shapes[i]}"); done; fi
+    for p in "${points[@]}"; do
+        for app in "${apps[@]}"; do
+            for s in "${order[@]}"; do
+                # shellcheck disable=SC2086
+                run "${p%%|*}|$s|$round" "$app" ${p#*|} --path compute --workgroup "$s"
+            done
+        done
+    done
+done
+for s in "${shapes[@]}"; do
+    for app in vk gl; do
+        "$bin/twinray-$app" --headless --scene teapot --size 64x64 --path compute --workgroup "$s" \
+            --dump-shaders "$out/shaders-$app-$s" > /dev/null 2>> "$errors"
+    done
+done
+touch "$out/done"
