@@ -9,8 +9,9 @@
 # registers, OpenGL's local memory). About three minutes for six shapes on an H100.
 # OUT_DIR/workgroups.jsonl: a label line (point|shape|round), then the app's
 # --json report.
-# Usage: comparison/investigations/scale/gpu-workgroups.sh BIN_DIR OUT_DIR SHAPE...
+# Usage: comparison/investigations/scale/gpu-workgroups.sh BIN_DIR OUT_DIR SHAPE... [-- OPTION...]
 #   SHAPE: a --workgroup, e.g. 8x4 8x8 16x8
+#   OPTION: added to every run, e.g. -- --experiment shared-bvh-stack
 set -uo pipefail
 bin=$1
 out=$2
@@ -30,7 +31,13 @@ points=(
     "box-brute|--scene box --size 1000x1000 --accel none --frames 60"
     "spherelist-10k-brute|--scene spherelist --set extra_spheres=10000 --size 300x300 --accel none --frames 20"
 )
-shapes=("$@")
+shapes=()
+while [ $# -gt 0 ] && [ "$1" != -- ]; do
+    shapes+=("$1")
+    shift
+done
+[ $# -gt 0 ] && shift
+extra=("$@")
 for app in vk gl; do
     "$bin/twinray-$app" --headless --scene teapot --size 1920x1080 --frames 10 --path compute > /dev/null 2>> "$errors"
 done
@@ -40,7 +47,7 @@ for round in 1 2; do
         for app in "${apps[@]}"; do
             for s in "${order[@]}"; do
                 # shellcheck disable=SC2086
-                run "${p%%|*}|$s|$round" "$app" ${p#*|} --path compute --workgroup "$s"
+                run "${p%%|*}|$s|$round" "$app" ${p#*|} --path compute --workgroup "$s" "${extra[@]}"
             done
         done
     done
@@ -48,7 +55,7 @@ done
 for s in "${shapes[@]}"; do
     for app in vk gl; do
         "$bin/twinray-$app" --headless --scene teapot --size 64x64 --path compute --workgroup "$s" \
-            --dump-shaders "$out/shaders-$app-$s" > /dev/null 2>> "$errors"
+            "${extra[@]}" --dump-shaders "$out/shaders-$app-$s" > /dev/null 2>> "$errors"
     done
 done
 touch "$out/done"
