@@ -90,7 +90,7 @@ fn no_local_array_keeps_an_initialiser() {
     let mut arrays_seen = 0;
     for v in &variants {
         let s = build::build(v).unwrap_or_else(|e| panic!("{}: {e:#}", v.label()));
-        let c = build::build_compute(v, Api::Vulkan.default_workgroup()).unwrap();
+        let c = build::build_compute(v, Api::Vulkan.default_workgroup(true)).unwrap();
         for (what, words, glsl) in [
             ("fragment", &s.fragment.spirv, &s.fragment.glsl),
             ("compute", &c.stage.spirv, &c.stage.glsl),

@@ -224,7 +224,7 @@ fn glslang_and_spirv_val_accept_every_variant() {
                     s.fragment.glsl,
                 )
             } else {
-                let s = build_compute(variant, Api::Vulkan.default_workgroup())
+                let s = build_compute(variant, Api::Vulkan.default_workgroup(true))
                     .unwrap_or_else(|e| panic!("{label} compute: {e:#}"));
                 compute_sources += 1;
                 // The compute variant adds WG_X, WG_Y (and BVH_STACK_SHARED).

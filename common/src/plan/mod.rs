@@ -31,7 +31,8 @@ pub struct Planner {
     args: RenderArgs,
     api: Api,
     changes: Changes,
-    workgroup: Workgroup,
+    /// `--workgroup`, if given (`workgroup` gives the default otherwise).
+    workgroup: Option<Workgroup>,
 }
 
 /// Everything one scene needs on the GPU, decided and prepared.
@@ -78,7 +79,7 @@ impl Planner {
     /// do) and decides everything that needs no scene.
     pub fn new(args: &RenderArgs, api: Api) -> anyhow::Result<Planner> {
         lab::check(args, api)?;
-        let workgroup = args.compute_workgroup()?.unwrap_or(api.default_workgroup());
+        let workgroup = args.compute_workgroup()?;
         args.check_outputs()?;
         let mut changes = lab::changes(args);
         changes.device.count_rays = args.count_rays;
@@ -104,9 +105,12 @@ impl Planner {
         self.changes.pass
     }
 
-    /// The compute path's workgroup (also kept while the fragment path draws).
-    pub fn workgroup(&self) -> Workgroup {
+    /// The compute path's workgroup for a tracer that walks `bvh` or none:
+    /// `--workgroup`, or the app's default for it (also kept while the
+    /// fragment path draws).
+    pub fn workgroup(&self, bvh: Option<&Bvh>) -> Workgroup {
         self.workgroup
+            .unwrap_or(self.api.default_workgroup(bvh.is_some()))
     }
 
     /// The plan for `--scene` with every `--set`, at `width`×`height`.
@@ -221,7 +225,7 @@ impl Planner {
         Ok(
             RunReport::builder(api, device, plan.scene.stats(), variant_label)
                 .size(args.size.width, args.size.height)
-                .path(args.path, self.workgroup)
+                .path(args.path, self.workgroup(plan.bvh.as_ref()))
                 .frames(frames, setup_ms)
                 .nonfinite_pixels(image.nonfinite_pixels())
                 .shader_stats(shader_stats)
@@ -248,7 +252,7 @@ impl Planner {
             v.counts = counts;
         }
         v.tags = c.tags.clone();
-        v.entry = Entry::new(path, self.workgroup);
+        v.entry = Entry::new(path, self.workgroup(bvh));
         v
     }
 }

@@ -75,19 +75,20 @@ impl Api {
         }
     }
 
-    /// The compute path's workgroup where `--workgroup` does not set one: the
-    /// shape that traced the teapot fastest on the H100 in this API, and no
-    /// brute-force point more than 3 % slower than at the old 8x4. Vulkan's
-    /// driver gives a workgroup of several warps 64 registers instead of 76
-    /// (spilling to shared memory instead of local), and 8x16 took its
-    /// 1080p teapot from 0.220 to 0.196 ms; OpenGL's keeps one-warp
-    /// workgroups best, and 4x8 beat 8x4 by 2 % (the figures:
-    /// comparison/results/nvidia-h100/FINDINGS.md#each-apis-workgroup-investigationworkgroups).
-    /// A side-by-side run at one shape for both is `--workgroup WxH`.
-    pub fn default_workgroup(&self) -> crate::cli::Workgroup {
-        match self {
-            Api::Vulkan => crate::cli::Workgroup { x: 8, y: 16 },
-            Api::OpenGl => crate::cli::Workgroup { x: 4, y: 8 },
+    /// The compute path's workgroup where `--workgroup` does not set one, for
+    /// a tracer that walks a BVH (`bvh`) or tests every primitive. One warp,
+    /// 8x4, except for Vulkan's BVH walks: at 64 invocations or more its
+    /// driver gives the teapot's walk 64 registers instead of 76 (spilling
+    /// to shared memory instead of local), and 8x16 took the 1080p teapot
+    /// from 0.219 to 0.196 ms. Brute force stays at 8x4 in Vulkan, where
+    /// 8x16 cost the teapot up to 10 %, and OpenGL keeps 8x4 for both, as
+    /// no other shape gained it more than 2 % without costing some point 3 %
+    /// (the figures: comparison/results/nvidia-h100/FINDINGS.md#each-apis-workgroup-investigationworkgroups).
+    /// `--workgroup WxH` runs both apps at one shape.
+    pub fn default_workgroup(&self, bvh: bool) -> crate::cli::Workgroup {
+        match (self, bvh) {
+            (Api::Vulkan, true) => crate::cli::Workgroup { x: 8, y: 16 },
+            _ => crate::cli::Workgroup { x: 8, y: 4 },
         }
     }
 

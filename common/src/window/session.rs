@@ -80,7 +80,7 @@ pub fn run<R: Renderer>(
     Ok(WindowedRun {
         frames: session.frames,
         path,
-        workgroup: session.planner.workgroup(),
+        workgroup: session.planner.workgroup(session.plan.bvh.as_ref()),
         scene: session.plan.scene,
         variant: session.plan.variant,
         width: session.size.width,
@@ -257,10 +257,10 @@ impl<R: Renderer> Session<R> {
                     RenderPath::Fragment => RenderPath::Compute,
                     RenderPath::Compute => RenderPath::Fragment,
                 };
-                self.plan.variant = self
-                    .plan
-                    .variant
-                    .on(Entry::new(path, self.planner.workgroup()));
+                self.plan.variant = self.plan.variant.on(Entry::new(
+                    path,
+                    self.planner.workgroup(self.plan.bvh.as_ref()),
+                ));
                 self.rebuild()?;
                 self.restart_title();
                 eprintln!("{}: path {path}", self.program);

@@ -12,6 +12,8 @@
 # Usage: comparison/investigations/scale/gpu-workgroups.sh BIN_DIR OUT_DIR SHAPE... [-- OPTION...]
 #   SHAPE: a --workgroup, e.g. 8x4 8x8 16x8
 #   OPTION: added to every run, e.g. -- --experiment shared-bvh-stack
+# With POINTS=brute-teapot in the environment the points are instead the
+# study's brute-force teapot at five sizes (brute.jsonl in the results).
 set -uo pipefail
 bin=$1
 out=$2
@@ -31,6 +33,12 @@ points=(
     "box-brute|--scene box --size 1000x1000 --accel none --frames 60"
     "spherelist-10k-brute|--scene spherelist --set extra_spheres=10000 --size 300x300 --accel none --frames 20"
 )
+if [ "${POINTS:-}" = brute-teapot ]; then
+    points=()
+    for n in 300 400 500 600 1000; do
+        points+=("teapot-brute-$n|--scene teapot --size ${n}x$n --accel none --frames 20")
+    done
+fi
 shapes=()
 while [ $# -gt 0 ] && [ "$1" != -- ]; do
     shapes+=("$1")
