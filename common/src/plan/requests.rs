@@ -78,9 +78,9 @@ impl Api {
     /// The compute path's workgroup where `--workgroup` does not set one, for
     /// a tracer that walks a BVH (`bvh`) or tests every primitive. One warp,
     /// 8x4, except for Vulkan's BVH walks: at 64 invocations or more its
-    /// driver gives the teapot's walk 64 registers instead of 76 (spilling
-    /// to shared memory instead of local), and 8x16 took the 1080p teapot
-    /// from 0.219 to 0.196 ms. Brute force stays at 8x4 in Vulkan, where
+    /// driver compiles the teapot's walk to 64 registers and 36 bytes of
+    /// shared memory per invocation instead of 76 registers, and 8x16 took
+    /// the 1080p teapot from 0.219 to 0.196 ms. Brute force stays at 8x4 in Vulkan, where
     /// 8x16 cost the teapot up to 10 %, and OpenGL keeps 8x4 for both, as
     /// no other shape gained it more than 2 % without costing some point 3 %
     /// (the figures: comparison/results/nvidia-h100/FINDINGS.md#each-apis-workgroup-investigationworkgroups).

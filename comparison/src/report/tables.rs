@@ -33,8 +33,9 @@ pub fn machine(outcomes: &[Outcome], cpu: &str) -> String {
             field(Api::Opengl, g)
         );
     }
-    // Each app has its own default workgroup (Api::default_workgroup), so
-    // the table says which shapes the compute rows ran at.
+    // The default workgroup depends on the app and the tree
+    // (Api::default_workgroup), so the table says which shapes the compute
+    // rows ran at.
     let workgroups = |api: Api| {
         let mut shapes: Vec<&str> = outcomes
             .iter()
