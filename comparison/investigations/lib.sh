@@ -93,6 +93,32 @@ labelled_rounds() {
     done
 }
 
+# alternating_rounds STEP ITEM...: every entry of the array `points` with each
+# ITEM (a build, a shape, a configuration) and both apps, in two rounds: the
+# first in ITEM order with Vulkan first, the second in reverse order with
+# OpenGL first, so that no item and no API always runs first or on a warmer
+# GPU. Calls STEP POINT APP ITEM ROUND for each run.
+alternating_rounds() {
+    local step=$1 round p app item i
+    shift
+    local -a apps order
+    for round in 1 2; do
+        if [ "$round" = 1 ]; then
+            apps=(vk gl) order=("$@")
+        else
+            apps=(gl vk) order=()
+            for ((i = $#; i >= 1; i--)); do order+=("${!i}"); done
+        fi
+        for p in "${points[@]}"; do
+            for app in "${apps[@]}"; do
+                for item in "${order[@]}"; do
+                    "$step" "$p" "$app" "$item" "$round"
+                done
+            done
+        done
+    done
+}
+
 # teapot_points: sets the array `points` to the teapot's traversal points as
 # "label|options": 1080p and 4K with their rays counted (Grays/s), and four
 # tessellations at 1000x1000 (the growth from 19.2k to 4.9M triangles). The

@@ -30,19 +30,15 @@ points=(
     "teapot-1080p-8x8-bvh4|--scene teapot --size 1920x1080 --frames 60 --accel bvh4 --workgroup 8x8 --count-rays"
     "teapot-1080p-8x8-bvh|--scene teapot --size 1920x1080 --frames 60 --accel bvh --workgroup 8x8 --count-rays"
 )
+# One run of build B (NAME=BIN_DIR) at point P.
+step() {
+    local p=$1 app=$2 b=$3 round=$4
+    bin=${b#*=}
+    # shellcheck disable=SC2086
+    run "${p%%|*}|${b%%=*}|$round" "$app" ${p#*|} --path compute
+}
 builds=("$@")
-for round in 1 2; do
-    if [ "$round" = 1 ]; then apps=(vk gl); order=("${builds[@]}"); else apps=(gl vk); order=(); for ((i = ${#builds[@]} - 1; i >= 0; i--)); do order+=("${builds[i]}"); done; fi
-    for p in "${points[@]}"; do
-        for app in "${apps[@]}"; do
-            for b in "${order[@]}"; do
-                bin=${b#*=}
-                # shellcheck disable=SC2086
-                run "${p%%|*}|${b%%=*}|$round" "$app" ${p#*|} --path compute
-            done
-        done
-    done
-done
+alternating_rounds step "${builds[@]}"
 for b in "${builds[@]}"; do
     for app in vk gl; do
         for accel in bvh4 bvh; do

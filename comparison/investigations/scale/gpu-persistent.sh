@@ -45,20 +45,16 @@ for app in vk gl; do
     use_build new
     "$bin/twinray-$app" --headless --scene teapot --size 1920x1080 --frames 10 --path compute > /dev/null 2>> "$errors"
 done
-for round in 1 2; do
-    if [ "$round" = 1 ]; then apps=(vk gl); order=("${configs[@]}"); else apps=(gl vk); order=(); for ((i = ${#configs[@]} - 1; i >= 0; i--)); do order+=("${configs[i]}"); done; fi
-    for p in "${points[@]}"; do
-        for app in "${apps[@]}"; do
-            for c in "${order[@]}"; do
-                IFS='|' read -r name build wg groups blocks <<< "$c"
-                use_build "$build"
-                export TWINRAY_PERSISTENT_GROUPS=${groups:-0} TWINRAY_TILE_BLOCK=${blocks:-1x1}
-                # shellcheck disable=SC2086
-                run "${p%%|*}|$name|$round" "$app" ${p#*|} --path compute --workgroup "$wg"
-            done
-        done
-    done
-done
+# One run of configuration C at point P.
+step() {
+    local p=$1 app=$2 c=$3 round=$4 name build wg groups blocks
+    IFS='|' read -r name build wg groups blocks <<< "$c"
+    use_build "$build"
+    export TWINRAY_PERSISTENT_GROUPS=${groups:-0} TWINRAY_TILE_BLOCK=${blocks:-1x1}
+    # shellcheck disable=SC2086
+    run "${p%%|*}|$name|$round" "$app" ${p#*|} --path compute --workgroup "$wg"
+}
+alternating_rounds step "${configs[@]}"
 for b in old new; do
     use_build "$b"
     for app in vk gl; do

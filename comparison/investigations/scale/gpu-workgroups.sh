@@ -25,10 +25,10 @@ errors=$out/workgroups.log
 # shellcheck source=comparison/investigations/lib.sh
 source "$(dirname "$0")/../lib.sh"
 gpu_info
+# The teapot at 1080p, 4K and 1000x1000 (teapot_points' first three).
+teapot_points
 points=(
-    "teapot-1080p|--scene teapot --size 1920x1080 --frames 60 --count-rays"
-    "teapot-4k|--scene teapot --size 3840x2160 --frames 60 --count-rays"
-    "teapot-19.2k|--scene teapot --size 1000x1000 --frames 60"
+    "${points[@]:0:3}"
     "spherelist-10k|--scene spherelist --set extra_spheres=10000 --size 300x300 --frames 60"
     "box-brute|--scene box --size 1000x1000 --accel none --frames 60"
     "spherelist-10k-brute|--scene spherelist --set extra_spheres=10000 --size 300x300 --accel none --frames 20"
@@ -49,17 +49,13 @@ extra=("$@")
 for app in vk gl; do
     "$bin/twinray-$app" --headless --scene teapot --size 1920x1080 --frames 10 --path compute > /dev/null 2>> "$errors"
 done
-for round in 1 2; do
-    if [ "$round" = 1 ]; then apps=(vk gl); order=("${shapes[@]}"); else apps=(gl vk); order=(); for ((i = ${#shapes[@]} - 1; i >= 0; i--)); do order+=("${shapes[i]}"); done; fi
-    for p in "${points[@]}"; do
-        for app in "${apps[@]}"; do
-            for s in "${order[@]}"; do
-                # shellcheck disable=SC2086
-                run "${p%%|*}|$s|$round" "$app" ${p#*|} --path compute --workgroup "$s" "${extra[@]}"
-            done
-        done
-    done
-done
+# One run at point P with workgroup shape S.
+step() {
+    local p=$1 app=$2 s=$3 round=$4
+    # shellcheck disable=SC2086
+    run "${p%%|*}|$s|$round" "$app" ${p#*|} --path compute --workgroup "$s" "${extra[@]}"
+}
+alternating_rounds step "${shapes[@]}"
 for s in "${shapes[@]}"; do
     for app in vk gl; do
         "$bin/twinray-$app" --headless --scene teapot --size 64x64 --path compute --workgroup "$s" \
