@@ -133,3 +133,32 @@ teapot_points() {
         "teapot-4.9m|--scene teapot --set tessellation=320x240 --size 1000x1000 --frames 30"
     )
 }
+
+# same_images A_BIN B_BIN "A_OPTIONS" "B_OPTIONS": every built-in and hard
+# scene on the compute path at 640x480, each app rendered by A_BIN with
+# A_OPTIONS and by B_BIN with B_OPTIONS, the PNGs compared byte for byte and,
+# where they differ, with `twinray diff`. Prints one line per difference and
+# a last line "N pairs, M differ", and keeps the same in $out/images.txt.
+same_images() {
+    local a_bin=$1 b_bin=$2 a_opts=$3 b_opts=$4 scene name app a b
+    local here report=$out/images.txt pairs=0 differ=0
+    here=$(cd "$(dirname "${BASH_SOURCE[0]}")/../.." && pwd)
+    : > "$report"
+    for scene in teapot box spherelist "$here"/scenes/hard/*.toml; do
+        name=$(basename "$scene" .toml)
+        for app in vk gl; do
+            a=$out/$name-$app-a.png b=$out/$name-$app-b.png
+            # shellcheck disable=SC2086 # the options are words
+            "$a_bin/twinray-$app" --headless --scene "$scene" --size 640x480 --path compute $a_opts --out "$a" 2>> "$out/errors.log"
+            # shellcheck disable=SC2086
+            "$b_bin/twinray-$app" --headless --scene "$scene" --size 640x480 --path compute $b_opts --out "$b" 2>> "$out/errors.log"
+            pairs=$((pairs + 1))
+            if ! cmp -s "$a" "$b"; then
+                differ=$((differ + 1))
+                echo "$name $app: $("$b_bin/twinray" diff "$a" "$b" 2>&1 | tr '\n' ' ')" | tee -a "$report"
+            fi
+            rm -f "$a" "$b"
+        done
+    done
+    echo "$pairs pairs, $differ differ" | tee -a "$report"
+}

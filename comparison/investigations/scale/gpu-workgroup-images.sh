@@ -8,22 +8,6 @@
 set -u
 bin=$1 out=$2
 mkdir -p "$out"
-here=$(cd "$(dirname "$0")/../../.." && pwd)
-report=$out/images.txt
-: > "$report"
-pairs=0 differ=0
-for scene in teapot box spherelist "$here"/scenes/hard/*.toml; do
-    name=$(basename "$scene" .toml)
-    for app in vk gl; do
-        a=$out/$name-$app-8x4.png b=$out/$name-$app-default.png
-        "$bin/twinray-$app" --headless --scene "$scene" --size 640x480 --path compute --workgroup 8x4 --out "$a" 2>> "$out/errors.log"
-        "$bin/twinray-$app" --headless --scene "$scene" --size 640x480 --path compute --out "$b" 2>> "$out/errors.log"
-        pairs=$((pairs + 1))
-        if ! cmp -s "$a" "$b"; then
-            differ=$((differ + 1))
-            echo "$name $app: $("$bin/twinray" diff "$a" "$b" 2>&1 | tr '\n' ' ')" | tee -a "$report"
-        fi
-        rm -f "$a" "$b"
-    done
-done
-echo "$pairs pairs, $differ differ" | tee -a "$report"
+# shellcheck source=comparison/investigations/lib.sh
+source "$(dirname "$0")/../lib.sh"
+same_images "$bin" "$bin" "--workgroup 8x4" ""
