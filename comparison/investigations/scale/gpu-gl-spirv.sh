@@ -7,7 +7,7 @@
 # configuration and API order, after one untimed run of each configuration.
 # Then what each driver made of the teapot's compute shader in each
 # configuration (OUT_DIR/shaders-CONFIG: Vulkan's registers and shared memory,
-# OpenGL's local memory). About four minutes on an H100.
+# OpenGL's local memory). About a minute and a half on an H100.
 # OUT_DIR/gl-spirv.jsonl: a label line (point|configuration|round), then the
 # app's --json report.
 # Usage: comparison/investigations/scale/gpu-gl-spirv.sh BIN_DIR OUT_DIR
