@@ -165,6 +165,17 @@ impl GpuBvhWideNode {
         }
     }
 
+    /// This node with its interior children `by` nodes further on: a
+    /// subtree laid out after others (leaves and empty slots stay).
+    pub fn moved_by(mut self, by: u32) -> GpuBvhWideNode {
+        for c in &mut self.child {
+            if child_ref::as_leaf(*c).is_none() {
+                *c += by;
+            }
+        }
+        self
+    }
+
     /// Slot `k`'s box.
     pub fn bounds(&self, k: usize) -> Bounds {
         (

@@ -248,6 +248,43 @@ fn wide_trees_hold_every_primitive_once_inside_their_boxes() {
     );
 }
 
+/// The wide tree is collapsed in pieces on several threads and laid out as
+/// one depth-first collapse would write it: the same bytes, depth and stack
+/// bound whether no level, the default levels or every level (one piece a
+/// node) is made apart, and on any number of threads.
+#[test]
+fn the_wide_tree_is_the_same_however_it_is_split() {
+    let teapot = Scene::load("teapot", &[("tessellation".into(), "40x30".into())]).unwrap();
+    let spheres = Scene::load("spherelist", &[("extra_spheres".into(), "1000".into())]).unwrap();
+    let mut one = Scene::load("spherelist", &[]).unwrap();
+    one.spheres.truncate(1);
+    one.triangles.clear();
+    let bytes = |b: &Bvh| bytemuck::cast_slice::<_, u8>(&b.wide).to_vec();
+    for scene in [&teapot, &spheres, &one] {
+        let binary = Bvh::build(scene);
+        for width in [4, 8] {
+            let serial = binary.clone().widen_on(width, 0);
+            for (levels, threads) in [(super::wide::PARALLEL_LEVELS, 1), (4, 3), (2, 8), (64, 8)] {
+                let pool = rayon::ThreadPoolBuilder::new()
+                    .num_threads(threads)
+                    .build()
+                    .unwrap();
+                let b = pool.install(|| binary.clone().widen_on(width, levels));
+                let what = format!(
+                    "{} at width {width}, {levels} levels, {threads} threads",
+                    scene.name
+                );
+                assert!(bytes(&b) == bytes(&serial), "{what}: nodes");
+                assert_eq!(
+                    (b.depth, b.wide_stack),
+                    (serial.depth, serial.wide_stack),
+                    "{what}"
+                );
+            }
+        }
+    }
+}
+
 /// `--accel auto`'s width: the 4-wide tree, on spheres and meshes alike, as
 /// measured; an explicit width is kept.
 #[test]

@@ -8,10 +8,13 @@
 //! order alike, so the leaf primitive array is shared and only the nodes differ.
 //!
 //! Like the builder it depends only on the binary tree, so the wide tree is
-//! as deterministic as the binary one.
+//! as deterministic as the binary one. The top levels are made first, the
+//! subtrees below them collapsed side by side on every core, and the pieces
+//! laid out where a depth-first collapse on one thread would put them.
 
 use super::split::{Box3, INTERSECT_COST, TRAVERSAL_COST};
 use crate::gpu::layout::{child_ref, Bounds, Bvh, GpuBvhNode, GpuBvhWideNode};
+use rayon::prelude::*;
 
 /// The widths a tree can have: binary, and the wide nodes of one or two `GpuBvhWideNode`s.
 pub const WIDTHS: [u32; 3] = [2, 4, 8];
@@ -32,10 +35,30 @@ fn area((min, max): Bounds) -> f64 {
 /// A wide node's children before they are written: box and child reference.
 type Kids = ([(Bounds, u32); 8], usize);
 
+/// Levels of the wide tree whose nodes are made first, on one thread; the
+/// subtrees below them are then collapsed side by side (rayon). Four levels
+/// of a 4-wide tree are up to 256 subtrees, enough for any core count here.
+pub(super) const PARALLEL_LEVELS: u32 = 4;
+
 struct Collapse<'a> {
     binary: &'a [GpuBvhNode],
     width: usize,
-    out: Vec<GpuBvhWideNode>,
+}
+
+/// A run of the wide tree's nodes, in the order the tree lays them out.
+enum Piece {
+    /// A node of the top levels: its children, with the piece that holds
+    /// each interior child's subtree.
+    Top { kids: Kids, pieces: [usize; 8] },
+    /// The whole subtree of a binary node, collapsed on its own, with its
+    /// child references counted from its own first node; its depth and stack
+    /// entries as `Collapse::node` returns them.
+    Subtree {
+        root: usize,
+        nodes: Vec<GpuBvhWideNode>,
+        depth: u32,
+        stack: u32,
+    },
 }
 
 impl Collapse<'_> {
@@ -75,10 +98,10 @@ impl Collapse<'_> {
     /// index, its depth (leaves included) and the most stack entries a walk
     /// of it leaves pending: each node pushes every child it enters but the
     /// nearest, so all but one of its children on the way down.
-    fn node(&mut self, index: usize) -> (u32, u32, u32) {
+    fn node(&self, index: usize, out: &mut Vec<GpuBvhWideNode>) -> (u32, u32, u32) {
         let (kids, count) = self.kids(index);
-        let at = self.out.len();
-        self.out.extend(std::iter::repeat_n(
+        let at = out.len();
+        out.extend(std::iter::repeat_n(
             GpuBvhWideNode::empty(),
             quads(self.width as u32),
         ));
@@ -87,34 +110,142 @@ impl Collapse<'_> {
             let child = if child_ref::as_leaf(child).is_some() {
                 child
             } else {
-                let (r, d, s) = self.node(child as usize);
+                let (r, d, s) = self.node(child as usize, out);
                 depth = depth.max(1 + d);
                 below = below.max(s);
                 r
             };
-            self.out[at + k / 4].set(k % 4, bounds, child);
+            out[at + k / 4].set(k % 4, bounds, child);
         }
         (at as u32, depth, count as u32 - 1 + below)
+    }
+
+    /// The pieces of the subtree of binary node `index`, `level` levels
+    /// below the root, appended to `pieces` in layout order (the node, then
+    /// each interior child's subtree in slot order); returns the first.
+    /// Below `levels` levels a subtree is one piece, collapsed later.
+    fn top(&self, index: usize, level: u32, levels: u32, pieces: &mut Vec<Piece>) -> usize {
+        let me = pieces.len();
+        if level == levels {
+            pieces.push(Piece::Subtree {
+                root: index,
+                nodes: Vec::new(),
+                depth: 0,
+                stack: 0,
+            });
+            return me;
+        }
+        let kids = self.kids(index);
+        pieces.push(Piece::Top {
+            kids,
+            pieces: [0; 8],
+        });
+        let mut at = [0; 8];
+        for (k, &(_, child)) in kids.0[..kids.1].iter().enumerate() {
+            if child_ref::as_leaf(child).is_none() {
+                at[k] = self.top(child as usize, level + 1, levels, pieces);
+            }
+        }
+        if let Piece::Top { pieces: p, .. } = &mut pieces[me] {
+            *p = at;
+        }
+        me
+    }
+}
+
+/// The depth and stack entries of the subtree that starts at piece `i`, as
+/// `Collapse::node` gives them for a whole tree.
+fn shape(pieces: &[Piece], i: usize) -> (u32, u32) {
+    match &pieces[i] {
+        Piece::Subtree { depth, stack, .. } => (*depth, *stack),
+        Piece::Top { kids, pieces: at } => {
+            let (mut depth, mut below) = (2, 0);
+            for (k, &(_, child)) in kids.0[..kids.1].iter().enumerate() {
+                if child_ref::as_leaf(child).is_none() {
+                    let (d, s) = shape(pieces, at[k]);
+                    depth = depth.max(1 + d);
+                    below = below.max(s);
+                }
+            }
+            (depth, kids.1 as u32 - 1 + below)
+        }
     }
 }
 
 impl Bvh {
     /// This tree collapsed to `width` children a node (4 or 8; 2 keeps it
     /// binary). The binary nodes are dropped: the wide tree replaces them.
-    pub fn widen(mut self, width: u32) -> Bvh {
+    pub fn widen(self, width: u32) -> Bvh {
+        self.widen_on(width, PARALLEL_LEVELS)
+    }
+
+    /// `widen` with the top `levels` levels made first and the subtrees
+    /// below them collapsed in parallel, then laid out in the order a
+    /// depth-first collapse writes them: the same tree for every `levels`
+    /// (0: the whole tree one subtree, on this thread), which a test holds.
+    pub(super) fn widen_on(mut self, width: u32, levels: u32) -> Bvh {
         debug_assert!(WIDTHS.contains(&width), "width {width}");
         if width <= 2 || self.nodes.is_empty() {
             return self;
         }
         let start = std::time::Instant::now();
-        let mut c = Collapse {
+        let c = Collapse {
             binary: &self.nodes,
             width: width as usize,
-            // A binary tree of n nodes collapses into about n / (width - 1) nodes.
-            out: Vec::with_capacity(self.nodes.len() / (width as usize - 1) * quads(width) + 2),
         };
-        let (_, depth, stack) = c.node(0);
-        self.wide = c.out;
+        let mut pieces = Vec::new();
+        c.top(0, 0, levels, &mut pieces);
+        pieces.par_iter_mut().for_each(|p| {
+            if let Piece::Subtree {
+                root,
+                nodes,
+                depth,
+                stack,
+            } = p
+            {
+                (_, *depth, *stack) = c.node(*root, nodes);
+            }
+        });
+        let (depth, stack) = shape(&pieces, 0);
+        // Where each piece starts, in nodes.
+        let q = quads(width);
+        let mut starts = Vec::with_capacity(pieces.len());
+        let mut len = 0;
+        for p in &pieces {
+            starts.push(len);
+            len += match p {
+                Piece::Top { .. } => q,
+                Piece::Subtree { nodes, .. } => nodes.len(),
+            };
+        }
+        // Each node made where it goes, on every thread: a node of the top
+        // levels names its children where their pieces start; a subtree's
+        // own references count from its first node.
+        let mut wide = Vec::with_capacity(len);
+        (0..len)
+            .into_par_iter()
+            .map(|i| {
+                let p = starts.partition_point(|&s| s <= i) - 1;
+                let at = starts[p];
+                match &pieces[p] {
+                    Piece::Top { kids, pieces: to } => {
+                        let mut node = GpuBvhWideNode::empty();
+                        let first = ((i - at) * 4).min(kids.1);
+                        let slots = first..(first + 4).min(kids.1);
+                        for (k, &(bounds, child)) in kids.0[slots.clone()].iter().enumerate() {
+                            let child = match child_ref::as_leaf(child) {
+                                Some(_) => child,
+                                None => starts[to[slots.start + k]] as u32,
+                            };
+                            node.set(k, bounds, child);
+                        }
+                        node
+                    }
+                    Piece::Subtree { nodes, .. } => nodes[i - at].moved_by(at as u32),
+                }
+            })
+            .collect_into_vec(&mut wide);
+        self.wide = wide;
         self.width = width;
         self.depth = depth;
         self.wide_stack = stack;
