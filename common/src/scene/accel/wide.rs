@@ -49,7 +49,7 @@ struct Collapse<'a> {
 enum Piece {
     /// A node of the top levels: its children, with the piece that holds
     /// each interior child's subtree.
-    Top { kids: Kids, pieces: [usize; 8] },
+    Top { kids: Box<Kids>, pieces: [usize; 8] },
     /// The whole subtree of a binary node, collapsed on its own, with its
     /// child references counted from its own first node; its depth and stack
     /// entries as `Collapse::node` returns them.
@@ -137,7 +137,7 @@ impl Collapse<'_> {
         }
         let kids = self.kids(index);
         pieces.push(Piece::Top {
-            kids,
+            kids: Box::new(kids),
             pieces: [0; 8],
         });
         let mut at = [0; 8];
