@@ -5,14 +5,16 @@
 //!
 //! The scene buffers are immutable (`glBufferStorage`) and filled by the GPU,
 //! the way the Vulkan twin fills its device-local buffers (vk/src/memory.rs):
-//! the CPU makes a chunk in host memory, `glBufferSubData` puts it in one
-//! small staging buffer and `glCopyBufferSubData` copies it across. A buffer
-//! the CPU may neither map nor rewrite is one the driver need not shadow in
-//! system memory. Filled by `glBufferData` and `glBufferSubData` directly,
-//! the buffers cost NVIDIA's GL driver about 150 bytes of host memory a
-//! triangle more than Vulkan's. (A persistently mapped staging buffer, written
-//! in place, gave NVIDIA's GL driver wrong BVH buffers: comparison/results/
-//! nvidia-h100/FINDINGS.md, "OpenGL's upload, after".)
+//! the CPU makes each chunk in one small staging buffer, mapped for the
+//! writing (`glMapBufferRange`) and unmapped before `glCopyBufferSubData`
+//! copies it across. A buffer the CPU may neither map nor rewrite is one the
+//! driver need not shadow in system memory. Filled by `glBufferData` and
+//! `glBufferSubData` directly, the buffers cost NVIDIA's GL driver about 150
+//! bytes of host memory a triangle more than Vulkan's. Each chunk is mapped
+//! and unmapped, not mapped once for good: the unmap is what the GL
+//! specification makes the writes visible to the copy by, and a persistent
+//! mapping without it gave NVIDIA's driver wrong BVH buffers
+//! (comparison/results/nvidia-h100/FINDINGS.md, "OpenGL's upload, after").
 
 use anyhow::{anyhow, Context as _};
 use glow::HasContext;
@@ -103,17 +105,15 @@ fn gl_size(len: usize) -> anyhow::Result<i32> {
 
 /// Immutable buffers filled through one small staging buffer: each
 /// [`Uploads::add`] makes a buffer and fills it a chunk at a time (the CPU
-/// writes a chunk into the staging buffer, the GPU copies it across, and the
-/// CPU waits for the copy before writing the next), so that a scene of any
-/// size needs only a few tens of MiB of host memory. [`Uploads::finish`]
+/// writes a chunk into the mapped staging buffer, the GPU copies it across,
+/// and the CPU waits for the copy before writing the next), so that a scene
+/// of any size needs only a few tens of MiB of memory. [`Uploads::finish`]
 /// hands the buffers over; until then they are deleted with the uploads on an
 /// error.
 struct Uploads<'gl> {
     gl: &'gl glow::Context,
     staging: glow::Buffer,
-    /// Host memory for one chunk (u32s: aligned for every GPU struct, which
-    /// `write_storage` fills in place), `len` bytes.
-    chunk: Vec<u32>,
+    /// The staging buffer's size in bytes.
     len: usize,
     /// Filled and bound, in the order they were added.
     filled: Vec<glow::Buffer>,
@@ -124,23 +124,17 @@ impl<'gl> Uploads<'gl> {
     fn new(gl: &'gl glow::Context, len: usize) -> anyhow::Result<Uploads<'gl>> {
         let size = gl_size(len)?;
         // SAFETY: a fresh buffer on the current context, given `len` bytes of
-        // storage that glBufferSubData may rewrite; `Drop` deletes it.
+        // storage that the CPU may map for writing; `Drop` deletes it.
         unsafe {
             let staging = gl
                 .create_buffer()
                 .map_err(|e| anyhow!(e))
                 .context("glCreateBuffer (staging buffer)")?;
             gl.bind_buffer(glow::COPY_READ_BUFFER, Some(staging));
-            gl.buffer_storage(
-                glow::COPY_READ_BUFFER,
-                size,
-                None,
-                glow::DYNAMIC_STORAGE_BIT,
-            );
+            gl.buffer_storage(glow::COPY_READ_BUFFER, size, None, glow::MAP_WRITE_BIT);
             Ok(Uploads {
                 gl,
                 staging,
-                chunk: vec![0; len.div_ceil(4)],
                 len,
                 filled: Vec::new(),
             })
@@ -162,8 +156,10 @@ impl<'gl> Uploads<'gl> {
         let size = gl_size(len)?;
         // SAFETY: a fresh buffer on the current context, given `len` bytes of
         // storage; every chunk lies within it and within the staging buffer
-        // (so its offset and length fit in i32); each copy is waited for
-        // before the staging buffer is rewritten.
+        // (so its offset and length fit in i32), whose mapping `write` gets
+        // as a slice of exactly the chunk's length and no longer than the
+        // map lasts; each copy is waited for before the staging buffer is
+        // mapped again.
         unsafe {
             let buffer = gl
                 .create_buffer()
@@ -181,10 +177,24 @@ impl<'gl> Uploads<'gl> {
                         self.len
                     ));
                 }
-                let bytes = &mut bytemuck::cast_slice_mut(&mut self.chunk)[..c.len()];
-                write(c.start, bytes);
-                gl.buffer_sub_data_u8_slice(glow::COPY_READ_BUFFER, 0, bytes);
                 let (start, n) = (c.start as i32, c.len() as i32);
+                // INVALIDATE: nothing of the last chunk need survive, and the
+                // copy that read it has been waited for.
+                let mapped = gl.map_buffer_range(
+                    glow::COPY_READ_BUFFER,
+                    0,
+                    n,
+                    glow::MAP_WRITE_BIT | glow::MAP_INVALIDATE_RANGE_BIT,
+                );
+                if mapped.is_null() {
+                    return Err(anyhow!(
+                        "glMapBufferRange returned no memory for a {n}-byte chunk of binding {index}"
+                    ));
+                }
+                // The map is at least GL_MIN_MAP_BUFFER_ALIGNMENT (64) bytes
+                // aligned, enough for every GPU struct `write` fills in place.
+                write(c.start, std::slice::from_raw_parts_mut(mapped, c.len()));
+                gl.unmap_buffer(glow::COPY_READ_BUFFER);
                 gl.copy_buffer_sub_data(
                     glow::COPY_READ_BUFFER,
                     glow::COPY_WRITE_BUFFER,
@@ -208,7 +218,7 @@ impl<'gl> Uploads<'gl> {
                     ("SHADER_STORAGE_BUFFER", "no flags: never mapped or rewritten by the CPU")
                 };
                 format!(
-                    "{len} bytes, {kind}, immutable storage, {flags}\nfilled through a {}-byte staging buffer: {} glBufferSubData + glCopyBufferSubData, each waited for with glFenceSync + glClientWaitSync",
+                    "{len} bytes, {kind}, immutable storage, {flags}\nfilled through a {}-byte staging buffer: {} glMapBufferRange + glUnmapBuffer + glCopyBufferSubData, each waited for with glFenceSync + glClientWaitSync",
                     self.len,
                     chunks.len()
                 )

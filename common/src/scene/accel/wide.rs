@@ -120,6 +120,18 @@ impl Collapse<'_> {
         (at as u32, depth, count as u32 - 1 + below)
     }
 
+    /// The interior nodes of binary node `index`'s subtree, itself included.
+    fn interior(&self, index: usize) -> usize {
+        let n = &self.binary[index];
+        let mut count = 1;
+        for c in [n.left, n.right] {
+            if child_ref::as_leaf(c).is_none() {
+                count += self.interior(c as usize);
+            }
+        }
+        count
+    }
+
     /// The pieces of the subtree of binary node `index`, `level` levels
     /// below the root, appended to `pieces` in layout order (the node, then
     /// each interior child's subtree in slot order); returns the first.
@@ -195,6 +207,23 @@ impl Bvh {
         };
         let mut pieces = Vec::new();
         c.top(0, 0, levels, &mut pieces);
+        // Each subtree's memory taken here, on this thread, as much as it
+        // can need: a wide subtree has no more nodes than its binary one has
+        // interior nodes. Grown on the worker threads instead, it would come
+        // from their allocators, which keep it after it is freed (a whole
+        // wide tree's worth more resident memory for the rest of the run).
+        let most: Vec<usize> = pieces
+            .par_iter()
+            .map(|p| match p {
+                Piece::Subtree { root, .. } => c.interior(*root),
+                Piece::Top { .. } => 0,
+            })
+            .collect();
+        for (p, n) in pieces.iter_mut().zip(most) {
+            if let Piece::Subtree { nodes, .. } = p {
+                *nodes = Vec::with_capacity(n * quads(width));
+            }
+        }
         pieces.par_iter_mut().for_each(|p| {
             if let Piece::Subtree {
                 root,
@@ -206,6 +235,10 @@ impl Bvh {
                 (_, *depth, *stack) = c.node(*root, nodes);
             }
         });
+        // The binary tree is done with: gone before the wide array is made,
+        // so that the pieces and the array are the only trees in memory at
+        // once (as the binary tree and the array were, before the pieces).
+        self.nodes = Vec::new();
         let (depth, stack) = shape(&pieces, 0);
         // Where each piece starts, in nodes.
         let q = quads(width);
@@ -249,7 +282,6 @@ impl Bvh {
         self.width = width;
         self.depth = depth;
         self.wide_stack = stack;
-        self.nodes = Vec::new();
         self.build_ms += start.elapsed().as_secs_f64() * 1e3;
         self
     }
