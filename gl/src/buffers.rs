@@ -178,14 +178,11 @@ impl<'gl> Uploads<'gl> {
                     ));
                 }
                 let (start, n) = (c.start as i32, c.len() as i32);
-                // INVALIDATE: nothing of the last chunk need survive, and the
-                // copy that read it has been waited for.
-                let mapped = gl.map_buffer_range(
-                    glow::COPY_READ_BUFFER,
-                    0,
-                    n,
-                    glow::MAP_WRITE_BIT | glow::MAP_INVALIDATE_RANGE_BIT,
-                );
+                // INVALIDATE_RANGE: nothing of the last chunk need survive,
+                // so no driver copies it into the mapping (the copy that read
+                // it has been waited for).
+                let access = glow::MAP_WRITE_BIT | glow::MAP_INVALIDATE_RANGE_BIT;
+                let mapped = gl.map_buffer_range(glow::COPY_READ_BUFFER, 0, n, access);
                 if mapped.is_null() {
                     return Err(anyhow!(
                         "glMapBufferRange returned no memory for a {n}-byte chunk of binding {index}"
