@@ -6,7 +6,9 @@
 //! carries the number of the Vulkan step it twins), and times them.
 //!
 //! A step's time is the time since the previous report (or since `enable`), so
-//! it covers the creation call and whatever preparation led up to it; reports
+//! it covers the creation call and whatever preparation led up to it, but not
+//! the reporting: a report's details can cost time of their own (the BVH
+//! line's SAH cost walks the whole tree), which no step is charged; reports
 //! come in the order they happen, which is the order of the code, so a reader
 //! who runs `--explain` beside the page sees where the code's order and the
 //! page's differ (tests/tests/walkthrough_steps.rs holds the two together).
@@ -46,12 +48,12 @@ pub fn numbered(step: u32, title: &str, details: impl FnOnce() -> String) {
 fn report(n: u32, title: &str, details: impl FnOnce() -> String) {
     let now = Instant::now();
     let elapsed_ms = {
-        let mut last = LAST.lock().unwrap_or_else(|e| e.into_inner());
-        let ms = last.map(|t| (now - t).as_secs_f64() * 1e3).unwrap_or(0.0);
-        *last = Some(now);
-        ms
+        let last = LAST.lock().unwrap_or_else(|e| e.into_inner());
+        last.map(|t| (now - t).as_secs_f64() * 1e3).unwrap_or(0.0)
     };
     eprintln!("{}", format_step(n, elapsed_ms, title, &details()));
+    // The next step's time starts after this report.
+    *LAST.lock().unwrap_or_else(|e| e.into_inner()) = Some(Instant::now());
 }
 
 /// `[ 4]  +0.42 ms  VkDevice` then the details, one per indented line.
