@@ -162,3 +162,34 @@ same_images() {
     done
     echo "$pairs pairs, $differ differ" | tee -a "$report"
 }
+
+# teapot_points: sets the array `points` to the teapot's points, each
+# "name|options": 1080p and 4K, then 1000x1000 at 19.2k, 307k, 1.2M and 4.9M
+# triangles.
+teapot_points() {
+    points=(
+        "1080p|--scene teapot --size 1920x1080"
+        "4k|--scene teapot --size 3840x2160"
+        "t19k|--scene teapot --size 1000x1000"
+        "t307k|--scene teapot --size 1000x1000 --set tessellation=80x60"
+        "t1.2M|--scene teapot --size 1000x1000 --set tessellation=160x120"
+        "t4.9M|--scene teapot --size 1000x1000 --set tessellation=320x240"
+    )
+}
+
+# texel_run LABEL APP FORM OPTIONS...: one timed run through the 4-wide tree
+# (compute, 60 frames) of a build with a texel-nodes patch, the reads in FORM:
+# base (the storage blocks), nodes (the nodes through a buffer texture) or both
+# (the leaves' primitives too); appends "LABEL median_ms setup_ms" to $report.
+texel_run() {
+    local label=$1 app=$2 form=$3 json
+    shift 3
+    local -a env=(TWINRAY_FORM="$form")
+    case $form in
+        nodes) env+=(TWINRAY_TEXEL_NODES=1) ;;
+        both) env+=(TWINRAY_TEXEL_NODES=1 TWINRAY_TEXEL_PRIMS=1) ;;
+    esac
+    json=$(env "${env[@]}" timeout 120 "$bin/twinray-$app" --headless --json --path compute --accel bvh4 \
+        --frames 60 "$@" 2>> "$out/errors.log")
+    echo "$label $(echo "$json" | grep -o '"median":[0-9.]*' | head -1 | cut -d: -f2) $(echo "$json" | grep -o '"setup_ms":[0-9.]*' | cut -d: -f2)" >> "$report"
+}

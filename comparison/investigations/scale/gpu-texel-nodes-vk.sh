@@ -9,7 +9,8 @@
 # 1000x1000 in four tessellations, compute, --accel bvh4, 60 frames, two
 # rounds in alternating order; then Vulkan's register counts and shared
 # memory (--dump-shaders) and its images with and without, byte for byte, at
-# three tessellations. OUT_DIR/tv.txt: round, API, point, form, median GPU ms.
+# three tessellations. OUT_DIR/tv.txt: round, API, point, form, median GPU ms,
+# setup_ms.
 # About 70 s on an H100.
 # Usage: comparison/investigations/scale/gpu-texel-nodes-vk.sh BIN_DIR OUT_DIR
 set -u
@@ -18,25 +19,10 @@ mkdir -p "$out"
 export PATH=$bin:$PATH
 report=$out/tv.txt
 : > "$report"
-points=(
-    "1080p|--scene teapot --size 1920x1080"
-    "4k|--scene teapot --size 3840x2160"
-    "t19k|--scene teapot --size 1000x1000"
-    "t307k|--scene teapot --size 1000x1000 --set tessellation=80x60"
-    "t1.2M|--scene teapot --size 1000x1000 --set tessellation=160x120"
-    "t4.9M|--scene teapot --size 1000x1000 --set tessellation=320x240"
-)
-# one LABEL APP TEXEL OPTIONS...: one timed run, the texel reads on (1) or off (0)
-one() {
-    local label=$1 app=$2 texel=$3 json
-    shift 3
-    local -a env=(TWINRAY_FORM="$label")
-    [ "$texel" = 1 ] && env+=(TWINRAY_TEXEL_NODES=1)
-    json=$(env "${env[@]}" timeout 120 "$bin/twinray-$app" --headless --json --path compute --accel bvh4 \
-        --frames 60 "$@" 2>> "$out/errors.log")
-    echo "$label $(echo "$json" | grep -o '"median":[0-9.]*' | head -1 | cut -d: -f2)" >> "$report"
-}
-one "warm vk" vk 0 --scene teapot --size 64x64 --experiment glslang
+# shellcheck source=comparison/investigations/lib.sh
+source "$(dirname "$0")/../lib.sh"
+teapot_points
+texel_run "warm vk" vk base --scene teapot --size 64x64 --experiment glslang
 for round in 1 2; do
     if [ $round = 1 ]; then forms=(naga glslang texel gl gltexel); else forms=(gltexel gl texel glslang naga); fi
     for p in "${points[@]}"; do
@@ -44,11 +30,11 @@ for round in 1 2; do
         for form in "${forms[@]}"; do
             # shellcheck disable=SC2086 # the options are words
             case $form in
-                naga) one "$round vk $name naga" vk 0 $args ;;
-                glslang) one "$round vk $name glslang" vk 0 $args --experiment glslang ;;
-                texel) one "$round vk $name glslang-texel" vk 1 $args --experiment glslang ;;
-                gl) one "$round gl $name base" gl 0 $args ;;
-                gltexel) one "$round gl $name texel" gl 1 $args ;;
+                naga) texel_run "$round vk $name naga" vk base $args ;;
+                glslang) texel_run "$round vk $name glslang" vk base $args --experiment glslang ;;
+                texel) texel_run "$round vk $name glslang-texel" vk nodes $args --experiment glslang ;;
+                gl) texel_run "$round gl $name base" gl base $args ;;
+                gltexel) texel_run "$round gl $name texel" gl nodes $args ;;
             esac
         done
     done

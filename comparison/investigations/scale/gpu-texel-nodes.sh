@@ -16,38 +16,20 @@ bin=$1 out=$2
 mkdir -p "$out"
 report=$out/tex.txt
 : > "$report"
-points=(
-    "1080p|--scene teapot --size 1920x1080"
-    "4k|--scene teapot --size 3840x2160"
-    "t19k|--scene teapot --size 1000x1000"
-    "t307k|--scene teapot --size 1000x1000 --set tessellation=80x60"
-    "t1.2M|--scene teapot --size 1000x1000 --set tessellation=160x120"
-    "t4.9M|--scene teapot --size 1000x1000 --set tessellation=320x240"
-)
-# one LABEL APP FORM OPTIONS...: one timed run in FORM (base, nodes or both)
-one() {
-    local label=$1 app=$2 form=$3 json
-    shift 3
-    local -a env=(TWINRAY_FORM="$form")
-    case $form in
-        nodes) env+=(TWINRAY_TEXEL_NODES=1) ;;
-        both) env+=(TWINRAY_TEXEL_NODES=1 TWINRAY_TEXEL_PRIMS=1) ;;
-    esac
-    json=$(env "${env[@]}" timeout 120 "$bin/twinray-$app" --headless --json --path compute --accel bvh4 \
-        --frames 60 "$@" 2>> "$out/errors.log")
-    echo "$label $(echo "$json" | grep -o '"median":[0-9.]*' | head -1 | cut -d: -f2) $(echo "$json" | grep -o '"setup_ms":[0-9.]*' | cut -d: -f2)" >> "$report"
-}
-one "warm gl base" gl base --scene teapot --size 64x64
+# shellcheck source=comparison/investigations/lib.sh
+source "$(dirname "$0")/../lib.sh"
+teapot_points
+texel_run "warm gl base" gl base --scene teapot --size 64x64
 for round in 1 2; do
     if [ $round = 1 ]; then forms=(base nodes both); else forms=(both nodes base); fi
     for p in "${points[@]}"; do
         name=${p%%|*} args=${p#*|}
         for form in "${forms[@]}"; do
             # shellcheck disable=SC2086 # the options are words
-            one "$round gl $name $form" gl "$form" $args
+            texel_run "$round gl $name $form" gl "$form" $args
         done
         # shellcheck disable=SC2086
-        one "$round vk $name base" vk base $args
+        texel_run "$round vk $name base" vk base $args
     done
 done
 for p in "${points[@]}"; do
