@@ -95,9 +95,7 @@ impl Collapse<'_> {
 
     /// Writes the wide subtree of binary node `index`, depth-first (the
     /// node, then each interior child's subtree in slot order). Returns its
-    /// index, its depth (leaves included) and the most stack entries a walk
-    /// of it leaves pending: each node pushes every child it enters but the
-    /// nearest, so all but one of its children on the way down.
+    /// index in `out`, and its depth and stack entries (`node_shape`).
     fn node(&self, index: usize, out: &mut Vec<GpuBvhWideNode>) -> (u32, u32, u32) {
         let (kids, count) = self.kids(index);
         let at = out.len();
@@ -105,19 +103,20 @@ impl Collapse<'_> {
             GpuBvhWideNode::empty(),
             quads(self.width as u32),
         ));
-        let (mut depth, mut below) = (2, 0);
+        let (mut below, mut n) = ([(0, 0); 8], 0);
         for (k, &(bounds, child)) in kids[..count].iter().enumerate() {
             let child = if child_ref::as_leaf(child).is_some() {
                 child
             } else {
                 let (r, d, s) = self.node(child as usize, out);
-                depth = depth.max(1 + d);
-                below = below.max(s);
+                below[n] = (d, s);
+                n += 1;
                 r
             };
             out[at + k / 4].set(k % 4, bounds, child);
         }
-        (at as u32, depth, count as u32 - 1 + below)
+        let (depth, stack) = node_shape(count, &below[..n]);
+        (at as u32, depth, stack)
     }
 
     /// The interior nodes of binary node `index`'s subtree, itself included.
@@ -171,17 +170,27 @@ fn shape(pieces: &[Piece], i: usize) -> (u32, u32) {
     match &pieces[i] {
         Piece::Subtree { depth, stack, .. } => (*depth, *stack),
         Piece::Top { kids, pieces: at } => {
-            let (mut depth, mut below) = (2, 0);
-            for (k, &(_, child)) in kids.0[..kids.1].iter().enumerate() {
-                if child_ref::as_leaf(child).is_none() {
-                    let (d, s) = shape(pieces, at[k]);
-                    depth = depth.max(1 + d);
-                    below = below.max(s);
-                }
-            }
-            (depth, kids.1 as u32 - 1 + below)
+            let below: Vec<(u32, u32)> = kids.0[..kids.1]
+                .iter()
+                .enumerate()
+                .filter(|(_, &(_, child))| child_ref::as_leaf(child).is_none())
+                .map(|(k, _)| shape(pieces, at[k]))
+                .collect();
+            node_shape(kids.1, &below)
         }
     }
+}
+
+/// A wide node's depth (leaves included) and the most stack entries a walk
+/// of its subtree leaves pending, from its `children` and the depth and stack
+/// entries of its interior children's subtrees: the walk pushes every child
+/// it enters but the nearest, so all but one of a node's children on the way
+/// down. The shader's BVH_STACK is this bound.
+fn node_shape(children: usize, below: &[(u32, u32)]) -> (u32, u32) {
+    let (depth, stack) = below
+        .iter()
+        .fold((2, 0), |(d, s), &(bd, bs)| (d.max(1 + bd), s.max(bs)));
+    (depth, children as u32 - 1 + stack)
 }
 
 impl Bvh {
