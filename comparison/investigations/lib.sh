@@ -163,10 +163,10 @@ same_images() {
     echo "$pairs pairs, $differ differ" | tee -a "$report"
 }
 
-# teapot_points: sets the array `points` to the teapot's points, each
-# "name|options": 1080p and 4K, then 1000x1000 at 19.2k, 307k, 1.2M and 4.9M
-# triangles.
-teapot_points() {
+# teapot_sizes: sets the array `points` to the teapot's sizes alone, each
+# "name|options" with no frame count (the caller adds its own): 1080p and 4K,
+# then 1000x1000 at 19.2k, 307k, 1.2M and 4.9M triangles.
+teapot_sizes() {
     points=(
         "1080p|--scene teapot --size 1920x1080"
         "4k|--scene teapot --size 3840x2160"

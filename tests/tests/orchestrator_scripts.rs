@@ -2,7 +2,7 @@
 //! `--experiment NAME` a script passes is a name both apps accept today, so an
 //! investigation cannot record an app's refusal as its data and look as if it
 //! ran (as `gpu-lmem.sh` did with the retired `global-bvh-stack`); and every
-//! script passes shellcheck at its warning level.
+//! script passes shellcheck at its warning level and defines no function twice.
 
 use std::collections::BTreeSet;
 use std::path::{Path, PathBuf};
@@ -147,4 +147,53 @@ fn every_tracked_script_passes_shellcheck() {
         String::from_utf8_lossy(&out.stdout),
         String::from_utf8_lossy(&out.stderr)
     );
+}
+
+/// No shell function is defined twice in one script: bash keeps the last
+/// definition silently, so a second `teapot_points` in `lib.sh` once gave
+/// every script that sourced it another set of points (no `--frames`, no
+/// `--count-rays`) with no warning from shellcheck.
+#[test]
+fn no_script_defines_a_function_twice() {
+    let mut checked = 0;
+    let mut twice = Vec::new();
+    for script in tracked_scripts() {
+        let text = std::fs::read_to_string(&script)
+            .unwrap_or_else(|e| panic!("reading {}: {e}", script.display()));
+        let mut seen = BTreeSet::new();
+        for (n, line) in text.lines().enumerate() {
+            let Some(name) = function_defined(line) else {
+                continue;
+            };
+            checked += 1;
+            if !seen.insert(name.to_string()) {
+                twice.push(format!("{}:{}: {name}", script.display(), n + 1));
+            }
+        }
+    }
+    // lib.sh alone defines a dozen; none found means the search is broken.
+    assert!(checked > 10, "only {checked} function definitions found");
+    assert!(
+        twice.is_empty(),
+        "functions defined a second time (bash keeps only the last):\n{}",
+        twice.join("\n")
+    );
+}
+
+/// `name` where `line` opens a function definition, `name() {` at the start
+/// of the line (the form every tracked script uses).
+fn function_defined(line: &str) -> Option<&str> {
+    let name = line.strip_suffix("() {")?;
+    let ok = !name.is_empty()
+        && name
+            .chars()
+            .all(|c| c.is_ascii_alphanumeric() || c == '_' || c == '-');
+    ok.then_some(name)
+}
+
+#[test]
+fn a_function_definition_is_recognised_and_a_call_is_not() {
+    assert_eq!(function_defined("teapot_points() {"), Some("teapot_points"));
+    assert_eq!(function_defined("    teapot_points"), None);
+    assert_eq!(function_defined("echo \"f() {\""), None);
 }

@@ -21,7 +21,7 @@ report=$out/tv.txt
 : > "$report"
 # shellcheck source=comparison/investigations/lib.sh
 source "$(dirname "$0")/../lib.sh"
-teapot_points
+teapot_sizes
 texel_run "warm vk" vk base --scene teapot --size 64x64 --experiment glslang
 for round in 1 2; do
     if [ $round = 1 ]; then forms=(naga glslang texel gl gltexel); else forms=(gltexel gl texel glslang naga); fi

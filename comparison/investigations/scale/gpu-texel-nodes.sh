@@ -18,7 +18,7 @@ report=$out/tex.txt
 : > "$report"
 # shellcheck source=comparison/investigations/lib.sh
 source "$(dirname "$0")/../lib.sh"
-teapot_points
+teapot_sizes
 texel_run "warm gl base" gl base --scene teapot --size 64x64
 for round in 1 2; do
     if [ $round = 1 ]; then forms=(base nodes both); else forms=(both nodes base); fi
