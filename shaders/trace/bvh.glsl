@@ -218,50 +218,68 @@ void wide_order(inout float ta, inout uint ca, inout float tb, inout uint cb) {
 // others pushed; NO_CHILD (which has LEAF_BIT set) if the ray enters none. An
 // empty slot's box is inside out (gpu::layout::EMPTY_SLOT_MIN), so its entry
 // distance exceeds its exit in any rounding and its NO_CHILD need not be
-// tested (that test cost 1-3 %). A macro, like BVH_STEP.
+// tested (that test cost 1-3 %). Macros, like BVH_STEP.
+//
+// A 4-wide node's one quad is not walked by a loop. naga writes a `for` as a
+// loop with a first-time flag, and NVIDIA's OpenGL compiler kept that loop of
+// one turn in its machine code, with the push of an earlier nearest child that
+// only an 8-wide node's second quad can need; its Vulkan compiler removed both.
+// Without the loop OpenGL's teapot frames are 7-18 % shorter and Vulkan's
+// unchanged
+// (comparison/results/nvidia-h100/FINDINGS.md#opengls-node-step-in-machine-code-investigationgl-gap).
+#define WIDE_QUAD(n)                                                                   \
+    {                                                                                  \
+        vec4 xn = fma(bvh_wide_buf.nodes[n].bounds[near_k.x], vec4(inv_dir.x), -oi_near.xxxx); \
+        vec4 xf = fma(bvh_wide_buf.nodes[n].bounds[far_k.x], vec4(inv_dir.x), -oi_far.xxxx);   \
+        vec4 yn = fma(bvh_wide_buf.nodes[n].bounds[near_k.y], vec4(inv_dir.y), -oi_near.yyyy); \
+        vec4 yf = fma(bvh_wide_buf.nodes[n].bounds[far_k.y], vec4(inv_dir.y), -oi_far.yyyy);   \
+        vec4 zn = fma(bvh_wide_buf.nodes[n].bounds[near_k.z], vec4(inv_dir.z), -oi_near.zzzz); \
+        vec4 zf = fma(bvh_wide_buf.nodes[n].bounds[far_k.z], vec4(inv_dir.z), -oi_far.zzzz);   \
+        vec4 enter = max(max(xn, yn), max(zn, vec4(0.0)));                             \
+        vec4 leave = min(min(xf, yf), min(zf, vec4(h.t)));                             \
+        uvec4 c = bvh_wide_buf.nodes[n].child;                                         \
+        float t0 = enter.x <= leave.x ? enter.x : WIDE_MISS;                           \
+        float t1 = enter.y <= leave.y ? enter.y : WIDE_MISS;                           \
+        float t2 = enter.z <= leave.z ? enter.z : WIDE_MISS;                           \
+        float t3 = enter.w <= leave.w ? enter.w : WIDE_MISS;                           \
+        uint c0 = c.x;                                                                 \
+        uint c1 = c.y;                                                                 \
+        uint c2 = c.z;                                                                 \
+        uint c3 = c.w;                                                                 \
+        if (any_hit) {                                                                 \
+            wide_order(t0, c0, t1, c1);                                                \
+            wide_order(t0, c0, t2, c2);                                                \
+            wide_order(t0, c0, t3, c3);                                                \
+        } else {                                                                       \
+            wide_order(t0, c0, t1, c1);                                                \
+            wide_order(t2, c2, t3, c3);                                                \
+            wide_order(t0, c0, t2, c2);                                                \
+            wide_order(t1, c1, t3, c3);                                                \
+            wide_order(t1, c1, t2, c2);                                                \
+        }                                                                              \
+        if (t3 < WIDE_MISS) WIDE_PUSH(c3, t3)                                          \
+        if (t2 < WIDE_MISS) WIDE_PUSH(c2, t2)                                          \
+        if (t1 < WIDE_MISS) WIDE_PUSH(c1, t1)                                          \
+        if (t0 < near_t) {                                                             \
+            if (near != NO_CHILD) WIDE_PUSH(near, near_t)                              \
+            near = c0;                                                                 \
+            near_t = t0;                                                               \
+        } else if (t0 < WIDE_MISS) WIDE_PUSH(c0, t0)                                   \
+    }
+#if BVH_WIDE_QUADS == 1
+// near and near_t are still at their start here, so no earlier nearest child
+// is pushed.
+#define WIDE_QUADS() WIDE_QUAD(child)
+#else
+// An 8-wide node keeps the loop over its two quads: written out twice, it
+// made OpenGL's 8-wide walk 8 % faster but Vulkan's 1-5 % slower.
+#define WIDE_QUADS() for (uint q = 0u; q < uint(BVH_WIDE_QUADS); q++) WIDE_QUAD(child + q)
+#endif
 #define WIDE_STEP()                                                                    \
     {                                                                                  \
         uint near = NO_CHILD;                                                          \
         float near_t = WIDE_MISS;                                                      \
-        for (uint q = 0u; q < uint(BVH_WIDE_QUADS); q++) {                             \
-            uint n = child + q;                                                        \
-            vec4 xn = fma(bvh_wide_buf.nodes[n].bounds[near_k.x], vec4(inv_dir.x), -oi_near.xxxx); \
-            vec4 xf = fma(bvh_wide_buf.nodes[n].bounds[far_k.x], vec4(inv_dir.x), -oi_far.xxxx);   \
-            vec4 yn = fma(bvh_wide_buf.nodes[n].bounds[near_k.y], vec4(inv_dir.y), -oi_near.yyyy); \
-            vec4 yf = fma(bvh_wide_buf.nodes[n].bounds[far_k.y], vec4(inv_dir.y), -oi_far.yyyy);   \
-            vec4 zn = fma(bvh_wide_buf.nodes[n].bounds[near_k.z], vec4(inv_dir.z), -oi_near.zzzz); \
-            vec4 zf = fma(bvh_wide_buf.nodes[n].bounds[far_k.z], vec4(inv_dir.z), -oi_far.zzzz);   \
-            vec4 enter = max(max(xn, yn), max(zn, vec4(0.0)));                         \
-            vec4 leave = min(min(xf, yf), min(zf, vec4(h.t)));                         \
-            uvec4 c = bvh_wide_buf.nodes[n].child;                                     \
-            float t0 = enter.x <= leave.x ? enter.x : WIDE_MISS;                       \
-            float t1 = enter.y <= leave.y ? enter.y : WIDE_MISS;                       \
-            float t2 = enter.z <= leave.z ? enter.z : WIDE_MISS;                       \
-            float t3 = enter.w <= leave.w ? enter.w : WIDE_MISS;                       \
-            uint c0 = c.x;                                                             \
-            uint c1 = c.y;                                                             \
-            uint c2 = c.z;                                                             \
-            uint c3 = c.w;                                                             \
-            if (any_hit) {                                                             \
-                wide_order(t0, c0, t1, c1);                                            \
-                wide_order(t0, c0, t2, c2);                                            \
-                wide_order(t0, c0, t3, c3);                                            \
-            } else {                                                                   \
-                wide_order(t0, c0, t1, c1);                                            \
-                wide_order(t2, c2, t3, c3);                                            \
-                wide_order(t0, c0, t2, c2);                                            \
-                wide_order(t1, c1, t3, c3);                                            \
-                wide_order(t1, c1, t2, c2);                                            \
-            }                                                                          \
-            if (t3 < WIDE_MISS) WIDE_PUSH(c3, t3)                                      \
-            if (t2 < WIDE_MISS) WIDE_PUSH(c2, t2)                                      \
-            if (t1 < WIDE_MISS) WIDE_PUSH(c1, t1)                                      \
-            if (t0 < near_t) {                                                         \
-                if (near != NO_CHILD) WIDE_PUSH(near, near_t)                          \
-                near = c0;                                                             \
-                near_t = t0;                                                           \
-            } else if (t0 < WIDE_MISS) WIDE_PUSH(c0, t0)                               \
-        }                                                                              \
+        WIDE_QUADS()                                                                   \
         child = near;                                                                  \
     }
 #endif
