@@ -273,7 +273,11 @@ void wide_order(inout float ta, inout uint ca, inout float tb, inout uint cb) {
 #else
 // An 8-wide node keeps the loop over its two quads: written out twice, it
 // made OpenGL's 8-wide walk 8 % faster but Vulkan's 1-5 % slower.
-#define WIDE_QUADS() for (uint q = 0u; q < uint(BVH_WIDE_QUADS); q++) WIDE_QUAD(child + q)
+#define WIDE_QUADS()                                                                   \
+    for (uint q = 0u; q < uint(BVH_WIDE_QUADS); q++) {                                 \
+        uint n = child + q;                                                            \
+        WIDE_QUAD(n)                                                                   \
+    }
 #endif
 #define WIDE_STEP()                                                                    \
     {                                                                                  \
