@@ -56,7 +56,7 @@ pub struct RenderArgs {
     #[arg(long, conflicts_with = "generic", hide = true)]
     pub specialize: bool,
     /// Acceleration structure: auto (for scenes with many primitives a BVH, 4-wide: the
-    /// faster tree on the H100 in both APIs but at a million triangles in OpenGL), none (test every
+    /// faster tree on the H100 in both APIs), none (test every
     /// primitive, as the 2018 study did), bvh (two children a node), bvh4 or bvh8 (the same
     /// tree collapsed to four or eight children a node).
     #[arg(long, value_enum, default_value_t = Accel::Auto)]

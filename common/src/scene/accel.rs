@@ -37,15 +37,13 @@ impl Accel {
     }
 
     /// Children per node of the BVH this choice traces through `scene`.
-    /// `auto` takes the 4-wide tree: since its step reads each axis's near
-    /// and far planes by the ray's signs, it is the faster tree at every
-    /// point measured on the H100 in both APIs but one: OpenGL's compute
-    /// path on the teapot tessellated past a million triangles, where the
-    /// binary tree is 4 to 9 % faster and the 4-wide one 6 to 10 % faster in
-    /// Vulkan (comparison/results/nvidia-h100/FINDINGS.md#the-wide-steps-arithmetic-investigationoctant).
-    /// On the 19.2k teapot at 1080p it is 17 % faster in Vulkan and 8 % in
-    /// OpenGL. One rule for both APIs keeps the comparison honest: both trace
-    /// the same tree; `--accel bvh` still gives the binary one.
+    /// `auto` takes the 4-wide tree: it is the faster tree at every point
+    /// measured on the H100 in both APIs. On the teapot at 1080p it is 23 %
+    /// faster than the binary tree in Vulkan and 20 % in OpenGL, and past a
+    /// million triangles about 10 % in Vulkan and 4 to 7 % in OpenGL
+    /// (comparison/results/nvidia-h100/FINDINGS.md#opengls-node-step-in-machine-code-investigationgl-gap).
+    /// One rule for both APIs keeps the comparison honest: both trace the
+    /// same tree; `--accel bvh` still gives the binary one.
     pub fn width(self) -> u32 {
         match self {
             Accel::Auto | Accel::Bvh4 => 4,
