@@ -224,7 +224,7 @@ void wide_order(inout float ta, inout uint ca, inout float tb, inout uint cb) {
 // loop with a first-time flag, and NVIDIA's OpenGL compiler kept that loop of
 // one turn in its machine code, with the push of an earlier nearest child that
 // only an 8-wide node's second quad can need; its Vulkan compiler removed both.
-// Without the loop OpenGL's teapot frames are 7-18 % shorter and Vulkan's
+// Without the loop OpenGL's teapot frames are 6-19 % shorter and Vulkan's
 // unchanged
 // (comparison/results/nvidia-h100/FINDINGS.md#opengls-node-step-in-machine-code-investigationgl-gap).
 #define WIDE_QUAD(n)                                                                   \
@@ -272,7 +272,7 @@ void wide_order(inout float ta, inout uint ca, inout float tb, inout uint cb) {
 #define WIDE_QUADS() WIDE_QUAD(child)
 #else
 // An 8-wide node keeps the loop over its two quads: written out twice, it
-// made OpenGL's 8-wide walk 8 % faster but Vulkan's 1-5 % slower.
+// made OpenGL's 8-wide walk 4-10 % faster but Vulkan's 1-5 % slower.
 #define WIDE_QUADS()                                                                   \
     for (uint q = 0u; q < uint(BVH_WIDE_QUADS); q++) {                                 \
         uint n = child + q;                                                            \
