@@ -253,14 +253,41 @@ impl Xvfb {
         cmd
     }
 
-    /// Runs `program` on this display (and nowhere else: WAYLAND_DISPLAY is cleared).
+    /// Runs `program` on this display (and nowhere else: WAYLAND_DISPLAY is
+    /// cleared). Under load the X server now and then refuses a connection
+    /// outright, as it does xdotool's (windowed/common.rs,
+    /// `xdotool_retrying`): once in a CI run on two cores, twinray-gl exited 3
+    /// with winit's "Failed to open connection to X server" on a display
+    /// that had just served twinray-vk. An app that could not connect has
+    /// done nothing yet, so it is started again, up to ten times; any other
+    /// outcome is returned as it is.
     pub fn run(&self, program: &Path, args: &[&str], env: &[(&str, &str)], dir: &Path) -> Output {
-        self.command(program, args, env, dir)
-            .output()
-            .unwrap_or_else(|e| panic!("starting {}: {e}", program.display()))
+        let start = || {
+            self.command(program, args, env, dir)
+                .output()
+                .unwrap_or_else(|e| panic!("starting {}: {e}", program.display()))
+        };
+        let mut o = start();
+        for _ in 0..10 {
+            if !refused_by_the_x_server(&o) {
+                break;
+            }
+            eprintln!(
+                "{}: the X server {} refused the connection; trying again",
+                program.display(),
+                self.display
+            );
+            std::thread::sleep(std::time::Duration::from_millis(300));
+            o = start();
+        }
+        o
     }
 
     /// Starts `program` on this display without waiting, its output captured.
+    /// As in `run`, an app the X server refused is started again: one that
+    /// exits 3 (no display) within two seconds, before it could open a
+    /// window; it is not asked why, so that a child handed back keeps all of
+    /// its output. A running app costs the caller those two seconds.
     pub fn spawn(
         &self,
         program: &Path,
@@ -268,11 +295,26 @@ impl Xvfb {
         env: &[(&str, &str)],
         dir: &Path,
     ) -> std::process::Child {
-        self.command(program, args, env, dir)
-            .stdout(std::process::Stdio::piped())
-            .stderr(std::process::Stdio::piped())
-            .spawn()
-            .unwrap_or_else(|e| panic!("starting {}: {e}", program.display()))
+        let start = || {
+            self.command(program, args, env, dir)
+                .stdout(std::process::Stdio::piped())
+                .stderr(std::process::Stdio::piped())
+                .spawn()
+                .unwrap_or_else(|e| panic!("starting {}: {e}", program.display()))
+        };
+        let mut child = start();
+        for _ in 0..10 {
+            if !exits_3_soon(&mut child) {
+                break;
+            }
+            eprintln!(
+                "{}: exit 3 at start on {}, the X server's refusal; trying again",
+                program.display(),
+                self.display
+            );
+            child = start();
+        }
+        child
     }
 
     /// Real X input through XTEST, as a user's mouse and keyboard make it
@@ -292,10 +334,68 @@ impl Xvfb {
     }
 }
 
+/// Whether `child` exits 3 within two seconds (it is left running otherwise).
+fn exits_3_soon(child: &mut std::process::Child) -> bool {
+    let until = std::time::Instant::now() + std::time::Duration::from_secs(2);
+    while std::time::Instant::now() < until {
+        match child.try_wait() {
+            Ok(Some(status)) => return status.code() == Some(3),
+            Ok(None) => std::thread::sleep(std::time::Duration::from_millis(50)),
+            Err(_) => return false,
+        }
+    }
+    false
+}
+
+/// An app's exit when the X server refused its connection: exit 3 (no
+/// display) with winit's words for a failed XOpenDisplay.
+fn refused_by_the_x_server(o: &Output) -> bool {
+    o.status.code() == Some(3)
+        && String::from_utf8_lossy(&o.stderr).contains("Failed to open connection to X server")
+}
+
 impl Drop for Xvfb {
     fn drop(&mut self) {
         let _ = self.child.kill();
         let _ = self.child.wait();
         let _ = std::fs::remove_dir_all(&self.fbdir);
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use std::os::unix::process::ExitStatusExt;
+
+    fn exited(code: i32, stderr: &str) -> Output {
+        Output {
+            status: std::process::ExitStatus::from_raw(code << 8),
+            stdout: Vec::new(),
+            stderr: stderr.as_bytes().to_vec(),
+        }
+    }
+
+    #[test]
+    fn only_a_refused_x_connection_is_started_again() {
+        let refused = "twinray-gl: error: cannot open a window (Failed to open connection to X server): no X display (is DISPLAY set?); run under xvfb-run, or use --headless";
+        assert!(refused_by_the_x_server(&exited(3, refused)));
+        assert!(!refused_by_the_x_server(&exited(
+            3,
+            "twinray-vk: error: no Vulkan device"
+        )));
+        assert!(!refused_by_the_x_server(&exited(2, refused)));
+        assert!(!refused_by_the_x_server(&exited(0, "")));
+    }
+
+    #[test]
+    fn a_child_that_exits_3_at_once_is_told_from_one_that_runs_or_fails_otherwise() {
+        let sh = |script: &str| Command::new("sh").args(["-c", script]).spawn().unwrap();
+        assert!(exits_3_soon(&mut sh("exit 3")));
+        assert!(!exits_3_soon(&mut sh("exit 2")));
+        let mut running = sh("sleep 10");
+        assert!(!exits_3_soon(&mut running));
+        assert!(running.try_wait().unwrap().is_none(), "left running");
+        running.kill().unwrap();
+        running.wait().unwrap();
     }
 }
