@@ -284,10 +284,6 @@ impl Xvfb {
     }
 
     /// Starts `program` on this display without waiting, its output captured.
-    /// As in `run`, an app the X server refused is started again: one that
-    /// exits 3 (no display) within two seconds, before it could open a
-    /// window; it is not asked why, so that a child handed back keeps all of
-    /// its output. A running app costs the caller those two seconds.
     pub fn spawn(
         &self,
         program: &Path,
@@ -295,26 +291,11 @@ impl Xvfb {
         env: &[(&str, &str)],
         dir: &Path,
     ) -> std::process::Child {
-        let start = || {
-            self.command(program, args, env, dir)
-                .stdout(std::process::Stdio::piped())
-                .stderr(std::process::Stdio::piped())
-                .spawn()
-                .unwrap_or_else(|e| panic!("starting {}: {e}", program.display()))
-        };
-        let mut child = start();
-        for _ in 0..10 {
-            if !exits_3_soon(&mut child) {
-                break;
-            }
-            eprintln!(
-                "{}: exit 3 at start on {}, the X server's refusal; trying again",
-                program.display(),
-                self.display
-            );
-            child = start();
-        }
-        child
+        self.command(program, args, env, dir)
+            .stdout(std::process::Stdio::piped())
+            .stderr(std::process::Stdio::piped())
+            .spawn()
+            .unwrap_or_else(|e| panic!("starting {}: {e}", program.display()))
     }
 
     /// Real X input through XTEST, as a user's mouse and keyboard make it
@@ -332,19 +313,6 @@ impl Xvfb {
                 panic!("running xdotool ({e}): install xdotool (tests/run.sh does)")
             })
     }
-}
-
-/// Whether `child` exits 3 within two seconds (it is left running otherwise).
-fn exits_3_soon(child: &mut std::process::Child) -> bool {
-    let until = std::time::Instant::now() + std::time::Duration::from_secs(2);
-    while std::time::Instant::now() < until {
-        match child.try_wait() {
-            Ok(Some(status)) => return status.code() == Some(3),
-            Ok(None) => std::thread::sleep(std::time::Duration::from_millis(50)),
-            Err(_) => return false,
-        }
-    }
-    false
 }
 
 /// An app's exit when the X server refused its connection: exit 3 (no
@@ -385,17 +353,5 @@ mod tests {
         )));
         assert!(!refused_by_the_x_server(&exited(2, refused)));
         assert!(!refused_by_the_x_server(&exited(0, "")));
-    }
-
-    #[test]
-    fn a_child_that_exits_3_at_once_is_told_from_one_that_runs_or_fails_otherwise() {
-        let sh = |script: &str| Command::new("sh").args(["-c", script]).spawn().unwrap();
-        assert!(exits_3_soon(&mut sh("exit 3")));
-        assert!(!exits_3_soon(&mut sh("exit 2")));
-        let mut running = sh("sleep 10");
-        assert!(!exits_3_soon(&mut running));
-        assert!(running.try_wait().unwrap().is_none(), "left running");
-        running.kill().unwrap();
-        running.wait().unwrap();
     }
 }
