@@ -1,7 +1,9 @@
 //! What the windowed scenarios share: a run's stderr, its clean validated
-//! report, the resize hook's counts, and xdotool that retries a refused connection.
+//! report, the resize hook's counts, xdotool that retries a refused connection,
+//! and what a failed xdotool chain reports.
 
-use std::process::Output;
+use std::io::Read;
+use std::process::{Child, Output};
 use twinray_common::report::RunReport;
 use twinray_tests::{App, Xvfb};
 
@@ -80,4 +82,27 @@ pub fn xdotool_retrying(x: &Xvfb, app: App, cmd: &[&str]) -> Output {
 pub fn escape_delivered(xd: &Output) -> bool {
     let err = String::from_utf8_lossy(&xd.stderr);
     xd.status.success() || (err.contains("BadWindow") && err.contains("X_SendEvent"))
+}
+
+/// Ends a test whose xdotool chain failed: stops the app and panics with
+/// xdotool's error, whether the app was still running, and what it printed,
+/// which tells a window that went away from one that never answered.
+pub fn xdotool_failed(app: App, cmd: &[&str], xd: &Output, child: &mut Child) -> ! {
+    let running = matches!(child.try_wait(), Ok(None));
+    let _ = child.kill();
+    let mut app_err = String::new();
+    if let Some(mut e) = child.stderr.take() {
+        let _ = e.read_to_string(&mut app_err);
+    }
+    let _ = child.wait();
+    panic!(
+        "{app:?}: xdotool {cmd:?} ({}): {}\nthe app {}; its stderr:\n{app_err}",
+        xd.status,
+        String::from_utf8_lossy(&xd.stderr),
+        if running {
+            "was still running"
+        } else {
+            "had exited"
+        },
+    );
 }

@@ -4,7 +4,7 @@
 //! its path, under the validation layer's synchronisation validation.
 
 use crate::common::{
-    assert_resized, clean_report, escape_delivered, stderr, xdotool_retrying, FOCUS,
+    assert_resized, clean_report, escape_delivered, stderr, xdotool_failed, xdotool_retrying, FOCUS,
 };
 use std::path::Path;
 use twinray_common::cli::RenderPath;
@@ -194,29 +194,7 @@ fn c_key_switches_the_path_the_title_follows_and_the_screen_equals_headless() {
         let mut step = |cmd: &[&str]| {
             let xd = xdotool_retrying(&x, app, cmd);
             if !xd.status.success() {
-                // Whether the app was still running, and what it said, tells a
-                // window that went away from one that never answered.
-                let running = matches!(child.try_wait(), Ok(None));
-                let _ = child.kill();
-                let app_err = child
-                    .stderr
-                    .take()
-                    .map(|mut e| {
-                        let mut text = String::new();
-                        let _ = std::io::Read::read_to_string(&mut e, &mut text);
-                        text
-                    })
-                    .unwrap_or_default();
-                panic!(
-                    "{app:?}: xdotool {cmd:?} ({}): {}\nthe app {}; its stderr:\n{app_err}",
-                    xd.status,
-                    String::from_utf8_lossy(&xd.stderr),
-                    if running {
-                        "was still running"
-                    } else {
-                        "had exited"
-                    },
-                );
+                xdotool_failed(app, cmd, &xd, &mut child);
             }
             String::from_utf8_lossy(&xd.stdout).into_owned()
         };
@@ -263,7 +241,7 @@ fn c_key_switches_the_path_the_title_follows_and_the_screen_equals_headless() {
         let escape = [&FOCUS[..], &["key", "Escape"]].concat();
         let xd = xdotool_retrying(&x, app, &escape);
         if !escape_delivered(&xd) {
-            step(&escape);
+            xdotool_failed(app, &escape, &xd, &mut child);
         }
         let o = child.wait_with_output().unwrap();
         assert!(o.status.success(), "{app:?}: {}", stderr(&o));

@@ -1,7 +1,7 @@
 //! Real mouse input (xdotool through XTEST): a drag orbits the camera, the
 //! wheel zooms, and R restores the initial view.
 
-use crate::common::{escape_delivered, stderr, xdotool_retrying, FOCUS};
+use crate::common::{escape_delivered, stderr, xdotool_failed, xdotool_retrying, FOCUS};
 use twinray_common::reference::metrics::compare;
 use twinray_tests::{render, scratch, App, Xvfb};
 
@@ -41,12 +41,7 @@ fn after_gesture(
     cmd.extend(["sleep", "0.5", "key", "Escape"]);
     let xd = xdotool_retrying(x, app, &cmd);
     if !escape_delivered(&xd) {
-        let _ = child.kill();
-        let _ = child.wait();
-        panic!(
-            "{app:?}: xdotool {cmd:?}: {}",
-            String::from_utf8_lossy(&xd.stderr)
-        );
+        xdotool_failed(app, &cmd, &xd, &mut child);
     }
     let o = child.wait_with_output().unwrap();
     assert!(o.status.success(), "{app:?}: {}", stderr(&o));
