@@ -77,7 +77,7 @@ pub struct RenderArgs {
     /// tracer as a compute shader writing a storage image.
     #[arg(long, value_enum, default_value_t = RenderPath::Fragment)]
     pub path: RenderPath,
-    /// Compute path only: the workgroup size WxH (e.g. 8x4, 4x8, 8x16) [default: 8x4; 8x16 for Vulkan's BVH walks].
+    /// Compute path only: the workgroup size WxH (e.g. 8x4, 4x8, 8x16) [default: 8x4; for BVH walks 8x16 in Vulkan, 4x8 in OpenGL].
     #[arg(long, value_name = "WxH", value_parser = parse_workgroup)]
     pub workgroup: Option<Workgroup>,
     /// Compute path: declare 1-32 KiB of workgroup memory that the tracer does

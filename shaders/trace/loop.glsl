@@ -49,6 +49,19 @@
 #define RAY_POP(i) o = st_origin_weight[i].xyz; w = st_origin_weight[i].w; d = st_dir_depth[i].xyz; depth = uint(st_dir_depth[i].w)
 #endif
 
+// Mirror and glass push rays, so the tracer pops until none is left. Without
+// them a pixel has its one ray and no loop: NVIDIA's OpenGL compiler kept the
+// loop of one turn in its machine code (its Vulkan compiler removed it), and
+// held the colour and the material's shininess in shared memory across it.
+// Without the loop OpenGL's teapot frames at 1080p and 4K are 4-6 % shorter;
+// Vulkan's do not move
+// (comparison/results/nvidia-h100/FINDINGS.md#the-ray-loop-of-one-turn-investigationone-ray).
+#if defined(HAS_MIRROR) || defined(HAS_GLASS)
+#define RAY_LOOP while (sp > 0)
+#else
+#define RAY_LOOP
+#endif
+
 vec3 trace(vec3 origin, vec3 dir) {
     RAY_STACK_DECLARE;
 #ifdef HAS_GLASS
@@ -64,7 +77,7 @@ vec3 trace(vec3 origin, vec3 dir) {
     RAY_PUSH(0, origin, dir, 1.0, 0u);
     sp = 1;
 
-    while (sp > 0) {
+    RAY_LOOP {
         sp -= 1;
         vec3 o;
         vec3 d;
@@ -79,138 +92,137 @@ vec3 trace(vec3 origin, vec3 dir) {
         Hit h = closest_hit(o, d);
         if (h.kind == 0u) {
             color += w * frame.background;
-            continue;
-        }
-
-        vec3 p = o + h.t * d;
-        vec3 ng;
-        vec3 ns;
-        uint mat_index;
-        float scale = max_abs(o);
-        if (h.kind == 1u) {
-            Sphere s = sphere_buf.spheres[h.index];
-            // One Newton step on |o + t d - c|^2 = r^2 from the test's t: the
-            // test's division and square root are approximate on GPUs (2 to 3
-            // ULPs of t, which refraction through nested glass magnifies into
-            // visible error); the step's residual is exactly rounded arithmetic,
-            // relative to the sphere rather than to t. Near tangency, where
-            // the step is ill-conditioned (its size past 2^-10 radii, or NaN),
-            // t stays.
-            vec3 rel = (o - s.center) + h.t * d;
-            float dt = (dot(rel, rel) - s.radius * s.radius) / (2.0 * dot(rel, d));
-            if (abs(dt) < s.radius * (1.0 / 1024.0)) {
-                p = o + (h.t - dt) * d;
-            }
-            ng = (p - s.center) / s.radius;
-            ns = ng;
-            mat_index = s.material;
-            // Sphere tests square their inputs (c = f.f - r^2), so a start a few
-            // ULPs inside glass can still re-hit the same sphere: 4x the margin
-            // (scenes/box's glass sphere speckled with 2^-22).
-            scale = 4.0 * max(scale, max_abs(p));
         } else {
-            Triangle tri = triangle_buf.triangles[h.index];
-            // A triangle test's error grows with its vertices' magnitude (a floor
-            // quad reaching x = 8 seen from a glass sphere at |o| = 1 re-hit itself).
-            scale = max(scale, max(max_abs(tri.p0), max(max_abs(tri.p1), max_abs(tri.p2))));
-            vec3 e1 = tri.p1 - tri.p0;
-            vec3 e2 = tri.p2 - tri.p0;
+            vec3 p = o + h.t * d;
+            vec3 ng;
+            vec3 ns;
+            uint mat_index;
+            float scale = max_abs(o);
+            if (h.kind == 1u) {
+                Sphere s = sphere_buf.spheres[h.index];
+                // One Newton step on |o + t d - c|^2 = r^2 from the test's t: the
+                // test's division and square root are approximate on GPUs (2 to 3
+                // ULPs of t, which refraction through nested glass magnifies into
+                // visible error); the step's residual is exactly rounded arithmetic,
+                // relative to the sphere rather than to t. Near tangency, where
+                // the step is ill-conditioned (its size past 2^-10 radii, or NaN),
+                // t stays.
+                vec3 rel = (o - s.center) + h.t * d;
+                float dt = (dot(rel, rel) - s.radius * s.radius) / (2.0 * dot(rel, d));
+                if (abs(dt) < s.radius * (1.0 / 1024.0)) {
+                    p = o + (h.t - dt) * d;
+                }
+                ng = (p - s.center) / s.radius;
+                ns = ng;
+                mat_index = s.material;
+                // Sphere tests square their inputs (c = f.f - r^2), so a start a few
+                // ULPs inside glass can still re-hit the same sphere: 4x the margin
+                // (scenes/box's glass sphere speckled with 2^-22).
+                scale = 4.0 * max(scale, max_abs(p));
+            } else {
+                Triangle tri = triangle_buf.triangles[h.index];
+                // A triangle test's error grows with its vertices' magnitude (a floor
+                // quad reaching x = 8 seen from a glass sphere at |o| = 1 re-hit itself).
+                scale = max(scale, max(max_abs(tri.p0), max(max_abs(tri.p1), max_abs(tri.p2))));
+                vec3 e1 = tri.p1 - tri.p0;
+                vec3 e2 = tri.p2 - tri.p0;
 #if defined(OFFSET_SCALE_AWARE) || defined(OFFSET_ULP)
-            // These offsets assume p lies within a few ULPs of its coordinates
-            // off the plane. o + t d does not: its error grows with t and with
-            // how thin the triangle is (acne on the teapot's spout and handle).
-            // Rebuilt from the barycentrics, an error in u, v only slides p
-            // along the plane (Wachter & Binder, Ray Tracing Gems ch. 6).
-            p = tri.p0 + h.u * e1 + h.v * e2;
+                // These offsets assume p lies within a few ULPs of its coordinates
+                // off the plane. o + t d does not: its error grows with t and with
+                // how thin the triangle is (acne on the teapot's spout and handle).
+                // Rebuilt from the barycentrics, an error in u, v only slides p
+                // along the plane (Wachter & Binder, Ray Tracing Gems ch. 6).
+                p = tri.p0 + h.u * e1 + h.v * e2;
 #endif
-            ng = normalize(cross(e1, e2));
-            ns = normalize((1.0 - h.u - h.v) * tri.n0 + h.u * tri.n1 + h.v * tri.n2);
-            mat_index = tri.material;
-        }
-        // Face both normals towards the incoming ray; `inside` tells glass which way it goes.
-        bool inside = dot(d, ng) > 0.0;
-        if (inside) {
-            ng = -ng;
-        }
-        if (dot(ns, ng) < 0.0) {
-            ns = -ns;
-        }
-        Material m = material_buf.materials[mat_index];
+                ng = normalize(cross(e1, e2));
+                ns = normalize((1.0 - h.u - h.v) * tri.n0 + h.u * tri.n1 + h.v * tri.n2);
+                mat_index = tri.material;
+            }
+            // Face both normals towards the incoming ray; `inside` tells glass which way it goes.
+            bool inside = dot(d, ng) > 0.0;
+            if (inside) {
+                ng = -ng;
+            }
+            if (dot(ns, ng) < 0.0) {
+                ns = -ns;
+            }
+            Material m = material_buf.materials[mat_index];
 
-        vec3 local = m.ambient;
-        for (uint li = 0u; li < LIGHT_COUNT; li++) {
-            Light light = light_buf.lights[li];
-            // The offset may depend on the direction (OFFSET_RAY): aim from p first.
-            vec3 p_out = spawn_point(p, ng, normalize(light.position - p), scale);
-            vec3 to_light = light.position - p_out;
-            float dist = length(to_light);
-            vec3 l = to_light / dist;
-            float ndl = dot(ns, l);
-            bool lit = ndl > 0.0 && dot(ng, l) > 0.0;
-            if (lit) {
-                // Stop a hair before the light: a light lying on a surface would
-                // otherwise be hidden by that surface at the whim of rounding.
-                lit = !occluded(p_out, l, dist * SHADOW_REACH);
+            vec3 local = m.ambient;
+            for (uint li = 0u; li < LIGHT_COUNT; li++) {
+                Light light = light_buf.lights[li];
+                // The offset may depend on the direction (OFFSET_RAY): aim from p first.
+                vec3 p_out = spawn_point(p, ng, normalize(light.position - p), scale);
+                vec3 to_light = light.position - p_out;
+                float dist = length(to_light);
+                vec3 l = to_light / dist;
+                float ndl = dot(ns, l);
+                bool lit = ndl > 0.0 && dot(ng, l) > 0.0;
+                if (lit) {
+                    // Stop a hair before the light: a light lying on a surface would
+                    // otherwise be hidden by that surface at the whim of rounding.
+                    lit = !occluded(p_out, l, dist * SHADOW_REACH);
+                }
+                if (lit) {
+                    vec3 r = reflect(-l, ns);
+                    float spec = pow(max(dot(r, -d), 0.0), m.shininess);
+                    local += light.color * (m.diffuse * ndl + m.specular * spec);
+                }
             }
-            if (lit) {
-                vec3 r = reflect(-l, ns);
-                float spec = pow(max(dot(r, -d), 0.0), m.shininess);
-                local += light.color * (m.diffuse * ndl + m.specular * spec);
-            }
-        }
-        color += w * local;
+            color += w * local;
 
 #if defined(HAS_MIRROR) || defined(HAS_GLASS)
-        SPEC(SPEC_MIRROR || SPEC_GLASS)
-        if (depth + 1u < max_depth) {
-            float kr = m.reflectivity;
+            SPEC(SPEC_MIRROR || SPEC_GLASS)
+            if (depth + 1u < max_depth) {
+                float kr = m.reflectivity;
 #ifdef HAS_GLASS
-            float kt = m.transparency;
-            SPEC(SPEC_GLASS)
-            if (kt > 0.0) {
-                float eta = inside ? m.ior : 1.0 / m.ior;
-                // Near a smooth mesh's silhouette the interpolated normal can
-                // face away from the ray (cos_i < 0), where Fresnel's formula
-                // exceeds 1 and glass would send on more than arrived (F = 19.5
-                // on a tilted-normal triangle). There Fresnel and the bend take
-                // the geometric normal, which faces the ray, so F stays in
-                // [0, 1]; the f64 reference does the same.
-                vec3 nt = dot(d, ns) > 0.0 ? ng : ns;
-                float cos_i = -dot(d, nt);
-                float k = 1.0 - eta * eta * (1.0 - cos_i * cos_i);
-                if (k < 0.0) {
-                    kr += kt;  // total internal reflection
-                } else {
-                    float cos_t = sqrt(k);
-                    float f = fresnel(cos_i, cos_t, eta);
-                    kr += kt * f;
-                    float wt = w * kt * (1.0 - f);
-                    if (wt >= frame.min_weight && sp < STACK_SIZE) {
-                        vec3 t_dir = normalize(eta * d + (eta * cos_i - cos_t) * nt);
-                        RAY_PUSH(sp, spawn_point(p, -ng, t_dir, scale), t_dir, wt, depth + 1u);
-                        sp += 1;
+                float kt = m.transparency;
+                SPEC(SPEC_GLASS)
+                if (kt > 0.0) {
+                    float eta = inside ? m.ior : 1.0 / m.ior;
+                    // Near a smooth mesh's silhouette the interpolated normal can
+                    // face away from the ray (cos_i < 0), where Fresnel's formula
+                    // exceeds 1 and glass would send on more than arrived (F = 19.5
+                    // on a tilted-normal triangle). There Fresnel and the bend take
+                    // the geometric normal, which faces the ray, so F stays in
+                    // [0, 1]; the f64 reference does the same.
+                    vec3 nt = dot(d, ns) > 0.0 ? ng : ns;
+                    float cos_i = -dot(d, nt);
+                    float k = 1.0 - eta * eta * (1.0 - cos_i * cos_i);
+                    if (k < 0.0) {
+                        kr += kt;  // total internal reflection
+                    } else {
+                        float cos_t = sqrt(k);
+                        float f = fresnel(cos_i, cos_t, eta);
+                        kr += kt * f;
+                        float wt = w * kt * (1.0 - f);
+                        if (wt >= frame.min_weight && sp < STACK_SIZE) {
+                            vec3 t_dir = normalize(eta * d + (eta * cos_i - cos_t) * nt);
+                            RAY_PUSH(sp, spawn_point(p, -ng, t_dir, scale), t_dir, wt, depth + 1u);
+                            sp += 1;
 #ifdef COUNT_RAYS
-                        rays_traced.glass_refracted += 1u;
+                            rays_traced.glass_refracted += 1u;
 #endif
+                        }
                     }
                 }
-            }
 #endif
-            float wr = w * kr;
-            if (wr >= frame.min_weight && sp < STACK_SIZE) {
-                vec3 r_dir = reflect(d, ns);
-                RAY_PUSH(sp, spawn_point(p, ng, r_dir, scale), r_dir, wr, depth + 1u);
-                sp += 1;
+                float wr = w * kr;
+                if (wr >= frame.min_weight && sp < STACK_SIZE) {
+                    vec3 r_dir = reflect(d, ns);
+                    RAY_PUSH(sp, spawn_point(p, ng, r_dir, scale), r_dir, wr, depth + 1u);
+                    sp += 1;
 #ifdef COUNT_RAYS
-                if (m.transparency > 0.0) {
-                    rays_traced.glass_reflected += 1u;
-                } else {
-                    rays_traced.mirror += 1u;
+                    if (m.transparency > 0.0) {
+                        rays_traced.glass_reflected += 1u;
+                    } else {
+                        rays_traced.mirror += 1u;
+                    }
+#endif
                 }
-#endif
             }
-        }
 #endif
+        }
     }
     return color;
 }

@@ -77,17 +77,23 @@ impl Api {
 
     /// The compute path's workgroup where `--workgroup` does not set one, for
     /// a tracer that walks a BVH (`bvh`) or tests every primitive. One warp,
-    /// 8x4, except for Vulkan's BVH walks: at 64 invocations or more its
-    /// driver compiles the teapot's walk to 64 registers and 36 bytes of
-    /// shared memory per invocation instead of 76 registers, and 8x16 took
-    /// the 1080p teapot from 0.219 to 0.196 ms. Brute force stays at 8x4 in Vulkan, where
-    /// 8x16 cost the teapot up to 10 %, and OpenGL keeps 8x4 for both, as
-    /// no other shape gained it more than 2 % without costing some point 3 %
-    /// (the figures: comparison/results/nvidia-h100/FINDINGS.md#each-apis-workgroup-investigationworkgroups).
+    /// 8x4, except for the BVH walks:
+    /// - Vulkan's take 8x16: at 64 invocations or more its driver compiles
+    ///   the teapot's walk to 64 registers and 36 bytes of shared memory per
+    ///   invocation instead of 76 registers, and 8x16 took the 1080p teapot
+    ///   from 0.219 to 0.196 ms
+    ///   (comparison/results/nvidia-h100/FINDINGS.md#each-apis-workgroup-investigationworkgroups).
+    /// - OpenGL's take 4x8, still one warp (its driver is slower with more):
+    ///   0.2-7 % faster than 8x4 at every teapot point, and 4.5 % slower on
+    ///   the 10k sphere list's small frame
+    ///   (comparison/results/nvidia-h100/FINDINGS.md#the-ray-loop-of-one-turn-investigationone-ray).
+    ///
+    /// Brute force stays at 8x4 in both: 8x16 cost Vulkan's teapot up to 10 %.
     /// `--workgroup WxH` runs both apps at one shape.
     pub fn default_workgroup(&self, bvh: bool) -> crate::cli::Workgroup {
         match (self, bvh) {
             (Api::Vulkan, true) => crate::cli::Workgroup { x: 8, y: 16 },
+            (Api::OpenGl, true) => crate::cli::Workgroup { x: 4, y: 8 },
             _ => crate::cli::Workgroup { x: 8, y: 4 },
         }
     }
