@@ -4,8 +4,9 @@
 # workgroups of several warps resident, and does a larger workgroup then beat
 # one warp? The teapot at 1080p (Grays/s) and at 1000x1000 with 19.2k and 1.2M
 # triangles, and the 10k sphere list at 300x300, through the default tree; two
-# rounds, the second in reverse order, after one untimed run of each
-# configuration so that no round meets a cold shader cache. With POINTS=all
+# rounds in alternating configuration and API order (lib.sh's
+# alternating_rounds), after one untimed run of each configuration so that no
+# round meets a cold shader cache. With POINTS=all
 # also the teapot at 4K and at 307k and 4.9M triangles, and the box through
 # the default tree at 1000x1000. About half a second a run on an H100.
 # OUT_DIR/shapes.jsonl: a label line (point|config|round), then the app's
@@ -26,21 +27,16 @@ errors=$out/shapes.log
 # shellcheck source=comparison/investigations/lib.sh
 source "$(dirname "$0")/../lib.sh"
 gpu_info
-read -r -a apps <<< "${APPS:-vk gl}"
-points=(
-    "teapot-1080p|--scene teapot --size 1920x1080 --frames 60 --count-rays"
-    "teapot-19.2k|--scene teapot --size 1000x1000 --frames 60"
-    "teapot-1.2m|--scene teapot --set tessellation=160x120 --size 1000x1000 --frames 60"
-    "spherelist-10k|--scene spherelist --set extra_spheres=10000 --size 300x300 --frames 60"
-)
+read -r -a run_apps <<< "${APPS:-vk gl}"
+# The teapot's points as the other teapot scripts label them: 1080p, 19.2k
+# and 1.2M, or with POINTS=all every one.
+teapot_points
 if [ "${POINTS:-}" = all ]; then
-    points+=(
-        "teapot-4k|--scene teapot --size 3840x2160 --frames 60 --count-rays"
-        "teapot-307k|--scene teapot --set tessellation=80x60 --size 1000x1000 --frames 60"
-        "teapot-4.9m|--scene teapot --set tessellation=320x240 --size 1000x1000 --frames 30"
-        "box|--scene box --size 1000x1000 --frames 60"
-    )
+    points+=("box|--scene box --size 1000x1000 --frames 60")
+else
+    points=("${points[0]}" "${points[2]}" "${points[4]}")
 fi
+points+=("spherelist-10k|--scene spherelist --set extra_spheres=10000 --size 300x300 --frames 60")
 # config_args CONFIG: the options of one configuration, in the array `cargs`,
 # and its variables exported (those of the configuration before unset).
 config_args() {
@@ -53,28 +49,20 @@ config_args() {
     [[ $shape == *:* ]] && cargs+=(--shared-pad "${shape#*:}")
 }
 cvars=()
-for app in "${apps[@]}"; do
+for app in "${run_apps[@]}"; do
     for c in "$@"; do
         config_args "$c"
         "$bin/twinray-$app" --headless --scene teapot --size 64x64 --path compute "${cargs[@]}" \
             > /dev/null 2>> "$errors"
     done
 done
-configs=("$@")
-for round in 1 2; do
-    order=("${configs[@]}")
-    if [ "$round" = 2 ]; then
-        order=()
-        for ((i = ${#configs[@]} - 1; i >= 0; i--)); do order+=("${configs[i]}"); done
-    fi
-    for p in "${points[@]}"; do
-        for app in "${apps[@]}"; do
-            for c in "${order[@]}"; do
-                config_args "$c"
-                # shellcheck disable=SC2086
-                run "${p%%|*}|$c|$round" "$app" ${p#*|} --path compute "${cargs[@]}"
-            done
-        done
-    done
-done
+# One run at point P with configuration C, for the apps APPS names.
+step() {
+    local p=$1 app=$2 c=$3 round=$4
+    [[ " ${run_apps[*]} " == *" $app "* ]] || return 0
+    config_args "$c"
+    # shellcheck disable=SC2086
+    run "${p%%|*}|$c|$round" "$app" ${p#*|} --path compute "${cargs[@]}"
+}
+alternating_rounds step "$@"
 touch "$out/done"
