@@ -18,6 +18,21 @@ run() {
         echo "{\"failed\":\"twinray-$app $*\"}" >> "$log"
 }
 
+# explained_run LABEL CACHE APP OPTIONS...: `run` with --explain, and NVIDIA's
+# shader disk cache on (CACHE 1) or off (0: the driver compiles, as on a
+# machine's first run; its Vulkan and its GL driver both read the variable).
+# Appends each --explain step line, and each line the app writes of its own
+# (`twinray-...:`, errors included), labelled, to $out/explain.txt.
+explained_run() {
+    local label=$1 cache=$2 app=$3
+    shift 3
+    echo "{\"label\":\"$label\",\"cmd\":\"twinray-$app $*\"}" >> "$log"
+    __GL_SHADER_DISK_CACHE=$cache timeout 120 "$bin/twinray-$app" --headless --json --explain "$@" \
+        >> "$log" 2> "$out/stderr.txt" || echo "{\"failed\":\"twinray-$app $*\"}" >> "$log"
+    grep -E '^\[[ 0-9]+\] +\+|^twinray-' "$out/stderr.txt" | sed "s/^/$label | /" >> "$out/explain.txt"
+    rm -f "$out/stderr.txt"
+}
+
 # use_build old|new: points `bin` (what `run` starts) at that build's folder.
 use_build() {
     if [ "$1" = old ]; then bin=$old; else bin=$new; fi

@@ -9,7 +9,7 @@
 # cold at 19.2k. Two rounds. OUT_DIR/cold.jsonl: a label line
 # ("cold|prime|warm|API|tessellation|round"), then the app's --json report;
 # OUT_DIR/explain.txt: every --explain step line of each run, labelled, which
-# says where the time went. About 90 s on an H100.
+# says where the time went, and any line the app writes of its own. About 90 s on an H100.
 # Usage: comparison/investigations/scale/gpu-cold-start.sh BIN_DIR OUT_DIR
 set -uo pipefail
 bin=$1
@@ -18,15 +18,8 @@ mkdir -p "$out"
 log=$out/cold.jsonl
 : > "$log"
 : > "$out/explain.txt"
-# one LABEL CACHE APP OPTIONS...: one run, the disk cache on (1) or off (0)
-one() {
-    local label=$1 cache=$2 app=$3
-    shift 3
-    echo "{\"label\":\"$label\",\"cmd\":\"twinray-$app $*\"}" >> "$log"
-    __GL_SHADER_DISK_CACHE=$cache timeout 120 "$bin/twinray-$app" --headless --json --explain "$@" \
-        >> "$log" 2> "$out/stderr.txt" || echo "{\"failed\":\"twinray-$app $*\"}" >> "$log"
-    grep -E '^\[[ 0-9]+\] +\+' "$out/stderr.txt" | sed "s/^/$label | /" >> "$out/explain.txt"
-}
+# shellcheck source=comparison/investigations/lib.sh
+source "$(dirname "$0")/../lib.sh"
 for round in 1 2; do
     for t in 20x15 80x60 160x120 320x240; do
         c="--scene teapot --set tessellation=$t --size 640x480 --frames 3 --path compute"
@@ -37,17 +30,16 @@ for round in 1 2; do
                 gl-spirv) app=gl extra=(--gl-spirv) ;;
             esac
             # shellcheck disable=SC2086 # the options are words
-            one "cold|$api|$t|$round" 0 $app $c "${extra[@]}"
+            explained_run "cold|$api|$t|$round" 0 $app $c "${extra[@]}"
             # shellcheck disable=SC2086
-            one "prime|$api|$t|$round" 1 $app $c "${extra[@]}"
+            explained_run "prime|$api|$t|$round" 1 $app $c "${extra[@]}"
             # shellcheck disable=SC2086
-            one "warm|$api|$t|$round" 1 $app $c "${extra[@]}"
+            explained_run "warm|$api|$t|$round" 1 $app $c "${extra[@]}"
         done
     done
     c="--scene teapot --set tessellation=20x15 --size 640x480 --frames 3 --path compute --generic"
     for app in gl vk; do
         # shellcheck disable=SC2086
-        one "cold|$app|generic|$round" 0 $app $c
+        explained_run "cold|$app|generic|$round" 0 $app $c
     done
 done
-rm -f "$out/stderr.txt"

@@ -20,6 +20,8 @@ mkdir -p "$out"
 log=$out/compile.jsonl
 : > "$log"
 : > "$out/explain.txt"
+# shellcheck source=comparison/investigations/lib.sh
+source "$(dirname "$0")/../lib.sh"
 sets=(
     "none|"
     "optimize-off|#pragma optimize(off)"
@@ -38,15 +40,12 @@ cases=(
     "box|--scene box --path compute"
     "spherelist|--scene spherelist --path compute"
 )
-# one LABEL CACHE APP PRAGMAS OPTIONS...: one run
+# one LABEL CACHE APP PRAGMAS OPTIONS...: one run, the pragmas given to the patch
 one() {
-    local label=$1 cache=$2 app=$3 pragmas=$4
+    local label=$1 cache=$2 app=$3
+    export TWINRAY_GL_PRAGMAS=$4
     shift 4
-    echo "{\"label\":\"$label\",\"cmd\":\"twinray-$app $*\"}" >> "$log"
-    TWINRAY_GL_PRAGMAS=$pragmas __GL_SHADER_DISK_CACHE=$cache timeout 120 "$bin/twinray-$app" \
-        --headless --json --explain "$@" >> "$log" 2> "$out/stderr.txt" \
-        || echo "{\"failed\":\"twinray-$app $*\"}" >> "$log"
-    grep -E '^\[[ 0-9]+\] +\+' "$out/stderr.txt" | sed "s/^/$label | /" >> "$out/explain.txt"
+    explained_run "$label" "$cache" "$app" "$@"
 }
 for round in 1 2; do
     for s in "${sets[@]}"; do
@@ -68,5 +67,4 @@ for round in 1 2; do
     done
     one "speed|vk|vk|$round" 1 vk "" --scene teapot --size 1920x1080 --frames 60 --path compute
 done
-rm -f "$out/stderr.txt"
 touch "$out/done"

@@ -20,18 +20,16 @@ bin=$1
 out=$2
 mkdir -p "$out"
 log=$out/overlap.jsonl
-ex=$out/explain.txt
 : > "$log"
-: > "$ex"
-# one LABEL CACHE MODE TESSELLATION: one run
+: > "$out/explain.txt"
+# shellcheck source=comparison/investigations/lib.sh
+source "$(dirname "$0")/../lib.sh"
+# one LABEL CACHE MODE TESSELLATION: one run, plain or with the overlap
 one() {
     local label=$1 cache=$2 mode=$3 t=$4
-    echo "{\"label\":\"$label\"}" >> "$log"
     if [ "$mode" = overlap ]; then export TWINRAY_GL_OVERLAP=1; else unset TWINRAY_GL_OVERLAP; fi
-    __GL_SHADER_DISK_CACHE=$cache timeout 120 "$bin/twinray-gl" --headless --json --explain \
-        --scene teapot --set tessellation="$t" --size 640x480 --frames 3 --path compute \
-        >> "$log" 2> "$out/stderr.txt" || echo '{"failed":1}' >> "$log"
-    grep -E '^\[[ 0-9]+\] +\+|parallel' "$out/stderr.txt" | sed "s/^/$label | /" >> "$ex"
+    explained_run "$label" "$cache" gl --scene teapot --set tessellation="$t" --size 640x480 \
+        --frames 3 --path compute
 }
 for round in 1 2 3; do
     modes=(plain overlap)
@@ -46,5 +44,4 @@ for mode in plain overlap; do one "prime|$mode|320x240|0" 1 "$mode" 320x240; don
 for round in 1 2; do
     for mode in plain overlap; do one "warm|$mode|320x240|$round" 1 "$mode" 320x240; done
 done
-rm -f "$out/stderr.txt"
 touch "$out/done"
