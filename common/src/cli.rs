@@ -31,6 +31,11 @@ pub struct RenderArgs {
     // Hyphen values reach parse_frames, so `-1` is refused as a count, not as an unknown option.
     #[arg(long, value_parser = parse_frames, allow_hyphen_values = true)]
     pub frames: Option<u32>,
+    /// Headless: stop once the median frame time's 95 % confidence interval
+    /// lies within ±PCT % of it (after a warm-up, at least 6 timed frames);
+    /// --frames is then the cap [default cap: 60].
+    #[arg(long, value_name = "PCT", value_parser = parse_settle, allow_hyphen_values = true, requires = "headless")]
+    pub settle: Option<f64>,
     /// Save the last frame as PNG (top row first, same orientation in both APIs).
     #[arg(long)]
     pub out: Option<PathBuf>,
@@ -228,6 +233,16 @@ fn parse_frames(s: &str) -> Result<u32, String> {
     }
 }
 
+/// `--settle`: a percentage above 0 and at most 50.
+fn parse_settle(s: &str) -> Result<f64, String> {
+    match s.trim().parse::<f64>() {
+        Ok(p) if p > 0.0 && p <= 50.0 => Ok(p),
+        _ => Err(
+            "give the interval's half-width as a percentage above 0 and at most 50, e.g. 1".into(),
+        ),
+    }
+}
+
 impl RenderArgs {
     /// A headless run of `scene` at `size` with every other option at its default.
     pub fn headless(scene: &str, size: Size) -> RenderArgs {
@@ -236,6 +251,7 @@ impl RenderArgs {
             size,
             headless: true,
             frames: None,
+            settle: None,
             out: None,
             json: false,
             count_rays: false,
@@ -272,6 +288,18 @@ impl RenderArgs {
 
     pub fn frame_count(&self) -> u32 {
         self.frames.unwrap_or(1)
+    }
+
+    /// The headless loop's frames: `--frames` alone, or with `--settle` a cap
+    /// (60, the study's count, unless `--frames` gives one).
+    pub fn frame_plan(&self) -> crate::stats::FramePlan {
+        match self.settle {
+            Some(pct) => crate::stats::FramePlan {
+                cap: self.frames.unwrap_or(60),
+                settle: Some(pct / 100.0),
+            },
+            None => crate::stats::FramePlan::fixed(self.frame_count()),
+        }
     }
 
     /// The `--set` pairs split into (key, value).

@@ -5,7 +5,7 @@ use crate::cli::{RenderPath, Workgroup};
 use crate::rays::{grays_per_s, RateClock, RayCounts, RayKinds};
 use crate::scene::SceneStats;
 use crate::shader::build::Stage;
-use crate::stats::{summarize, Summary};
+use crate::stats::{study_warmup, summarize, summarize_all, FramePlan, Summary};
 use serde::{Deserialize, Serialize};
 
 #[derive(Debug, Clone, Serialize, Deserialize)]
@@ -14,6 +14,10 @@ pub struct FrameTime {
     pub gpu_ms: Option<f64>,
     /// One loop iteration: submit + wait, as the 2018 study measured.
     pub wall_ms: f64,
+    /// A warm-up frame: rendered and shown, left out of the statistics.
+    /// Reports from before the mark use the study's rule (the last 30 of 60).
+    #[serde(default, skip_serializing_if = "std::ops::Not::not")]
+    pub warmup: bool,
 }
 
 #[derive(Debug, Clone, Serialize, Deserialize)]
@@ -151,16 +155,33 @@ impl RunReport {
 
     /// Adds the counting frame's rays (`--count-rays`) and the rate they give.
     pub fn add_rays(&mut self, kinds: RayKinds) {
-        self.rays = Some(kinds.counts());
+        self.set_rays(kinds.counts());
+    }
+
+    /// Sets the frame's rays (counted by another run of the same scene and
+    /// size: both paths trace the same rays) and the rate they give.
+    pub fn set_rays(&mut self, counts: RayCounts) {
+        self.rays = Some(counts);
         self.summarise();
     }
 
     /// Fills the summaries from `frames`.
     pub fn summarise(&mut self) {
-        let wall: Vec<f64> = self.frames.iter().map(|f| f.wall_ms).collect();
-        self.wall_ms = summarize(&wall);
-        let gpu: Option<Vec<f64>> = self.frames.iter().map(|f| f.gpu_ms).collect();
-        self.gpu_ms = gpu.and_then(|g| summarize(&g));
+        // Frames marked as warm-up stay out; unmarked reports (older ones,
+        // tests) keep the study's tail.
+        let marked = self.frames.iter().any(|f| f.warmup);
+        let stats = |v: &[f64]| {
+            if marked {
+                summarize_all(v)
+            } else {
+                summarize(v)
+            }
+        };
+        let timed = || self.frames.iter().filter(|f| !marked || !f.warmup);
+        let wall: Vec<f64> = timed().map(|f| f.wall_ms).collect();
+        self.wall_ms = stats(&wall);
+        let gpu: Option<Vec<f64>> = timed().map(|f| f.gpu_ms).collect();
+        self.gpu_ms = gpu.and_then(|g| stats(&g));
         if let Some(rays) = &self.rays {
             let (clock, median) = match (&self.gpu_ms, &self.wall_ms) {
                 (Some(g), _) => (RateClock::Gpu, g.median),
@@ -268,29 +289,60 @@ pub fn dump_shaders(dir: &std::path::Path, stages: &[&Stage]) -> anyhow::Result<
 /// `started` (first thing in main) to the first frame. The first frame is an
 /// `--explain` step titled `title`.
 pub fn timed_frames(
-    count: u32,
+    plan: FramePlan,
     started: std::time::Instant,
     title: &str,
     mut frame: impl FnMut() -> anyhow::Result<()>,
     mut gpu_ms: impl FnMut() -> anyhow::Result<Option<f64>>,
 ) -> anyhow::Result<(Vec<FrameTime>, f64)> {
-    let mut frames = Vec::with_capacity(count as usize);
+    let mut frames: Vec<FrameTime> = Vec::with_capacity(plan.cap.min(4096) as usize);
     let mut setup_ms = 0.0;
-    for i in 0..count {
+    // A fixed count warms up as the study did; a settling run until
+    // FramePlan::warmup_over says so.
+    let fixed_warmup = study_warmup(plan.cap as usize);
+    let mut warming = true;
+    let mut first_start = None;
+    // The clock the stopping rule reads: GPU time while every timed frame
+    // has it, wall time otherwise (as the reports choose).
+    let mut timed_gpu: Option<Vec<f64>> = Some(Vec::new());
+    let mut timed_wall: Vec<f64> = Vec::new();
+    for i in 0..plan.cap as usize {
         let t0 = std::time::Instant::now();
         if i == 0 {
             setup_ms = (t0 - started).as_secs_f64() * 1e3;
         }
+        let first = *first_start.get_or_insert(t0);
         frame()?;
         let wall_ms = t0.elapsed().as_secs_f64() * 1e3;
         let gpu_ms = gpu_ms()?;
-        frames.push(FrameTime { gpu_ms, wall_ms });
+        let warmup = match plan.settle {
+            None => i < fixed_warmup,
+            Some(_) => warming,
+        };
+        frames.push(FrameTime {
+            gpu_ms,
+            wall_ms,
+            warmup,
+        });
         if i == 0 {
             // The frames are the walkthrough's step 11 in both APIs.
             crate::explain::numbered(11, title, || {
                 let gpu = gpu_ms.map_or("no GPU time".into(), |g| format!("GPU {g:.3} ms"));
                 format!("wall {wall_ms:.3} ms, {gpu}; later frames repeat the same work")
             });
+        }
+        if warmup {
+            let elapsed = first.elapsed().as_secs_f64() * 1e3;
+            warming = !plan.warmup_over(i + 1, elapsed);
+            continue;
+        }
+        timed_wall.push(wall_ms);
+        timed_gpu = timed_gpu.and_then(|mut v| {
+            v.push(gpu_ms?);
+            Some(v)
+        });
+        if plan.settled(timed_gpu.as_deref().unwrap_or(&timed_wall)) {
+            break;
         }
     }
     Ok((frames, setup_ms))

@@ -127,6 +127,7 @@ pub fn app_args(args: &RenderArgs) -> Vec<String> {
         size,
         headless: _,
         frames,
+        settle,
         out,
         json,
         count_rays,
@@ -155,6 +156,9 @@ pub fn app_args(args: &RenderArgs) -> Vec<String> {
     ];
     if let Some(f) = frames {
         v.extend(["--frames".into(), f.to_string()]);
+    }
+    if let Some(p) = settle {
+        v.extend(["--settle".into(), p.to_string()]);
     }
     if let Some(o) = out {
         v.extend(["--out".into(), o.display().to_string()]);
@@ -235,9 +239,18 @@ pub fn is_software(device: &str) -> bool {
         .any(|s| d.contains(s))
 }
 
+/// How many app processes this orchestrator has started: the reports state it.
+static RUNS_STARTED: std::sync::atomic::AtomicUsize = std::sync::atomic::AtomicUsize::new(0);
+
+/// The app runs started so far (every `run_json`).
+pub fn runs_started() -> usize {
+    RUNS_STARTED.load(std::sync::atomic::Ordering::Relaxed)
+}
+
 /// Runs an app with `--json` and returns its report; a failure carries the app's own message and exit code.
 pub fn run_json(api: Api, args: &RenderArgs) -> anyhow::Result<RunReport> {
     let bin = api.binary().expect("an app");
+    RUNS_STARTED.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
     let mut args = args.clone();
     args.json = true;
     args.gl_spirv |= api == Api::OpenglSpirv;
@@ -332,6 +345,7 @@ mod tests {
             // app_args always adds --headless: the orchestrator never opens a window.
             headless: true,
             frames: Some(7),
+            settle: Some(1.5),
             out: Some(PathBuf::from("out dir/a.png")),
             json: true,
             count_rays: true,
@@ -412,6 +426,7 @@ mod tests {
             "scene" => "spherelist",
             "size" => "33x17",
             "frames" => "7",
+            "settle" => "1.5",
             "out" => "a.png",
             "set" => "max_depth=3",
             "workgroup" => "8x4",

@@ -74,7 +74,10 @@ struct Preset {
     box_sides: Vec<u32>,
     extra_spheres: Vec<u32>,
     spherelist_side: u32,
+    /// Frames per run at most: each stops once settled (`settle`).
     frames: u32,
+    /// The half-width, in per cent, each run's median interval must reach.
+    settle: f64,
     seconds_per_point: f64,
     why: WhyPlan,
 }
@@ -84,19 +87,24 @@ impl Preset {
         if quick {
             Preset {
                 name: "quick",
-                teapot_sides: vec![40, 80],
-                box_sides: vec![100, 200, 300],
-                extra_spheres: vec![1, 10, 100, 1000],
+                // A brute-force teapot costs half a second a frame on a
+                // CPU at 40², and seconds at 80²: small sizes, few frames.
+                teapot_sides: vec![24, 40],
+                box_sides: vec![100, 200],
+                extra_spheres: vec![1, 10, 100],
                 spherelist_side: 100,
+                // Enough for an interval (a warm-up and 6 timed frames); a
+                // CPU's frames rarely settle to ±2 %, so most runs take 8.
                 frames: 8,
-                seconds_per_point: 8.0,
-                // A brute-force teapot costs seconds a frame on a CPU even at 40².
+                settle: 2.0,
+                seconds_per_point: 4.0,
                 why: WhyPlan {
                     box_side: 100,
                     teapot_side: 16,
-                    frames: 4,
-                    seconds_per_point: 4.0,
-                    rounds: 2,
+                    frames: 8,
+                    settle: 2.0,
+                    seconds_per_point: 2.0,
+                    rounds: 1,
                 },
             }
         } else {
@@ -107,11 +115,16 @@ impl Preset {
                 extra_spheres: vec![1, 10, 50, 100, 500, 1000, 2500, 5000, 10000],
                 spherelist_side: 300,
                 frames: 60,
+                settle: 1.0,
                 seconds_per_point: 30.0,
+                // The brute-force teapot's fragment frame takes seconds at
+                // 1000²: its gap is measured at 400², where its ratio is the
+                // sweep's (report: the teapot table).
                 why: WhyPlan {
                     box_side: 1000,
-                    teapot_side: 1000,
+                    teapot_side: 400,
                     frames: 60,
+                    settle: 1.0,
                     seconds_per_point: 30.0,
                     rounds: 2,
                 },
@@ -165,6 +178,7 @@ pub fn plan(args: &CompareArgs) -> anyhow::Result<Plan> {
     Ok(Plan {
         points,
         frames: args.frames.unwrap_or(preset.frames),
+        settle: Some(preset.settle),
         seconds_per_point: args.seconds_per_point.unwrap_or(preset.seconds_per_point),
         preset: preset.name,
     })
@@ -197,6 +211,7 @@ pub fn run(args: &CompareArgs) -> anyhow::Result<()> {
     // Before the device probe and every render: a bad --out must cost nothing.
     twinray_common::reference::image_io::prepare_output_dir("--out", &args.out)?;
     let stop = crate::interrupt::Stop::install()?;
+    let started = std::time::Instant::now();
     let args = &with_preset(args)?;
     let plan = plan(args)?;
     let mut apis = vec![Api::Vulkan, Api::Opengl];
@@ -239,6 +254,7 @@ pub fn run(args: &CompareArgs) -> anyhow::Result<()> {
         // bound its runs too, so a short GPU lease can afford it.
         let mut why_plan = Preset::of(args.quick).why;
         why_plan.frames = args.frames.unwrap_or(why_plan.frames);
+        why_plan.settle = plan.settle.unwrap_or(why_plan.settle);
         why_plan.seconds_per_point = args.seconds_per_point.unwrap_or(why_plan.seconds_per_point);
         Some(why::run(&args.out, &why_plan, &paths, stop.flag()))
     } else {
@@ -255,6 +271,7 @@ pub fn run(args: &CompareArgs) -> anyhow::Result<()> {
         signal,
         step: stopped_in.unwrap_or(last),
     });
+    let cost = (crate::apps::runs_started(), started.elapsed().as_secs_f64());
     let results = runs::Results {
         plan: &plan,
         outcomes: &outcomes,
@@ -262,11 +279,14 @@ pub fn run(args: &CompareArgs) -> anyhow::Result<()> {
         agreement: &agreement,
         runs: &runs,
         interrupted,
+        cost: Some(cost),
     };
     write_report(&args.out, &results, &shader_rows, why.as_ref(), only_why)?;
     let failed = failures(&results, &shader_rows, why.as_ref());
     eprintln!(
-        "twinray compare: {} of {} runs done{}; report: {}",
+        "twinray compare: {} app runs in {:.0} s; the sweep's {} of {} runs done{}; report: {}",
+        cost.0,
+        cost.1,
         outcomes.iter().filter(|o| o.result.is_ok()).count(),
         plan.points.len() * runs.len(),
         match interrupted {
@@ -446,7 +466,7 @@ fn sweep(
                 Some(&(work, ms)) if ms > 0.0 => {
                     let predicted = ms * point.work / work;
                     ((plan.seconds_per_point * 1e3 / predicted).floor() as u32)
-                        .clamp(plan.frames.min(4), plan.frames)
+                        .clamp(plan.frames.min(MIN_SETTLING_FRAMES), plan.frames)
                 }
                 _ => plan.frames,
             };
@@ -461,10 +481,14 @@ fn sweep(
             ));
             let ra = RenderArgs {
                 frames: Some(frames),
+                settle: plan.settle,
                 out: None,
                 json: true,
-                // One untimed frame more per point, for the Grays/s column and plot.
-                count_rays: args.count_rays || !args.quick,
+                // One untimed frame more per point, for the Grays/s column and
+                // plot, on the compute path only: both paths trace the very
+                // same rays (tests/tests/rays.rs), and a brute-force fragment
+                // frame costs seconds. share_rays gives the fragment runs theirs.
+                count_rays: (args.count_rays || !args.quick) && path == RenderPath::Compute,
                 set: point.set.clone(),
                 // The study's tracer tests every primitive: so do the sweeps.
                 accel: Accel::None,
@@ -504,5 +528,40 @@ fn sweep(
         }
     }
     bar.finish_and_clear();
+    share_rays(&mut outcomes);
     outcomes
+}
+
+/// The fewest frames that can settle: a warm-up frame and the 6 timed frames
+/// a 95 % interval of the median needs (`stats::interval_rank`).
+const MIN_SETTLING_FRAMES: u32 = 7;
+
+/// Gives each run that did not count its rays the count of the same API at
+/// the same point on the other path, and the rate it makes with its own time.
+fn share_rays(outcomes: &mut [Outcome]) {
+    let counted: Vec<(String, &'static str, Api, twinray_common::rays::RayCounts)> = outcomes
+        .iter()
+        .filter_map(|o| {
+            let r = o.result.as_ref().ok()?;
+            Some((
+                o.point.param_value.clone(),
+                o.point.experiment,
+                o.api,
+                r.rays?,
+            ))
+        })
+        .collect();
+    for o in outcomes.iter_mut() {
+        let (value, experiment, api) = (o.point.param_value.clone(), o.point.experiment, o.api);
+        if let Ok(r) = &mut o.result {
+            if r.rays.is_none() {
+                if let Some(c) = counted
+                    .iter()
+                    .find(|c| c.0 == value && c.1 == experiment && c.2 == api)
+                {
+                    r.set_rays(c.3);
+                }
+            }
+        }
+    }
 }

@@ -7,6 +7,7 @@
 //! report.md and plots; `accuracy` is `twinray accuracy` with its own report;
 //! `diff` is `twinray diff`; `csv` writes every CSV file; `failures` and
 //! `interrupt` are how a long run ends when some run failed or a signal came;
+//! `summary` is `twinray summary`, the verdict table over compare folders;
 //! `ulp` is `twinray ulp`, the GPU's f32 arithmetic measured; `unsettled` is
 //! `render --unsettled`, the reference's mask of pixels f32 cannot settle.
 
@@ -18,6 +19,7 @@ mod diff;
 mod failures;
 mod interrupt;
 mod report;
+mod summary;
 mod ulp;
 mod unsettled;
 
@@ -67,6 +69,12 @@ enum Command {
     Accuracy(accuracy::AccuracyArgs),
     /// The GPU's f32 arithmetic: each operation the tracer uses, per API and path, against f64 (ULP error).
     Ulp(ulp::UlpArgs),
+    /// The study's verdict in one table (Markdown) from the results.csv of `twinray compare` folders, e.g. comparison/results/*/compare*.
+    Summary {
+        /// Folders that `twinray compare` wrote (or their results.csv files).
+        #[arg(required = true, value_name = "DIR")]
+        dirs: Vec<std::path::PathBuf>,
+    },
     /// Compare two PNGs: RMSE, PSNR, max abs error, share of pixels above 1/255 and 8/255.
     Diff {
         a: std::path::PathBuf,
@@ -112,6 +120,7 @@ fn main() {
             exclude,
         } => diff::run(&a, &b, json, heatmap.as_deref(), exclude.as_deref()),
         Command::Compare(args) => compare::run(&args),
+        Command::Summary { dirs } => summary::run(&dirs),
         Command::Accuracy(args) => accuracy::run(&args),
         Command::Ulp(args) => ulp::run(&args),
         Command::HardRuns => {

@@ -4,7 +4,7 @@
 //! section of report.md is written by its own module, in the order it appears.
 
 mod accel_table;
-mod cells;
+pub mod cells;
 pub mod plots;
 mod summary;
 mod tables;

@@ -149,7 +149,7 @@ impl HeadlessRun<'_> {
         let gl = &self.ctx.gl;
         self.log.check(gl, "after setup");
         timed_frames(
-            self.args.frame_count(),
+            self.args.frame_plan(),
             self.started,
             "Frame 1: the draw or dispatch between timer queries, then glFinish",
             || {

@@ -141,7 +141,7 @@ impl HeadlessRun<'_> {
         timestamps: Option<&Timestamps>,
     ) -> Result<(Vec<FrameTime>, f64)> {
         timed_frames(
-            self.args.frame_count(),
+            self.args.frame_plan(),
             self.process_start,
             "Frame 1: vkQueueSubmit + vkWaitForFences, timestamps read, vkResetFences",
             || {

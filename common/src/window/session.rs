@@ -367,6 +367,7 @@ impl<R: Renderer> Session<R> {
                     self.setup_ms = (now - self.started).as_secs_f64() * 1e3;
                 }
                 self.frames.push(FrameTime {
+                    warmup: false,
                     gpu_ms: d.gpu_ms,
                     wall_ms: (now - self.last_frame_end).as_secs_f64() * 1e3,
                 });

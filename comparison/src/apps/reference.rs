@@ -58,6 +58,7 @@ pub fn render_reference(args: &RenderArgs, truth: bool) -> anyhow::Result<()> {
             api_version: String::new(),
         };
         let frames = vec![FrameTime {
+            warmup: false,
             gpu_ms: None,
             wall_ms: ms,
         }];
@@ -85,6 +86,7 @@ fn gpu_only_options(args: &RenderArgs) -> Vec<&'static str> {
         size: _,
         headless: _,
         frames,
+        settle,
         out: _,
         json: _,
         count_rays: _,
@@ -106,6 +108,7 @@ fn gpu_only_options(args: &RenderArgs) -> Vec<&'static str> {
     } = args;
     [
         (frames.is_some_and(|f| f > 1), "--frames above 1"),
+        (settle.is_some(), "--settle"),
         (*validate, "--validate"),
         (*generic, "--generic"),
         (*specialize, "--specialize"),

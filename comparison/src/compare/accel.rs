@@ -6,7 +6,7 @@ use crate::apps::overrides;
 use crate::apps::{run_json, Api};
 use crate::compare::runs::{AccelRun, BvhStats, Plan, ACCEL_CONFIGS};
 use std::sync::atomic::{AtomicBool, Ordering};
-use twinray_common::cli::{RenderArgs, Size};
+use twinray_common::cli::{RenderArgs, RenderPath, Size};
 use twinray_common::scene::accel::Accel;
 
 /// One scene setting and the ACCEL_CONFIGS it runs in.
@@ -54,6 +54,16 @@ pub fn acceleration(plan: &Plan, stop: &AtomicBool) -> Vec<AccelRun> {
                 }
                 let ra = RenderArgs {
                     frames: Some(if quick { 4 } else { 12 }),
+                    settle: (!quick).then_some(1.0),
+                    // The full preset's configurations run as compute shaders:
+                    // the same tracer, 25-30x cheaper on a GPU than a fragment
+                    // frame, so the brute-force teapot at 1000² costs
+                    // milliseconds instead of seconds a frame.
+                    path: if quick {
+                        RenderPath::Fragment
+                    } else {
+                        RenderPath::Compute
+                    },
                     json: true,
                     set: set.clone(),
                     generic: config.starts_with("generic"),

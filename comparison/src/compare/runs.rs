@@ -30,11 +30,32 @@ pub struct Point {
 /// The points of a comparison and how long each may run.
 pub struct Plan {
     pub points: Vec<Point>,
+    /// Frames per run, or with `settle` the cap.
     pub frames: u32,
+    /// Each run stops once its median's 95 % interval is within ±this % (`--settle`).
+    pub settle: Option<f64>,
     /// Fewer frames for a point predicted to take longer than this per app.
     pub seconds_per_point: f64,
     /// "quick" or "full".
     pub preset: &'static str,
+}
+
+impl Plan {
+    /// How long each run went on, as the report's method paragraph says it.
+    pub fn describe(&self) -> String {
+        match self.settle {
+            Some(p) => format!(
+                "each run until its median's 95 % interval was within ±{p} % (after a warm-up of its first 0.2 s, \
+                 at least 6 timed frames), at most {} frames (fewer for slow points, about {} s per app per point)",
+                self.frames, self.seconds_per_point
+            ),
+            None => format!(
+                "up to {} frames per point (fewer for slow points, about {} s per app per point), statistics over \
+                 the last 30 (or the last half of shorter runs)",
+                self.frames, self.seconds_per_point
+            ),
+        }
+    }
 }
 
 /// One API at one point: its report, or why it failed.
@@ -164,6 +185,9 @@ pub struct Results<'a> {
     pub runs: &'a [(Api, RenderPath)],
     /// A signal stopped the run: the report says so in its title and summary.
     pub interrupted: Option<Interruption>,
+    /// How many app runs the whole comparison made, every step included, and
+    /// how long it took: the report states both.
+    pub cost: Option<(usize, f64)>,
 }
 
 /// What stopped a comparison early: the signal, and the step it stopped.

@@ -123,7 +123,9 @@ pub const CASES: &[Case] = &[
 pub struct WhyPlan {
     pub box_side: u32,
     pub teapot_side: u32,
+    /// Frames per run at most; each stops once settled (`settle`, per cent).
     pub frames: u32,
+    pub settle: f64,
     pub seconds_per_point: f64,
     pub rounds: u32,
 }
@@ -296,7 +298,7 @@ fn measure(
                 .filter(|&ms| ms > 0.0)
                 .map(|ms| {
                     ((plan.seconds_per_point * 1e3 / ms).floor() as u32)
-                        .clamp(plan.frames.min(3), plan.frames)
+                        .clamp(plan.frames.min(7), plan.frames)
                 })
                 .unwrap_or(plan.frames),
             Err(_) => plan.frames,
@@ -321,6 +323,7 @@ fn measure(
                 _ => {
                     let args = RenderArgs {
                         frames: Some(frames),
+                        settle: (!images).then_some(plan.settle),
                         out: images.then(|| dir.join(format!("{}-{label}.png", gap.scene))),
                         experiment: run.1.to_vec(),
                         ..base.clone()

@@ -48,6 +48,13 @@ struct Row<'a> {
     grays_per_s: Option<Decimals<6>>,
     /// "gpu" or "wall": which median frame time `grays_per_s` divides by.
     grays_clock: Option<RateClock>,
+    /// The frames the statistics cover (the rest warmed up), and each
+    /// median's 95 % interval (empty below 6 timed frames).
+    timed_frames: Option<usize>,
+    wall_median_lo_ms: Option<Decimals<6>>,
+    wall_median_hi_ms: Option<Decimals<6>>,
+    gpu_median_lo_ms: Option<Decimals<6>>,
+    gpu_median_hi_ms: Option<Decimals<6>>,
 }
 
 type Stats = [Option<Decimals<6>>; 4];
@@ -102,6 +109,11 @@ fn row<'a>(o: &'a Outcome, cpu: &'a str) -> Row<'a> {
                 rays_total: r.rays.map(|c| c.total),
                 grays_per_s: r.grays_per_s.map(Decimals),
                 grays_clock: r.grays_clock,
+                timed_frames: r.wall_ms.map(|s| s.n),
+                wall_median_lo_ms: r.wall_ms.and_then(|s| s.median_lo).map(Decimals),
+                wall_median_hi_ms: r.wall_ms.and_then(|s| s.median_hi).map(Decimals),
+                gpu_median_lo_ms: r.gpu_ms.and_then(|s| s.median_lo).map(Decimals),
+                gpu_median_hi_ms: r.gpu_ms.and_then(|s| s.median_hi).map(Decimals),
                 ..row
             }
         }
@@ -149,17 +161,17 @@ mod tests {
         let mut lines = text.lines();
         assert_eq!(
             lines.next().unwrap(),
-            "experiment,param_name,param_value,api,path,workgroup,status,frames,wall_mean_ms,wall_median_ms,wall_min_ms,wall_max_ms,gpu_mean_ms,gpu_median_ms,gpu_min_ms,gpu_max_ms,setup_ms,nonfinite_pixels,variant,width,height,device,driver,api_version,os,cpu,rays_primary,rays_shadow,rays_secondary,rays_total,grays_per_s,grays_clock",
+            "experiment,param_name,param_value,api,path,workgroup,status,frames,wall_mean_ms,wall_median_ms,wall_min_ms,wall_max_ms,gpu_mean_ms,gpu_median_ms,gpu_min_ms,gpu_max_ms,setup_ms,nonfinite_pixels,variant,width,height,device,driver,api_version,os,cpu,rays_primary,rays_shadow,rays_secondary,rays_total,grays_per_s,grays_clock,timed_frames,wall_median_lo_ms,wall_median_hi_ms,gpu_median_lo_ms,gpu_median_hi_ms",
             "the committed results and their readers rely on these columns in this order"
         );
         let body: Vec<&str> = lines.collect();
         assert_eq!(
             body,
             [
-                "box,resolution,8x8,vulkan,fragment,,ok,1,10.000000,10.000000,10.000000,10.000000,10.000000,10.000000,10.000000,10.000000,1.000,0,v,8,8,d,v,1,o,\"cpu, 2 threads\",,,,,,",
-                "box,resolution,8x8,opengl,fragment,,ok,1,10.000000,10.000000,10.000000,10.000000,10.000000,10.000000,10.000000,10.000000,1.000,0,v,8,8,d,v,1,o,\"cpu, 2 threads\",,,,,,",
-                "box,resolution,8x8,vulkan,compute,16x8,ok,1,1.000000,1.000000,1.000000,1.000000,1.000000,1.000000,1.000000,1.000000,1.000,0,v,8,8,d,v,1,o,\"cpu, 2 threads\",64,10,5,79,0.000079,gpu",
-                "box,resolution,8x8,opengl,compute,,\"failed: twinray-gl exited with 1: \"\"no\"\", device\",0,,,,,,,,,,,,8,8,,,,,\"cpu, 2 threads\",,,,,,",
+                "box,resolution,8x8,vulkan,fragment,,ok,1,10.000000,10.000000,10.000000,10.000000,10.000000,10.000000,10.000000,10.000000,1.000,0,v,8,8,d,v,1,o,\"cpu, 2 threads\",,,,,,,1,,,,",
+                "box,resolution,8x8,opengl,fragment,,ok,1,10.000000,10.000000,10.000000,10.000000,10.000000,10.000000,10.000000,10.000000,1.000,0,v,8,8,d,v,1,o,\"cpu, 2 threads\",,,,,,,1,,,,",
+                "box,resolution,8x8,vulkan,compute,16x8,ok,1,1.000000,1.000000,1.000000,1.000000,1.000000,1.000000,1.000000,1.000000,1.000,0,v,8,8,d,v,1,o,\"cpu, 2 threads\",64,10,5,79,0.000079,gpu,1,,,,",
+                "box,resolution,8x8,opengl,compute,,\"failed: twinray-gl exited with 1: \"\"no\"\", device\",0,,,,,,,,,,,,8,8,,,,,\"cpu, 2 threads\",,,,,,,,,,,",
             ]
         );
     }

@@ -2,7 +2,7 @@
 //! faster on each path and why, the summary by path with the two paths side
 //! by side, and how the figures were measured.
 
-use super::cells::{f, first_report, paths_in, range, ratio, report_of};
+use super::cells::{f, first_report, paths_in, range, ratio, ratio_interval, report_of, who};
 use crate::apps::Api;
 use crate::compare::runs::{Interruption, Outcome, Results, EXPERIMENTS};
 use crate::compare::study::{self, StudyRow};
@@ -63,17 +63,10 @@ pub fn headline(
         let mut why = String::new();
         for &path in &paths {
             let r = ratios(exp, path, outcomes, study);
-            let (what, m) = match (med(&r.gpu), med(&r.wall)) {
-                (Some(g), _) => ("GPU", g),
-                (None, Some(w)) => ("wall", w),
+            let (what, m, who) = match (med(&r.gpu), med(&r.wall)) {
+                (Some(g), _) => ("GPU", g, verdict(&r.gpu, &r.gpu_iv)),
+                (None, Some(w)) => ("wall", w, verdict(&r.wall, &r.wall_iv)),
                 _ => continue,
-            };
-            let who = if m > 1.02 {
-                "OpenGL faster"
-            } else if m < 0.98 {
-                "Vulkan faster"
-            } else {
-                "a tie"
             };
             parts.push(format!("{path} {m:.2}× ({what}, {who})"));
             if path == RenderPath::Fragment {
@@ -148,8 +141,8 @@ pub fn by_path(results: &Results, study: &[StudyRow]) -> String {
             let _ = writeln!(
             s,
             "- **{exp}, {path} path**: Vulkan/OpenGL {}; {}; study (fragment) {}. {why}.{spirv}",
-            describe("wall", &r.wall),
-            describe("GPU", &r.gpu),
+            describe_with("wall", &r.wall, &r.wall_iv),
+            describe_with("GPU", &r.gpu, &r.gpu_iv),
             describe("", &r.study).trim_start()
         );
         }
@@ -170,17 +163,28 @@ pub fn by_path(results: &Results, study: &[StudyRow]) -> String {
         s,
         "Ratios are Vulkan time / OpenGL time (above 1: OpenGL faster). Wall time is one render-loop iteration \
          (submit + wait), as the study measured; GPU time comes from Vulkan timestamps and GL_TIME_ELAPSED queries \
-         around the draw (fragment path) or the dispatch (compute path); the study measured the fragment path only. Preset: {}; up to {} frames per point (fewer for slow points, about {} s per app per point), \
-         statistics over the last 30 (or the last half of shorter runs). Each API runs in its own process, the order \
+         around the draw (fragment path) or the dispatch (compute path); the study measured the fragment path only. Preset: {}; {}. \
+         Medians carry their 95 % confidence interval (±% of the median; from the order statistics), ratios the interval \
+         the two medians' intervals give; a ratio whose interval holds 1.00 is a tie. Each API runs in its own process, the order \
          alternating from point to point. The study's times are seconds per frame; ours are milliseconds.\n",
-        plan.preset, plan.frames, plan.seconds_per_point
+        plan.preset,
+        plan.describe()
     );
+    if let Some((runs, seconds)) = results.cost {
+        let _ = writeln!(
+            s,
+            "This comparison made {runs} app runs, every step included, in {seconds:.0} s.\n"
+        );
+    }
     s
 }
 
 struct ExpRatios {
     wall: Vec<f64>,
     gpu: Vec<f64>,
+    /// Each ratio's interval from its two medians' 95 % intervals.
+    wall_iv: Vec<Option<(f64, f64)>>,
+    gpu_iv: Vec<Option<(f64, f64)>>,
     study: Vec<f64>,
     /// Vulkan GPU time / OpenGL-on-the-same-SPIR-V GPU time.
     spirv: Vec<f64>,
@@ -196,6 +200,8 @@ fn ratios(exp: &str, path: RenderPath, outcomes: &[Outcome], study: &[StudyRow])
     let mut r = ExpRatios {
         wall: vec![],
         gpu: vec![],
+        wall_iv: vec![],
+        gpu_iv: vec![],
         study: vec![],
         spirv: vec![],
     };
@@ -207,12 +213,20 @@ fn ratios(exp: &str, path: RenderPath, outcomes: &[Outcome], study: &[StudyRow])
             gl.and_then(|r| r.wall_ms).map(|s| s.median),
         ) {
             r.wall.push(x);
+            r.wall_iv.push(ratio_interval(
+                vk.and_then(|r| r.wall_ms),
+                gl.and_then(|r| r.wall_ms),
+            ));
         }
         if let Some(x) = ratio(
             vk.and_then(|r| r.gpu_ms).map(|s| s.median),
             gl.and_then(|r| r.gpu_ms).map(|s| s.median),
         ) {
             r.gpu.push(x);
+            r.gpu_iv.push(ratio_interval(
+                vk.and_then(|r| r.gpu_ms),
+                gl.and_then(|r| r.gpu_ms),
+            ));
         }
         let glspv = report_of(&rows, v, Api::OpenglSpirv, path);
         if let Some(x) = ratio(
@@ -228,16 +242,25 @@ fn ratios(exp: &str, path: RenderPath, outcomes: &[Outcome], study: &[StudyRow])
     r
 }
 
+/// Who is faster over a sweep: the verdict at its median point, a tie where
+/// that point's interval holds 1.00 ([`who`]).
+fn verdict(values: &[f64], intervals: &[Option<(f64, f64)>]) -> &'static str {
+    let mut order: Vec<usize> = (0..values.len()).collect();
+    order.sort_by(|&a, &b| values[a].total_cmp(&values[b]));
+    match order.get(order.len() / 2) {
+        Some(&i) => who(values[i], intervals.get(i).copied().flatten()),
+        None => "–",
+    }
+}
+
 fn describe(label: &str, v: &[f64]) -> String {
+    describe_with(label, v, &[])
+}
+
+fn describe_with(label: &str, v: &[f64], intervals: &[Option<(f64, f64)>]) -> String {
     match range(v) {
         Some((lo, med, hi)) => {
-            let who = if med > 1.02 {
-                "OpenGL faster"
-            } else if med < 0.98 {
-                "Vulkan faster"
-            } else {
-                "a tie"
-            };
+            let who = verdict(v, intervals);
             format!("{label} {lo:.2}–{hi:.2}× (median {med:.2}×, {who})")
         }
         None => format!("{label} –"),

@@ -1,7 +1,7 @@
 //! report.md's tables: the machine, each experiment's sweep beside the
 //! study's figures, the image agreement, and the points that failed.
 
-use super::cells::{f, first_report, paths_in, ratio, report_of};
+use super::cells::{f, first_report, median_cell, paths_in, ratio, ratio_cell, report_of, sig3};
 use crate::apps::api_name;
 use crate::apps::Api;
 use crate::compare::runs::{Agreement, Outcome, Point, Results, EXPERIMENTS};
@@ -139,11 +139,14 @@ pub fn experiments(outcomes: &[Outcome], study: &[StudyRow], plots: &[String]) -
                 } else {
                     String::new()
                 };
-                let rate = |r: Option<&RunReport>| f(r.and_then(|r| r.grays_per_s), 3);
+                let rate = |r: Option<&RunReport>| sig3(r.and_then(|r| r.grays_per_s));
                 let rays = if has_rays {
                     format!(" {} | {} |", rate(vk), rate(gl))
                 } else {
                     String::new()
+                };
+                let summary = |r: Option<&RunReport>, gpu: bool| {
+                    r.and_then(|r| if gpu { r.gpu_ms } else { r.wall_ms })
                 };
                 let _ = writeln!(
                     s,
@@ -153,12 +156,12 @@ pub fn experiments(outcomes: &[Outcome], study: &[StudyRow], plots: &[String]) -
                     st.map(|x| format!("{:.5} / {:.5}", x.opengl_mean_s, x.opengl_median_s))
                         .unwrap_or_else(|| "–".into()),
                     f(st.map(|x| x.vulkan_median_s / x.opengl_median_s), 2),
-                    f(med(vk, false), 3),
-                    f(med(gl, false), 3),
-                    f(ratio(med(vk, false), med(gl, false)), 2),
-                    f(med(vk, true), 3),
-                    f(med(gl, true), 3),
-                    f(ratio(med(vk, true), med(gl, true)), 2),
+                    median_cell(summary(vk, false), 3),
+                    median_cell(summary(gl, false), 3),
+                    ratio_cell(summary(vk, false), summary(gl, false)),
+                    median_cell(summary(vk, true), 3),
+                    median_cell(summary(gl, true), 3),
+                    ratio_cell(summary(vk, true), summary(gl, true)),
                     frames(vk),
                     frames(gl)
                 );
