@@ -49,8 +49,15 @@ fn git(args: &[&str]) -> Option<String> {
 /// The Markdown files git tracks, or would (new and not ignored), that are in
 /// the working tree, relative to the root.
 fn tracked_markdown() -> Vec<String> {
-    let listed = git(&["ls-files", "--cached", "--others", "--exclude-standard", "--", "*.md"])
-        .expect("git ls-files: these checks read the tracked Markdown files");
+    let listed = git(&[
+        "ls-files",
+        "--cached",
+        "--others",
+        "--exclude-standard",
+        "--",
+        "*.md",
+    ])
+    .expect("git ls-files: these checks read the tracked Markdown files");
     listed
         .lines()
         .filter(|f| root().join(f).is_file())
@@ -171,7 +178,9 @@ fn citations(line: &str) -> Vec<String> {
             let word = word.trim_end_matches(['.', ':']);
             let (commit, path) = word.split_once(':')?;
             let hex = (7..=40).contains(&commit.len())
-                && commit.chars().all(|c| c.is_ascii_hexdigit() && !c.is_ascii_uppercase());
+                && commit
+                    .chars()
+                    .all(|c| c.is_ascii_hexdigit() && !c.is_ascii_uppercase());
             (hex && !path.is_empty() && !path.contains(':') && !path.starts_with('/'))
                 .then(|| word.to_string())
         })
@@ -186,7 +195,12 @@ fn findings_pages() -> Vec<(String, String)> {
         .map(|e| e.unwrap().path())
         .filter(|p| p.extension().is_some_and(|e| e == "md"))
         .filter(|p| p.file_name().is_some_and(|n| n != INDEX))
-        .map(|p| (p.file_name().unwrap().to_string_lossy().into_owned(), read(&p)))
+        .map(|p| {
+            (
+                p.file_name().unwrap().to_string_lossy().into_owned(),
+                read(&p),
+            )
+        })
         .collect();
     pages.sort();
     pages
@@ -342,7 +356,9 @@ fn every_findings_page_opens_with_its_verdict() {
             ));
         }
         if !lines.first().is_some_and(|l| l.starts_with("# ")) {
-            wrong.push(format!("{name}: the first line is not the page's title (`# …`)"));
+            wrong.push(format!(
+                "{name}: the first line is not the page's title (`# …`)"
+            ));
             continue;
         }
         let verdict: Vec<&str> = lines[1..]
@@ -357,7 +373,10 @@ fn every_findings_page_opens_with_its_verdict() {
                 verdict.len()
             ));
         }
-        if verdict.iter().any(|l| l.starts_with('|') || l.starts_with('#')) {
+        if verdict
+            .iter()
+            .any(|l| l.starts_with('|') || l.starts_with('#'))
+        {
             wrong.push(format!("{name}: the verdict holds a table or heading"));
         }
     }
@@ -383,10 +402,7 @@ fn the_index_lists_every_page() {
 #[test]
 fn no_figure_is_stated_on_two_findings_pages() {
     let mut pages = findings_pages();
-    pages.push((
-        INDEX.to_string(),
-        read(&root().join(FINDINGS).join(INDEX)),
-    ));
+    pages.push((INDEX.to_string(), read(&root().join(FINDINGS).join(INDEX))));
     let mut seen: BTreeMap<String, Vec<String>> = BTreeMap::new();
     let mut total = 0;
     for (name, text) in &pages {
@@ -424,10 +440,15 @@ fn the_parsers_read_what_the_pages_write() {
     );
     assert!(citations("at 17:48, see docs/a.md: 3 ms").is_empty());
     assert_eq!(
-        figures("0.233 ms and 13.7 Grays/s, 1.13× Vulkan's, ×3.62, 8×4 and `--size 1000x1000 2 ms`"),
+        figures(
+            "0.233 ms and 13.7 Grays/s, 1.13× Vulkan's, ×3.62, 8×4 and `--size 1000x1000 2 ms`"
+        ),
         ["0.233 ms", "13.7 Grays/s", "1.13×", "×3.62"]
     );
-    assert_eq!(figures("1,277 ms, 4 MiB; 2,048 invocations"), ["1,277 ms", "4 MiB"]);
+    assert_eq!(
+        figures("1,277 ms, 4 MiB; 2,048 invocations"),
+        ["1,277 ms", "4 MiB"]
+    );
     assert_eq!(
         links("[a](x.md#y \"t\") `[c](code.md)` ![b](i.png)\n"),
         ["x.md#y", "i.png"]
