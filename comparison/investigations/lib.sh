@@ -1,7 +1,7 @@
 # Shared by the investigation scripts in comparison/investigations/<topic>/
 # (sourced, not run: `source "$(dirname "$0")/../lib.sh"`). Each topic's
-# findings are in comparison/results/<device>/FINDINGS.md, which names the
-# script and the files it wrote. The caller sets bin (release binaries), out
+# findings are in docs/findings/, whose pages name the script and cite the
+# files it wrote (f8d14ba:comparison/results/<device>/investigation/...). The caller sets bin (release binaries), out
 # (the results folder), log (the JSONL file) and errors (where the apps'
 # stderr goes); for two builds against each other, old and new (their
 # release folders) in place of bin.

@@ -14,7 +14,8 @@
 //! and unmapped, not mapped once for good: the unmap is what the GL
 //! specification makes the writes visible to the copy by, and a persistent
 //! mapping without it gave NVIDIA's driver wrong BVH buffers
-//! (comparison/results/nvidia-h100/FINDINGS.md, "OpenGL's upload, after").
+//! (docs/findings/startup.md#tried-and-not-kept; data:
+//! f8d14ba:comparison/results/nvidia-h100/investigation/gl-upload/mapped/).
 
 use anyhow::{anyhow, Context as _};
 use glow::HasContext;

@@ -9,7 +9,8 @@ const uint SPHERE_BIT = 0x80000000u;
 // uvec2(child reference, floatBitsToUint(entry t)), two entries to a uvec4: NVIDIA's
 // OpenGL compiler gives every element of a local array a whole 16-byte slot,
 // so two scalar arrays cost it four times the memory of these pairs (what
-// that was worth: comparison/results/nvidia-h100/FINDINGS.md#what-each-change-is-worth-one-removal-put-back-at-a-time).
+// that was worth: docs/findings/bvh.md#what-made-the-walk-fast; data:
+// f8d14ba:comparison/results/nvidia-h100/investigation/paired.jsonl).
 // BVH_STACK is the built tree's depth - 1
 // (common/src/shader/variant.rs): the traversal pushes at most one child per level of
 // the current path, so no push is ever dropped and no slot is wasted.
@@ -186,7 +187,7 @@ bool hit_leaf(inout Hit h, vec3 origin, vec3 dir, TriRay ray, uint first, uint c
 // positive inverse direction keeps min * inv - a <= max * inv - b for a >= b
 // under rounding. That took Vulkan's 1080p teapot from 0.259 to 0.232 ms and
 // OpenGL's from 0.319 to 0.294
-// (comparison/results/nvidia-h100/FINDINGS.md#the-wide-steps-arithmetic-investigationoctant).
+// (docs/findings/bvh.md#the-tree-auto-takes; data: f8d14ba:comparison/results/nvidia-h100/investigation/octant/).
 // Each distance is one fma against a per-ray origin term, padded so that no
 // box is missed for its rounding (traverse has why).
 #ifdef USE_BVH_WIDE
@@ -226,7 +227,7 @@ void wide_order(inout float ta, inout uint ca, inout float tb, inout uint cb) {
 // only an 8-wide node's second quad can need; its Vulkan compiler removed both.
 // Without the loop OpenGL's teapot frames are 6-19 % shorter and Vulkan's
 // unchanged
-// (comparison/results/nvidia-h100/FINDINGS.md#opengls-node-step-in-machine-code-investigationgl-gap).
+// (docs/findings/opengl-compute.md#what-closed-the-gap).
 #define WIDE_QUAD(n)                                                                   \
     {                                                                                  \
         vec4 xn = fma(bvh_wide_buf.nodes[n].bounds[near_k.x], vec4(inv_dir.x), -oi_near.xxxx); \
@@ -294,7 +295,7 @@ void wide_order(inout float ta, inout uint ca, inout float tb, inout uint cb) {
 // and Laine 2009's "while-while") visits the same nodes and leaves in the
 // same order as one loop taking a node or a leaf per turn, and was faster in
 // both APIs, never slower (measured in
-// comparison/results/nvidia-h100/FINDINGS.md#the-node-layout-investigationnode-layout).
+// docs/findings/bvh.md#what-made-the-walk-fast; data: f8d14ba:comparison/results/nvidia-h100/investigation/node-layout/).
 //
 // The descent goes on only through references > 0 (int(child) > 0: an
 // interior node, as no reference names slot 0, the sentinel before the root;
@@ -311,8 +312,7 @@ void wide_order(inout float ta, inout uint ca, inout float tb, inout uint cb) {
 // was lost in 4x4 blocks. Now such a lane takes reference 0 for a leaf, whose
 // zero primitive is degenerate and never hit, and is done after two turns.
 // (A first fix took the root's step before the loops instead: it cost up to
-// 5 % in OpenGL, the step's code twice; comparison/results/nvidia-h100/FINDINGS.md,
-// "The BVH's sentinel".) comparison/investigations/mesa-bvh/README.md has the
+// 5 % in OpenGL, the step's code twice; f8d14ba:comparison/results/nvidia-h100/investigation/sentinel/.) comparison/investigations/mesa-bvh/README.md has the
 // driver's side and a reproducer.
 //
 // NODE_STEP is the step of the tree's width: the one loop walks either tree.
@@ -345,7 +345,7 @@ Hit traverse(vec3 origin, vec3 dir, float t_max, bool any_hit) {
     // are entered (MIN_DIR keeps o * inv finite). The 1080p teapot: Vulkan
     // -4 %, OpenGL -2 %; OpenGL's compute path loses 7-8 % from a million
     // triangles up
-    // (comparison/results/nvidia-h100/FINDINGS.md#the-slab-distance-as-one-padded-fma-investigationfma-pad).
+    // (docs/findings/bvh.md#what-made-the-walk-fast; data: f8d14ba:comparison/results/nvidia-h100/investigation/fma-pad/).
     vec3 oi = origin * inv_dir;
     vec3 oi_pad = abs(oi) * ORIGIN_PAD;
     vec3 oi_near = oi + oi_pad;

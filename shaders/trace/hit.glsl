@@ -37,7 +37,7 @@ Hit closest_hit_brute(vec3 origin, vec3 dir) {
 // right of them is evaluated every time (gfx-rs/wgpu#4394), so the code says
 // so. The four tests of a group all run and are or-ed, which is what the GPU
 // runs fastest (early exits after each were slower on the brute-force points:
-// comparison/results/nvidia-h100/FINDINGS.md#naga-does-not-short-circuit--and--investigationnaga-and-or);
+// docs/findings/shader-compilers.md#what-naga-adds-and-what-the-source-now-says);
 // the index is clamped so that the tests past the last primitive
 // read a real one, and `i < COUNT` then discards them.
 bool sphere_blocks(vec3 origin, vec3 dir, float dist, uint i) {

@@ -122,7 +122,7 @@ vec3 hit_triangle(TriRay r, Triangle tri, float t_min, float t_max) {
     // this once was (the product's timings include it; testing it only
     // inside the branch, along with early exits in the shadow test, was
     // slower on the brute-force points:
-    // comparison/results/nvidia-h100/FINDINGS.md#naga-does-not-short-circuit--and--investigationnaga-and-or).
+    // docs/findings/shader-compilers.md#what-naga-adds-and-what-the-source-now-says).
     bool degenerate = is_degenerate(tri);
     if (!(t > t_min && t < t_max) || degenerate) {
         return miss;
@@ -153,7 +153,7 @@ vec3 hit_triangle(TriRay r, Triangle tri, float t_min, float t_max) {
     // this once was (the product's timings include it; testing it only
     // inside the branch, along with early exits in the shadow test, was
     // slower on the brute-force points:
-    // comparison/results/nvidia-h100/FINDINGS.md#naga-does-not-short-circuit--and--investigationnaga-and-or).
+    // docs/findings/shader-compilers.md#what-naga-adds-and-what-the-source-now-says).
     bool degenerate = is_degenerate(tri);
     if (!(t > t_min && t < t_max) || degenerate) {
         return miss;

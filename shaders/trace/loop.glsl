@@ -27,8 +27,7 @@
 // 16-byte slot of its own, so an entry kept as a vec3, a vec3, a float and a
 // uint took four slots where these take two; and NVIDIA's OpenGL runs a
 // compute shader on fewer multiprocessors the more local memory each
-// invocation needs (comparison/results/nvidia-h100/FINDINGS.md, "Local memory
-// and OpenGL's multiprocessors"). RAY_STACK_SPLIT (--experiment
+// invocation needs (docs/findings/opengl-compute.md#what-closed-the-gap). RAY_STACK_SPLIT (--experiment
 // split-ray-stack) puts back the four arrays. The depth is a small integer,
 // exact as a float.
 #ifdef RAY_STACK_SPLIT
@@ -56,7 +55,7 @@
 // Without the loop OpenGL's 1080p and 4K teapot frames are 3.6 and 5.5 %
 // shorter (its million-triangle ones 2 % longer, for a reason not found);
 // Vulkan's do not move
-// (comparison/results/nvidia-h100/FINDINGS.md#the-ray-loop-of-one-turn-investigationone-ray).
+// (docs/findings/opengl-compute.md#what-closed-the-gap; data: f8d14ba:comparison/results/nvidia-h100/investigation/one-ray/).
 #if defined(HAS_MIRROR) || defined(HAS_GLASS)
 #define RAY_LOOP while (sp > 0)
 #else
@@ -89,7 +88,7 @@ vec3 trace(vec3 origin, vec3 dir) {
         // The shading stays written out here rather than in functions: naga's
         // output for a struct returned by value and `out` parameters cost both
         // APIs time on every BVH point
-        // (comparison/results/nvidia-h100/FINDINGS.md#one-query-site-for-every-ray-investigationone-query).
+        // (docs/findings/shader-compilers.md#what-naga-adds-and-what-the-source-now-says).
         Hit h = closest_hit(o, d);
         if (h.kind == 0u) {
             color += w * frame.background;

@@ -2,7 +2,7 @@
 //! read (at most 150 lines); every relative link of README.md,
 //! comparison/results/README.md and tests/README.md reaches a file or folder,
 //! and where it names a heading (`page.md#anchor`) that page has the heading;
-//! and every `page.md#anchor` a code comment cites (a FINDINGS section instead
+//! and every `page.md#anchor` a code comment cites (a findings page instead
 //! of a timing that would go stale, the module map in docs/architecture.md)
 //! names a heading that is there; and the Rust version the pages ask a
 //! newcomer to install is the one cargo enforces.

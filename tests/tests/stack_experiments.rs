@@ -1,6 +1,6 @@
 //! The measurements that came with OpenGL's compute path reaching all of an
-//! H100's multiprocessors (comparison/results/nvidia-h100/FINDINGS.md, "Local
-//! memory and OpenGL's multiprocessors") change only where the tracer keeps
+//! H100's multiprocessors (docs/findings/opengl-compute.md, "What closed the
+//! gap") change only where the tracer keeps
 //! what it stores, or what the driver is told: on lavapipe and llvmpipe each
 //! renders the default image bit for bit, with the validation layer / GL debug
 //! context silent. `local-bvh-stack` and `split-ray-stack` put back the old

@@ -307,7 +307,7 @@ pub mod binding {
     pub const BVH_NODES: u32 = 6;
     pub const BVH_PRIMS: u32 = 7;
     // 8 held the parent links of a stackless traversal, measured and rejected
-    // (comparison/results/nvidia-h100/FINDINGS.md).
+    // (docs/findings/bvh.md#tried-and-not-kept).
     /// The sphere, triangle and light counts, where the shader reads them at
     /// run time (`--experiment storage-counts`) instead of baking them in.
     pub const COUNTS: u32 = 9;

@@ -359,8 +359,8 @@ pub fn page() -> String {
          twinray's product is the tracer and its two apps. Each gap the comparison found between Vulkan and OpenGL \
          has an experiment that puts a cost back, or takes one away, so that its effect can be measured in both APIs. \
          None is needed to render correctly, and none appears in `--help`; `twinray-vk --experiments` prints this page. \
-         The comparison's why step (`twinray compare`) runs them, and the findings under `comparison/results/` \
-         report what each one measured.\n\n\
+         The comparison's why step (`twinray compare`) runs them, and the findings pages \
+         ([findings/](findings/README.md)) report what each one measured.\n\n\
          ## Measurement options\n\n| option | what it does |\n|---|---|\n",
     );
     for (name, what) in measurement_options() {

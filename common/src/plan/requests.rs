@@ -82,11 +82,12 @@ impl Api {
     ///   the teapot's walk to 64 registers and 36 bytes of shared memory per
     ///   invocation instead of 76 registers, and 8x16 took the 1080p teapot
     ///   from 0.219 to 0.196 ms
-    ///   (comparison/results/nvidia-h100/FINDINGS.md#each-apis-workgroup-investigationworkgroups).
+    ///   (docs/findings/opengl-compute.md#each-apis-workgroup).
     /// - OpenGL's take 4x8, still one warp (its driver is slower with more):
     ///   0.2-7 % faster than 8x4 at every teapot point, and 4.5 % slower on
     ///   the 10k sphere list's small frame
-    ///   (comparison/results/nvidia-h100/FINDINGS.md#the-ray-loop-of-one-turn-investigationone-ray).
+    ///   (docs/findings/opengl-compute.md#what-closed-the-gap; data:
+    ///   f8d14ba:comparison/results/nvidia-h100/investigation/one-ray/).
     ///
     /// Brute force stays at 8x4 in both: 8x16 cost Vulkan's teapot up to 10 %.
     /// `--workgroup WxH` runs both apps at one shape.

@@ -41,7 +41,8 @@ impl Accel {
     /// measured on the H100 in both APIs. On the teapot at 1080p it is 23 %
     /// faster than the binary tree in Vulkan and 20 % in OpenGL, and past a
     /// million triangles about 10 % in Vulkan and 4 to 7 % in OpenGL
-    /// (comparison/results/nvidia-h100/FINDINGS.md#opengls-node-step-in-machine-code-investigationgl-gap).
+    /// (docs/findings/bvh.md#the-tree-auto-takes; data:
+    /// f8d14ba:comparison/results/nvidia-h100/investigation/gl-gap/unrolled/).
     /// One rule for both APIs keeps the comparison honest: both trace the
     /// same tree; `--accel bvh` still gives the binary one.
     pub fn width(self) -> u32 {

@@ -265,7 +265,7 @@ pub fn build_compute(variant: &Variant, workgroup: Workgroup) -> anyhow::Result<
 /// the BVH variants time in Vulkan, but without it NVIDIA's Vulkan compiler,
 /// given the constant trip count of the brute-force sphere loop, made the
 /// 10,000-sphere list slower
-/// (comparison/results/nvidia-h100/FINDINGS.md#brute-force-the-studys-points-and-the-loop-bound-trap).
+/// (docs/findings/shader-compilers.md#loop-bounds-the-trap-and-the-choice).
 /// So the BVH variants go without it and the brute-force ones keep it, unless
 /// the laboratory says otherwise.
 pub fn loop_bounding(variant: &Variant) -> bool {

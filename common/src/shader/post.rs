@@ -8,7 +8,7 @@
 // prove every element is written before it is read, so it stores N zeros at
 // every call: the tracer's ray stack at every pixel and the BVH stack at every
 // traversal (stores into NVIDIA's local memory; what they cost:
-// comparison/results/nvidia-h100/FINDINGS.md#what-each-change-is-worth-one-removal-put-back-at-a-time).
+// docs/findings/shader-compilers.md#what-naga-adds-and-what-the-source-now-says).
 // The tracer only reads stack entries below the stack
 // pointer, each written by a push first, so the zeros are never read: both
 // passes remove the initialisers of per-invocation arrays (function-local, or

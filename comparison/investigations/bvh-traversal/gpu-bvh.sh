@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# The traversal experiments behind comparison/results/<gpu>/investigation/bvh-*.jsonl:
+# The traversal experiments behind f8d14ba:comparison/results/nvidia-h100/investigation/bvh.jsonl:
 # every BVH point of the study's scenes (teapot 1000², sphere list with 10,000
 # spheres at 300², the teapot tessellated to 1.2M triangles) on both paths and
 # both APIs, with the product's shader and with each of the build's removals put

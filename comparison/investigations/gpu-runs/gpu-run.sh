@@ -2,7 +2,7 @@
 # The whole GPU run in one go: the full comparison (both APIs, both paths,
 # OpenGL also on naga's SPIR-V), the compute workgroup sizes, and the full
 # accuracy report. It takes about 25 minutes on an H200; where a machine is
-# lent for less, run the parts as comparison/results/nvidia-h200/FINDINGS.md
+# lent for less, run the parts as comparison/results/README.md
 # lists them (compare --only ..., gpu-followup.sh). Usage: comparison/investigations/gpu-runs/gpu-run.sh BIN_DIR OUT_DIR
 # (BIN_DIR holds release builds of twinray, twinray-vk and twinray-gl).
 set -uo pipefail

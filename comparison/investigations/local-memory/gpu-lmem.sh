@@ -22,7 +22,7 @@ points=(
     "--scene box --size 1000x1000 --accel none --frames 60"
     "--scene spherelist --size 300x300 --set extra_spheres=10000 --accel none --frames 20"
 )
-# Where the stack lives: local to each walk (the default when FINDINGS was
+# Where the stack lives: local to each walk (the default when the data was
 # measured, now --experiment local-bvh-stack), at module scope (then
 # --experiment global-bvh-stack, now the default), or in shared memory.
 configs=(

@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# As run for barrier.jsonl (FINDINGS, "What is not closed"), from the repository root, with
+# As run for barrier.jsonl (f8d14ba:comparison/results/nvidia-h100/FINDINGS.md, "What is not closed"), from the repository root, with
 # .bin/bar/in holding 8ffab01's twinray-gl and twinray-vk and .bin/bar/out the twinray-gl that starts
 # its timer after the barrier.
 set -uo pipefail

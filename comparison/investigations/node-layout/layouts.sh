@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
-# As run for layouts (FINDINGS, "The node layout"), from the repository root, with
-# each build's twinray-vk and twinray-gl in .bin/<build>/ (builds named in FINDINGS).
+# As run for layouts (f8d14ba:comparison/results/nvidia-h100/FINDINGS.md, "The node layout"), from the repository root, with
+# each build's twinray-vk and twinray-gl in .bin/<build>/ (builds named there).
 # ad-hoc: three builds at the BVH points, both APIs and paths, two rounds alternating; then rays at 1080p
 set -uo pipefail
 out=$1

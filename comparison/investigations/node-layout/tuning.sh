@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
-# As run for tuning (FINDINGS, "The node layout"), from the repository root, with
-# each build's twinray-vk and twinray-gl in .bin/<build>/ (builds named in FINDINGS).
+# As run for tuning (f8d14ba:comparison/results/nvidia-h100/FINDINGS.md, "The node layout"), from the repository root, with
+# each build's twinray-vk and twinray-gl in .bin/<build>/ (builds named there).
 set -uo pipefail
 out=$1
 mkdir -p "$out"

@@ -4,7 +4,7 @@
 # 1.2M triangles; both APIs, two rounds in alternating API and build order.
 # Then each build's Vulkan statistics per workgroup (--dump-shaders: registers,
 # shared memory). Written for the shadow-ray compaction experiment
-# (comparison/results/nvidia-h100/investigation/compact/per-light.patch), whose
+# (f8d14ba:comparison/results/nvidia-h100/investigation/compact/per-light.patch), whose
 # shader changes with the workgroup. About 2 minutes on an H100.
 # OUT_DIR/wg.jsonl: a label line (point@workgroup|build|round), then the app's
 # --json report.

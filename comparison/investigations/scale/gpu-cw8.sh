@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # The compressed 8-wide node against the binary and 4-wide trees: a build of
-# comparison/results/nvidia-h100/investigation/cw8/compressed-8-wide.patch, in
+# f8d14ba:comparison/results/nvidia-h100/investigation/cw8/compressed-8-wide.patch, in
 # which --accel bvh8 uploads and walks 96-byte compressed nodes, at the
 # teapot's points (1080p and 4K with Grays/s, four tessellations at
 # 1000x1000), the 10k sphere list and the box; --accel bvh, bvh4 and bvh8,

@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # Persistent workgroups against the hardware's launch of one workgroup per
-# tile (investigation/persistent/): OLD is main's build, NEW the build of
+# tile (f8d14ba:comparison/results/nvidia-h100/investigation/persistent/): OLD is main's build, NEW the build of
 # persistent-tiles.patch (in that folder), whose workgroups each trace the tile
 # of their own index and then take the next from an atomic counter until none
 # is left. NEW reads its workgroup count from TWINRAY_PERSISTENT_GROUPS and the

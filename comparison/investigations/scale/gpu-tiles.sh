@@ -3,7 +3,7 @@
 # (empty.toml) and the box at six workgroup shapes, then K tiles per
 # workgroup (K = 1, 2, 4, 8, 16; TWINRAY_TILES) at the study's compute points
 # and the empty scene, both APIs, two rounds in alternating order. The tiles
-# need a build with comparison/results/nvidia-h100/investigation/tiles/
+# need a build with f8d14ba:comparison/results/nvidia-h100/investigation/tiles/
 # tiles-per-group.patch applied (main's shader loops over its workgroup's
 # tiles, the dispatch shrinks by K); main ignores TWINRAY_TILES, so with main
 # every K measures K = 1. About 2 minutes on an H100.

@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# One build at several compute workgroup shapes (investigation/workgroups/):
+# One build at several compute workgroup shapes (f8d14ba:comparison/results/nvidia-h100/investigation/workgroups/):
 # the teapot at 1080p and 4K with Grays/s and at 1000x1000, the 10k sphere
 # list at 300x300 through its default tree, and the study's two brute-force
 # points (the box at 1000x1000, the 10k sphere list at 300x300); both APIs,

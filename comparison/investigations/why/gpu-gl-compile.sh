@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # What OpenGL's first compile of the tracer costs, and what it depends on.
-# Needs a build with gl-pragmas.patch (investigation/gl-gap/pragmas/), which
+# Needs a build with gl-pragmas.patch (f8d14ba:comparison/results/nvidia-h100/investigation/gl-gap/pragmas/), which
 # puts the lines of TWINRAY_GL_PRAGMAS (';'-separated) after the #version line
 # of every shader OpenGL compiles. Each run has NVIDIA's shader disk cache off
 # (__GL_SHADER_DISK_CACHE=0, read by its Vulkan and its GL driver), so the

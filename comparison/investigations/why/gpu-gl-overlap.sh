@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # Does NVIDIA's OpenGL driver compile the tracer while the application goes
-# on? Needs a build with experiments.patch (investigation/gl-compile/): with
+# on? Needs a build with experiments.patch (f8d14ba:comparison/results/nvidia-h100/investigation/gl-compile/): with
 # TWINRAY_GL_OVERLAP=1 the compute program is compiled and linked without
 # asking for its status (GL_KHR_parallel_shader_compile allows the driver to
 # finish it on threads of its own; the patch asks for as many as it likes),
