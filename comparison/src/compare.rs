@@ -101,6 +101,7 @@ impl Preset {
                 why: WhyPlan {
                     box_side: 100,
                     teapot_side: 16,
+                    teapot_brute_side: 16,
                     frames: 8,
                     settle: 2.0,
                     seconds_per_point: 2.0,
@@ -119,14 +120,16 @@ impl Preset {
                 seconds_per_point: 30.0,
                 // The brute-force teapot's fragment frame takes seconds at
                 // 1000²: its gap is measured at 400², where its ratio is the
-                // sweep's (report: the teapot table).
+                // sweep's (report: the teapot table). One round: each run's
+                // interval already says how far its median can be trusted.
                 why: WhyPlan {
                     box_side: 1000,
-                    teapot_side: 400,
+                    teapot_side: 1000,
+                    teapot_brute_side: 400,
                     frames: 60,
                     settle: 1.0,
                     seconds_per_point: 30.0,
-                    rounds: 2,
+                    rounds: 1,
                 },
             }
         }
@@ -224,7 +227,16 @@ pub fn run(args: &CompareArgs) -> anyhow::Result<()> {
         .collect();
     // The first step a signal stopped; the steps after it do not start.
     let mut stopped_in: Option<&'static str> = None;
+    // Each step's seconds, for the log and the report.
+    let mut timings: Vec<(&'static str, f64)> = Vec::new();
+    let mut step_start = std::time::Instant::now();
     let mut step = |name: &'static str, stop: &crate::interrupt::Stop| {
+        let seconds = step_start.elapsed().as_secs_f64();
+        step_start = std::time::Instant::now();
+        if seconds >= 0.5 {
+            eprintln!("twinray compare: {name} took {seconds:.0} s");
+            timings.push((name, seconds));
+        }
         if stop.stopped() && stopped_in.is_none() {
             stopped_in = Some(name);
         }
@@ -272,6 +284,11 @@ pub fn run(args: &CompareArgs) -> anyhow::Result<()> {
         step: stopped_in.unwrap_or(last),
     });
     let cost = (crate::apps::runs_started(), started.elapsed().as_secs_f64());
+    let steps = timings
+        .iter()
+        .map(|(name, s)| format!("{name} {s:.0} s"))
+        .collect::<Vec<_>>()
+        .join(", ");
     let results = runs::Results {
         plan: &plan,
         outcomes: &outcomes,
@@ -279,7 +296,7 @@ pub fn run(args: &CompareArgs) -> anyhow::Result<()> {
         agreement: &agreement,
         runs: &runs,
         interrupted,
-        cost: Some(cost),
+        cost: Some((cost.0, cost.1, steps)),
     };
     write_report(&args.out, &results, &shader_rows, why.as_ref(), only_why)?;
     let failed = failures(&results, &shader_rows, why.as_ref());

@@ -174,7 +174,7 @@ pub struct Why {
 }
 
 /// Everything one `twinray compare` measured: what its report is written from.
-#[derive(Clone, Copy)]
+#[derive(Clone)]
 pub struct Results<'a> {
     pub plan: &'a Plan,
     pub outcomes: &'a [Outcome],
@@ -185,9 +185,9 @@ pub struct Results<'a> {
     pub runs: &'a [(Api, RenderPath)],
     /// A signal stopped the run: the report says so in its title and summary.
     pub interrupted: Option<Interruption>,
-    /// How many app runs the whole comparison made, every step included, and
-    /// how long it took: the report states both.
-    pub cost: Option<(usize, f64)>,
+    /// How many app runs the whole comparison made, every step included, how
+    /// long it took, and each step's share: the report states them.
+    pub cost: Option<(usize, f64, String)>,
 }
 
 /// What stopped a comparison early: the signal, and the step it stopped.

@@ -123,6 +123,8 @@ pub const CASES: &[Case] = &[
 pub struct WhyPlan {
     pub box_side: u32,
     pub teapot_side: u32,
+    /// The brute-force teapot's side: its frames cost seconds at 1000².
+    pub teapot_brute_side: u32,
     /// Frames per run at most; each stops once settled (`settle`, per cent).
     pub frames: u32,
     pub settle: f64,
@@ -194,10 +196,10 @@ pub fn run(out: &Path, plan: &WhyPlan, paths: &[RenderPath], stop: &AtomicBool) 
         if stop.load(Ordering::SeqCst) {
             break;
         }
-        let side = if gap.scene == "teapot" {
-            plan.teapot_side
-        } else {
-            plan.box_side
+        let side = match (gap.scene, gap.accel) {
+            ("teapot", Accel::None) => plan.teapot_brute_side,
+            ("teapot", _) => plan.teapot_side,
+            _ => plan.box_side,
         };
         let size = Size {
             width: side,

@@ -104,7 +104,7 @@ pub fn headline(
 /// "Summary by path": the ratios' ranges per experiment and path, the two
 /// paths compared, and the paragraph on method.
 pub fn by_path(results: &Results, study: &[StudyRow]) -> String {
-    let Results { plan, outcomes, .. } = *results;
+    let Results { plan, outcomes, .. } = results;
     let mut s = String::new();
     let paths = paths_in(outcomes);
     let _ = writeln!(s, "## Summary by path\n");
@@ -170,10 +170,10 @@ pub fn by_path(results: &Results, study: &[StudyRow]) -> String {
         plan.preset,
         plan.describe()
     );
-    if let Some((runs, seconds)) = results.cost {
+    if let Some((runs, seconds, steps)) = &results.cost {
         let _ = writeln!(
             s,
-            "This comparison made {runs} app runs, every step included, in {seconds:.0} s.\n"
+            "This comparison made {runs} app runs, every step included, in {seconds:.0} s ({steps}).\n"
         );
     }
     s
