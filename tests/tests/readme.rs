@@ -280,3 +280,55 @@ fn the_pages_name_the_rust_version_cargo_enforces() {
         );
     }
 }
+
+/// The README opens with the study's verdict: the table between its summary
+/// markers, within the first 40 lines, is exactly what `twinray summary`
+/// prints over the committed compare folders, so a new result cannot land
+/// without the table that states it.
+#[test]
+fn the_readme_verdict_is_what_twinray_summary_prints() {
+    let readme = read(&root().join("README.md"));
+    let begin = "<!-- twinray summary: begin -->\n";
+    let end = "<!-- twinray summary: end -->";
+    let (Some(b), Some(e)) = (readme.find(begin), readme.find(end)) else {
+        panic!("README.md lacks the '{begin}' and '{end}' markers around its verdict table");
+    };
+    let end_line = readme[..e].lines().count() + 1;
+    assert!(
+        end_line <= 40,
+        "the verdict table must end within README.md's first 40 lines; its end marker is on line {end_line}"
+    );
+    let mut dirs: Vec<PathBuf> = std::fs::read_dir(root().join("comparison/results"))
+        .unwrap()
+        .flatten()
+        .filter(|m| m.path().is_dir())
+        .flat_map(|m| std::fs::read_dir(m.path()).unwrap().flatten())
+        .map(|e| e.path())
+        .filter(|p| {
+            p.is_dir()
+                && p.file_name()
+                    .is_some_and(|n| n.to_string_lossy().starts_with("compare"))
+        })
+        .collect();
+    // The shell's glob order: the README's command is `comparison/results/*/compare*`.
+    dirs.sort();
+    assert!(
+        !dirs.is_empty(),
+        "no compare folder under comparison/results"
+    );
+    let mut args = vec!["summary".to_string()];
+    args.extend(dirs.iter().map(|d| d.display().to_string()));
+    let args: Vec<&str> = args.iter().map(String::as_str).collect();
+    let out = twinray_tests::run(&twinray_tests::bin("twinray"), &args, &[]);
+    assert!(
+        out.status.success(),
+        "twinray summary failed: {}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let printed = String::from_utf8(out.stdout).unwrap();
+    assert_eq!(
+        &readme[b + begin.len()..e],
+        printed,
+        "README.md's verdict table is not what `twinray summary comparison/results/*/compare*` prints; paste its output between the markers"
+    );
+}

@@ -23,6 +23,9 @@ pub struct HardRow {
     pub api: Api,
     /// (wrong share, crack pixels if checked, time ms, non-finite pixels)
     pub result: Result<(f64, Option<usize>, f64, u64), String>,
+    /// The same image over the pixels outside the truth's unsettled mask
+    /// (its `above_8` is the wrong share there).
+    pub outside: Option<super::sweeps::Outside>,
 }
 
 impl HardRow {
@@ -140,6 +143,7 @@ fn run_hard(case: &HardCase, size: Size, out: &Path) -> anyhow::Result<Vec<HardR
     let truth = reference::render_truth(&scene, size.width, size.height);
     truth.save_png(&out.join(format!("images/hard-{}-truth.png", case.name)))?;
     let truth = truth.to_rgb8();
+    let mask = super::sweeps::truth_mask(&scene, size);
     let bg = twinray_common::reference::image_io::FloatImage {
         width: 1,
         height: 1,
@@ -158,9 +162,11 @@ fn run_hard(case: &HardCase, size: Size, out: &Path) -> anyhow::Result<Vec<HardR
                 label.replace('=', "-"),
                 api_name(api)
             ));
+            let mut outside = None;
             let result = render_app(api, &path, size, strategy.set_args(), 1, &png)
                 .map(|(g, w, nan, img)| {
                     let crack = cracks.then(|| hard::crack_pixels(&img, &truth, background));
+                    outside = super::sweeps::outside(&img, &truth, &mask).ok();
                     (hard::wrong_share(&img, &truth), crack, g.unwrap_or(w), nan)
                 })
                 .map_err(|e| format!("{e:#}"));
@@ -170,6 +176,7 @@ fn run_hard(case: &HardCase, size: Size, out: &Path) -> anyhow::Result<Vec<HardR
                 strategy: label.clone(),
                 api,
                 result,
+                outside,
             });
         }
     }

@@ -19,6 +19,8 @@ pub struct RandomRow {
     /// "Vulkan vs reference", "OpenGL vs reference", "Vulkan vs OpenGL".
     pub pair: &'static str,
     pub result: Result<metrics::Metrics, String>,
+    /// The same pair over the pixels outside the reference's unsettled mask.
+    pub outside: Option<super::sweeps::Outside>,
 }
 
 pub const RANDOM_PAIRS: [&str; 3] = [
@@ -59,6 +61,7 @@ pub fn run_random(
         let reference = reference::render(&scene, size.width, size.height);
         let ref_nan = reference.nonfinite_pixels() as u64;
         let reference = reference.to_rgb8();
+        let mask = twinray_common::reference::unsettled::unsettled(&scene, size.width, size.height);
         let mut imgs = Vec::new();
         for api in [Api::Vulkan, Api::Opengl] {
             let png = out.join(format!("images/random-{seed}-{}.png", api_name(api)));
@@ -91,7 +94,17 @@ pub fn run_random(
             cmp(&imgs[1], None),
             cmp(&imgs[0], Some(&imgs[1])),
         ];
-        for (pair, result) in RANDOM_PAIRS.into_iter().zip(results) {
+        let img = |i: usize| imgs[i].as_ref().ok().map(|(_, img)| img);
+        let pairs = [
+            (img(0), Some(&reference)),
+            (img(1), Some(&reference)),
+            (img(0), img(1)),
+        ];
+        let outsides = pairs.map(|(a, b)| {
+            a.zip(b)
+                .and_then(|(a, b)| super::sweeps::outside(a, b, &mask).ok())
+        });
+        for ((pair, result), outside) in RANDOM_PAIRS.into_iter().zip(results).zip(outsides) {
             let bad = match &result {
                 Ok(m) => random_scene::disagreement(m),
                 Err(e) => Some(e.clone()),
@@ -102,7 +115,12 @@ pub fn run_random(
                     random_scene::reproduce(seed, size.width, size.height, "")
                 );
             }
-            rows.push(RandomRow { seed, pair, result });
+            rows.push(RandomRow {
+                seed,
+                pair,
+                result,
+                outside,
+            });
         }
     }
     Ok(rows)
@@ -131,7 +149,7 @@ pub fn random_markdown(rows: &[RandomRow], size: Size) -> String {
     );
     let _ = writeln!(
         s,
-        "| pair | seeds | disagree | off by >8/255: median / 90% / 99% / max | within 1/255: min / 1% / median | max abs: median / max |\n|---|---|---|---|---|---|"
+        "| pair | seeds | disagree | off by >8/255: median / 90% / 99% / max | within 1/255: min / 1% / median | max abs: median / max | outside the unsettled mask: pixels over 8/255 (all seeds) / max abs | mask pixels: median / max |\n|---|---|---|---|---|---|---|---|"
     );
     let mut failing = Vec::new();
     for pair in RANDOM_PAIRS {
@@ -165,9 +183,21 @@ pub fn random_markdown(rows: &[RandomRow], size: Size) -> String {
                 random_scene::reproduce(r.seed, size.width, size.height, "")
             ));
         }
+        let outs: Vec<&super::sweeps::Outside> =
+            these.iter().filter_map(|r| r.outside.as_ref()).collect();
+        let outside_over_8: f64 = outs
+            .iter()
+            .map(|o| {
+                let compared = (size.width * size.height) as usize - o.mask_pixels;
+                (o.above_8 * compared as f64).round()
+            })
+            .sum();
+        let outside_max = outs.iter().map(|o| o.max_abs).max();
+        let mut mask_px: Vec<f64> = outs.iter().map(|o| o.mask_pixels as f64).collect();
+        mask_px.sort_by(f64::total_cmp);
         let _ = writeln!(
             s,
-            "| {pair} | {} | {} | {:.3}% / {:.3}% / {:.3}% / {:.3}% | {:.2}% / {:.2}% / {:.2}% | {:.0} / {:.0} |",
+            "| {pair} | {} | {} | {:.3}% / {:.3}% / {:.3}% / {:.3}% | {:.2}% / {:.2}% / {:.2}% | {:.0} / {:.0} | {} / {} | {} / {} |",
             these.len(),
             bad.len(),
             quantile(&off, 0.5),
@@ -179,6 +209,10 @@ pub fn random_markdown(rows: &[RandomRow], size: Size) -> String {
             quantile(&within, 0.5),
             quantile(&max_abs, 0.5),
             quantile(&max_abs, 1.0),
+            outside_over_8,
+            outside_max.map_or("–".into(), |m| m.to_string()),
+            quantile(&mask_px, 0.5),
+            quantile(&mask_px, 1.0),
         );
     }
     if failing.is_empty() {

@@ -124,7 +124,9 @@ pub fn scenes(quick: bool) -> Vec<(&'static str, Size, Vec<String>)> {
     }
 }
 
-/// Error of one image against the truth.
+/// Error of one image against the truth: over every pixel, and over the
+/// pixels outside the truth's unsettled mask, the ones an f32 tracer can be
+/// held to (`Outside`).
 #[derive(Debug, Clone, Copy)]
 pub struct Error {
     pub rmse: f64,
@@ -132,9 +134,51 @@ pub struct Error {
     pub above_1: f64,
     pub wrong: f64,
     pub flip: Option<f64>,
+    pub outside: Outside,
 }
 
-fn error_of(test: &image::RgbImage, truth: &image::RgbImage) -> anyhow::Result<Error> {
+/// The error outside the unsettled mask, and the mask's size.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Outside {
+    /// Pixels in the mask: left out of the figures below.
+    pub mask_pixels: usize,
+    /// The largest channel difference outside the mask, in 1/255 steps.
+    pub max_abs: u8,
+    /// Share of the pixels outside the mask off by more than 8/255.
+    pub above_8: f64,
+}
+
+/// `test` against `truth` over the pixels `mask` leaves (true: unsettled).
+pub fn outside(
+    test: &image::RgbImage,
+    truth: &image::RgbImage,
+    mask: &[bool],
+) -> anyhow::Result<Outside> {
+    let m = metrics::compare_outside(test, truth, mask)?;
+    Ok(Outside {
+        mask_pixels: mask.iter().filter(|&&m| m).count(),
+        max_abs: m.max_abs,
+        above_8: m.above_8,
+    })
+}
+
+/// The truth's unsettled mask: pixels whose f64 colour moves by more than
+/// 8/255 when the primary ray turns by 4 f32 ULPs, at the truth's numerics.
+pub fn truth_mask(scene: &Scene, size: Size) -> Vec<bool> {
+    twinray_common::reference::unsettled::unsettled_with(
+        scene,
+        size.width,
+        size.height,
+        &reference::truth_numerics(),
+        twinray_common::reference::unsettled::TURN,
+    )
+}
+
+fn error_of(
+    test: &image::RgbImage,
+    truth: &image::RgbImage,
+    mask: &[bool],
+) -> anyhow::Result<Error> {
     let m = metrics::compare(test, truth)?;
     Ok(Error {
         rmse: m.rmse,
@@ -142,6 +186,7 @@ fn error_of(test: &image::RgbImage, truth: &image::RgbImage) -> anyhow::Result<E
         above_1: m.above_1,
         wrong: hard::wrong_share(test, truth),
         flip: flip_mean(test, truth),
+        outside: outside(test, truth, mask)?,
     })
 }
 
@@ -257,6 +302,7 @@ pub fn run_scene(
     let truth = reference::render_truth(&deep, size.width, size.height);
     truth.save_png(&out.join(format!("images/{scene_name}-truth.png")))?;
     let truth = truth.to_rgb8();
+    let mask = truth_mask(&deep, size);
     // The default goes in the middle of the run order, not first: on the
     // software driver the first timed configuration after the truth render
     // came out 30-45% slower than the same shader later on.
@@ -312,7 +358,7 @@ pub fn run_scene(
             let png = out.join(format!("images/{scene_name}-{}-{k}.png", api_name(api)));
             let program = program_of(scene_name, &s)?;
             let result = render_app(api, scene_name, size, s, frames, &png)
-                .and_then(|(g, w, nan, img)| Ok((g, w, error_of(&img, &truth)?, nan)))
+                .and_then(|(g, w, nan, img)| Ok((g, w, error_of(&img, &truth, &mask)?, nan)))
                 .map_err(|e| format!("{e:#}"));
             if let Err(e) = &result {
                 eprintln!(
@@ -347,6 +393,37 @@ pub fn run_scene(
             .collect();
     }
     Ok(rows)
+}
+
+#[cfg(test)]
+mod outside_tests {
+    use super::*;
+
+    /// A flat image with one pixel changed by `by` at `at`.
+    fn flat(at: Option<(u32, u32)>, by: u8) -> image::RgbImage {
+        let mut img = image::RgbImage::from_pixel(8, 4, image::Rgb([100, 100, 100]));
+        if let Some((x, y)) = at {
+            img.put_pixel(x, y, image::Rgb([100 + by, 100, 100]));
+        }
+        img
+    }
+
+    #[test]
+    fn a_flip_inside_the_mask_leaves_the_outside_figure_alone() {
+        let truth = flat(None, 0);
+        let mut mask = vec![false; 32];
+        mask[8 + 3] = true; // (3, 1)
+        let clean = outside(&flat(None, 0), &truth, &mask).unwrap();
+        let inside = outside(&flat(Some((3, 1)), 40), &truth, &mask).unwrap();
+        let beyond = outside(&flat(Some((5, 2)), 40), &truth, &mask).unwrap();
+        assert_eq!(clean.mask_pixels, 1);
+        assert_eq!(inside, clean, "a pixel the mask names must not count");
+        assert_eq!(beyond.max_abs, 40);
+        assert!((beyond.above_8 - 1.0 / 31.0).abs() < 1e-12, "{beyond:?}");
+        // Over every pixel, the flip inside the mask does count.
+        let all = metrics::compare(&flat(Some((3, 1)), 40), &truth).unwrap();
+        assert_eq!(all.max_abs, 40);
+    }
 }
 
 #[cfg(test)]

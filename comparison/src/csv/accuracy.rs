@@ -39,6 +39,10 @@ struct ConfigLine<'a> {
     above_8: Option<Num>,
     flip_mean: Option<Num>,
     nonfinite_pixels: Option<u64>,
+    /// The truth's unsettled pixels, and the error over the rest.
+    mask_pixels: Option<usize>,
+    max_abs_outside: Option<u8>,
+    above_8_outside: Option<Num>,
 }
 
 /// accuracy.csv's text.
@@ -75,6 +79,9 @@ pub fn accuracy(rows: &[Row]) -> anyhow::Result<String> {
             above_8: error.map(|e| Num(e.wrong)),
             flip_mean: error.and_then(|e| e.flip.map(Num)),
             nonfinite_pixels: ok.map(|(.., nan)| *nan),
+            mask_pixels: error.map(|e| e.outside.mask_pixels),
+            max_abs_outside: error.map(|e| e.outside.max_abs),
+            above_8_outside: error.map(|e| Num(e.outside.above_8)),
         }
     }))
 }
@@ -94,6 +101,9 @@ struct HardLine<'a> {
     /// GPU time where the driver has timers, else wall time.
     time_ms: Option<Num>,
     nonfinite_pixels: Option<u64>,
+    /// The truth's unsettled pixels, and the wrong share over the rest.
+    mask_pixels: Option<usize>,
+    wrong_outside_pct: Option<Num>,
 }
 
 /// hard_cases.csv's text.
@@ -110,6 +120,8 @@ pub fn hard_cases(rows: &[HardRow]) -> anyhow::Result<String> {
             crack_pixels: ok.and_then(|(_, c, ..)| *c),
             time_ms: ok.map(|(_, _, t, _)| Num(*t)),
             nonfinite_pixels: ok.map(|(.., nan)| *nan),
+            mask_pixels: r.outside.map(|o| o.mask_pixels),
+            wrong_outside_pct: r.outside.map(|o| Num(100.0 * o.above_8)),
         }
     }))
 }
@@ -125,6 +137,10 @@ struct RandomLine<'a> {
     max_abs: Option<u8>,
     rmse: Option<Num>,
     nonfinite_pixels: Option<u64>,
+    /// The reference's unsettled pixels, and the pair over the rest.
+    mask_pixels: Option<usize>,
+    off_8_outside_pct: Option<Num>,
+    max_abs_outside: Option<u8>,
 }
 
 /// random.csv's text.
@@ -146,6 +162,9 @@ fn random_line(r: &RandomRow) -> RandomLine<'_> {
         max_abs: m.map(|m| m.max_abs),
         rmse: m.map(|m| Num(m.rmse)),
         nonfinite_pixels: m.map(|m| m.nan_pixels),
+        mask_pixels: r.outside.map(|o| o.mask_pixels),
+        off_8_outside_pct: r.outside.map(|o| Num(100.0 * o.above_8)),
+        max_abs_outside: r.outside.map(|o| o.max_abs),
     }
 }
 
@@ -159,15 +178,15 @@ mod tests {
     fn the_columns_stay_as_committed_even_without_rows() {
         assert_eq!(
             accuracy(&[]).unwrap(),
-            "scene,width,height,api,max_depth,offset,triangle,sphere,sweeps,default,pareto,point_ms,repeat_ms,status,gpu_min_ms,wall_min_ms,rmse,max_abs,above_1,above_8,flip_mean,nonfinite_pixels\n"
+            "scene,width,height,api,max_depth,offset,triangle,sphere,sweeps,default,pareto,point_ms,repeat_ms,status,gpu_min_ms,wall_min_ms,rmse,max_abs,above_1,above_8,flip_mean,nonfinite_pixels,mask_pixels,max_abs_outside,above_8_outside\n"
         );
         assert_eq!(
             hard_cases(&[]).unwrap(),
-            "case,tolerance_pct,strategy,api,status,wrong_pct,crack_pixels,time_ms,nonfinite_pixels\n"
+            "case,tolerance_pct,strategy,api,status,wrong_pct,crack_pixels,time_ms,nonfinite_pixels,mask_pixels,wrong_outside_pct\n"
         );
         assert_eq!(
             random(&[]).unwrap(),
-            "seed,pair,status,off_8_pct,within_1_pct,max_abs,rmse,nonfinite_pixels\n"
+            "seed,pair,status,off_8_pct,within_1_pct,max_abs,rmse,nonfinite_pixels,mask_pixels,off_8_outside_pct,max_abs_outside\n"
         );
     }
 }
