@@ -11,6 +11,7 @@
 pub mod instance;
 pub mod device;
 pub mod memory;
+pub mod barrier;
 pub mod descriptors;
 pub mod pipeline;
 pub mod scene;

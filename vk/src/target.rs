@@ -9,9 +9,9 @@
 //! An OPTIMAL-tiled image cannot be mapped, so after the last frame the GPU
 //! copies it into a host-visible *readback* buffer as plain rows, top row first.
 
+use crate::barrier::{self, On};
 use crate::device::Device;
 use crate::memory::{self, Buffer};
-use crate::memory::{buffer_barrier, pipeline_barrier};
 use crate::pipeline::target_format;
 use anyhow::{Context, Result};
 use ash::vk;
@@ -122,7 +122,9 @@ impl Target {
 /// Records the copy of a `TRANSFER_SRC_OPTIMAL` RGBA32F image into `readback`,
 /// then the barrier that makes it visible to the CPU: a queue or fence wait
 /// covers only the GPU's side, the copy's writes reach the CPU's reads only
-/// through a barrier to HOST. Shared by the fragment and compute paths.
+/// through a barrier to HOST (and, in memory that is not host-coherent, an
+/// invalidate before the read: `Buffer::read`). Shared by the fragment and
+/// compute paths.
 pub fn record_copy_to_host(
     device: &Device,
     cmd: vk::CommandBuffer,
@@ -143,12 +145,6 @@ pub fn record_copy_to_host(
             height,
             depth: 1,
         });
-    // Read after write: the CPU maps what the copy wrote.
-    let to_host = buffer_barrier(
-        readback.buffer,
-        vk::AccessFlags::TRANSFER_WRITE,
-        vk::AccessFlags::HOST_READ,
-    );
     let d = &device.device;
     // SAFETY: `cmd` is run_once's, recording; the caller owns `image` (in
     // TRANSFER_SRC_OPTIMAL, as the region's layout says) and `readback`, which
@@ -157,18 +153,13 @@ pub fn record_copy_to_host(
         d.cmd_copy_image_to_buffer(
             cmd,
             image,
-            vk::ImageLayout::TRANSFER_SRC_OPTIMAL,
+            barrier::layout_for(barrier::Access::CopyRead),
             readback.buffer,
             &[region],
         );
-        pipeline_barrier(
-            d,
-            cmd,
-            vk::PipelineStageFlags::TRANSFER,
-            vk::PipelineStageFlags::HOST,
-            &[to_host],
-            &[],
-        );
+        // Read after write: the CPU maps what the copy wrote.
+        let to_host = [readback.buffer];
+        barrier::record(device, cmd, &[(barrier::READBACK, On::Buffers(&to_host))]);
     }
 }
 
