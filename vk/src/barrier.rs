@@ -169,7 +169,14 @@ impl Access {
                 A::TRANSFER_WRITE,
                 L::TRANSFER_DST_OPTIMAL,
             ),
-            Access::UpdateBufferWrite => (transfer(S::CLEAR), A::TRANSFER_WRITE, L::UNDEFINED),
+            // The specification runs vkCmdUpdateBuffer in the CLEAR stage; the
+            // validation layer of Debian 12 (1.3.239) still checks it at COPY,
+            // where it ran before. Both are named until that layer is gone.
+            Access::UpdateBufferWrite => (
+                transfer(S::CLEAR | S::COPY),
+                A::TRANSFER_WRITE,
+                L::UNDEFINED,
+            ),
             Access::BlitRead => (transfer(S::BLIT), A::TRANSFER_READ, L::TRANSFER_SRC_OPTIMAL),
             Access::BlitWrite => (
                 transfer(S::BLIT),
