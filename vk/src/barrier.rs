@@ -9,9 +9,9 @@
 //! records Vulkan 1.0 barriers only, and knows no semaphore waits or
 //! subpass dependencies: too little for one table, so this module is its own.)
 //!
-//! One source for three readers: the code records the [`Barrier`]s of [`ALL`],
-//! `--explain` prints each barrier from the very structures handed to the
-//! driver ([`record`]), and docs/vulkan-walkthrough.md's barrier table is
+//! One source for three readers: the code records the [`Barrier`]s of [`ALL`]
+//! (pipeline_barrier.rs), `--explain` prints each barrier from the very
+//! structures handed to the driver, and docs/vulkan-walkthrough.md's barrier table is
 //! checked against [`ALL`] by tests/tests/barriers.rs.
 //!
 //! The same names make two recordings ([`Recording`]): Vulkan 1.0's
@@ -20,8 +20,6 @@
 //! vkCmdPipelineBarrier2 (Vulkan 1.3, `--vk-sync2`), where each barrier carries
 //! its own stages and `TRANSFER` splits into `COPY`, `BLIT` and `CLEAR`.
 
-use crate::device::Device;
-use crate::memory::COLOR_IMAGE;
 use ash::vk;
 use std::collections::BTreeSet;
 use std::sync::Mutex;
@@ -458,6 +456,13 @@ impl Barrier {
         })
     }
 
+    /// The masks as Vulkan 1.0 writes them: the source's stages and access,
+    /// then the destination's.
+    pub fn masks_1_0(&self) -> [(vk::PipelineStageFlags, vk::AccessFlags); 2] {
+        let r = Recording::Vulkan10;
+        [self.source(r), self.destination(r)].map(|(s, a)| (narrow_stages(s), narrow_access(a)))
+    }
+
     /// The image's old and new layouts.
     pub fn layouts(&self) -> (vk::ImageLayout, vk::ImageLayout) {
         let layout = |a: &[Access]| a[0].masks(Recording::Vulkan10).layout;
@@ -471,15 +476,14 @@ impl Barrier {
 
     /// The render pass's dependency from `src` to `dst` subpass, in 1.0's masks.
     pub fn subpass_dependency(&self, src: u32, dst: u32) -> vk::SubpassDependency {
-        let (src_stages, src_access) = self.source(Recording::Vulkan10);
-        let (dst_stages, dst_access) = self.destination(Recording::Vulkan10);
+        let [(src_stages, src_access), (dst_stages, dst_access)] = self.masks_1_0();
         let dependency = vk::SubpassDependency::default()
             .src_subpass(src)
             .dst_subpass(dst)
-            .src_stage_mask(narrow_stages(src_stages))
-            .src_access_mask(narrow_access(src_access))
-            .dst_stage_mask(narrow_stages(dst_stages))
-            .dst_access_mask(narrow_access(dst_access));
+            .src_stage_mask(src_stages)
+            .src_access_mask(src_access)
+            .dst_stage_mask(dst_stages)
+            .dst_access_mask(dst_access);
         explain_once(
             self.step,
             &format!("VkSubpassDependency: {}", self.name),
@@ -534,229 +538,8 @@ impl Timestamp {
 /// command of the submit (synchronization2 names it; 1.0 signals after all).
 pub const SIGNAL_AFTER_ALL: vk::PipelineStageFlags2 = vk::PipelineStageFlags2::ALL_COMMANDS;
 
-/// What one barrier guards: buffers, an image, or nothing (an execution dependency).
-pub enum On<'a> {
-    Buffers(&'a [vk::Buffer]),
-    Image(vk::Image),
-    Nothing,
-}
-
-/// Records `barriers` (each with what it guards) as one barrier call, in the
-/// device's recording, and prints each with `--explain` the first time it is
-/// recorded, from the structures the call was given.
-///
-/// # Safety
-/// `cmd` was allocated from `device` and is recording, outside a render pass,
-/// and every buffer and image named is alive until the commands have run.
-pub unsafe fn record(device: &Device, cmd: vk::CommandBuffer, barriers: &[(Barrier, On)]) {
-    match device.recording {
-        // SAFETY: forwarded from the caller.
-        Recording::Vulkan10 => unsafe { record_1_0(&device.device, cmd, barriers) },
-        // SAFETY: forwarded from the caller; the device enabled synchronization2
-        // (Device::new does, for this recording).
-        Recording::Synchronization2 => unsafe { record_2(&device.device, cmd, barriers) },
-    }
-}
-
-/// One vkCmdPipelineBarrier: the stage masks of all the barriers together.
-///
-/// # Safety
-/// As for [`record`].
-unsafe fn record_1_0(d: &ash::Device, cmd: vk::CommandBuffer, barriers: &[(Barrier, On)]) {
-    let r = Recording::Vulkan10;
-    let (mut src, mut dst) = (
-        vk::PipelineStageFlags::empty(),
-        vk::PipelineStageFlags::empty(),
-    );
-    let (mut buffers, mut images) = (Vec::new(), Vec::new());
-    for (b, on) in barriers {
-        let ((src_stages, src_access), (dst_stages, dst_access)) = (b.source(r), b.destination(r));
-        src |= narrow_stages(src_stages);
-        dst |= narrow_stages(dst_stages);
-        let (src_access, dst_access) = (narrow_access(src_access), narrow_access(dst_access));
-        match on {
-            On::Buffers(list) => buffers.extend(list.iter().map(|&buffer| {
-                vk::BufferMemoryBarrier::default()
-                    .src_access_mask(src_access)
-                    .dst_access_mask(dst_access)
-                    .src_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
-                    .dst_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
-                    .buffer(buffer)
-                    .size(vk::WHOLE_SIZE)
-            })),
-            On::Image(image) => {
-                let (old, new) = b.layouts();
-                images.push(
-                    vk::ImageMemoryBarrier::default()
-                        .src_access_mask(src_access)
-                        .dst_access_mask(dst_access)
-                        .old_layout(old)
-                        .new_layout(new)
-                        .src_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
-                        .dst_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
-                        .image(*image)
-                        .subresource_range(COLOR_IMAGE),
-                )
-            }
-            // An execution dependency: the stage masks alone.
-            On::Nothing => {}
-        }
-    }
-    // SAFETY: forwarded from the caller.
-    unsafe {
-        d.cmd_pipeline_barrier(
-            cmd,
-            src,
-            dst,
-            vk::DependencyFlags::empty(),
-            &[],
-            &buffers,
-            &images,
-        )
-    };
-    if explain::is_on() {
-        let mut lines = vec![format!("stages {src:?} -> {dst:?}")];
-        lines.extend(buffers.iter().map(|b| {
-            format!(
-                "buffer access {:?} -> {:?}",
-                b.src_access_mask, b.dst_access_mask
-            )
-        }));
-        lines.extend(images.iter().map(|i| {
-            format!(
-                "image access {:?} -> {:?}, layout {:?} -> {:?}",
-                i.src_access_mask, i.dst_access_mask, i.old_layout, i.new_layout
-            )
-        }));
-        explain_call("vkCmdPipelineBarrier", barriers, &lines);
-    }
-}
-
-/// One vkCmdPipelineBarrier2: each barrier with its own stages.
-///
-/// # Safety
-/// As for [`record`], on a device with synchronization2 enabled.
-unsafe fn record_2(d: &ash::Device, cmd: vk::CommandBuffer, barriers: &[(Barrier, On)]) {
-    let r = Recording::Synchronization2;
-    let (mut memory, mut buffers, mut images) = (Vec::new(), Vec::new(), Vec::new());
-    for (b, on) in barriers {
-        let ((src_stages, src_access), (dst_stages, dst_access)) = (b.source(r), b.destination(r));
-        match on {
-            On::Buffers(list) => buffers.extend(list.iter().map(|&buffer| {
-                vk::BufferMemoryBarrier2::default()
-                    .src_stage_mask(src_stages)
-                    .src_access_mask(src_access)
-                    .dst_stage_mask(dst_stages)
-                    .dst_access_mask(dst_access)
-                    .src_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
-                    .dst_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
-                    .buffer(buffer)
-                    .size(vk::WHOLE_SIZE)
-            })),
-            On::Image(image) => {
-                let (old, new) = b.layouts();
-                images.push(
-                    vk::ImageMemoryBarrier2::default()
-                        .src_stage_mask(src_stages)
-                        .src_access_mask(src_access)
-                        .dst_stage_mask(dst_stages)
-                        .dst_access_mask(dst_access)
-                        .old_layout(old)
-                        .new_layout(new)
-                        .src_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
-                        .dst_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
-                        .image(*image)
-                        .subresource_range(COLOR_IMAGE),
-                )
-            }
-            // Stages live in the barriers now: an execution dependency is a
-            // memory barrier with stages and no access bits.
-            On::Nothing => memory.push(
-                vk::MemoryBarrier2::default()
-                    .src_stage_mask(src_stages)
-                    .dst_stage_mask(dst_stages),
-            ),
-        }
-    }
-    let info = vk::DependencyInfo::default()
-        .memory_barriers(&memory)
-        .buffer_memory_barriers(&buffers)
-        .image_memory_barriers(&images);
-    // SAFETY: forwarded from the caller; the arrays outlive the call.
-    unsafe { d.cmd_pipeline_barrier2(cmd, &info) };
-    if explain::is_on() {
-        let mut lines: Vec<String> = memory
-            .iter()
-            .map(|m| {
-                format!(
-                    "memory {}/{} -> {}/{}",
-                    show(m.src_stage_mask),
-                    show(m.src_access_mask),
-                    show(m.dst_stage_mask),
-                    show(m.dst_access_mask)
-                )
-            })
-            .collect();
-        lines.extend(buffers.iter().map(|b| {
-            format!(
-                "buffer {}/{} -> {}/{}",
-                show(b.src_stage_mask),
-                show(b.src_access_mask),
-                show(b.dst_stage_mask),
-                show(b.dst_access_mask)
-            )
-        }));
-        lines.extend(images.iter().map(|i| {
-            format!(
-                "image {}/{} -> {}/{}, layout {:?} -> {:?}",
-                show(i.src_stage_mask),
-                show(i.src_access_mask),
-                show(i.dst_stage_mask),
-                show(i.dst_access_mask),
-                i.old_layout,
-                i.new_layout
-            )
-        }));
-        explain_call("vkCmdPipelineBarrier2", barriers, &lines);
-    }
-}
-
-/// `[n] vkCmdPipelineBarrier: a + b`, the named accesses, then what was recorded.
-fn explain_call(call: &str, barriers: &[(Barrier, On)], recorded: &[String]) {
-    let title: Vec<&str> = barriers.iter().map(|(b, _)| b.name).collect();
-    let mut details: Vec<String> = barriers
-        .iter()
-        .map(|(b, on)| {
-            let what = match on {
-                On::Buffers(list) => format!("{} buffer(s)", list.len()),
-                On::Image(_) => "image".into(),
-                On::Nothing => "execution only".into(),
-            };
-            format!("{}: {} ({what})", b.name, b.words())
-        })
-        .collect();
-    // The upload's seven buffer barriers are one line, "7 x ...".
-    let mut counted: Vec<(usize, &String)> = Vec::new();
-    for line in recorded {
-        match counted.last_mut() {
-            Some((n, last)) if *last == line => *n += 1,
-            _ => counted.push((1, line)),
-        }
-    }
-    details.extend(counted.iter().map(|(n, line)| match n {
-        1 => line.to_string(),
-        n => format!("{n} x {line}"),
-    }));
-    let step = barriers.iter().map(|(b, _)| b.step).max().unwrap_or(0);
-    explain_once(
-        step,
-        &format!("{call}: {}", title.join(" + ")),
-        &details.join("\n"),
-    );
-}
-
 /// Prints a barrier once: frames re-record theirs every frame.
-fn explain_once(step: u32, title: &str, details: &str) {
+pub(crate) fn explain_once(step: u32, title: &str, details: &str) {
     static SEEN: Mutex<BTreeSet<String>> = Mutex::new(BTreeSet::new());
     if !explain::is_on() {
         return;

@@ -26,11 +26,12 @@
 //! shader cannot write the swapchain image itself: its `rgba32f` image format
 //! is not the swapchain's, and few surfaces offer STORAGE usage anyway.
 
-use crate::barrier::{self, Access, On};
+use crate::barrier::{self, Access};
 use crate::commands::Commands;
 use crate::descriptors::Descriptors;
 use crate::device::Device;
 use crate::memory::Buffer;
+use crate::pipeline_barrier::{self, On};
 use crate::scene::scene_buffers;
 use crate::target::{create_image_with_view, read_image, readback_buffer, record_copy_to_host};
 use crate::timestamps::Timestamps;
@@ -103,7 +104,7 @@ impl Compute {
             let after_last_frame = (barrier::FRAME_AFTER_FRAME, On::Image(image.image));
             // SAFETY: `cmd` is recording (inside record_with); the storage image
             // is owned by the `Compute` that will own these commands too.
-            unsafe { barrier::record(device, cmd, &[after_last_frame]) };
+            unsafe { pipeline_barrier::record(device, cmd, &[after_last_frame]) };
             if let Some(t) = timestamps {
                 t.record(cmd, 0);
             }
@@ -146,7 +147,7 @@ impl Compute {
             // the last frame, so the move costs the timed frames nothing.
             let after_dispatch = (barrier::STORAGE_IMAGE_TO_COPY, On::Image(self.image.image));
             // SAFETY: `cmd` is run_once's, recording; `self` owns the image.
-            unsafe { barrier::record(device, cmd, &[after_dispatch]) };
+            unsafe { pipeline_barrier::record(device, cmd, &[after_dispatch]) };
             record_copy_to_host(
                 device,
                 cmd,
@@ -287,7 +288,7 @@ impl WindowCompute {
         // until the GPU is idle (a path switch or resize waits first); `target`
         // is the swapchain image acquired for this frame, alive with the swapchain.
         unsafe {
-            barrier::record(device, cmd, &[to_general]);
+            pipeline_barrier::record(device, cmd, &[to_general]);
             d.cmd_bind_pipeline(cmd, vk::PipelineBindPoint::COMPUTE, self.pipeline.pipeline);
             d.cmd_bind_descriptor_sets(
                 cmd,
@@ -298,7 +299,7 @@ impl WindowCompute {
                 &[],
             );
             d.cmd_dispatch(cmd, self.groups.0, self.groups.1, 1);
-            barrier::record(device, cmd, &to_blit);
+            pipeline_barrier::record(device, cmd, &to_blit);
             d.cmd_blit_image(
                 cmd,
                 self.image.image,
@@ -308,7 +309,7 @@ impl WindowCompute {
                 &[region],
                 vk::Filter::NEAREST,
             );
-            barrier::record(device, cmd, &[to_present]);
+            pipeline_barrier::record(device, cmd, &[to_present]);
         }
     }
 }
@@ -429,7 +430,7 @@ impl StorageImage {
         let to_general = (barrier::STORAGE_IMAGE_SETUP, On::Image(this.image));
         device.run_once("moving the storage image to GENERAL layout", |cmd| {
             // SAFETY: `cmd` is run_once's, recording; `this` owns the image.
-            unsafe { barrier::record(device, cmd, &[to_general]) }
+            unsafe { pipeline_barrier::record(device, cmd, &[to_general]) }
         })?;
         Ok(this)
     }

@@ -32,10 +32,11 @@
 //! that into the swapchain image (compute.rs, `WindowCompute::record`), with
 //! the layout transitions a render pass would otherwise make.
 
-use crate::barrier::{self, Access, Barrier, On, Recording};
+use crate::barrier::{self, Access, Barrier, Recording};
 use crate::compute::WindowCompute;
 use crate::device::Device;
 use crate::hooks::ForcedOutOfDate;
+use crate::pipeline_barrier::{self, On};
 use crate::scene::SceneResources;
 use crate::swapchain::Swapchain;
 use crate::timestamps::Timestamps;
@@ -326,9 +327,9 @@ fn record(
     // scene resources in `draw`, which the window keeps until the GPU is idle;
     // `frame` fits vkCmdUpdateBuffer (asserted at compile time above).
     unsafe {
-        barrier::record(device, cmd, &[(barrier::UNIFORM_AFTER_READS, On::Nothing)]);
+        pipeline_barrier::record(device, cmd, &[(barrier::UNIFORM_AFTER_READS, On::Nothing)]);
         d.cmd_update_buffer(cmd, uniform[0], 0, bytemuck::bytes_of(frame));
-        barrier::record(
+        pipeline_barrier::record(
             device,
             cmd,
             &[(draw.uniform_to_tracer(), On::Buffers(&uniform))],

@@ -12,8 +12,9 @@
 //! on every device, scene buffers are filled by writing into a host-visible
 //! *staging* buffer and letting the GPU copy it across.
 
-use crate::barrier::{self, On};
+use crate::barrier;
 use crate::device::Device;
+use crate::pipeline_barrier::{self, On};
 use anyhow::{anyhow, Context, Result};
 use ash::vk;
 use ash::vk::MemoryPropertyFlags as Flags;
@@ -301,7 +302,9 @@ impl<'a> Uploads<'a> {
         self.device.run_once("uploading the scene", |cmd| {
             // SAFETY: `cmd` is run_once's, recording; every buffer is in
             // `self.filled`, alive until run_once has waited for the queue.
-            unsafe { barrier::record(self.device, cmd, &[(barrier, On::Buffers(&buffers))]) };
+            unsafe {
+                pipeline_barrier::record(self.device, cmd, &[(barrier, On::Buffers(&buffers))])
+            };
         })?;
         Ok(self.filled)
     }

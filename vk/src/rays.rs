@@ -4,13 +4,14 @@
 //! by kind into its slot of a host-visible storage buffer (binding 10), which
 //! is read back and added up. The timed pipeline never sees that buffer.
 
-use crate::barrier::{self, On};
+use crate::barrier;
 use crate::commands::Commands;
 use crate::compute::Compute;
 use crate::descriptors::Descriptors;
 use crate::device::Device;
 use crate::memory::Buffer;
 use crate::pipeline::{Pipeline, RenderPass};
+use crate::pipeline_barrier::{self, On};
 use crate::scene::scene_buffers;
 use crate::target::Target;
 use anyhow::Result;
@@ -70,7 +71,9 @@ pub fn count_rays(device: &Device, run: &CountingRun) -> Result<RayKinds> {
         let counts = [counts_handle];
         // SAFETY: `cmd` is recording (inside run_once); the buffer is
         // alive in `storage` until the end of this function.
-        unsafe { barrier::record(device, cmd, &[(barrier::RAY_COUNTS, On::Buffers(&counts))]) };
+        unsafe {
+            pipeline_barrier::record(device, cmd, &[(barrier::RAY_COUNTS, On::Buffers(&counts))])
+        };
     })?;
     let (_, counts) = storage
         .last()

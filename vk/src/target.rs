@@ -9,10 +9,11 @@
 //! An OPTIMAL-tiled image cannot be mapped, so after the last frame the GPU
 //! copies it into a host-visible *readback* buffer as plain rows, top row first.
 
-use crate::barrier::{self, On};
+use crate::barrier;
 use crate::device::Device;
 use crate::memory::{self, Buffer};
 use crate::pipeline::target_format;
+use crate::pipeline_barrier::{self, On};
 use anyhow::{Context, Result};
 use ash::vk;
 use ash::vk::MemoryPropertyFlags as Flags;
@@ -159,7 +160,7 @@ pub fn record_copy_to_host(
         );
         // Read after write: the CPU maps what the copy wrote.
         let to_host = [readback.buffer];
-        barrier::record(device, cmd, &[(barrier::READBACK, On::Buffers(&to_host))]);
+        pipeline_barrier::record(device, cmd, &[(barrier::READBACK, On::Buffers(&to_host))]);
     }
 }
 

@@ -15,13 +15,14 @@
 //! needs: frames, swapchain, the path's per-scene objects, render pass, device, surface, instance,
 //! and the window last of all (the surface refers to it).
 
-use crate::barrier::{self, On};
+use crate::barrier;
 use crate::commands::Commands;
 use crate::compute::{self, Compute, WindowCompute};
 use crate::device::Device;
 use crate::frames::{Draw, FrameResult, Frames};
 use crate::instance::Instance;
 use crate::pipeline::{Pipeline, RenderPass};
+use crate::pipeline_barrier::{self, On};
 use crate::scene::SceneResources;
 use crate::surface::{self, Surface};
 use crate::swapchain::{self, Swapchain};
@@ -344,7 +345,7 @@ impl Renderer for VkWindow {
             // owns; `frame` fits vkCmdUpdateBuffer (asserted in frames.rs).
             unsafe {
                 d.cmd_update_buffer(cmd, uniform, 0, bytemuck::bytes_of(frame));
-                barrier::record(
+                pipeline_barrier::record(
                     device,
                     cmd,
                     &[(barrier::UNIFORM_TO_CAPTURE, On::Buffers(&written))],
