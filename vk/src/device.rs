@@ -487,6 +487,7 @@ impl Drop for Device {
     fn drop(&mut self) {
         // SAFETY: every object made on this device was dropped before it (see app.rs).
         unsafe { self.device.destroy_device(None) };
+        explain::numbered(20, "Device::drop: vkDestroyDevice", String::new);
     }
 }
 

@@ -323,17 +323,15 @@ fn record(
     // execution dependency is enough; both stages, as the previous frame may
     // have run the other path), and the tracer waits for the write.
     let uniform = [draw.uniform()];
+    let after_reads = [(barrier::UNIFORM_AFTER_READS, On::Nothing)];
+    let to_tracer = [(draw.uniform_to_tracer(), On::Buffers(&uniform))];
     // SAFETY: `cmd` began recording above; the uniform buffer belongs to the
     // scene resources in `draw`, which the window keeps until the GPU is idle;
     // `frame` fits vkCmdUpdateBuffer (asserted at compile time above).
     unsafe {
-        pipeline_barrier::record(device, cmd, &[(barrier::UNIFORM_AFTER_READS, On::Nothing)]);
+        pipeline_barrier::record(device, cmd, &after_reads);
         d.cmd_update_buffer(cmd, uniform[0], 0, bytemuck::bytes_of(frame));
-        pipeline_barrier::record(
-            device,
-            cmd,
-            &[(draw.uniform_to_tracer(), On::Buffers(&uniform))],
-        );
+        pipeline_barrier::record(device, cmd, &to_tracer);
     }
     match draw {
         Draw::Fragment { render_pass, scene } => {
@@ -409,5 +407,10 @@ impl Drop for Frames {
             }
             self.device.destroy_command_pool(self.pool, None);
         }
+        explain::numbered(
+            20,
+            "Frames::drop: vkDeviceWaitIdle; per slot vkDestroySemaphore, vkDestroyFence; vkDestroyCommandPool",
+            String::new,
+        );
     }
 }

@@ -212,5 +212,10 @@ impl Drop for Instance {
             }
             self.instance.destroy_instance(None);
         }
+        explain::numbered(
+            20,
+            "Instance::drop: vkDestroyDebugUtilsMessengerEXT (with --validate), vkDestroyInstance",
+            String::new,
+        );
     }
 }

@@ -306,5 +306,10 @@ impl Drop for Swapchain {
             }
             self.loader.destroy_swapchain(self.swapchain, None);
         }
+        explain::numbered(
+            20,
+            "Swapchain::drop: per image vkDestroySemaphore, vkDestroyFramebuffer, vkDestroyImageView; vkDestroySwapchainKHR",
+            String::new,
+        );
     }
 }
