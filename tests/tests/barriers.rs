@@ -124,6 +124,9 @@ fn access_table() -> String {
 /// The page between `<!-- name:begin -->` and `<!-- name:end -->` must be
 /// `expected`; `TWINRAY_UPDATE_DOCS=1` rewrites it instead.
 fn page_holds(name: &str, expected: &str) {
+    // The two table tests run at once; a rewrite must not undo the other's.
+    static PAGE: std::sync::Mutex<()> = std::sync::Mutex::new(());
+    let _only_one = PAGE.lock().unwrap_or_else(|e| e.into_inner());
     let path = page_path();
     let doc = std::fs::read_to_string(&path).unwrap();
     let (begin, end) = (

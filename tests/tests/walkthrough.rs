@@ -299,8 +299,11 @@ fn calls_with_arguments(snippet: &str) -> Vec<String> {
     calls
 }
 
+/// Without whitespace, and without the trailing comma rustfmt adds to a
+/// call it wraps.
 fn squeezed(text: &str) -> String {
-    text.chars().filter(|c| !c.is_whitespace()).collect()
+    let text: String = text.chars().filter(|c| !c.is_whitespace()).collect();
+    text.replace(",)", ")")
 }
 
 /// The call, arguments and all, is in the code; where `…` leaves some out,
