@@ -266,7 +266,15 @@ fn the_pages_drop_order_is_the_windows() {
     let xvfb = twinray_tests::Xvfb::start();
     let dir = twinray_tests::scratch("drop-order");
     let app = twinray_tests::bin("twinray-vk");
-    let args = ["--scene", "box", "--size", "64x48", "--frames", "3", "--explain"];
+    let args = [
+        "--scene",
+        "box",
+        "--size",
+        "64x48",
+        "--frames",
+        "3",
+        "--explain",
+    ];
     let out = xvfb.run(&app, &args, &[], &dir);
     let stderr = String::from_utf8_lossy(&out.stderr);
     assert!(out.status.success(), "the window failed:\n{stderr}");
