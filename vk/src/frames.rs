@@ -9,13 +9,14 @@
 //!   slot's command buffer; created signalled so the first wait passes;
 //! - an **image-available semaphore** (presentation → GPU): signalled when the
 //!   acquired swapchain image may be written; the submit waits on it at the
-//!   stage that first writes the image: the colour-output stage on the
+//!   stage of the image's first access (`Draw::first_image_access`,
+//!   barrier.rs's `acquire_wait_stage`): the colour-output stage on the
 //!   fragment path, which lets the fragment shader trace before the image is
-//!   acquired; the transfer stage on the compute path, which does not: the
-//!   dispatch waits for the frame's uniform update and (through the storage
-//!   image's transition) for the previous frame's blit, both transfer commands,
-//!   and so for the acquire. docs/vulkan-walkthrough.md, step 22, says what
-//!   synchronization2 would change;
+//!   acquired; the blit on the compute path, which in Vulkan 1.0 is every
+//!   transfer, so the dispatch, after the frame's uniform update and (through
+//!   the storage image's transition) the previous frame's blit, waits for the
+//!   acquire too. With `--vk-sync2` the wait is at the blit alone
+//!   (docs/vulkan-walkthrough.md, step 22);
 //! - the swapchain's per-image **render-finished semaphore** (GPU → presentation).
 //!
 //! Command buffers are **re-recorded every frame**, not pre-recorded once per
