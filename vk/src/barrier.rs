@@ -90,7 +90,7 @@ fn narrow_access(a: vk::AccessFlags2) -> vk::AccessFlags {
 }
 
 impl Access {
-    /// Every access, for the tests and the page.
+    /// Every access, in the page's table's order.
     pub const EVERY: [Access; 14] = [
         Access::Nothing,
         Access::Acquire,
@@ -107,13 +107,6 @@ impl Access {
         Access::HostRead,
         Access::Present,
     ];
-
-    /// The access a name (as `Debug` prints it) stands for.
-    pub fn from_name(name: &str) -> Option<Access> {
-        Access::EVERY
-            .into_iter()
-            .find(|a| format!("{a:?}") == name.trim())
-    }
 
     /// Whether the access writes: only writes need making available, so only
     /// they put access bits in a barrier's source mask.
