@@ -76,7 +76,16 @@ pub enum Recording {
 pub struct Masks {
     pub stages: vk::PipelineStageFlags2,
     pub access: vk::AccessFlags2,
-    pub layout: vk::ImageLayout,
+    /// The layout an image must be in; `None` for an access twinray makes
+    /// to buffers only.
+    pub layout: Option<vk::ImageLayout>,
+}
+
+impl Masks {
+    /// The masks as Vulkan 1.0 writes them.
+    pub fn narrowed(&self) -> (vk::PipelineStageFlags, vk::AccessFlags) {
+        (narrow_stages(self.stages), narrow_access(self.access))
+    }
 }
 
 /// 1.0's flags are 2's low 32 bits, with the same meaning: the 1.0 recording
@@ -152,39 +161,43 @@ impl Access {
             (S::TOP_OF_PIPE, S::BOTTOM_OF_PIPE)
         };
         let (stages, access, layout) = match self {
-            Access::Nothing => (none_before, A::NONE, L::UNDEFINED),
-            Access::Acquire => (S::NONE, A::NONE, L::UNDEFINED),
-            Access::CopyRead => (transfer(S::COPY), A::TRANSFER_READ, L::TRANSFER_SRC_OPTIMAL),
+            Access::Nothing => (none_before, A::NONE, Some(L::UNDEFINED)),
+            Access::Acquire => (S::NONE, A::NONE, Some(L::UNDEFINED)),
+            Access::CopyRead => (
+                transfer(S::COPY),
+                A::TRANSFER_READ,
+                Some(L::TRANSFER_SRC_OPTIMAL),
+            ),
             Access::CopyWrite => (
                 transfer(S::COPY),
                 A::TRANSFER_WRITE,
-                L::TRANSFER_DST_OPTIMAL,
+                Some(L::TRANSFER_DST_OPTIMAL),
             ),
             // The specification runs vkCmdUpdateBuffer in the CLEAR stage; the
             // validation layer of Debian 12 (1.3.239) still checks it at COPY,
             // where it ran before. Both are named until that layer is gone.
-            Access::UpdateBufferWrite => (
-                transfer(S::CLEAR | S::COPY),
-                A::TRANSFER_WRITE,
-                L::UNDEFINED,
+            Access::UpdateBufferWrite => (transfer(S::CLEAR | S::COPY), A::TRANSFER_WRITE, None),
+            Access::BlitRead => (
+                transfer(S::BLIT),
+                A::TRANSFER_READ,
+                Some(L::TRANSFER_SRC_OPTIMAL),
             ),
-            Access::BlitRead => (transfer(S::BLIT), A::TRANSFER_READ, L::TRANSFER_SRC_OPTIMAL),
             Access::BlitWrite => (
                 transfer(S::BLIT),
                 A::TRANSFER_WRITE,
-                L::TRANSFER_DST_OPTIMAL,
+                Some(L::TRANSFER_DST_OPTIMAL),
             ),
-            Access::FragmentShaderRead => (S::FRAGMENT_SHADER, shader_read, L::GENERAL),
-            Access::FragmentShaderWrite => (S::FRAGMENT_SHADER, shader_write, L::GENERAL),
-            Access::ComputeShaderRead => (S::COMPUTE_SHADER, shader_read, L::GENERAL),
-            Access::ComputeShaderWrite => (S::COMPUTE_SHADER, shader_write, L::GENERAL),
+            Access::FragmentShaderRead => (S::FRAGMENT_SHADER, shader_read, None),
+            Access::FragmentShaderWrite => (S::FRAGMENT_SHADER, shader_write, None),
+            Access::ComputeShaderRead => (S::COMPUTE_SHADER, shader_read, None),
+            Access::ComputeShaderWrite => (S::COMPUTE_SHADER, shader_write, Some(L::GENERAL)),
             Access::ColorAttachmentWrite => (
                 S::COLOR_ATTACHMENT_OUTPUT,
                 A::COLOR_ATTACHMENT_WRITE,
-                L::COLOR_ATTACHMENT_OPTIMAL,
+                Some(L::COLOR_ATTACHMENT_OPTIMAL),
             ),
-            Access::HostRead => (S::HOST, A::HOST_READ, L::GENERAL),
-            Access::Present => (none_after, A::NONE, L::PRESENT_SRC_KHR),
+            Access::HostRead => (S::HOST, A::HOST_READ, None),
+            Access::Present => (none_after, A::NONE, Some(L::PRESENT_SRC_KHR)),
         };
         Masks {
             stages,
@@ -458,7 +471,7 @@ impl Barrier {
 
     /// The image's old and new layouts.
     pub fn layouts(&self) -> (vk::ImageLayout, vk::ImageLayout) {
-        let layout = |a: &[Access]| a[0].masks(Recording::Vulkan10).layout;
+        let layout = |a: &[Access]| layout_for(a[0]);
         let old = if self.guards == Guards::ImageDiscarded {
             vk::ImageLayout::UNDEFINED
         } else {
@@ -494,8 +507,11 @@ impl Barrier {
 }
 
 /// The layout a render pass leaves its attachment in for what comes next.
+/// Also the layout of an image barrier's side, and of the commands' image arguments.
 pub fn layout_for(next: Access) -> vk::ImageLayout {
-    next.masks(Recording::Vulkan10).layout
+    next.masks(Recording::Vulkan10)
+        .layout
+        .unwrap_or_else(|| panic!("{next:?} is a buffer access; no image layout goes with it"))
 }
 
 /// The stage at which a frame's submit waits for the acquired image: that of
