@@ -216,7 +216,7 @@ pub fn create_image_with_view(
         .samples(vk::SampleCountFlags::TYPE_1)
         .tiling(vk::ImageTiling::OPTIMAL)
         .usage(usage)
-        .initial_layout(vk::ImageLayout::UNDEFINED);
+        .initial_layout(barrier::layout_for(barrier::Access::Nothing));
     // SAFETY: a create on the live device from a local info; the size is within the device's
     // limits (check_size for --size and captures; in the window the swapchain's extent, which the
     // surface bounds); RGBA32F supports these usages on every device (the spec makes them
