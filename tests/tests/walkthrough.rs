@@ -1,8 +1,8 @@
 //! The docs stay true to the code. In every README and document: every file
 //! named exists (in the repository, or as a name the code writes), every
 //! `path::function` is still defined there, every relative link resolves. In
-//! docs/vulkan-walkthrough.md also: its object diagram and its side-by-side
-//! tables name types and calls the two apps really use, every picture exists,
+//! docs/vulkan-walkthrough.md also: its object diagram names types and calls
+//! the two apps really use (the side-by-side tables: side_by_side.rs), every picture exists,
 //! and its lines-of-code table is the one this test counts
 //! (`TWINRAY_UPDATE_DOCS=1` rewrites the table instead of failing).
 
@@ -253,65 +253,8 @@ fn a_file_name_is_recognised_with_or_without_a_folder() {
     assert_eq!(r("vk::QueueFlags"), None);
 }
 
-/// Identifiers directly followed by `(`: the functions a snippet calls.
-fn called(snippet: &str) -> Vec<String> {
-    let mut names = Vec::new();
-    let mut current = String::new();
-    for c in snippet.chars() {
-        if c.is_alphanumeric() || c == '_' {
-            current.push(c);
-            continue;
-        }
-        let function = current.starts_with(|f: char| f.is_lowercase() || f == '_');
-        if c == '(' && function {
-            names.push(current.clone());
-        }
-        current.clear();
-    }
-    names
-}
-
 fn calls_in(source: &str, name: &str) -> bool {
     source.contains(&format!("{name}("))
-}
-
-/// Each call of a snippet with its arguments, as written: `name(args)`, the
-/// parentheses balanced. `…` in the arguments marks some left out.
-fn calls_with_arguments(snippet: &str) -> Vec<String> {
-    let mut calls = Vec::new();
-    for name in called(snippet) {
-        let Some(start) = snippet.find(&format!("{name}(")) else {
-            continue;
-        };
-        let mut depth = 0;
-        for (i, c) in snippet[start..].char_indices() {
-            match c {
-                '(' => depth += 1,
-                ')' => depth -= 1,
-                _ => continue,
-            }
-            if depth == 0 {
-                calls.push(snippet[start..start + i + 1].to_string());
-                break;
-            }
-        }
-    }
-    calls
-}
-
-/// Without whitespace, and without the trailing comma rustfmt adds to a
-/// call it wraps.
-fn squeezed(text: &str) -> String {
-    let text: String = text.chars().filter(|c| !c.is_whitespace()).collect();
-    text.replace(",)", ")")
-}
-
-/// The call, arguments and all, is in the code; where `…` leaves some out,
-/// the parts around it are.
-fn call_in(squeezed_source: &str, call: &str) -> bool {
-    squeezed(call)
-        .split('…')
-        .all(|part| squeezed_source.contains(part))
 }
 
 /// The object diagram's Vulkan half names ash types and calls of vk/src, each
@@ -392,77 +335,6 @@ fn the_object_diagram_names_what_the_code_uses() {
         missing.join("\n")
     );
     assert!(checked >= 50, "only {checked} names read from the diagram");
-}
-
-/// The per-step "Vulkan (ash) | OpenGL (glow)" tables quote calls the two apps
-/// really make, with the arguments they make them with.
-#[test]
-fn the_side_by_side_calls_are_in_the_code() {
-    let doc = std::fs::read_to_string(doc_path()).unwrap();
-    let (vk_sq, gl_sq) = (
-        squeezed(&sources(&["vk/src"])),
-        squeezed(&sources(&["gl/src"])),
-    );
-    let mut in_table = false;
-    let mut missing = Vec::new();
-    let (mut tables, mut checked) = (0, 0);
-    for line in doc.lines() {
-        if line.starts_with("| Vulkan (ash) | OpenGL (") {
-            in_table = true;
-            tables += 1;
-            continue;
-        }
-        if !line.starts_with('|') {
-            in_table = false;
-            continue;
-        }
-        if !in_table || line.starts_with("|---") {
-            continue;
-        }
-        // Split on cell borders, not on `\|` inside a closure's code span.
-        let cells: Vec<String> = line
-            .replace("\\|", "¦")
-            .trim()
-            .trim_matches('|')
-            .split('|')
-            .map(str::to_string)
-            .collect();
-        for (cell, (side, source)) in cells.iter().zip([("vk", &vk_sq), ("gl", &gl_sq)]) {
-            for span in code_spans(cell) {
-                // Each call with its arguments: `draw_arrays(…, 0, 3)` where the
-                // code draws `pass.vertices()` vertices is a different call.
-                for call in calls_with_arguments(&span.replace('¦', "|")) {
-                    checked += 1;
-                    if !call_in(source, &call) {
-                        missing.push(format!("`{span}`: {call} is not in {side}/src"));
-                    }
-                }
-            }
-        }
-    }
-    assert!(
-        missing.is_empty(),
-        "the side-by-side tables quote calls the code does not make:\n{}",
-        missing.join("\n")
-    );
-    assert!(tables >= 15, "only {tables} side-by-side tables found");
-    assert!(checked >= 60, "only {checked} calls read from the tables");
-}
-
-#[test]
-fn a_quoted_call_is_held_to_its_arguments() {
-    let code = squeezed("gl.draw_arrays(glow::TRIANGLES, 0, pass.vertices() as i32);");
-    let calls = calls_with_arguments("`gl.draw_arrays(glow::TRIANGLES, 0, 3)`, every frame");
-    assert_eq!(calls, ["draw_arrays(glow::TRIANGLES, 0, 3)"]);
-    assert!(
-        !call_in(&code, &calls[0]),
-        "a different vertex count passed"
-    );
-    assert!(call_in(
-        &code,
-        "draw_arrays(glow::TRIANGLES, 0, pass.vertices() as i32)"
-    ));
-    assert!(call_in(&code, "draw_arrays(…, pass.vertices() as i32)"));
 }
 
 #[test]
@@ -650,87 +522,4 @@ fn the_module_map_names_every_module_of_common() {
         "docs/architecture.md's map of `common` does not name {}",
         missing.join(", ")
     );
-}
-
-/// Counts that comments and pages give of the scene's storage buffers (`four
-/// storage buffers`) are the count in `common/src/gpu/layout.rs`'s
-/// `binding::STORAGE`, and every binding constant's doc comment names its own
-/// binding, not a neighbour's (`5 is ...` over binding 6).
-#[test]
-fn comments_count_what_layout_rs_declares() {
-    let layout = std::fs::read_to_string(root().join("common/src/gpu/layout.rs")).unwrap();
-    let declared = layout
-        .split("pub const STORAGE: [u32; ")
-        .nth(1)
-        .and_then(|rest| rest.split(']').next()?.parse::<usize>().ok())
-        .expect("layout.rs declares binding::STORAGE");
-    let numbers = [
-        "one", "two", "three", "four", "five", "six", "seven", "eight", "nine", "ten",
-    ];
-    let mut texts = vec![(
-        "docs/vulkan-walkthrough.md".to_string(),
-        std::fs::read_to_string(doc_path()).unwrap(),
-    )];
-    for dir in ["vk/src", "gl/src", "common/src"] {
-        let mut text = String::new();
-        rust_sources(&root().join(dir), &mut text);
-        texts.push((dir.to_string(), text));
-    }
-    let mut wrong = Vec::new();
-    let mut seen = 0;
-    for (name, text) in &texts {
-        let words: Vec<&str> = text.split_whitespace().collect();
-        for pair in words.windows(3) {
-            if pair[1] != "storage" || !pair[2].starts_with("buffers") {
-                continue;
-            }
-            let word = pair[0].trim_start_matches(['(', '`']).to_lowercase();
-            let Some(n) = numbers.iter().position(|w| *w == word).map(|i| i + 1) else {
-                continue;
-            };
-            seen += 1;
-            if n != declared {
-                wrong.push(format!(
-                    "{name}: \"{} storage buffers\", layout.rs declares {declared}",
-                    pair[0]
-                ));
-            }
-        }
-    }
-    // A binding's doc comment that opens with a number speaks of that binding.
-    let module = layout
-        .split("pub mod binding {")
-        .nth(1)
-        .expect("layout.rs's binding module");
-    let mut doc = String::new();
-    for line in module.lines().map(str::trim) {
-        if let Some(comment) = line.strip_prefix("///") {
-            doc += comment;
-            continue;
-        }
-        if let Some(rest) = line.strip_prefix("pub const ") {
-            let value = rest
-                .split('=')
-                .nth(1)
-                .map(|v| v.trim().trim_end_matches(';'));
-            let opening: String = doc
-                .trim()
-                .chars()
-                .take_while(char::is_ascii_digit)
-                .collect();
-            if let (false, Some(value)) = (opening.is_empty(), value) {
-                if opening != value {
-                    wrong.push(format!(
-                        "layout.rs: the comment over `{rest}` speaks of binding {opening}"
-                    ));
-                }
-            }
-        }
-        doc.clear();
-    }
-    assert!(
-        seen >= 2,
-        "only {seen} storage-buffer counts found: is the search still reading?"
-    );
-    assert!(wrong.is_empty(), "{}", wrong.join("\n"));
 }

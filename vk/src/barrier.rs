@@ -88,6 +88,17 @@ impl Masks {
     }
 }
 
+/// All of a colour image with one mip level and one layer: every image twinray
+/// makes (targets, storage images, swapchain images), every view of one, and
+/// so every image barrier.
+pub const COLOR_IMAGE: vk::ImageSubresourceRange = vk::ImageSubresourceRange {
+    aspect_mask: vk::ImageAspectFlags::COLOR,
+    base_mip_level: 0,
+    level_count: 1,
+    base_array_layer: 0,
+    layer_count: 1,
+};
+
 /// 1.0's flags are 2's low 32 bits, with the same meaning: the 1.0 recording
 /// narrows them (every 1.0 mask of this table exists in 1.0).
 fn narrow_stages(s: vk::PipelineStageFlags2) -> vk::PipelineStageFlags {

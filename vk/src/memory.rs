@@ -333,13 +333,3 @@ impl Drop for Buffer {
         }
     }
 }
-
-/// All of a colour image with one mip level and one layer: every image twinray
-/// makes (targets, storage images, swapchain images) and every view of one.
-pub const COLOR_IMAGE: vk::ImageSubresourceRange = vk::ImageSubresourceRange {
-    aspect_mask: vk::ImageAspectFlags::COLOR,
-    base_mip_level: 0,
-    level_count: 1,
-    base_array_layer: 0,
-    layer_count: 1,
-};

@@ -5,9 +5,8 @@
 //! own. Either way the masks are the names' (barrier.rs) and nothing here
 //! chooses one; `--explain` prints each call from the structures it was given.
 
-use crate::barrier::{explain_once, show, Barrier, Recording};
+use crate::barrier::{explain_once, show, Barrier, Recording, COLOR_IMAGE};
 use crate::device::Device;
-use crate::memory::COLOR_IMAGE;
 use ash::vk;
 use twinray_common::explain;
 

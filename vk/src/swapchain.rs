@@ -252,7 +252,7 @@ impl Swapchain {
                 .image(image)
                 .view_type(vk::ImageViewType::TYPE_2D)
                 .format(format.format)
-                .subresource_range(crate::memory::COLOR_IMAGE);
+                .subresource_range(crate::barrier::COLOR_IMAGE);
             // SAFETY: `image` is one of this swapchain's images and `format` its
             // format; `this` destroys the view before the swapchain.
             let view = unsafe { d.create_image_view(&info, None) }

@@ -234,7 +234,7 @@ pub fn create_image_with_view(
         .image(*image)
         .view_type(vk::ImageViewType::TYPE_2D)
         .format(format)
-        .subresource_range(crate::memory::COLOR_IMAGE);
+        .subresource_range(crate::barrier::COLOR_IMAGE);
     // SAFETY: the image is bound to its memory and has the format, one level and one layer the view
     // describes.
     *view = unsafe { d.create_image_view(&info, None) }
