@@ -487,3 +487,49 @@ fn both_recordings_make_the_same_image_under_sync_validation() {
         );
     }
 }
+
+/// The window, both paths, both recordings, 100 frames with the resize hook
+/// (a new size every few frames, a minimize every 20th): no message from
+/// synchronisation validation, and at least 20 swapchains made anew.
+#[test]
+fn both_recordings_survive_resizes_under_sync_validation() {
+    let xvfb = twinray_tests::Xvfb::start();
+    let app = twinray_tests::bin("twinray-vk");
+    for recording in RECORDINGS {
+        for path in ["fragment", "compute"] {
+            let dir = twinray_tests::scratch(&format!("barriers-resize-{path}-{recording:?}"));
+            let args = [
+                "--scene",
+                "box",
+                "--size",
+                "64x48",
+                "--frames",
+                "100",
+                "--path",
+                path,
+                "--validate",
+                "--explain",
+            ];
+            let env = [
+                SYNC_VALIDATION,
+                sync2_env(recording),
+                ("TWINRAY_TEST_RESIZE", "1"),
+            ];
+            let out = xvfb.run(&app, &args, &env, &dir);
+            let stderr = String::from_utf8_lossy(&out.stderr);
+            assert!(out.status.success(), "{path}, {recording:?}:\n{stderr}");
+            assert!(
+                !stderr.contains("twinray-vk: validation"),
+                "{path}, {recording:?}:\n{stderr}"
+            );
+            let swapchains = stderr
+                .lines()
+                .filter(|l| l.ends_with("VkSwapchainKHR"))
+                .count();
+            assert!(
+                swapchains > 20,
+                "{path}, {recording:?}: only {swapchains} swapchains: the resizes did not happen"
+            );
+        }
+    }
+}
