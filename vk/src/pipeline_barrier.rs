@@ -5,7 +5,7 @@
 //! own. Either way the masks are the names' (barrier.rs) and nothing here
 //! chooses one; `--explain` prints each call from the structures it was given.
 
-use crate::barrier::{explain_once, show, Barrier, Recording, COLOR_IMAGE};
+use crate::barrier::{explain_once, show, Barrier, Guards, Recording, COLOR_IMAGE};
 use crate::device::Device;
 use ash::vk;
 use twinray_common::explain;
@@ -25,6 +25,20 @@ pub enum On<'a> {
 /// `cmd` was allocated from `device` and is recording, outside a render pass,
 /// and every buffer and image named is alive until the commands have run.
 pub unsafe fn record(device: &Device, cmd: vk::CommandBuffer, barriers: &[(Barrier, On)]) {
+    // What a barrier guards is part of its name: the table says "buffers", the
+    // call must hand it buffers.
+    for (b, on) in barriers {
+        let fits = matches!(
+            (b.guards, on),
+            (Guards::Buffers, On::Buffers(_))
+                | (Guards::Image | Guards::ImageDiscarded, On::Image(_))
+                | (Guards::Execution, On::Nothing)
+        );
+        assert!(fits, "the {} barrier guards {:?}", b.name, b.guards);
+    }
+    if barriers.is_empty() {
+        return;
+    }
     match device.recording {
         // SAFETY: forwarded from the caller.
         Recording::Vulkan10 => unsafe { record_1_0(&device.device, cmd, barriers) },
