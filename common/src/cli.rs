@@ -399,6 +399,15 @@ pub struct VulkanKnobs {
         hide = true
     )]
     pub wait: FrameWait,
+    /// Record the barriers with Vulkan 1.3's synchronization2
+    /// (vkCmdPipelineBarrier2, vkQueueSubmit2) instead of Vulkan 1.0's calls:
+    /// the same named accesses, each barrier with its own, finer stages.
+    #[arg(
+        long = "vk-sync2",
+        env = "TWINRAY_VK_SYNC2",
+        value_parser = named_in_env(clap::builder::BoolishValueParser::new())
+    )]
+    pub sync2: bool,
 }
 
 impl VulkanKnobs {

@@ -240,3 +240,55 @@ fn the_main_path_reads_in_one_sitting() {
     );
     assert!(words > 2000, "only {words} words before the appendix");
 }
+
+/// Step 20's drop order is the window's: the `Type::drop`s its **Where.**
+/// names after the wait, in its order, are `--explain`'s teardown lines.
+#[test]
+fn the_pages_drop_order_is_the_windows() {
+    let doc = page();
+    let step = steps(&doc)
+        .into_iter()
+        .find(|s| s.number == 20)
+        .expect("the page has step 20");
+    let start = step.text.find("**Where.**").expect("step 20 says where");
+    let paragraph = &step.text[start..];
+    let paragraph = &paragraph[..paragraph.find("\n\n").unwrap_or(paragraph.len())];
+    let stated: Vec<String> = paragraph
+        .split('`')
+        .skip(1)
+        .step_by(2)
+        .filter_map(|span| {
+            let parts: Vec<&str> = span.split("::").collect();
+            (parts.len() == 3 && parts[2] == "drop" && parts[1] != "VkWindow")
+                .then(|| format!("{}::drop", parts[1]))
+        })
+        .collect();
+    let xvfb = twinray_tests::Xvfb::start();
+    let dir = twinray_tests::scratch("drop-order");
+    let app = twinray_tests::bin("twinray-vk");
+    let args = [
+        "--scene",
+        "box",
+        "--size",
+        "64x48",
+        "--frames",
+        "3",
+        "--explain",
+    ];
+    let out = xvfb.run(&app, &args, &[], &dir);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "the window failed:\n{stderr}");
+    // The teardown: the [20] lines after the last line of any other step
+    // (a resize drops a swapchain earlier, too).
+    let lines = explained(&stderr);
+    let last_other = lines.iter().rposition(|(n, _)| *n != 20).unwrap_or(0);
+    let printed: Vec<String> = lines[last_other + 1..]
+        .iter()
+        .filter_map(|(_, title)| Some(title.split_once(": ")?.0.to_string()))
+        .collect();
+    assert!(stated.len() >= 4, "step 20 names only {stated:?}");
+    assert_eq!(
+        printed, stated,
+        "--explain's teardown lines, and step 20's drop order"
+    );
+}

@@ -82,7 +82,7 @@ fn render(
 ) -> Result<(RunReport, FloatImage)> {
     let args = planner.args();
     let (width, height) = (args.size.width, args.size.height);
-    let instance = Instance::new(args.validate, knobs.validation, &[])?;
+    let instance = Instance::new(args.validate, knobs.validation, &[], knobs.sync2)?;
     let device = Device::new(&instance, None, knobs, &planner.device())?;
     device.check_size(width, height)?;
     // The plan comes after the device, whose storage limit it is checked
@@ -212,7 +212,18 @@ fn render_compute(run: &HeadlessRun, shader: &ComputeShader) -> Result<Rendered>
         timestamps.as_ref(),
     )?;
     let (frames, setup_ms) = run.frames(&compute.commands, timestamps.as_ref())?;
-    Ok((frames, setup_ms, compute.read_back(run.device)?))
+    let image = compute.read_back(run.device)?;
+    explain::numbered(
+        11,
+        "Readback: vkCmdCopyImageToBuffer + HOST barrier, then map",
+        || {
+            format!(
+                "{}x{} R32G32B32A32_SFLOAT storage image, top row first",
+                size.width, size.height
+            )
+        },
+    );
+    Ok((frames, setup_ms, image))
 }
 
 /// The variant as the report names it, with the naive choices it was asked for.

@@ -8,7 +8,8 @@
 //! it into a *storage image* with `imageStore`. What the render pass did for us
 //! must now be said explicitly:
 //! - the image's *layout*: shaders may write an image only in GENERAL layout, so
-//!   it is moved there once at setup and stays until the readback;
+//!   it is moved there once at setup and stays until the readback (in the
+//!   window, until each frame's blit, and back);
 //! - the *barriers*: without a render pass's subpass dependencies, one frame's
 //!   writes are ordered against the next frame's writes, and the last frame's
 //!   against the readback copy, by pipeline barriers;
@@ -25,11 +26,12 @@
 //! shader cannot write the swapchain image itself: its `rgba32f` image format
 //! is not the swapchain's, and few surfaces offer STORAGE usage anyway.
 
+use crate::barrier::{self, Access};
 use crate::commands::Commands;
 use crate::descriptors::Descriptors;
 use crate::device::Device;
 use crate::memory::Buffer;
-use crate::memory::{image_barrier, pipeline_barrier};
+use crate::pipeline_barrier::{self, On};
 use crate::scene::scene_buffers;
 use crate::target::{create_image_with_view, read_image, readback_buffer, record_copy_to_host};
 use crate::timestamps::Timestamps;
@@ -99,16 +101,10 @@ impl Compute {
             // Write-after-write: this frame's imageStores must come after the
             // previous frame's (same image). A render pass's external subpass
             // dependency says this for the fragment path; here it is a barrier.
-            let after_last_frame = image.barrier(
-                vk::AccessFlags::SHADER_WRITE,
-                vk::AccessFlags::SHADER_WRITE,
-                vk::ImageLayout::GENERAL,
-                vk::ImageLayout::GENERAL,
-            );
-            let stages = vk::PipelineStageFlags::COMPUTE_SHADER;
+            let after_last_frame = (barrier::FRAME_AFTER_FRAME, On::Image(image.image));
             // SAFETY: `cmd` is recording (inside record_with); the storage image
             // is owned by the `Compute` that will own these commands too.
-            unsafe { pipeline_barrier(d, cmd, stages, stages, &[], &[after_last_frame]) };
+            unsafe { pipeline_barrier::record(device, cmd, &[after_last_frame]) };
             if let Some(t) = timestamps {
                 t.record(cmd, 0);
             }
@@ -149,23 +145,9 @@ impl Compute {
             // GENERAL works for copies too, but the layer (rightly) says the
             // copy may be faster from TRANSFER_SRC_OPTIMAL; this runs once, after
             // the last frame, so the move costs the timed frames nothing.
-            let after_dispatch = self.image.barrier(
-                vk::AccessFlags::SHADER_WRITE,
-                vk::AccessFlags::TRANSFER_READ,
-                vk::ImageLayout::GENERAL,
-                vk::ImageLayout::TRANSFER_SRC_OPTIMAL,
-            );
+            let after_dispatch = (barrier::STORAGE_IMAGE_TO_COPY, On::Image(self.image.image));
             // SAFETY: `cmd` is run_once's, recording; `self` owns the image.
-            unsafe {
-                pipeline_barrier(
-                    &device.device,
-                    cmd,
-                    vk::PipelineStageFlags::COMPUTE_SHADER,
-                    vk::PipelineStageFlags::TRANSFER,
-                    &[],
-                    &[after_dispatch],
-                )
-            };
+            unsafe { pipeline_barrier::record(device, cmd, &[after_dispatch]) };
             record_copy_to_host(
                 device,
                 cmd,
@@ -228,8 +210,9 @@ impl WindowCompute {
                     "{}x{} {IMAGE_FORMAT:?}, usage STORAGE|TRANSFER_SRC, binding 5 of the set; workgroup {}, {}x{} groups
                      per frame: storage image UNDEFINED->GENERAL, vkCmdDispatch, GENERAL->TRANSFER_SRC_OPTIMAL and the
                      acquired swapchain image UNDEFINED->TRANSFER_DST_OPTIMAL, vkCmdBlitImage (NEAREST, {IMAGE_FORMAT:?} -> {swapchain_format:?}),
-                     swapchain image TRANSFER_DST_OPTIMAL->PRESENT_SRC_KHR; the submit waits for the image at TRANSFER",
-                    extent.width, extent.height, shader.workgroup, groups.0, groups.1
+                     swapchain image TRANSFER_DST_OPTIMAL->PRESENT_SRC_KHR; the submit waits for the image at {:?}",
+                    extent.width, extent.height, shader.workgroup, groups.0, groups.1,
+                    barrier::acquire_wait_stage(Access::BlitWrite, device.recording)
                 )
             },
         );
@@ -263,44 +246,25 @@ impl WindowCompute {
     /// image, then blit it into the acquired swapchain image `target` and hand
     /// that to presentation. The submit must wait for `target` to be acquired
     /// at the TRANSFER stage, where the first barrier on it starts.
-    pub fn record(&self, d: &ash::Device, cmd: vk::CommandBuffer, target: vk::Image) {
-        let none = vk::AccessFlags::empty();
+    pub fn record(&self, device: &Device, cmd: vk::CommandBuffer, target: vk::Image) {
+        let d = &device.device;
         // Every pixel is written again, so the old contents may go (UNDEFINED).
-        // Waiting for TRANSFER orders this frame's writes after the previous
-        // frame's blit read the image (write after read: no access to flush).
-        let to_general = self.image.barrier(
-            none,
-            vk::AccessFlags::SHADER_WRITE,
-            vk::ImageLayout::UNDEFINED,
-            vk::ImageLayout::GENERAL,
+        // The barrier waits for the previous frame's blit to have read the
+        // image (write after read: no access to flush).
+        let to_general = (
+            barrier::STORAGE_IMAGE_AFTER_BLIT,
+            On::Image(self.image.image),
         );
         // The blit reads what the dispatch wrote; the swapchain image's old
-        // contents go, and the transition waits for the acquire semaphore,
-        // which the submit waits on at TRANSFER.
+        // contents go, and its transition starts at the stage where the submit
+        // waits for the acquire (Access::Acquire), so it follows the acquire.
         let to_blit = [
-            self.image.barrier(
-                vk::AccessFlags::SHADER_WRITE,
-                vk::AccessFlags::TRANSFER_READ,
-                vk::ImageLayout::GENERAL,
-                vk::ImageLayout::TRANSFER_SRC_OPTIMAL,
-            ),
-            image_barrier(
-                target,
-                none,
-                vk::AccessFlags::TRANSFER_WRITE,
-                vk::ImageLayout::UNDEFINED,
-                vk::ImageLayout::TRANSFER_DST_OPTIMAL,
-            ),
+            (barrier::STORAGE_IMAGE_TO_BLIT, On::Image(self.image.image)),
+            (barrier::SWAPCHAIN_TO_BLIT, On::Image(target)),
         ];
         // Presentation needs PRESENT_SRC_KHR; the render-finished semaphore,
         // signalled after every command, makes the blit's writes visible to it.
-        let to_present = image_barrier(
-            target,
-            vk::AccessFlags::TRANSFER_WRITE,
-            none,
-            vk::ImageLayout::TRANSFER_DST_OPTIMAL,
-            vk::ImageLayout::PRESENT_SRC_KHR,
-        );
+        let to_present = (barrier::SWAPCHAIN_TO_PRESENT, On::Image(target));
         let layers = vk::ImageSubresourceLayers {
             aspect_mask: vk::ImageAspectFlags::COLOR,
             mip_level: 0,
@@ -324,14 +288,7 @@ impl WindowCompute {
         // until the GPU is idle (a path switch or resize waits first); `target`
         // is the swapchain image acquired for this frame, alive with the swapchain.
         unsafe {
-            pipeline_barrier(
-                d,
-                cmd,
-                vk::PipelineStageFlags::TRANSFER,
-                vk::PipelineStageFlags::COMPUTE_SHADER,
-                &[],
-                &[to_general],
-            );
+            pipeline_barrier::record(device, cmd, &[to_general]);
             d.cmd_bind_pipeline(cmd, vk::PipelineBindPoint::COMPUTE, self.pipeline.pipeline);
             d.cmd_bind_descriptor_sets(
                 cmd,
@@ -342,31 +299,17 @@ impl WindowCompute {
                 &[],
             );
             d.cmd_dispatch(cmd, self.groups.0, self.groups.1, 1);
-            pipeline_barrier(
-                d,
-                cmd,
-                vk::PipelineStageFlags::COMPUTE_SHADER | vk::PipelineStageFlags::TRANSFER,
-                vk::PipelineStageFlags::TRANSFER,
-                &[],
-                &to_blit,
-            );
+            pipeline_barrier::record(device, cmd, &to_blit);
             d.cmd_blit_image(
                 cmd,
                 self.image.image,
-                vk::ImageLayout::TRANSFER_SRC_OPTIMAL,
+                barrier::layout_for(Access::BlitRead),
                 target,
-                vk::ImageLayout::TRANSFER_DST_OPTIMAL,
+                barrier::layout_for(Access::BlitWrite),
                 &[region],
                 vk::Filter::NEAREST,
             );
-            pipeline_barrier(
-                d,
-                cmd,
-                vk::PipelineStageFlags::TRANSFER,
-                vk::PipelineStageFlags::BOTTOM_OF_PIPE,
-                &[],
-                &[to_present],
-            );
+            pipeline_barrier::record(device, cmd, &[to_present]);
         }
     }
 }
@@ -455,7 +398,9 @@ impl Drop for ComputePipeline {
 }
 
 /// The RGBA32F storage image the shader writes, its memory and view. It is
-/// moved to GENERAL once, here, and never leaves it.
+/// moved to GENERAL once, here, for the shader's writes, and leaves it only to
+/// be copied or blitted from (TRANSFER_SRC_OPTIMAL): headless once, after the
+/// last frame; in the window every frame, and back to GENERAL after the blit.
 struct StorageImage {
     device: ash::Device,
     image: vk::Image,
@@ -482,32 +427,12 @@ impl StorageImage {
         )?;
 
         // UNDEFINED → GENERAL once: the old contents (none) may be discarded.
-        let to_general = this.barrier(
-            vk::AccessFlags::empty(),
-            vk::AccessFlags::SHADER_WRITE,
-            vk::ImageLayout::UNDEFINED,
-            vk::ImageLayout::GENERAL,
-        );
-        let (src, dst) = (
-            vk::PipelineStageFlags::TOP_OF_PIPE,
-            vk::PipelineStageFlags::COMPUTE_SHADER,
-        );
+        let to_general = (barrier::STORAGE_IMAGE_SETUP, On::Image(this.image));
         device.run_once("moving the storage image to GENERAL layout", |cmd| {
             // SAFETY: `cmd` is run_once's, recording; `this` owns the image.
-            unsafe { pipeline_barrier(d, cmd, src, dst, &[], &[to_general]) }
+            unsafe { pipeline_barrier::record(device, cmd, &[to_general]) }
         })?;
         Ok(this)
-    }
-
-    /// A barrier on the whole image, from layout `old` to `new`.
-    fn barrier(
-        &self,
-        src: vk::AccessFlags,
-        dst: vk::AccessFlags,
-        old: vk::ImageLayout,
-        new: vk::ImageLayout,
-    ) -> vk::ImageMemoryBarrier<'static> {
-        image_barrier(self.image, src, dst, old, new)
     }
 }
 

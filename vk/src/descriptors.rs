@@ -10,6 +10,7 @@
 //! their memory in bulk. The *set* is then written once to point at the buffers.
 //! Nothing changes between frames, so it is bound once, in the recorded commands.
 
+use crate::barrier::{self, Access};
 use crate::device::Device;
 use crate::memory::Buffer;
 use anyhow::{Context, Result};
@@ -122,11 +123,14 @@ impl Descriptors {
         // frees its set.
         this.pool = unsafe { d.create_descriptor_pool(&info, None) }
             .context("creating the descriptor pool")?;
+        // Printed from the sizes the pool was made with, so the compute path's
+        // storage image is there too.
         explain::numbered(step, "VkDescriptorPool", || {
-            format!(
-                "max 1 set; 1 UNIFORM_BUFFER, {} STORAGE_BUFFER",
-                storage.len()
-            )
+            let sizes: Vec<String> = sizes
+                .iter()
+                .map(|s| format!("{} {:?}", s.descriptor_count, s.ty))
+                .collect();
+            format!("max 1 set; {}", sizes.join(", "))
         });
 
         let layouts = [this.set_layout];
@@ -189,7 +193,7 @@ impl Descriptors {
         let info = [vk::DescriptorImageInfo {
             sampler: vk::Sampler::null(),
             image_view: view,
-            image_layout: vk::ImageLayout::GENERAL,
+            image_layout: barrier::layout_for(Access::ComputeShaderWrite),
         }];
         let write = vk::WriteDescriptorSet::default()
             .dst_set(self.set)

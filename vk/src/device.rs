@@ -8,6 +8,7 @@
 //! the driver sets up nothing else. Work reaches the GPU only through *queues*,
 //! which come in families with different abilities: we need one that can draw and dispatch.
 
+use crate::barrier::Recording;
 use crate::instance::Instance;
 use crate::surface::Surface;
 use anyhow::{Context, Result};
@@ -42,6 +43,8 @@ pub struct Device {
     /// fragmentStoresAndAtomics, enabled where offered: the fragment path's
     /// ray-counting frame writes a storage buffer (`--count-rays`).
     pub fragment_stores: bool,
+    /// How barriers are recorded (`--vk-sync2`): barrier.rs.
+    pub recording: Recording,
 }
 
 /// One physical device as the chooser sees it.
@@ -202,6 +205,8 @@ queue family {queue_family}: {flags:?}, timestampValidBits {timestamp_valid_bits
         let features = vk::PhysicalDeviceFeatures::default()
             .fragment_stores_and_atomics(fragment_stores && count_rays)
             .robust_buffer_access(robust_access && offered.robust_buffer_access == vk::TRUE);
+        let recording = recording(knobs, instance, &chosen.properties)?;
+        let mut vulkan_1_3 = vk::PhysicalDeviceVulkan13Features::default().synchronization2(true);
         let mut info = vk::DeviceCreateInfo::default()
             .queue_create_infos(&queue_infos)
             .enabled_extension_names(&extensions)
@@ -209,11 +214,14 @@ queue family {queue_family}: {flags:?}, timestampValidBits {timestamp_valid_bits
         if executable_info {
             info = info.push_next(&mut executable_features);
         }
+        if recording == Recording::Synchronization2 {
+            info = info.push_next(&mut vulkan_1_3);
+        }
         // SAFETY: `chosen.physical` belongs to the live instance; the queue info names a family
         // that exists (found in its list) with one priority; every extension name is a 'static C
         // string the device offers (swapchain only with a surface, which has_swapchain checked; the
-        // other only where has_extension found it); the feature struct chained with it outlives the
-        // call. The Device owns the result and destroys it on drop, after everything made on it.
+        // other only where has_extension found it); the feature structs chained with it outlive the
+        // call, synchronization2's only where `recording` found Vulkan 1.3. The Device owns the result and destroys it on drop, after everything made on it.
         let device = unsafe { vk_instance.create_device(chosen.physical, &info, None) }
             .with_context(|| format!("opening the Vulkan device '{}'", chosen.name))?;
         // SAFETY: queue 0 of `queue_family` is the one queue the create info asked for.
@@ -231,6 +239,12 @@ queue family {queue_family}: {flags:?}, timestampValidBits {timestamp_valid_bits
                     (true, _) => "fragmentStoresAndAtomics (--count-rays)",
                     (false, true) => "robustBufferAccess (bounds checks)",
                     (false, false) => "no optional features",
+                };
+                let features = match recording {
+                    Recording::Synchronization2 => {
+                        format!("{features}; synchronization2 (--vk-sync2)")
+                    }
+                    Recording::Vulkan10 => features.to_string(),
                 };
                 format!("1 queue from family {queue_family}, priority 1.0; device extensions: {ext}; {features}")
             },
@@ -254,6 +268,7 @@ queue family {queue_family}: {flags:?}, timestampValidBits {timestamp_valid_bits
             queue,
             fragment_stores: fragment_stores && count_rays,
             scene_memory: knobs.memory,
+            recording,
         })
     }
 
@@ -472,5 +487,28 @@ impl Drop for Device {
     fn drop(&mut self) {
         // SAFETY: every object made on this device was dropped before it (see app.rs).
         unsafe { self.device.destroy_device(None) };
+        explain::numbered(20, "Device::drop: vkDestroyDevice", String::new);
     }
+}
+
+/// The barrier calls a run records with: synchronization2 with `--vk-sync2`,
+/// which needs Vulkan 1.3 of the loader and the device (where it is core, so
+/// every 1.3 device offers the feature).
+fn recording(
+    knobs: &VulkanKnobs,
+    instance: &Instance,
+    properties: &vk::PhysicalDeviceProperties,
+) -> Result<Recording> {
+    if !knobs.sync2 {
+        return Ok(Recording::Vulkan10);
+    }
+    let version = instance.api_version.min(properties.api_version);
+    if version < vk::API_VERSION_1_3 {
+        return Err(bad_input(format!(
+            "--vk-sync2 needs Vulkan 1.3, and this loader and device offer {}.{}: leave it out to record Vulkan 1.0 barriers",
+            vk::api_version_major(version),
+            vk::api_version_minor(version)
+        )));
+    }
+    Ok(Recording::Synchronization2)
 }

@@ -9,13 +9,14 @@
 //!   slot's command buffer; created signalled so the first wait passes;
 //! - an **image-available semaphore** (presentation → GPU): signalled when the
 //!   acquired swapchain image may be written; the submit waits on it at the
-//!   stage that first writes the image: the colour-output stage on the
+//!   stage of the image's first access (`Draw::first_image_access`,
+//!   barrier.rs's `acquire_wait_stage`): the colour-output stage on the
 //!   fragment path, which lets the fragment shader trace before the image is
-//!   acquired; the transfer stage on the compute path, which does not: the
-//!   dispatch waits for the frame's uniform update and (through the storage
-//!   image's transition) for the previous frame's blit, both transfer commands,
-//!   and so for the acquire. docs/vulkan-walkthrough.md, step 22, says what
-//!   synchronization2 would change;
+//!   acquired; the blit on the compute path, which in Vulkan 1.0 is every
+//!   transfer, so the dispatch, after the frame's uniform update and (through
+//!   the storage image's transition) the previous frame's blit, waits for the
+//!   acquire too. With `--vk-sync2` the wait is at the blit alone
+//!   (docs/vulkan-walkthrough.md, step 22);
 //! - the swapchain's per-image **render-finished semaphore** (GPU → presentation).
 //!
 //! Command buffers are **re-recorded every frame**, not pre-recorded once per
@@ -32,10 +33,11 @@
 //! that into the swapchain image (compute.rs, `WindowCompute::record`), with
 //! the layout transitions a render pass would otherwise make.
 
+use crate::barrier::{self, Access, Barrier, Recording};
 use crate::compute::WindowCompute;
 use crate::device::Device;
 use crate::hooks::ForcedOutOfDate;
-use crate::memory::{buffer_barrier, pipeline_barrier};
+use crate::pipeline_barrier::{self, On};
 use crate::scene::SceneResources;
 use crate::swapchain::Swapchain;
 use crate::timestamps::Timestamps;
@@ -87,19 +89,20 @@ impl Draw<'_> {
         }
     }
 
-    /// The stage that reads the uniform buffer.
-    fn tracer_stage(self) -> vk::PipelineStageFlags {
+    /// The barrier from the uniform write to the tracer that reads it.
+    fn uniform_to_tracer(self) -> Barrier {
         match self {
-            Draw::Fragment { .. } => vk::PipelineStageFlags::FRAGMENT_SHADER,
-            Draw::Compute(_) => vk::PipelineStageFlags::COMPUTE_SHADER,
+            Draw::Fragment { .. } => barrier::UNIFORM_TO_FRAGMENT,
+            Draw::Compute(_) => barrier::UNIFORM_TO_COMPUTE,
         }
     }
 
-    /// The stage that first touches the acquired image, where the submit waits for it.
-    fn image_wait_stage(self) -> vk::PipelineStageFlags {
+    /// The first access to the acquired image: the submit waits for the image
+    /// at its stage (barrier.rs, `acquire_wait_stage`).
+    fn first_image_access(self) -> Access {
         match self {
-            Draw::Fragment { .. } => vk::PipelineStageFlags::COLOR_ATTACHMENT_OUTPUT,
-            Draw::Compute(_) => vk::PipelineStageFlags::TRANSFER,
+            Draw::Fragment { .. } => Access::ColorAttachmentWrite,
+            Draw::Compute(_) => Access::BlitWrite,
         }
     }
 }
@@ -216,24 +219,10 @@ impl Frames {
         // SAFETY: the fence is signalled (waited above), so no pending submission uses it.
         unsafe { d.reset_fences(&[slot.in_flight]) }.context("resetting a frame fence")?;
 
-        record(d, slot, swapchain, index, draw, frame)?;
+        record(device, slot, swapchain, index, draw, frame)?;
 
-        let waits = [slot.image_available];
-        let wait_stages = [draw.image_wait_stage()];
-        let cmds = [slot.cmd];
         let signals = [swapchain.render_finished[index as usize]];
-        let submit = vk::SubmitInfo::default()
-            .wait_semaphores(&waits)
-            .wait_dst_stage_mask(&wait_stages)
-            .command_buffers(&cmds)
-            .signal_semaphores(&signals);
-        // SAFETY: the slot's buffer was recorded just above and its previous submission has
-        // finished (its fence was waited on); the fence was reset above; the wait semaphore has a
-        // signal pending from this frame's acquire; the render-finished semaphore is that image's,
-        // whose last signal the previous present of the image waited on; only this thread uses the
-        // queue.
-        unsafe { d.queue_submit(device.queue, &[submit], slot.in_flight) }
-            .context("submitting a frame")?;
+        submit(device, slot, draw.first_image_access(), signals[0])?;
         slot.submitted = true;
         self.next = (self.next + 1) % FRAMES_IN_FLIGHT;
 
@@ -264,15 +253,59 @@ const _: () = {
     assert!(size % 4 == 0 && size <= 65536);
 };
 
+/// Submits the slot's frame: it waits for the acquired image at the stage of
+/// `first` (the image's first access), signals `finished` for the present and
+/// the slot's fence for the CPU. vkQueueSubmit2, with synchronization2, gives
+/// each semaphore its own stage.
+fn submit(device: &Device, slot: &Slot, first: Access, finished: vk::Semaphore) -> Result<()> {
+    let d = &device.device;
+    let cmds = [slot.cmd];
+    let (waits, signals) = ([slot.image_available], [finished]);
+    let submitted = match device.recording {
+        Recording::Vulkan10 => {
+            let wait_stages = [barrier::acquire_wait_stage_1_0(first)];
+            let submit = vk::SubmitInfo::default()
+                .wait_semaphores(&waits)
+                .wait_dst_stage_mask(&wait_stages)
+                .command_buffers(&cmds)
+                .signal_semaphores(&signals);
+            // SAFETY: the slot's buffer was recorded just before and its previous submission has
+            // finished (its fence was waited on); the fence was reset; the wait semaphore has a
+            // signal pending from this frame's acquire; the render-finished semaphore is that
+            // image's, whose last signal the previous present of the image waited on; only this
+            // thread uses the queue.
+            unsafe { d.queue_submit(device.queue, &[submit], slot.in_flight) }
+        }
+        Recording::Synchronization2 => {
+            let wait = [vk::SemaphoreSubmitInfo::default()
+                .semaphore(waits[0])
+                .stage_mask(barrier::acquire_wait_stage(first, device.recording))];
+            let signal = [vk::SemaphoreSubmitInfo::default()
+                .semaphore(signals[0])
+                .stage_mask(barrier::SIGNAL_AFTER_ALL)];
+            let buffers = [vk::CommandBufferSubmitInfo::default().command_buffer(slot.cmd)];
+            let submit = vk::SubmitInfo2::default()
+                .wait_semaphore_infos(&wait)
+                .command_buffer_infos(&buffers)
+                .signal_semaphore_infos(&signal);
+            // SAFETY: as for vkQueueSubmit above; the device enabled synchronization2
+            // (Device::new, for this recording).
+            unsafe { d.queue_submit2(device.queue, &[submit], slot.in_flight) }
+        }
+    };
+    submitted.context("submitting a frame")
+}
+
 /// The frame's commands, recorded afresh (see the module comment).
 fn record(
-    d: &ash::Device,
+    device: &Device,
     slot: &Slot,
     swapchain: &Swapchain,
     index: u32,
     draw: Draw,
     frame: &GpuFrame,
 ) -> Result<()> {
+    let d = &device.device;
     let cmd = slot.cmd;
     // SAFETY: the pool was made with RESET_COMMAND_BUFFER, and the slot's fence has been waited on,
     // so the buffer is not pending.
@@ -290,28 +323,22 @@ fn record(
     // the previous frame's shaders to finish reading it (write after read: an
     // execution dependency is enough; both stages, as the previous frame may
     // have run the other path), and the tracer waits for the write.
-    let uniform = draw.uniform();
-    let shaders = vk::PipelineStageFlags::FRAGMENT_SHADER | vk::PipelineStageFlags::COMPUTE_SHADER;
-    let transfer = vk::PipelineStageFlags::TRANSFER;
-    // Read after write: the tracer reads the block the update wrote.
-    let to_shader = buffer_barrier(
-        uniform,
-        vk::AccessFlags::TRANSFER_WRITE,
-        vk::AccessFlags::UNIFORM_READ,
-    );
+    let uniform = [draw.uniform()];
+    let after_reads = [(barrier::UNIFORM_AFTER_READS, On::Nothing)];
+    let to_tracer = [(draw.uniform_to_tracer(), On::Buffers(&uniform))];
     // SAFETY: `cmd` began recording above; the uniform buffer belongs to the
     // scene resources in `draw`, which the window keeps until the GPU is idle;
     // `frame` fits vkCmdUpdateBuffer (asserted at compile time above).
     unsafe {
-        pipeline_barrier(d, cmd, shaders, transfer, &[], &[]);
-        d.cmd_update_buffer(cmd, uniform, 0, bytemuck::bytes_of(frame));
-        pipeline_barrier(d, cmd, transfer, draw.tracer_stage(), &[to_shader], &[]);
+        pipeline_barrier::record(device, cmd, &after_reads);
+        d.cmd_update_buffer(cmd, uniform[0], 0, bytemuck::bytes_of(frame));
+        pipeline_barrier::record(device, cmd, &to_tracer);
     }
     match draw {
         Draw::Fragment { render_pass, scene } => {
             record_render_pass(d, cmd, swapchain, index, render_pass, scene)
         }
-        Draw::Compute(compute) => compute.record(d, cmd, swapchain.images[index as usize]),
+        Draw::Compute(compute) => compute.record(device, cmd, swapchain.images[index as usize]),
     }
     if let Some(t) = &slot.timestamps {
         t.record(cmd, 1);
@@ -381,5 +408,10 @@ impl Drop for Frames {
             }
             self.device.destroy_command_pool(self.pool, None);
         }
+        explain::numbered(
+            20,
+            "Frames::drop: vkDeviceWaitIdle; per slot vkDestroySemaphore, vkDestroyFence; vkDestroyCommandPool",
+            String::new,
+        );
     }
 }

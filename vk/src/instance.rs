@@ -36,11 +36,14 @@ impl Instance {
     /// `validate` is `--validate`: the layer is then required, not optional;
     /// `best_effort` is `--vk-validation`: on where installed, a note where not.
     /// `window_extensions` are the surface extensions a window needs (none headless).
+    /// `sync2` is `--vk-sync2`: Vulkan 1.3 is asked for, whose synchronization2
+    /// records the barriers (barrier.rs).
     // Long function: the walkthrough's first step in order (layers, extensions, application info, create, debug messenger), one block each.
     pub fn new(
         validate: bool,
         best_effort: bool,
         window_extensions: &[*const c_char],
+        sync2: bool,
     ) -> Result<Instance> {
         // SAFETY: dlopens the system's libvulkan.so.1 (its initialisers are the
         // loader's own); the Entry keeps it loaded while any of its function
@@ -79,12 +82,18 @@ impl Instance {
         let validation = installed && (validate || best_effort);
 
         // Vulkan 1.2 is asked for only to read VkPhysicalDeviceDriverProperties (the
-        // driver's name for the report). A 1.0 loader rejects any higher version.
+        // driver's name for the report), 1.3 only for --vk-sync2. A 1.0 loader
+        // rejects any higher version.
         // SAFETY: a global query through the open loader.
         let loader_version = unsafe { entry.try_enumerate_instance_version() }
             .context("asking the loader for its Vulkan version")?
             .unwrap_or(vk::API_VERSION_1_0);
-        let api_version = loader_version.min(vk::API_VERSION_1_2);
+        let wanted = if sync2 {
+            vk::API_VERSION_1_3
+        } else {
+            vk::API_VERSION_1_2
+        };
+        let api_version = loader_version.min(wanted);
         let app = vk::ApplicationInfo::default()
             .application_name(c"twinray-vk")
             .engine_name(c"twinray")
@@ -131,7 +140,7 @@ impl Instance {
                 .map(|&p| unsafe { CStr::from_ptr(p) }.to_string_lossy().into_owned())
                 .collect();
             format!(
-                "API version {} requested (loader supports {}; 1.2 only to read the driver's name)\n\
+                "API version {} requested (loader supports {}; 1.2 only to read the driver's name, 1.3 for --vk-sync2)\n\
                  layers: {}\nextensions: {}",
                 v(api_version),
                 v(loader_version),
@@ -203,5 +212,10 @@ impl Drop for Instance {
             }
             self.instance.destroy_instance(None);
         }
+        explain::numbered(
+            20,
+            "Instance::drop: vkDestroyDebugUtilsMessengerEXT (with --validate), vkDestroyInstance",
+            String::new,
+        );
     }
 }

@@ -11,6 +11,8 @@
 pub mod instance;
 pub mod device;
 pub mod memory;
+pub mod barrier;
+pub mod pipeline_barrier;
 pub mod descriptors;
 pub mod pipeline;
 pub mod scene;

@@ -12,7 +12,9 @@
 //! on every device, scene buffers are filled by writing into a host-visible
 //! *staging* buffer and letting the GPU copy it across.
 
+use crate::barrier;
 use crate::device::Device;
+use crate::pipeline_barrier::{self, On};
 use anyhow::{anyhow, Context, Result};
 use ash::vk;
 use ash::vk::MemoryPropertyFlags as Flags;
@@ -274,7 +276,7 @@ impl<'a> Uploads<'a> {
         }
         explain::numbered(5, &format!("VkBuffer + VkDeviceMemory: {what}"), || {
             format!(
-                "{size} bytes, usage {usage:?}, memory {:?}\nfilled through a {}-byte HOST_VISIBLE staging buffer: {} vkCmdCopyBuffer, then a TRANSFER -> FRAGMENT_SHADER barrier",
+                "{size} bytes, usage {usage:?}, memory {:?}\nfilled through a {}-byte HOST_VISIBLE staging buffer: {} vkCmdCopyBuffer, then the one barrier of all uploads, printed when recorded",
                 buffer.memory_flags,
                 self.staging.size,
                 chunks.len()
@@ -288,32 +290,21 @@ impl<'a> Uploads<'a> {
     /// buffers) and returns the buffers in the order they were added. The
     /// staging buffer goes: every copy from it has been waited for.
     pub fn finish(self) -> Result<Vec<Buffer>> {
-        let d = &self.device.device;
         // Read after write: the fragment (or compute) shader of every later
         // submission reads what the copies wrote; queue order alone does not
-        // order memory.
-        let barriers: Vec<_> = self
-            .filled
-            .iter()
-            .map(|buffer| {
-                buffer_barrier(
-                    buffer.buffer,
-                    vk::AccessFlags::TRANSFER_WRITE,
-                    vk::AccessFlags::UNIFORM_READ | vk::AccessFlags::SHADER_READ,
-                )
-            })
-            .collect();
-        // A compute-only queue runs no fragment stage to wait for.
-        let shaders = if self.device.queue_flags.contains(vk::QueueFlags::GRAPHICS) {
-            vk::PipelineStageFlags::FRAGMENT_SHADER | vk::PipelineStageFlags::COMPUTE_SHADER
+        // order memory. A compute-only queue runs no fragment stage to wait for.
+        let barrier = if self.device.queue_flags.contains(vk::QueueFlags::GRAPHICS) {
+            barrier::SCENE_UPLOAD
         } else {
-            vk::PipelineStageFlags::COMPUTE_SHADER
+            barrier::SCENE_UPLOAD_COMPUTE_QUEUE
         };
+        let buffers: Vec<vk::Buffer> = self.filled.iter().map(|b| b.buffer).collect();
         self.device.run_once("uploading the scene", |cmd| {
-            let transfer = vk::PipelineStageFlags::TRANSFER;
             // SAFETY: `cmd` is run_once's, recording; every buffer is in
             // `self.filled`, alive until run_once has waited for the queue.
-            unsafe { pipeline_barrier(d, cmd, transfer, shaders, &barriers, &[]) };
+            unsafe {
+                pipeline_barrier::record(self.device, cmd, &[(barrier, On::Buffers(&buffers))])
+            };
         })?;
         Ok(self.filled)
     }
@@ -340,86 +331,5 @@ impl Drop for Buffer {
             self.device.destroy_buffer(self.buffer, None);
             self.device.free_memory(self.memory, None);
         }
-    }
-}
-
-// Barriers: how a write by one stage or the host becomes visible to a later
-// access. They live beside the memory they guard, so that every module that
-// records a command can name its hazard without importing the command buffer.
-
-/// A barrier on the whole of `buffer`: the writes of `src` made available and
-/// visible to the accesses of `dst` (Arseny Kapoulkine's niagara has the same
-/// helper), so that each call site states its hazard and nothing else.
-pub fn buffer_barrier(
-    buffer: vk::Buffer,
-    src: vk::AccessFlags,
-    dst: vk::AccessFlags,
-) -> vk::BufferMemoryBarrier<'static> {
-    vk::BufferMemoryBarrier::default()
-        .src_access_mask(src)
-        .dst_access_mask(dst)
-        .src_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
-        .dst_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
-        .buffer(buffer)
-        .size(vk::WHOLE_SIZE)
-}
-
-/// All of a colour image with one mip level and one layer: every image twinray
-/// makes (targets, storage images, swapchain images) and every view of one.
-pub const COLOR_IMAGE: vk::ImageSubresourceRange = vk::ImageSubresourceRange {
-    aspect_mask: vk::ImageAspectFlags::COLOR,
-    base_mip_level: 0,
-    level_count: 1,
-    base_array_layer: 0,
-    layer_count: 1,
-};
-
-/// A barrier on a whole one-level colour image, from layout `old` to `new`.
-pub fn image_barrier(
-    image: vk::Image,
-    src: vk::AccessFlags,
-    dst: vk::AccessFlags,
-    old: vk::ImageLayout,
-    new: vk::ImageLayout,
-) -> vk::ImageMemoryBarrier<'static> {
-    vk::ImageMemoryBarrier {
-        src_access_mask: src,
-        dst_access_mask: dst,
-        old_layout: old,
-        new_layout: new,
-        src_queue_family_index: vk::QUEUE_FAMILY_IGNORED,
-        dst_queue_family_index: vk::QUEUE_FAMILY_IGNORED,
-        image,
-        subresource_range: COLOR_IMAGE,
-        ..Default::default()
-    }
-}
-
-/// Records one vkCmdPipelineBarrier from the `src` stages to the `dst` stages.
-/// Every barrier in twinray has this shape: no global memory barriers and no
-/// dependency flags, so only what differs is written at the call site.
-///
-/// # Safety
-/// `cmd` was allocated from `d` and is recording, and every buffer and image
-/// the barriers name is alive.
-pub unsafe fn pipeline_barrier(
-    d: &ash::Device,
-    cmd: vk::CommandBuffer,
-    src: vk::PipelineStageFlags,
-    dst: vk::PipelineStageFlags,
-    buffers: &[vk::BufferMemoryBarrier],
-    images: &[vk::ImageMemoryBarrier],
-) {
-    // SAFETY: forwarded from the caller.
-    unsafe {
-        d.cmd_pipeline_barrier(
-            cmd,
-            src,
-            dst,
-            vk::DependencyFlags::empty(),
-            &[],
-            buffers,
-            images,
-        )
     }
 }

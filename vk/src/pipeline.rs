@@ -16,6 +16,7 @@
 //! size never changes); windowed, the viewport and scissor are *dynamic state*,
 //! set while recording, so that a resize does not recompile the tracer.
 
+use crate::barrier::{self, Access, Barrier};
 use crate::device::Device;
 use anyhow::{Context, Result};
 use ash::vk;
@@ -51,23 +52,36 @@ impl RenderPass {
         } else {
             vk::AttachmentLoadOp::DONT_CARE
         };
-        let layout = vk::ImageLayout::TRANSFER_SRC_OPTIMAL;
-        RenderPass::new(device, target_format(pass), layout, load)
+        let out = Some(barrier::OFFSCREEN_PASS_OUT);
+        RenderPass::new(
+            device,
+            target_format(pass),
+            barrier::OFFSCREEN_PASS_IN,
+            out,
+            load,
+        )
     }
 
     /// The windowed pass: the swapchain's format, left in PRESENT_SRC_KHR.
     pub fn for_swapchain(device: &Device, format: vk::Format) -> Result<RenderPass> {
         let load = vk::AttachmentLoadOp::DONT_CARE;
-        RenderPass::new(device, format, vk::ImageLayout::PRESENT_SRC_KHR, load)
+        // Presenting needs no dependency out: the submit's semaphore covers it.
+        RenderPass::new(device, format, barrier::WINDOW_PASS_IN, None, load)
     }
 
+    /// A pass whose dependency `incoming` orders its colour writes after what
+    /// came before, and `outgoing` (headless) the next use after them; without
+    /// one, the image is presented next.
     fn new(
         device: &Device,
         format: vk::Format,
-        final_layout: vk::ImageLayout,
+        incoming: Barrier,
+        outgoing: Option<Barrier>,
         load: vk::AttachmentLoadOp,
     ) -> Result<RenderPass> {
         let d = &device.device;
+        let next = outgoing.map_or(Access::Present, |b| b.after[0]);
+        let final_layout = barrier::layout_for(next);
         // The fullscreen triangle writes every pixel, so the old contents are not
         // loaded (DONT_CARE) unless the pass asks for a CLEAR.
         let attachment = vk::AttachmentDescription::default()
@@ -75,45 +89,27 @@ impl RenderPass {
             .samples(vk::SampleCountFlags::TYPE_1)
             .load_op(load)
             .store_op(vk::AttachmentStoreOp::STORE)
-            .initial_layout(vk::ImageLayout::UNDEFINED)
+            .initial_layout(barrier::layout_for(Access::Nothing))
             .final_layout(final_layout);
         let color_ref = [vk::AttachmentReference {
             attachment: 0,
-            layout: vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL,
+            layout: barrier::layout_for(Access::ColorAttachmentWrite),
         }];
         let subpass = vk::SubpassDescription::default()
             .pipeline_bind_point(vk::PipelineBindPoint::GRAPHICS)
             .color_attachments(&color_ref);
-        // Into the pass: its writes wait for earlier colour output to the same
-        // image (headless: the previous frame; windowed: the acquire semaphore,
-        // which the submit waits on at this same stage).
-        let incoming = vk::SubpassDependency::default()
-            .src_subpass(vk::SUBPASS_EXTERNAL)
-            .dst_subpass(0)
-            .src_stage_mask(vk::PipelineStageFlags::COLOR_ATTACHMENT_OUTPUT)
-            .dst_stage_mask(vk::PipelineStageFlags::COLOR_ATTACHMENT_OUTPUT)
-            .dst_access_mask(vk::AccessFlags::COLOR_ATTACHMENT_WRITE);
+        // Into the pass: its writes wait for what came before in the same
+        // image (headless: the previous frame's colour writes; windowed: the
+        // acquire, which the submit waits for at the colour-output stage).
+        let mut dependencies = vec![incoming.subpass_dependency(vk::SUBPASS_EXTERNAL, 0)];
         // Out of the headless pass: the readback copy waits for the writes to land.
-        // (Presenting needs none: the submit's semaphore covers it.)
-        let to_copy = vk::SubpassDependency::default()
-            .src_subpass(0)
-            .dst_subpass(vk::SUBPASS_EXTERNAL)
-            .src_stage_mask(vk::PipelineStageFlags::COLOR_ATTACHMENT_OUTPUT)
-            .src_access_mask(vk::AccessFlags::COLOR_ATTACHMENT_WRITE)
-            .dst_stage_mask(vk::PipelineStageFlags::TRANSFER)
-            .dst_access_mask(vk::AccessFlags::TRANSFER_READ);
-        let dependencies: &[vk::SubpassDependency] =
-            if final_layout == vk::ImageLayout::TRANSFER_SRC_OPTIMAL {
-                &[incoming, to_copy]
-            } else {
-                &[incoming]
-            };
+        dependencies.extend(outgoing.map(|b| b.subpass_dependency(0, vk::SUBPASS_EXTERNAL)));
         let attachments = [attachment];
         let subpasses = [subpass];
         let info = vk::RenderPassCreateInfo::default()
             .attachments(&attachments)
             .subpasses(&subpasses)
-            .dependencies(dependencies);
+            .dependencies(&dependencies);
         // SAFETY: the attachment, subpass and dependency arrays are locals that outlive the call,
         // and the subpass's attachment reference names attachment 0, which exists; the RenderPass
         // returned destroys the pass.

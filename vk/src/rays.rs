@@ -4,12 +4,14 @@
 //! by kind into its slot of a host-visible storage buffer (binding 10), which
 //! is read back and added up. The timed pipeline never sees that buffer.
 
+use crate::barrier;
 use crate::commands::Commands;
 use crate::compute::Compute;
 use crate::descriptors::Descriptors;
 use crate::device::Device;
-use crate::memory::{buffer_barrier, pipeline_barrier, Buffer};
+use crate::memory::Buffer;
 use crate::pipeline::{Pipeline, RenderPass};
+use crate::pipeline_barrier::{self, On};
 use crate::scene::scene_buffers;
 use crate::target::Target;
 use anyhow::Result;
@@ -66,24 +68,11 @@ pub fn count_rays(device: &Device, run: &CountingRun) -> Result<RayKinds> {
     // Read after write: the CPU maps what the shader wrote. A barrier in a
     // later submission still orders the frame's writes, submitted before it.
     device.run_once("making the ray counts visible to the CPU", |cmd| {
-        let to_host = buffer_barrier(
-            counts_handle,
-            vk::AccessFlags::SHADER_WRITE,
-            vk::AccessFlags::HOST_READ,
-        );
-        let shaders =
-            vk::PipelineStageFlags::FRAGMENT_SHADER | vk::PipelineStageFlags::COMPUTE_SHADER;
+        let counts = [counts_handle];
         // SAFETY: `cmd` is recording (inside run_once); the buffer is
         // alive in `storage` until the end of this function.
         unsafe {
-            pipeline_barrier(
-                &device.device,
-                cmd,
-                shaders,
-                vk::PipelineStageFlags::HOST,
-                &[to_host],
-                &[],
-            )
+            pipeline_barrier::record(device, cmd, &[(barrier::RAY_COUNTS, On::Buffers(&counts))])
         };
     })?;
     let (_, counts) = storage

@@ -85,5 +85,6 @@ impl Drop for Surface {
     fn drop(&mut self) {
         // SAFETY: the swapchain made from it is gone (see window.rs's field order).
         unsafe { self.loader.destroy_surface(self.surface, None) };
+        explain::numbered(20, "Surface::drop: vkDestroySurfaceKHR", String::new);
     }
 }

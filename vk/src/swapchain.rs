@@ -252,7 +252,7 @@ impl Swapchain {
                 .image(image)
                 .view_type(vk::ImageViewType::TYPE_2D)
                 .format(format.format)
-                .subresource_range(crate::memory::COLOR_IMAGE);
+                .subresource_range(crate::barrier::COLOR_IMAGE);
             // SAFETY: `image` is one of this swapchain's images and `format` its
             // format; `this` destroys the view before the swapchain.
             let view = unsafe { d.create_image_view(&info, None) }
@@ -306,5 +306,10 @@ impl Drop for Swapchain {
             }
             self.loader.destroy_swapchain(self.swapchain, None);
         }
+        explain::numbered(
+            20,
+            "Swapchain::drop: per image vkDestroySemaphore, vkDestroyFramebuffer, vkDestroyImageView; vkDestroySwapchainKHR",
+            String::new,
+        );
     }
 }

@@ -9,10 +9,11 @@
 //! An OPTIMAL-tiled image cannot be mapped, so after the last frame the GPU
 //! copies it into a host-visible *readback* buffer as plain rows, top row first.
 
+use crate::barrier;
 use crate::device::Device;
 use crate::memory::{self, Buffer};
-use crate::memory::{buffer_barrier, pipeline_barrier};
 use crate::pipeline::target_format;
+use crate::pipeline_barrier::{self, On};
 use anyhow::{Context, Result};
 use ash::vk;
 use ash::vk::MemoryPropertyFlags as Flags;
@@ -122,7 +123,9 @@ impl Target {
 /// Records the copy of a `TRANSFER_SRC_OPTIMAL` RGBA32F image into `readback`,
 /// then the barrier that makes it visible to the CPU: a queue or fence wait
 /// covers only the GPU's side, the copy's writes reach the CPU's reads only
-/// through a barrier to HOST. Shared by the fragment and compute paths.
+/// through a barrier to HOST (and, in memory that is not host-coherent, an
+/// invalidate before the read: `Buffer::read`). Shared by the fragment and
+/// compute paths.
 pub fn record_copy_to_host(
     device: &Device,
     cmd: vk::CommandBuffer,
@@ -143,12 +146,6 @@ pub fn record_copy_to_host(
             height,
             depth: 1,
         });
-    // Read after write: the CPU maps what the copy wrote.
-    let to_host = buffer_barrier(
-        readback.buffer,
-        vk::AccessFlags::TRANSFER_WRITE,
-        vk::AccessFlags::HOST_READ,
-    );
     let d = &device.device;
     // SAFETY: `cmd` is run_once's, recording; the caller owns `image` (in
     // TRANSFER_SRC_OPTIMAL, as the region's layout says) and `readback`, which
@@ -157,18 +154,13 @@ pub fn record_copy_to_host(
         d.cmd_copy_image_to_buffer(
             cmd,
             image,
-            vk::ImageLayout::TRANSFER_SRC_OPTIMAL,
+            barrier::layout_for(barrier::Access::CopyRead),
             readback.buffer,
             &[region],
         );
-        pipeline_barrier(
-            d,
-            cmd,
-            vk::PipelineStageFlags::TRANSFER,
-            vk::PipelineStageFlags::HOST,
-            &[to_host],
-            &[],
-        );
+        // Read after write: the CPU maps what the copy wrote.
+        let to_host = [readback.buffer];
+        pipeline_barrier::record(device, cmd, &[(barrier::READBACK, On::Buffers(&to_host))]);
     }
 }
 
@@ -224,7 +216,7 @@ pub fn create_image_with_view(
         .samples(vk::SampleCountFlags::TYPE_1)
         .tiling(vk::ImageTiling::OPTIMAL)
         .usage(usage)
-        .initial_layout(vk::ImageLayout::UNDEFINED);
+        .initial_layout(barrier::layout_for(barrier::Access::Nothing));
     // SAFETY: a create on the live device from a local info; the size is within the device's
     // limits (check_size for --size and captures; in the window the swapchain's extent, which the
     // surface bounds); RGBA32F supports these usages on every device (the spec makes them
@@ -242,7 +234,7 @@ pub fn create_image_with_view(
         .image(*image)
         .view_type(vk::ImageViewType::TYPE_2D)
         .format(format)
-        .subresource_range(crate::memory::COLOR_IMAGE);
+        .subresource_range(crate::barrier::COLOR_IMAGE);
     // SAFETY: the image is bound to its memory and has the format, one level and one layer the view
     // describes.
     *view = unsafe { d.create_image_view(&info, None) }

@@ -7,6 +7,7 @@
 //! many nanoseconds a tick is, and the queue family's `timestampValidBits` says
 //! how many low bits count (0: this queue cannot write timestamps at all).
 
+use crate::barrier::Timestamp;
 use crate::device::Device;
 use anyhow::{Context, Result};
 use ash::vk;
@@ -66,9 +67,9 @@ impl Timestamps {
     /// when it has finished everything before it (BOTTOM_OF_PIPE).
     pub fn record(&self, cmd: vk::CommandBuffer, query: u32) {
         let stage = if query == 0 {
-            vk::PipelineStageFlags::TOP_OF_PIPE
+            Timestamp::Start.stage()
         } else {
-            vk::PipelineStageFlags::BOTTOM_OF_PIPE
+            Timestamp::End.stage()
         };
         assert!(query < 2, "the pool holds two queries");
         // SAFETY: as for record_reset; the query exists (checked above) and was

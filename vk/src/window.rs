@@ -15,13 +15,14 @@
 //! needs: frames, swapchain, the path's per-scene objects, render pass, device, surface, instance,
 //! and the window last of all (the surface refers to it).
 
+use crate::barrier;
 use crate::commands::Commands;
 use crate::compute::{self, Compute, WindowCompute};
 use crate::device::Device;
 use crate::frames::{Draw, FrameResult, Frames};
 use crate::instance::Instance;
-use crate::memory::{buffer_barrier, pipeline_barrier};
 use crate::pipeline::{Pipeline, RenderPass};
+use crate::pipeline_barrier::{self, On};
 use crate::scene::SceneResources;
 use crate::surface::{self, Surface};
 use crate::swapchain::{self, Swapchain};
@@ -98,6 +99,7 @@ pub fn run(
         args.validate,
         knobs.validation,
         surface::required_extensions(&window)?,
+        knobs.sync2,
     )?;
     let surface = Surface::new(&instance, &window)?;
     let device = Device::new(&instance, Some(&surface), knobs, &planner.device())?;
@@ -333,23 +335,21 @@ impl Renderer for VkWindow {
             PathResources::Fragment(s, _) => s.frame.buffer,
             PathResources::Compute(c) => c.frame.buffer,
         };
-        // Read after write: the capture's tracer reads the block the update wrote.
-        let barrier = buffer_barrier(
-            uniform,
-            vk::AccessFlags::TRANSFER_WRITE,
-            vk::AccessFlags::UNIFORM_READ,
-        );
-        let shaders =
-            vk::PipelineStageFlags::FRAGMENT_SHADER | vk::PipelineStageFlags::COMPUTE_SHADER;
         device.run_once("writing the frame uniform buffer", |cmd| {
             let d = &device.device;
+            // Read after write: the capture's tracer, of either path, reads
+            // the block the update wrote.
+            let written = [uniform];
             // SAFETY: `cmd` is run_once's, recording; the GPU is idle (waited
             // above), so no frame reads the uniform buffer, which `self.drawing`
             // owns; `frame` fits vkCmdUpdateBuffer (asserted in frames.rs).
             unsafe {
                 d.cmd_update_buffer(cmd, uniform, 0, bytemuck::bytes_of(frame));
-                let transfer = vk::PipelineStageFlags::TRANSFER;
-                pipeline_barrier(d, cmd, transfer, shaders, &[barrier], &[]);
+                pipeline_barrier::record(
+                    device,
+                    cmd,
+                    &[(barrier::UNIFORM_TO_CAPTURE, On::Buffers(&written))],
+                );
             }
         })?;
         let (scene, shaders) = match &self.drawing {

@@ -303,7 +303,7 @@ pub mod binding {
     pub const LIGHTS: u32 = 4;
     /// The compute path's RGBA32F storage image (the fragment path has a colour attachment instead).
     pub const IMAGE: u32 = 5;
-    /// 5 is the compute path's output image.
+    /// The BVH's nodes (`GpuBvhNode`), which the shader walks.
     pub const BVH_NODES: u32 = 6;
     pub const BVH_PRIMS: u32 = 7;
     // 8 held the parent links of a stackless traversal, measured and rejected

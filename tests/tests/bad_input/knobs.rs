@@ -43,6 +43,7 @@ fn each_knob_names_its_variable_or_option_and_the_bad_value() {
         (&vk, "TWINRAY_VK_MEMORY", "--vk-memory", "vram"),
         (&vk, "TWINRAY_VK_VALIDATION", "--vk-validation", "maybe"),
         (&vk, "TWINRAY_VK_WAIT", "--vk-wait", "spin"),
+        (&vk, "TWINRAY_VK_SYNC2", "--vk-sync2", "maybe"),
         (&gl, "TWINRAY_GL_DEVICE", "--gl-device", "x"),
     ] {
         let quoted = format!("'{bad}'");
