@@ -267,6 +267,41 @@ mod tests {
     }
 
     #[test]
+    fn every_obj_element_that_would_become_a_triangle_is_counted_or_refused() {
+        use crate::gpu::layout::GpuTriangle;
+        let dir = scratch("obj-elements");
+        // A device that binds exactly 1000 triangles.
+        let tiny = StorageLimit {
+            bytes: 1000 * size_of::<GpuTriangle>() as u64,
+            name: "a 1000-triangle limit",
+        };
+        let head = "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 1 1 0\n";
+        // 499 quads (998 triangles) and two triangles: the limit exactly.
+        let at_limit = format!("{head}{}f 1 2 3\nf 2 4 3\n", "f 1 2 4 3\n".repeat(499));
+        let scene = obj_scene(&dir, at_limit.as_bytes());
+        let loaded = Scene::load_limited(&scene, &[], &tiny).expect("at the limit");
+        assert_eq!(loaded.triangles.len(), 1000);
+        let over = format!("{at_limit}f 1 2 3\n");
+        let e = message(Scene::load_limited(&obj_scene(&dir, over.as_bytes()), &[], &tiny));
+        assert!(e.contains("line 506") && e.contains("1000-triangle"), "{e}");
+        // Each of these became a zero-area triangle that no count saw.
+        for (obj, words) in [
+            ("f 1\n", &["line 5", "one vertex"][..]),
+            ("f 1 2\n", &["line 5", "two vertices"]),
+            ("l 1 2\n", &["line 5", "line element"]),
+            ("l 1 2 3\n", &["line 5", "line element"]),
+            ("f\n", &["line 5", "names no vertex"]),
+        ] {
+            let scene = obj_scene(&dir, format!("{head}{obj}f 1 2 3\n").as_bytes());
+            let e = message(Scene::load(&scene, &[]));
+            for word in words {
+                assert!(e.contains(word), "{obj:?}: lacks '{word}': {e}");
+            }
+        }
+        let _ = std::fs::remove_dir_all(&dir);
+    }
+
+    #[test]
     fn obj_errors_name_their_line_and_a_byte_order_mark_is_read_past() {
         let dir = scratch("obj-lines");
         let tri = "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n";

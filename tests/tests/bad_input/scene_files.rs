@@ -153,6 +153,60 @@ fn a_polygon_past_the_triangle_limit_is_refused_from_its_line_in_little_memory()
     let _ = std::fs::remove_dir_all(&dir);
 }
 
+/// `exe args`'s exit code, stderr, seconds and peak resident memory in MB
+/// (its own, from wait4, not the largest of every child this test process ran).
+fn measured(exe: &std::path::Path, args: &[&str], dir: &std::path::Path) -> (i32, String, f64, f64) {
+    let log = dir.join("stderr.txt");
+    let start = std::time::Instant::now();
+    let child = std::process::Command::new(exe)
+        .args(args)
+        .stdout(std::process::Stdio::null())
+        .stderr(std::fs::File::create(&log).unwrap())
+        .spawn()
+        .unwrap();
+    let (mut status, mut usage) = (0, std::mem::MaybeUninit::<libc::rusage>::zeroed());
+    // SAFETY: `child` is ours and not yet reaped; wait4 writes status and usage.
+    let reaped = unsafe { libc::wait4(child.id() as i32, &mut status, 0, usage.as_mut_ptr()) };
+    assert_eq!(reaped, child.id() as i32, "wait4 on {exe:?}");
+    let secs = start.elapsed().as_secs_f64();
+    // SAFETY: wait4 succeeded, so it filled the rusage.
+    let mb = unsafe { usage.assume_init() }.ru_maxrss as f64 / 1024.0;
+    let code = if libc::WIFEXITED(status) { libc::WEXITSTATUS(status) } else { -1 };
+    (code, std::fs::read_to_string(&log).unwrap_or_default(), secs, mb)
+}
+
+#[test]
+fn fifty_million_points_or_lines_are_refused_from_their_first_line_in_little_memory() {
+    // Each `f 1` and `l 1 2` became a zero-area triangle no count saw: 50
+    // million of them took 5.9 GB and 173 s before an allocation of 10 GB failed.
+    let dir = scratch("points-and-lines");
+    for (name, head, line, words) in [
+        ("points", "v 0 0 0\n", "f 1\n", "one vertex"),
+        ("lines", "v 0 0 0\nv 1 0 0\n", "l 1 2\n", "line element"),
+    ] {
+        let mut obj = head.as_bytes().to_vec();
+        obj.extend(line.as_bytes().repeat(50_000_000));
+        std::fs::write(dir.join(format!("{name}.obj")), &obj).unwrap();
+        drop(obj);
+        let p = scene_file(
+            &dir,
+            &format!("{name}.toml"),
+            &format!("[[meshes]]\nobj = \"{name}.obj\"\nmaterial = \"m\"\n"),
+        );
+        let at = format!("{name}.obj', line {}", head.lines().count() + 1);
+        for (exe, mut args) in three_tools() {
+            args.extend(["--headless", "--size", "8x8", "--scene", &p]);
+            let (code, stderr, secs, mb) = measured(&exe, &args, &dir);
+            assert_eq!(code, 2, "{exe:?}: {stderr}");
+            assert!(stderr.contains(&at) && stderr.contains(words), "{exe:?}: {stderr}");
+            assert!(secs < 2.0, "{exe:?} took {secs:.1} s");
+            assert!(mb < 200.0, "{exe:?} took {mb:.0} MB");
+        }
+        let _ = std::fs::remove_file(dir.join(format!("{name}.obj")));
+    }
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
 #[test]
 fn an_obj_with_a_byte_order_mark_renders() {
     let dir = scratch("bom");
