@@ -153,26 +153,24 @@ fn a_polygon_past_the_triangle_limit_is_refused_from_its_line_in_little_memory()
     let _ = std::fs::remove_dir_all(&dir);
 }
 
-/// `exe args`'s exit code, stderr, seconds and peak resident memory in MB
-/// (its own, from wait4, not the largest of every child this test process ran).
-fn measured(exe: &std::path::Path, args: &[&str], dir: &std::path::Path) -> (i32, String, f64, f64) {
-    let log = dir.join("stderr.txt");
+/// `exe args`'s exit code, stderr, seconds and peak resident memory in MB.
+/// GNU time measures it: it forks `exe` from its own small process, where a
+/// child of this test process would inherit, through vfork and exec, the peak
+/// of every test that runs beside it.
+fn measured(exe: &std::path::Path, args: &[&str]) -> (i32, String, f64, f64) {
+    let time = std::path::Path::new("/usr/bin/time");
+    assert!(time.exists(), "GNU time is missing: source scripts/setup.sh installs it");
+    let mut all = vec!["-f", "peak-kb %M", exe.to_str().unwrap()];
+    all.extend(args);
     let start = std::time::Instant::now();
-    let child = std::process::Command::new(exe)
-        .args(args)
-        .stdout(std::process::Stdio::null())
-        .stderr(std::fs::File::create(&log).unwrap())
-        .spawn()
-        .unwrap();
-    let (mut status, mut usage) = (0, std::mem::MaybeUninit::<libc::rusage>::zeroed());
-    // SAFETY: `child` is ours and not yet reaped; wait4 writes status and usage.
-    let reaped = unsafe { libc::wait4(child.id() as i32, &mut status, 0, usage.as_mut_ptr()) };
-    assert_eq!(reaped, child.id() as i32, "wait4 on {exe:?}");
+    let (code, stderr) = fail(time, &all, &[]);
     let secs = start.elapsed().as_secs_f64();
-    // SAFETY: wait4 succeeded, so it filled the rusage.
-    let mb = unsafe { usage.assume_init() }.ru_maxrss as f64 / 1024.0;
-    let code = if libc::WIFEXITED(status) { libc::WEXITSTATUS(status) } else { -1 };
-    (code, std::fs::read_to_string(&log).unwrap_or_default(), secs, mb)
+    let kb: f64 = stderr
+        .lines()
+        .find_map(|l| l.strip_prefix("peak-kb "))
+        .and_then(|v| v.trim().parse().ok())
+        .unwrap_or_else(|| panic!("no peak memory from GNU time: {stderr}"));
+    (code, stderr, secs, kb / 1024.0)
 }
 
 #[test]
@@ -196,7 +194,7 @@ fn fifty_million_points_or_lines_are_refused_from_their_first_line_in_little_mem
         let at = format!("{name}.obj', line {}", head.lines().count() + 1);
         for (exe, mut args) in three_tools() {
             args.extend(["--headless", "--size", "8x8", "--scene", &p]);
-            let (code, stderr, secs, mb) = measured(&exe, &args, &dir);
+            let (code, stderr, secs, mb) = measured(&exe, &args);
             assert_eq!(code, 2, "{exe:?}: {stderr}");
             assert!(stderr.contains(&at) && stderr.contains(words), "{exe:?}: {stderr}");
             assert!(secs < 2.0, "{exe:?} took {secs:.1} s");
