@@ -30,7 +30,7 @@ pub struct AccuracyArgs {
     #[arg(long)]
     pub quick: bool,
     /// Output folder.
-    #[arg(long, default_value = "accuracy-out")]
+    #[arg(long, default_value = "accuracy-out", value_name = "DIR")]
     pub out: PathBuf,
     /// The hard-case folder (default: scenes/hard of this source tree).
     #[arg(long)]

@@ -32,7 +32,7 @@ pub struct CompareArgs {
     #[arg(long)]
     pub full: bool,
     /// Output folder.
-    #[arg(long, default_value = "comparison-out")]
+    #[arg(long, default_value = "comparison-out", value_name = "DIR")]
     pub out: PathBuf,
     /// Frames per point (the study: 60; statistics over the last 30).
     #[arg(long, value_parser = clap::value_parser!(u32).range(1..))]

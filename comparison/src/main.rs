@@ -21,7 +21,7 @@ mod report;
 mod ulp;
 mod unsettled;
 
-use clap::{Parser, Subcommand};
+use clap::{CommandFactory, FromArgMatches, Parser, Subcommand};
 use twinray_common::cli::{named_in_env, RenderArgs};
 use twinray_common::error::exit_with;
 
@@ -88,7 +88,15 @@ enum Command {
 }
 
 fn main() {
-    let cli = match Cli::try_parse() {
+    let cmd = Cli::command();
+    let parsed = cmd.clone().try_get_matches().and_then(|m| {
+        // Before any work: no output of any command may name one of its inputs.
+        if let Err(e) = twinray_common::cli::files::check_command(&cmd, &m) {
+            exit_with("twinray", e);
+        }
+        Cli::from_arg_matches(&m)
+    });
+    let cli = match parsed {
         Ok(c) => c,
         Err(e) => {
             let code = if e.use_stderr() { 2 } else { 0 };
@@ -123,5 +131,17 @@ fn main() {
     };
     if let Err(e) = result {
         exit_with("twinray", e);
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    #[test]
+    fn no_output_of_any_command_may_name_one_of_its_inputs() {
+        use clap::CommandFactory;
+        let dir = std::env::temp_dir().join(format!("twinray-pairs-{}", std::process::id()));
+        let failures = twinray_common::cli::files::every_pair_refused(&super::Cli::command(), &dir);
+        let _ = std::fs::remove_dir_all(&dir);
+        assert!(failures.is_empty(), "{}", failures.join("\n"));
     }
 }

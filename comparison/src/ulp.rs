@@ -29,7 +29,7 @@ pub struct UlpArgs {
     #[arg(long, default_value_t = 1 << 20, value_parser = clap::value_parser!(u32).range(1..=16_000_000))]
     pub inputs: u32,
     /// Output folder: ulp.md and ulp.csv.
-    #[arg(long, default_value = "ulp-out")]
+    #[arg(long, default_value = "ulp-out", value_name = "DIR")]
     pub out: PathBuf,
     /// The operations, comma-separated [default: all].
     #[arg(long, value_enum, value_delimiter = ',', value_name = "OPS")]

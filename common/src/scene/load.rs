@@ -3,7 +3,6 @@
 
 use crate::error::bad_input;
 use crate::limits::{self, StorageLimit};
-use crate::reference::image_io::same_file;
 use crate::scene::format::SceneFile;
 use crate::scene::mesh::{line_col, read_file, FileSource};
 use crate::scene::overrides::apply_overrides;
@@ -153,14 +152,20 @@ impl Scene {
 
 /// Refuses an output path (`option`, e.g. `--out`) that names the scene file
 /// `name_or_path` or a mesh file it loads: the write would replace an input
-/// with a PNG. Compared as files, so a link or another spelling of the same
-/// path is caught too. Cheap, and meant for before any work: a scene that
-/// cannot be read or parsed is left to `Scene::load` to refuse in its words.
+/// with a PNG. The check is `cli::files`'s, the one every command's outputs go through.
 pub fn check_output_not_input(option: &str, out: &Path, name_or_path: &str) -> anyhow::Result<()> {
+    crate::cli::files::check_output(option, out, name_or_path)
+}
+
+/// The files the scene `name_or_path` reads, each with what names it in a
+/// message: the scene file and the mesh of each `[[meshes]]` entry (none for a
+/// built-in or random scene). Cheap, and meant for before any work: a scene
+/// that cannot be read or parsed is left to `Scene::load` to refuse in its words.
+pub fn scene_inputs(name_or_path: &str) -> Vec<(String, std::path::PathBuf)> {
     if random::seed_of(name_or_path).is_some()
         || BUILTIN_SCENES.iter().any(|(n, _)| *n == name_or_path)
     {
-        return Ok(());
+        return Vec::new();
     }
     let scene = Path::new(name_or_path);
     let mut inputs = vec![("the scene file".to_string(), scene.to_path_buf())];
@@ -175,14 +180,7 @@ pub fn check_output_not_input(option: &str, out: &Path, name_or_path: &str) -> a
             }
         }
     }
-    match inputs.into_iter().find(|(_, input)| same_file(out, input)) {
-        Some((what, input)) => Err(bad_input(format!(
-            "{option} '{}' is {what} '{}': writing it would replace an input; choose another file name",
-            out.display(),
-            input.display()
-        ))),
-        None => Ok(()),
-    }
+    inputs
 }
 
 #[cfg(test)]

@@ -89,7 +89,7 @@ fn orchestrator_diff_and_render_errors() {
             "--heatmap",
             input.to_str().unwrap(),
         ];
-        expect_one(&tw, &args, &[], 2, &["--heatmap", "input image"]);
+        expect_one(&tw, &args, &[], 2, &["--heatmap", "replace an input"]);
     }
     // A mask of another size cannot say which pixels to leave out.
     expect_one(
@@ -105,6 +105,43 @@ fn orchestrator_diff_and_render_errors() {
         2,
         &["--exclude", "5x4"],
     );
+}
+
+/// An output that names an input, through any spelling of its path, is
+/// refused before any work and leaves the input as it was: the mask over the
+/// scene, the heatmap over the mask (each once wrote over the other, exit 0).
+#[test]
+fn an_output_never_replaces_an_input() {
+    let dir = scratch("output-over-input");
+    let tw = bin("twinray");
+    let scene = dir.join("scene.toml");
+    std::fs::write(&scene, crate::common::SCENE_HEAD).unwrap();
+    let mask = dir.join("mask.png");
+    image::RgbImage::new(4, 4).save(&mask).unwrap();
+    let a = dir.join("a.png");
+    image::RgbImage::new(4, 4).save(&a).unwrap();
+    std::fs::create_dir_all(dir.join("sub")).unwrap();
+    let spell = |file: &std::path::Path, n: usize| -> Vec<String> {
+        let (hard, sym) = (dir.join(format!("hard{n}")), dir.join(format!("sym{n}")));
+        std::fs::hard_link(file, &hard).unwrap();
+        std::os::unix::fs::symlink(file, &sym).unwrap();
+        let up = dir.join("sub/..").join(file.file_name().unwrap());
+        [file.to_path_buf(), hard, sym, up]
+            .iter()
+            .map(|p| p.to_str().unwrap().to_string())
+            .collect()
+    };
+    let before = (std::fs::read(&scene).unwrap(), std::fs::read(&mask).unwrap());
+    let (s, m, a_s) = (scene.to_str().unwrap(), mask.to_str().unwrap(), a.to_str().unwrap());
+    for out in spell(&scene, 0) {
+        let args = ["render", "--api", "reference", "--scene", s, "--size", "8x8", "--unsettled", &out];
+        expect_one(&tw, &args, &[], 2, &["--unsettled", "the scene file", "replace an input"]);
+    }
+    for out in spell(&mask, 1) {
+        let args = ["diff", a_s, a_s, "--exclude", m, "--heatmap", &out];
+        expect_one(&tw, &args, &[], 2, &["--heatmap", "--exclude", "replace an input"]);
+    }
+    assert_eq!(before, (std::fs::read(&scene).unwrap(), std::fs::read(&mask).unwrap()));
 }
 
 /// Only the f64 reference names unsettled pixels, and never over its image.
