@@ -478,8 +478,8 @@ fn sweep(
             };
             let result = run_json(api, &ra).map_err(|e| format!("{e:#}"));
             if stop.load(Ordering::SeqCst) && result.is_err() {
-                // The child got the Ctrl-C too: this point did not finish.
-                // (A SIGTERM sent to this process alone let it finish: kept.)
+                // The supervisor stopped the child with this process: this
+                // point did not finish, and is not a failed one.
                 break 'points;
             }
             if let Ok(r) = &result {

@@ -6,7 +6,8 @@
 //! `render`); `compare` is `twinray compare`'s plan and steps, `report` its
 //! report.md and plots; `accuracy` is `twinray accuracy` with its own report;
 //! `diff` is `twinray diff`; `csv` writes every CSV file; `failures` and
-//! `interrupt` are how a long run ends when some run failed or a signal came;
+//! `interrupt` are how a long run ends when some run failed or a signal came,
+//! `supervisor` how every child app is run and, on a signal, stopped;
 //! `ulp` is `twinray ulp`, the GPU's f32 arithmetic measured; `unsettled` is
 //! `render --unsettled`, the reference's mask of pixels f32 cannot settle.
 
@@ -18,6 +19,7 @@ mod diff;
 mod failures;
 mod interrupt;
 mod report;
+mod supervisor;
 mod ulp;
 mod unsettled;
 
@@ -130,6 +132,14 @@ fn main() {
         }
     };
     if let Err(e) = result {
+        // A signal before anything finished (during the device probe): no
+        // report to write, but the exit code still says which signal it was.
+        if supervisor::is_interrupted(&e) {
+            if let Some((name, code)) = interrupt::Stop::current().and_then(interrupt::Stop::signal) {
+                eprintln!("twinray: interrupted by {name} before any run finished");
+                std::process::exit(code);
+            }
+        }
         exit_with("twinray", e);
     }
 }
