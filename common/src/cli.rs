@@ -222,12 +222,25 @@ pub fn parse_size(s: &str) -> Result<Size, String> {
     Ok(Size { width, height })
 }
 
-/// `--frames`: a whole number from 1 to 100,000 (clap prefixes the option and value).
-fn parse_frames(s: &str) -> Result<u32, String> {
+/// `--frames`: a whole number from 1 to 100,000 (clap prefixes the option and
+/// value). The orchestrator's `--frames` takes the same parser, so that a
+/// count every app would refuse is refused before the first run.
+pub fn parse_frames(s: &str) -> Result<u32, String> {
     const MAX: u32 = 100_000;
     match s.trim().parse::<i64>() {
         Ok(n) if (1..=MAX as i64).contains(&n) => Ok(n as u32),
         _ => Err(format!("give a whole number of frames from 1 to {MAX}")),
+    }
+}
+
+/// A time in seconds that bounds a run (`compare --seconds-per-point`): a
+/// finite number above 0 and at most a day. It divides into a frame count, so
+/// NaN, infinity, 0 or 1e300 would each give a count no app takes.
+pub fn parse_seconds(s: &str) -> Result<f64, String> {
+    const MAX: f64 = 86_400.0;
+    match s.trim().parse::<f64>() {
+        Ok(x) if x > 0.0 && x <= MAX => Ok(x),
+        _ => Err(format!("give a number of seconds above 0 and at most {MAX}")),
     }
 }
 

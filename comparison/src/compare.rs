@@ -35,10 +35,11 @@ pub struct CompareArgs {
     #[arg(long, default_value = "comparison-out", value_name = "DIR")]
     pub out: PathBuf,
     /// Frames per point (the study: 60; statistics over the last 30).
-    #[arg(long, value_parser = clap::value_parser!(u32).range(1..))]
+    // The apps' own parser: a count they would refuse is refused here, before any run.
+    #[arg(long, value_parser = twinray_common::cli::parse_frames, allow_hyphen_values = true)]
     pub frames: Option<u32>,
     /// Fewer frames for slow points so that one app spends at most about this long on one point.
-    #[arg(long)]
+    #[arg(long, value_parser = twinray_common::cli::parse_seconds, allow_hyphen_values = true)]
     pub seconds_per_point: Option<f64>,
     /// Also run OpenGL on naga's SPIR-V (GL_ARB_gl_spirv): the same binary as Vulkan,
     /// which separates the API from the shader-compiler path.

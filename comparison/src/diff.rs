@@ -32,7 +32,14 @@ pub fn run(
                     ia.height()
                 )));
             }
-            mask_from_image(&mask)
+            let left_out = mask_from_image(&mask);
+            if left_out.iter().all(|&l| l) {
+                return Err(twinray_common::error::bad_input(format!(
+                    "--exclude '{}' names every pixel (white throughout): nothing is left to compare",
+                    path.display()
+                )));
+            }
+            left_out
         }
         None => Vec::new(),
     };

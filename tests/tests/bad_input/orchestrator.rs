@@ -91,6 +91,15 @@ fn orchestrator_diff_and_render_errors() {
         ];
         expect_one(&tw, &args, &[], 2, &["--heatmap", "replace an input"]);
     }
+    // A mask that leaves out every pixel leaves nothing to compare: it once
+    // gave a perfect match (rmse 0, exit 0) of no pixels.
+    let white = dir.join("white.png");
+    image::RgbImage::from_pixel(4, 4, image::Rgb([255, 255, 255]))
+        .save(&white)
+        .unwrap();
+    let (a_s, c_s) = (a.to_str().unwrap(), c.to_str().unwrap());
+    let args = ["diff", a_s, c_s, "--exclude", white.to_str().unwrap()];
+    expect_one(&tw, &args, &[], 2, &["--exclude", "white.png", "every pixel"]);
     // A mask of another size cannot say which pixels to leave out.
     expect_one(
         &tw,
@@ -226,6 +235,33 @@ fn compare_and_accuracy_refuse_before_creating_or_rendering() {
         &[],
         2,
         &["--frames", "'0'"],
+    );
+    // What no app accepts is refused up front, not in every run (it was
+    // accepted: "about NaN s per app per point", then each app refused 200000).
+    for (option, value) in [
+        ("--frames", "200000"),
+        ("--seconds-per-point", "nan"),
+        ("--seconds-per-point", "inf"),
+        ("--seconds-per-point", "0"),
+        ("--seconds-per-point", "-1"),
+        ("--seconds-per-point", "1e300"),
+    ] {
+        let quoted = format!("'{value}'");
+        expect_one(
+            &tw,
+            &["compare", "--quick", option, value, "--out", out_s],
+            &[],
+            2,
+            &[option, &quoted],
+        );
+    }
+    // A probe image no driver renders (2048x46875 for cross) is refused before any run.
+    expect_one(
+        &tw,
+        &["ulp", "--inputs", "16000000", "--ops", "cross", "--out", out_s],
+        &[],
+        2,
+        &["--inputs 16000000", "cross", "2048x46875", "at most 5592405"],
     );
     expect_one(
         &tw,
