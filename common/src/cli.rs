@@ -240,7 +240,9 @@ pub fn parse_seconds(s: &str) -> Result<f64, String> {
     const MAX: f64 = 86_400.0;
     match s.trim().parse::<f64>() {
         Ok(x) if x > 0.0 && x <= MAX => Ok(x),
-        _ => Err(format!("give a number of seconds above 0 and at most {MAX}")),
+        _ => Err(format!(
+            "give a number of seconds above 0 and at most {MAX}"
+        )),
     }
 }
 

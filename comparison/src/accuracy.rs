@@ -94,7 +94,11 @@ pub fn run(args: &AccuracyArgs) -> anyhow::Result<()> {
             .signal()
             .map(|(signal, _)| format!("interrupted by {signal} during the random scenes"));
         let csv = crate::csv::accuracy::random(&r)?;
-        write(&args.out, "random.csv", crate::csv::marked(csv, how.as_deref()))?;
+        write(
+            &args.out,
+            "random.csv",
+            crate::csv::marked(csv, how.as_deref()),
+        )?;
         r
     } else {
         Vec::new()

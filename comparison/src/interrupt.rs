@@ -18,6 +18,8 @@ const SIGNALS: [(i32, &str); 3] = [(SIGINT, "SIGINT"), (SIGTERM, "SIGTERM"), (SI
 static STOP: OnceLock<Stop> = OnceLock::new();
 
 /// Whether a stopping signal arrived, and which (the last, if several did).
+/// Every clone reads the same flags.
+#[derive(Clone)]
 pub struct Stop {
     flag: Arc<AtomicBool>,
     signal: Arc<AtomicUsize>,
@@ -26,9 +28,9 @@ pub struct Stop {
 impl Stop {
     /// Takes SIGINT, SIGTERM and SIGHUP over from their default (ending the
     /// process at once, losing every finished point).
-    pub fn install() -> anyhow::Result<&'static Stop> {
+    pub fn install() -> anyhow::Result<Stop> {
         if let Some(stop) = STOP.get() {
-            return Ok(stop);
+            return Ok(stop.clone());
         }
         let stop = Stop {
             flag: Arc::new(AtomicBool::new(false)),
@@ -40,7 +42,7 @@ impl Stop {
                 .and_then(|_| signal_hook::flag::register(signal, stop.flag.clone()))
                 .with_context(|| format!("installing the {name} handler"))?;
         }
-        Ok(STOP.get_or_init(|| stop))
+        Ok(STOP.get_or_init(|| stop).clone())
     }
 
     /// The installed `Stop`, if a command installed one.

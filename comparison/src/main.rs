@@ -135,7 +135,8 @@ fn main() {
         // A signal before anything finished (during the device probe): no
         // report to write, but the exit code still says which signal it was.
         if supervisor::is_interrupted(&e) {
-            if let Some((name, code)) = interrupt::Stop::current().and_then(interrupt::Stop::signal) {
+            if let Some((name, code)) = interrupt::Stop::current().and_then(interrupt::Stop::signal)
+            {
                 eprintln!("twinray: interrupted by {name} before any run finished");
                 std::process::exit(code);
             }

@@ -70,8 +70,18 @@ pub fn output(mut cmd: Command, what: &str) -> anyhow::Result<Output> {
             bytes
         })
     };
-    let stdout = drain(child.stdout.take().map(|p| Box::new(p) as Box<dyn Read + Send>));
-    let stderr = drain(child.stderr.take().map(|p| Box::new(p) as Box<dyn Read + Send>));
+    let stdout = drain(
+        child
+            .stdout
+            .take()
+            .map(|p| Box::new(p) as Box<dyn Read + Send>),
+    );
+    let stderr = drain(
+        child
+            .stderr
+            .take()
+            .map(|p| Box::new(p) as Box<dyn Read + Send>),
+    );
     let status = wait(&mut child, what)?;
     let collect = |h: std::thread::JoinHandle<Vec<u8>>| h.join().unwrap_or_default();
     let (stdout, stderr) = (collect(stdout), collect(stderr));

@@ -156,9 +156,9 @@ pub fn run(args: &UlpArgs) -> anyhow::Result<()> {
     eprintln!(
         "twinray ulp: {} runs in {seconds:.0} s{}; {} and {}",
         runs.len(),
-        interrupted
-            .as_deref()
-            .map_or(String::new(), |i| format!(" ({i}: the finished runs are kept)")),
+        interrupted.as_deref().map_or(String::new(), |i| format!(
+            " ({i}: the finished runs are kept)"
+        )),
         args.out.join("ulp.md").display(),
         args.out.join("ulp.csv").display()
     );

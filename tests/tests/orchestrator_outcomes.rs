@@ -294,13 +294,27 @@ struct Step {
 
 const STEPS: [Step; 8] = [
     Step {
-        command: &["compare", "--quick", "--only", "box,accel", "--paths", "fragment"],
+        command: &[
+            "compare",
+            "--quick",
+            "--only",
+            "box,accel",
+            "--paths",
+            "fragment",
+        ],
         hang_on: "*--frames*--accel\\ none*",
         during: "during the sweep",
         csv: "results.csv",
     },
     Step {
-        command: &["compare", "--quick", "--only", "box,accel", "--paths", "fragment"],
+        command: &[
+            "compare",
+            "--quick",
+            "--only",
+            "box,accel",
+            "--paths",
+            "fragment",
+        ],
         hang_on: "*--accel\\ bvh*",
         during: "during the acceleration runs",
         csv: "results.csv",
@@ -353,13 +367,17 @@ fn stop_while_an_app_hangs(n: usize, step: &Step, (name, code): (&str, i32)) -> 
     let mut args = vec!["--bin-dir", &apps];
     args.extend(step.command);
     args.extend(["--out", out.to_str().unwrap()]);
-    let child = orchestrator(&args);
+    let mut child = orchestrator(&args);
     let at = format!("{:?} with SIG{name}", step.command);
     let started = Instant::now();
     while !dir.join("hanging").exists() {
         if started.elapsed() > Duration::from_secs(120) {
-            let _ = Command::new("kill").args(["-KILL", &child.id().to_string()]).status();
-            return Err(format!("{at}: never reached the run matching {}", step.hang_on));
+            let _ = child.kill();
+            let _ = child.wait();
+            return Err(format!(
+                "{at}: never reached the run matching {}",
+                step.hang_on
+            ));
         }
         std::thread::sleep(Duration::from_millis(20));
     }
@@ -375,16 +393,30 @@ fn stop_while_an_app_hangs(n: usize, step: &Step, (name, code): (&str, i32)) -> 
     if secs > 2.0 {
         faults.push(format!("took {secs:.1} s after the signal"));
     }
-    let report = if step.csv == "ulp.csv" { "ulp.md" } else { "report.md" };
+    let report = if step.csv == "ulp.csv" {
+        "ulp.md"
+    } else {
+        "report.md"
+    };
     let title = std::fs::read_to_string(out.join(report)).unwrap_or_default();
     let title = title.lines().next().unwrap_or_default();
     let stated = format!("interrupted by SIG{name}");
     if !title.contains(&stated) || !title.contains(step.during) {
-        faults.push(format!("{report}'s title does not say '{stated} {}': {title}", step.during));
+        faults.push(format!(
+            "{report}'s title does not say '{stated} {}': {title}",
+            step.during
+        ));
     }
     let csv = std::fs::read_to_string(out.join(step.csv)).unwrap_or_default();
-    if !csv.lines().last().is_some_and(|l| l.starts_with(&format!("# {stated}"))) {
-        faults.push(format!("{} does not end marked interrupted:\n{csv}", step.csv));
+    if !csv
+        .lines()
+        .last()
+        .is_some_and(|l| l.starts_with(&format!("# {stated}")))
+    {
+        faults.push(format!(
+            "{} does not end marked interrupted:\n{csv}",
+            step.csv
+        ));
     }
     let left = processes_under(&dir);
     if !left.is_empty() {

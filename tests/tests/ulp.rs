@@ -204,7 +204,11 @@ fn a_run_in_which_some_apps_fail_exits_1_and_keeps_the_rest() {
     std::fs::create_dir_all(&apps).unwrap();
     std::os::unix::fs::symlink(bin("twinray-vk"), apps.join("twinray-vk")).unwrap();
     let gl = apps.join("twinray-gl");
-    std::fs::write(&gl, "#!/bin/sh\necho \"error: no context here\" >&2\nexit 3\n").unwrap();
+    std::fs::write(
+        &gl,
+        "#!/bin/sh\necho \"error: no context here\" >&2\nexit 3\n",
+    )
+    .unwrap();
     use std::os::unix::fs::PermissionsExt;
     std::fs::set_permissions(&gl, std::fs::Permissions::from_mode(0o755)).unwrap();
     let out = dir.join("out");
@@ -231,6 +235,9 @@ fn a_run_in_which_some_apps_fail_exits_1_and_keeps_the_rest() {
         "{stderr}"
     );
     let csv = std::fs::read_to_string(out.join("ulp.csv")).unwrap();
-    assert!(csv.lines().any(|l| l.starts_with("add,vulkan,fragment")), "{csv}");
+    assert!(
+        csv.lines().any(|l| l.starts_with("add,vulkan,fragment")),
+        "{csv}"
+    );
     let _ = std::fs::remove_dir_all(&dir);
 }

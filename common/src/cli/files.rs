@@ -60,9 +60,7 @@ pub fn output_kind(arg: &Arg) -> Option<Kind> {
 
 /// Whether `arg` names a file the command reads.
 pub fn is_input(arg: &Arg) -> bool {
-    names_a_path(arg)
-        && output_kind(arg).is_none()
-        && !NOT_INPUTS.contains(&arg.get_id().as_str())
+    names_a_path(arg) && output_kind(arg).is_none() && !NOT_INPUTS.contains(&arg.get_id().as_str())
 }
 
 /// How an option is named in a message: `--out`, or a positional's value name (`A`).
@@ -71,9 +69,10 @@ pub fn label(arg: &Arg) -> String {
         Some(long) => format!("--{long}"),
         None => format!(
             "the argument {}",
-            arg.get_value_names()
-                .and_then(|n| n.first())
-                .map_or_else(|| arg.get_id().to_string().to_uppercase(), |n| n.to_string())
+            arg.get_value_names().and_then(|n| n.first()).map_or_else(
+                || arg.get_id().to_string().to_uppercase(),
+                |n| n.to_string()
+            )
         ),
     }
 }
@@ -135,7 +134,10 @@ pub fn check_output(option: &str, out: &Path, scene: &str) -> anyhow::Result<()>
         .into_iter()
         .map(|(what, path)| Named { what, path })
         .collect();
-    check_paths(&[(option.to_string(), out.to_path_buf(), Kind::File)], &inputs)
+    check_paths(
+        &[(option.to_string(), out.to_path_buf(), Kind::File)],
+        &inputs,
+    )
 }
 
 /// The one comparison: each output against each input, and against the outputs before it.
@@ -148,12 +150,23 @@ fn check_paths(outputs: &[(String, PathBuf, Kind)], inputs: &[Named]) -> anyhow:
                 Kind::Folder => {
                     same_file(out, &input.path)
                         || input.path.parent().is_some_and(|p| {
-                            same_file(out, if p.as_os_str().is_empty() { Path::new(".") } else { p })
+                            same_file(
+                                out,
+                                if p.as_os_str().is_empty() {
+                                    Path::new(".")
+                                } else {
+                                    p
+                                },
+                            )
                         })
                 }
             };
             if clash {
-                let place = if *kind == Kind::File { "file name" } else { "folder" };
+                let place = if *kind == Kind::File {
+                    "file name"
+                } else {
+                    "folder"
+                };
                 let whose = if *kind == Kind::Folder && !same_file(out, &input.path) {
                     ", whose files this command replaces, holds"
                 } else {
@@ -250,7 +263,10 @@ pub fn every_pair_refused(cmd: &Command, dir: &Path) -> Vec<String> {
         }
     }
     if n == 0 {
-        failures.push(format!("{} has no (output, input) pair to test", cmd.get_name()));
+        failures.push(format!(
+            "{} has no (output, input) pair to test",
+            cmd.get_name()
+        ));
     }
     failures
 }

@@ -280,7 +280,11 @@ mod tests {
         let loaded = Scene::load_limited(&scene, &[], &tiny).expect("at the limit");
         assert_eq!(loaded.triangles.len(), 1000);
         let over = format!("{at_limit}f 1 2 3\n");
-        let e = message(Scene::load_limited(&obj_scene(&dir, over.as_bytes()), &[], &tiny));
+        let e = message(Scene::load_limited(
+            &obj_scene(&dir, over.as_bytes()),
+            &[],
+            &tiny,
+        ));
         assert!(e.contains("line 506") && e.contains("1000-triangle"), "{e}");
         // Each of these became a zero-area triangle that no count saw.
         for (obj, words) in [

@@ -104,9 +104,7 @@ pub fn read_file(what: &str, path: &Path, max: u64) -> anyhow::Result<String> {
     let too_big = || too_big(what, max);
     // Read at most max + 1 bytes: the file may grow between the check and the read.
     let mut bytes = Vec::with_capacity(len as usize);
-    file.take(max + 1)
-        .read_to_end(&mut bytes)
-        .map_err(cannot)?;
+    file.take(max + 1).read_to_end(&mut bytes).map_err(cannot)?;
     if bytes.len() as u64 > max {
         return Err(too_big());
     }

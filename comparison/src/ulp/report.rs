@@ -253,7 +253,10 @@ pub fn write(
     if let Some(how) = interrupted {
         // Said in the title and again before the tables, as compare and accuracy say it.
         let (title, rest) = md.split_once('\n').unwrap_or((&md, ""));
-        md = format!("{title} ({how})\n\n> {}: the tables hold the runs that finished.\n{rest}", capital(how));
+        md = format!(
+            "{title} ({how})\n\n> {}: the tables hold the runs that finished.\n{rest}",
+            capital(how)
+        );
     }
     write_file("--out", &out.join("ulp.md"), md.as_bytes())
 }

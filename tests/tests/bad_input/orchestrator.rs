@@ -99,7 +99,13 @@ fn orchestrator_diff_and_render_errors() {
         .unwrap();
     let (a_s, c_s) = (a.to_str().unwrap(), c.to_str().unwrap());
     let args = ["diff", a_s, c_s, "--exclude", white.to_str().unwrap()];
-    expect_one(&tw, &args, &[], 2, &["--exclude", "white.png", "every pixel"]);
+    expect_one(
+        &tw,
+        &args,
+        &[],
+        2,
+        &["--exclude", "white.png", "every pixel"],
+    );
     // A mask of another size cannot say which pixels to leave out.
     expect_one(
         &tw,
@@ -140,17 +146,52 @@ fn an_output_never_replaces_an_input() {
             .map(|p| p.to_str().unwrap().to_string())
             .collect()
     };
-    let before = (std::fs::read(&scene).unwrap(), std::fs::read(&mask).unwrap());
-    let (s, m, a_s) = (scene.to_str().unwrap(), mask.to_str().unwrap(), a.to_str().unwrap());
+    let before = (
+        std::fs::read(&scene).unwrap(),
+        std::fs::read(&mask).unwrap(),
+    );
+    let (s, m, a_s) = (
+        scene.to_str().unwrap(),
+        mask.to_str().unwrap(),
+        a.to_str().unwrap(),
+    );
     for out in spell(&scene, 0) {
-        let args = ["render", "--api", "reference", "--scene", s, "--size", "8x8", "--unsettled", &out];
-        expect_one(&tw, &args, &[], 2, &["--unsettled", "the scene file", "replace an input"]);
+        let args = [
+            "render",
+            "--api",
+            "reference",
+            "--scene",
+            s,
+            "--size",
+            "8x8",
+            "--unsettled",
+            &out,
+        ];
+        expect_one(
+            &tw,
+            &args,
+            &[],
+            2,
+            &["--unsettled", "the scene file", "replace an input"],
+        );
     }
     for out in spell(&mask, 1) {
         let args = ["diff", a_s, a_s, "--exclude", m, "--heatmap", &out];
-        expect_one(&tw, &args, &[], 2, &["--heatmap", "--exclude", "replace an input"]);
+        expect_one(
+            &tw,
+            &args,
+            &[],
+            2,
+            &["--heatmap", "--exclude", "replace an input"],
+        );
     }
-    assert_eq!(before, (std::fs::read(&scene).unwrap(), std::fs::read(&mask).unwrap()));
+    assert_eq!(
+        before,
+        (
+            std::fs::read(&scene).unwrap(),
+            std::fs::read(&mask).unwrap()
+        )
+    );
 }
 
 /// Only the f64 reference names unsettled pixels, and never over its image.
@@ -258,10 +299,17 @@ fn compare_and_accuracy_refuse_before_creating_or_rendering() {
     // A probe image no driver renders (2048x46875 for cross) is refused before any run.
     expect_one(
         &tw,
-        &["ulp", "--inputs", "16000000", "--ops", "cross", "--out", out_s],
+        &[
+            "ulp", "--inputs", "16000000", "--ops", "cross", "--out", out_s,
+        ],
         &[],
         2,
-        &["--inputs 16000000", "cross", "2048x46875", "at most 5592405"],
+        &[
+            "--inputs 16000000",
+            "cross",
+            "2048x46875",
+            "at most 5592405",
+        ],
     );
     expect_one(
         &tw,

@@ -159,7 +159,10 @@ fn a_polygon_past_the_triangle_limit_is_refused_from_its_line_in_little_memory()
 /// of every test that runs beside it.
 fn measured(exe: &std::path::Path, args: &[&str]) -> (i32, String, f64, f64) {
     let time = std::path::Path::new("/usr/bin/time");
-    assert!(time.exists(), "GNU time is missing: source scripts/setup.sh installs it");
+    assert!(
+        time.exists(),
+        "GNU time is missing: source scripts/setup.sh installs it"
+    );
     let mut all = vec!["-f", "peak-kb %M", exe.to_str().unwrap()];
     all.extend(args);
     let start = std::time::Instant::now();
@@ -196,7 +199,10 @@ fn fifty_million_points_or_lines_are_refused_from_their_first_line_in_little_mem
             args.extend(["--headless", "--size", "8x8", "--scene", &p]);
             let (code, stderr, secs, mb) = measured(&exe, &args);
             assert_eq!(code, 2, "{exe:?}: {stderr}");
-            assert!(stderr.contains(&at) && stderr.contains(words), "{exe:?}: {stderr}");
+            assert!(
+                stderr.contains(&at) && stderr.contains(words),
+                "{exe:?}: {stderr}"
+            );
             assert!(secs < 2.0, "{exe:?} took {secs:.1} s");
             assert!(mb < 200.0, "{exe:?} took {mb:.0} MB");
         }
