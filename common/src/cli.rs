@@ -308,7 +308,7 @@ impl RenderArgs {
     pub fn check_outputs(&self) -> anyhow::Result<()> {
         if let Some(out) = &self.out {
             crate::reference::image_io::check_output_file("--out", out)?;
-            crate::scene::load::check_output_not_input("--out", out, &self.scene)?;
+            files::check_output("--out", out, &self.scene)?;
         }
         Ok(())
     }

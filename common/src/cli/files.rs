@@ -309,3 +309,43 @@ fn command_line(
     argv.extend(positionals.into_iter().map(|(_, v)| v));
     argv
 }
+
+#[cfg(test)]
+mod tests {
+    use super::check_output;
+    use std::path::Path;
+
+    #[test]
+    fn an_output_may_not_name_the_scene_or_its_mesh() {
+        let dir = std::env::temp_dir().join(format!("twinray-clobber-{}", std::process::id()));
+        std::fs::create_dir_all(dir.join("sub")).unwrap();
+        std::fs::write(dir.join("mesh.obj"), "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n").unwrap();
+        let scene = dir.join("scene.toml");
+        std::fs::write(
+            &scene,
+            "[camera]\neye = [0.0, 0.0, 5.0]\nlook_at = [0.0, 0.0, 0.0]\n\
+             [[materials]]\nname = \"m\"\n[[meshes]]\nobj = \"mesh.obj\"\nmaterial = \"m\"\n",
+        )
+        .unwrap();
+        let scene = scene.to_str().unwrap();
+        for (out, words) in [
+            (
+                Path::new(scene).to_path_buf(),
+                ["the scene file", "scene.toml"],
+            ),
+            (
+                dir.join("sub/../scene.toml"),
+                ["the scene file", "scene.toml"],
+            ),
+            (dir.join("mesh.obj"), ["the mesh of meshes[0]", "mesh.obj"]),
+        ] {
+            let e = check_output("--out", &out, scene).unwrap_err();
+            for word in words {
+                assert!(e.to_string().contains(word), "{e}");
+            }
+        }
+        assert!(check_output("--out", &dir.join("image.png"), scene).is_ok());
+        assert!(check_output("--out", &dir.join("scene.toml"), "box").is_ok());
+        let _ = std::fs::remove_dir_all(&dir);
+    }
+}

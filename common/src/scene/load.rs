@@ -150,13 +150,6 @@ impl Scene {
     }
 }
 
-/// Refuses an output path (`option`, e.g. `--out`) that names the scene file
-/// `name_or_path` or a mesh file it loads: the write would replace an input
-/// with a PNG. The check is `cli::files`'s, the one every command's outputs go through.
-pub fn check_output_not_input(option: &str, out: &Path, name_or_path: &str) -> anyhow::Result<()> {
-    crate::cli::files::check_output(option, out, name_or_path)
-}
-
 /// The files the scene `name_or_path` reads, each with what names it in a
 /// message: the scene file and the mesh of each `[[meshes]]` entry (none for a
 /// built-in or random scene). Cheap, and meant for before any work: a scene
@@ -343,30 +336,6 @@ mod tests {
                 assert!(e.contains(word), "{obj:?}: lacks '{word}': {e}");
             }
         }
-        let _ = std::fs::remove_dir_all(&dir);
-    }
-
-    #[test]
-    fn an_output_may_not_name_the_scene_or_its_mesh() {
-        let dir = scratch("clobber");
-        let scene = obj_scene(&dir, b"v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n");
-        let other = dir.join("sub/../scene.toml");
-        std::fs::create_dir_all(dir.join("sub")).unwrap();
-        for (out, words) in [
-            (
-                Path::new(&scene).to_path_buf(),
-                ["the scene file", "scene.toml"],
-            ),
-            (other, ["the scene file", "scene.toml"]),
-            (dir.join("mesh.obj"), ["the mesh of meshes[0]", "mesh.obj"]),
-        ] {
-            let e = check_output_not_input("--out", &out, &scene).unwrap_err();
-            for word in words {
-                assert!(e.to_string().contains(word), "{e}");
-            }
-        }
-        assert!(check_output_not_input("--out", &dir.join("image.png"), &scene).is_ok());
-        assert!(check_output_not_input("--out", &dir.join("scene.toml"), "box").is_ok());
         let _ = std::fs::remove_dir_all(&dir);
     }
 
