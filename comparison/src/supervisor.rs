@@ -82,15 +82,15 @@ pub fn output(mut cmd: Command, what: &str) -> anyhow::Result<Output> {
             .take()
             .map(|p| Box::new(p) as Box<dyn Read + Send>),
     );
-    let status = wait(&mut child, what)?;
     let collect = |h: std::thread::JoinHandle<Vec<u8>>| h.join().unwrap_or_default();
-    let (stdout, stderr) = (collect(stdout), collect(stderr));
-    match status {
+    match wait(&mut child, what)? {
         Waited::Exited(status) => Ok(Output {
             status,
-            stdout,
-            stderr,
+            stdout: collect(stdout),
+            stderr: collect(stderr),
         }),
+        // The readers are not waited for: a process the app started may
+        // still hold the pipes, and they end by themselves when it lets go.
         Waited::Stopped(e) => Err(e),
     }
 }
@@ -114,17 +114,17 @@ enum Waited {
 }
 
 /// Waits for `child`, passing a stopping signal on to it and killing it when
-/// it outlives `GRACE`. A child that ends while the flag is up is reported as
-/// stopped whatever its status: the signal (a terminal's Ctrl-C reaches the
-/// whole process group) is why it ended.
+/// it outlives `GRACE`. A child that fails while the flag is up is reported
+/// as stopped: the signal (a terminal's Ctrl-C reaches the whole process
+/// group) is why it ended. One that succeeded finished its run: kept.
 fn wait(child: &mut Child, what: &str) -> anyhow::Result<Waited> {
     let waiting = |e| anyhow::Error::new(e).context(format!("waiting for {what}"));
     let mut signalled: Option<Instant> = None;
     loop {
         if let Some(status) = child.try_wait().map_err(waiting)? {
             return Ok(match Stop::current().filter(|s| s.stopped()) {
-                Some(stop) => Waited::Stopped(interrupted(stop)),
-                None => Waited::Exited(status),
+                Some(stop) if !status.success() => Waited::Stopped(interrupted(stop)),
+                _ => Waited::Exited(status),
             });
         }
         if let Some(stop) = Stop::current().filter(|s| s.stopped()) {
