@@ -12,8 +12,8 @@ use std::path::{Path, PathBuf};
 
 /// The options that name what a command writes, by clap id. Every other option
 /// or positional that names a path is an input. An output whose value name is
-/// `DIR` is a folder: `--out DIR` of a report command replaces the files in it,
-/// so an input may not lie there either; `--dump-shaders DIR` adds only its
+/// `DIR` is a folder: `--out DIR` of a report command replaces files in it
+/// (report.md, results.csv...), so an input file may not lie there either; `--dump-shaders DIR` adds only its
 /// own fixed names, so only the folder itself may not be an input.
 pub const OUTPUTS: &[&str] = &["out", "heatmap", "unsettled", "dump_shaders"];
 
@@ -147,18 +147,21 @@ fn check_paths(outputs: &[(String, PathBuf, Kind)], inputs: &[Named]) -> anyhow:
             let clash = match kind {
                 Kind::File => one_file(out, &input.path),
                 Kind::FolderOfFixedNames => same_file(out, &input.path),
+                // A file in the folder may bear a name the command writes
+                // (report.md, results.csv); a folder in it is left alone.
                 Kind::Folder => {
                     same_file(out, &input.path)
-                        || input.path.parent().is_some_and(|p| {
-                            same_file(
-                                out,
-                                if p.as_os_str().is_empty() {
-                                    Path::new(".")
-                                } else {
-                                    p
-                                },
-                            )
-                        })
+                        || input.path.is_file()
+                            && input.path.parent().is_some_and(|p| {
+                                same_file(
+                                    out,
+                                    if p.as_os_str().is_empty() {
+                                        Path::new(".")
+                                    } else {
+                                        p
+                                    },
+                                )
+                            })
                 }
             };
             if clash {
