@@ -13,8 +13,9 @@ use std::path::{Path, PathBuf};
 /// The options that name what a command writes, by clap id. Every other option
 /// or positional that names a path is an input. An output whose value name is
 /// `DIR` is a folder: `--out DIR` of a report command replaces files in it
-/// (report.md, results.csv...), so an input file may not lie there either; `--dump-shaders DIR` adds only its
-/// own fixed names, so only the folder itself may not be an input.
+/// (report.md, results.csv...), so an input file may not lie there either;
+/// `--dump-shaders DIR` adds only its own fixed names, so only the folder
+/// itself may not be an input.
 pub const OUTPUTS: &[&str] = &["out", "heatmap", "unsettled", "dump_shaders"];
 
 /// Options that name a path but are read-only places to look, not files this
@@ -63,7 +64,8 @@ pub fn is_input(arg: &Arg) -> bool {
     names_a_path(arg) && output_kind(arg).is_none() && !NOT_INPUTS.contains(&arg.get_id().as_str())
 }
 
-/// How an option is named in a message: `--out`, or a positional's value name (`A`).
+/// How an option is named in a message: `--out`, or a positional by its value
+/// name (`the argument A`).
 pub fn label(arg: &Arg) -> String {
     match arg.get_long() {
         Some(long) => format!("--{long}"),
@@ -83,8 +85,8 @@ struct Named {
     path: PathBuf,
 }
 
-/// Checks the outputs of the subcommand `matches` ran (or of `cmd` itself,
-/// for the apps, which have none) against its inputs and each other.
+/// Checks the outputs of the subcommand `matches` ran (or of `cmd` itself:
+/// the apps have no subcommands) against its inputs and each other.
 pub fn check_command(cmd: &Command, matches: &ArgMatches) -> anyhow::Result<()> {
     let (cmd, matches) = match matches.subcommand() {
         Some((name, sub)) => match cmd.find_subcommand(name) {
