@@ -452,3 +452,33 @@ fn every_signal_in_every_step_ends_the_run_at_once_even_while_an_app_hangs() {
     });
     assert!(failures.is_empty(), "{}", failures.join("\n"));
 }
+
+#[test]
+fn render_passes_every_signal_on_to_the_app_it_runs() {
+    // `twinray render --api vulkan` waited on its app: a signal to it alone
+    // ended it and left the app running.
+    for (name, code) in [("TERM", 143), ("INT", 130), ("HUP", 129)] {
+        let dir = scratch(&format!("render-{name}"));
+        let apps = hanging_apps(&dir, "*");
+        let child = orchestrator(&["--bin-dir", &apps, "render", "--api", "vulkan"]);
+        let started = Instant::now();
+        while !dir.join("hanging").exists() {
+            assert!(
+                started.elapsed() < Duration::from_secs(30),
+                "the app never started"
+            );
+            std::thread::sleep(Duration::from_millis(20));
+        }
+        signal(&child, name);
+        let sent = Instant::now();
+        let (got, stderr) = finish(child, Duration::from_secs(10));
+        assert_eq!(got, Some(code), "SIG{name}: {stderr}");
+        assert!(
+            sent.elapsed() < Duration::from_secs(2),
+            "SIG{name}: {:?}",
+            sent.elapsed()
+        );
+        assert_eq!(processes_under(&dir), Vec::<String>::new(), "SIG{name}");
+        let _ = std::fs::remove_dir_all(&dir);
+    }
+}
