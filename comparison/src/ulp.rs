@@ -117,7 +117,10 @@ pub fn run(args: &UlpArgs) -> anyhow::Result<()> {
     let scratch = std::env::temp_dir().join(format!("twinray-ulp-{}", std::process::id()));
     std::fs::create_dir_all(&scratch).with_context(|| format!("creating {}", scratch.display()))?;
     let started = Instant::now();
-    let mut runs = Vec::new();
+    let mut runs: Vec<Run> = Vec::new();
+    // The CPU's column, op by op as each op's runs end, so that a signal
+    // leaves at most one to compute (all 17 at 2^20 inputs take seconds).
+    let mut baseline: Vec<(UlpOp, ByClass)> = Vec::new();
     'runs: for &op in &ops {
         for &api in &apis {
             for &path in &paths {
@@ -141,12 +144,15 @@ pub fn run(args: &UlpArgs) -> anyhow::Result<()> {
                 runs.push(run);
             }
         }
+        baseline.push((op, measure::baseline(op, args.inputs)));
     }
     let _ = std::fs::remove_dir_all(&scratch);
-    let baseline: Vec<(UlpOp, ByClass)> = ops
-        .iter()
-        .map(|&op| (op, measure::baseline(op, args.inputs)))
-        .collect();
+    // An op the signal cut short keeps the runs it finished, and its column.
+    if let Some(last) = runs.last().map(|r| r.op) {
+        if !baseline.iter().any(|(op, _)| *op == last) {
+            baseline.push((last, measure::baseline(last, args.inputs)));
+        }
+    }
     let seconds = started.elapsed().as_secs_f64();
     let interrupted = stop
         .signal()
