@@ -316,7 +316,7 @@ fn write_report(
         }
     }
     if let Some(why) = why {
-        crate::report::why_table::write(out, why)?;
+        crate::report::why_table::write(out, why, results.interrupted)?;
     }
     Ok(())
 }

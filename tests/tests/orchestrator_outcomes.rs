@@ -292,7 +292,7 @@ struct Step {
     csv: &'static str,
 }
 
-const STEPS: [Step; 8] = [
+const STEPS: [Step; 9] = [
     Step {
         command: &[
             "compare",
@@ -330,6 +330,12 @@ const STEPS: [Step; 8] = [
         hang_on: "*--dump-shaders*",
         during: "during the shader statistics",
         csv: "results.csv",
+    },
+    Step {
+        command: &["compare", "--quick", "--only", "why", "--paths", "fragment"],
+        hang_on: "*--experiment*",
+        during: "during the why step",
+        csv: "why.csv",
     },
     Step {
         command: &["accuracy", "--quick", "--random", "1"],
