@@ -1,11 +1,12 @@
 # shellcheck shell=bash
 # Sourced by tests/run.sh, comparison/run.sh and .ci/run: installs what twinray
 # needs on Debian/Ubuntu (Vulkan loader + Mesa lavapipe, EGL + Mesa llvmpipe, the
-# Khronos validation layer, a C++ compiler, Xvfb and xdotool for the windowed
+# Khronos validation layer, a C++ compiler, GNU time (a child's own peak memory, for
+# the memory bounds of the bad-input tests), Xvfb and xdotool for the windowed
 # tests, glslangValidator and spirv-val to check the shader with compilers other
 # than naga, shellcheck for the scripts, and the rustfmt and clippy components) and gives Mesa a writable
 # shader cache.
-twinray_packages=(libvulkan1 mesa-vulkan-drivers vulkan-validationlayers libegl1 libegl-mesa0 libgl1-mesa-dri g++ pkg-config xvfb xauth xdotool glslang-tools spirv-tools shellcheck)
+twinray_packages=(libvulkan1 mesa-vulkan-drivers vulkan-validationlayers libegl1 libegl-mesa0 libgl1-mesa-dri g++ time pkg-config xvfb xauth xdotool glslang-tools spirv-tools shellcheck)
 twinray_missing=()
 for p in "${twinray_packages[@]}"; do
     dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || twinray_missing+=("$p")

@@ -13,12 +13,15 @@ use clap::parser::ValueSource;
 use clap::{Parser, ValueEnum};
 use std::path::PathBuf;
 
+pub mod files;
+
 // A hidden option (`hide = true`) is the laboratory's: its doc comment is its
 // row of the laboratory's page (`lab::measurement_options`, docs/experiments.md).
 #[derive(Parser, Debug, Clone, PartialEq)]
 pub struct RenderArgs {
     /// Built-in scene (teapot, box, spherelist) or a path to a scene file (.toml).
-    #[arg(long, default_value = "box")]
+    // The path hint makes it an input of `files`'s check of outputs against inputs.
+    #[arg(long, default_value = "box", value_hint = clap::ValueHint::FilePath)]
     pub scene: String,
     /// Image size as WxH.
     // Hyphen values reach parse_size, so `-64x48` is refused as a size, not as an unknown option.
@@ -224,8 +227,10 @@ pub fn parse_size(s: &str) -> Result<Size, String> {
     Ok(Size { width, height })
 }
 
-/// `--frames`: a whole number from 1 to 100,000 (clap prefixes the option and value).
-fn parse_frames(s: &str) -> Result<u32, String> {
+/// `--frames`: a whole number from 1 to 100,000 (clap prefixes the option and
+/// value). The orchestrator's `--frames` takes the same parser, so that a
+/// count every app would refuse is refused before the first run.
+pub fn parse_frames(s: &str) -> Result<u32, String> {
     const MAX: u32 = 100_000;
     match s.trim().parse::<i64>() {
         Ok(n) if (1..=MAX as i64).contains(&n) => Ok(n as u32),
@@ -240,6 +245,19 @@ fn parse_settle(s: &str) -> Result<f64, String> {
         _ => Err(
             "give the interval's half-width as a percentage above 0 and at most 50, e.g. 1".into(),
         ),
+    }
+}
+
+/// A time in seconds that bounds a run (`compare --seconds-per-point`): a
+/// finite number above 0 and at most a day. It divides into a frame count, so
+/// NaN, infinity, 0 or 1e300 would each give a count no app takes.
+pub fn parse_seconds(s: &str) -> Result<f64, String> {
+    const MAX: f64 = 86_400.0;
+    match s.trim().parse::<f64>() {
+        Ok(x) if x > 0.0 && x <= MAX => Ok(x),
+        _ => Err(format!(
+            "give a number of seconds above 0 and at most {MAX}"
+        )),
     }
 }
 
@@ -318,16 +336,30 @@ impl RenderArgs {
     pub fn check_outputs(&self) -> anyhow::Result<()> {
         if let Some(out) = &self.out {
             crate::reference::image_io::check_output_file("--out", out)?;
-            crate::scene::load::check_output_not_input("--out", out, &self.scene)?;
+            files::check_output("--out", out, &self.scene)?;
         }
         Ok(())
     }
 }
 
 /// Parses argv (and the knobs' environment variables), mapping clap's usage
-/// errors to exit code 2 (clap already prints one clear line naming the option).
+/// errors to exit code 2 (clap already prints one clear line naming the
+/// option), then refuses an output that names an input (`files`), before any work.
 pub fn parse_or_exit<T: Parser>() -> T {
-    match T::try_parse() {
+    // The binary's own name (twinray-vk, twinray-gl), as its other errors say it.
+    let program = std::env::current_exe()
+        .ok()
+        .and_then(|p| p.file_name().map(|n| n.to_string_lossy().into_owned()))
+        .unwrap_or_else(|| "twinray".to_string());
+    let cmd = T::command();
+    let matches = cmd.clone().try_get_matches();
+    let parsed = matches.and_then(|m| {
+        if let Err(e) = files::check_command(&cmd, &m) {
+            crate::error::exit_with(&program, e);
+        }
+        T::from_arg_matches(&m)
+    });
+    match parsed {
         Ok(a) => a,
         Err(e) => {
             let code = if e.use_stderr() { 2 } else { 0 };
@@ -516,6 +548,17 @@ mod tests {
     use crate::lab::experiment::Experiment;
     use crate::scene::numerics::{Offset, SphereTest, TriangleTest};
     use crate::scene::OriginMode;
+
+    #[test]
+    fn no_output_of_either_app_may_name_one_of_its_inputs() {
+        use clap::CommandFactory;
+        let dir = std::env::temp_dir().join(format!("twinray-cli-pairs-{}", std::process::id()));
+        for cmd in [VulkanCli::command(), OpenGlCli::command()] {
+            let failures = files::every_pair_refused(&cmd, &dir);
+            assert!(failures.is_empty(), "{}", failures.join("\n"));
+        }
+        let _ = std::fs::remove_dir_all(&dir);
+    }
 
     fn names<T: ValueEnum>() -> Vec<String> {
         T::value_variants().iter().map(ValueName::name).collect()

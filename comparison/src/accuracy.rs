@@ -30,7 +30,7 @@ pub struct AccuracyArgs {
     #[arg(long)]
     pub quick: bool,
     /// Output folder.
-    #[arg(long, default_value = "accuracy-out")]
+    #[arg(long, default_value = "accuracy-out", value_name = "DIR")]
     pub out: PathBuf,
     /// The hard-case folder (default: scenes/hard of this source tree).
     #[arg(long)]
@@ -90,7 +90,15 @@ pub fn run(args: &AccuracyArgs) -> anyhow::Result<()> {
         let size = random::random_size(args.quick);
         eprintln!("twinray accuracy: {random_n} random scenes at {size} x (2 APIs + reference)");
         let r = random::run_random(random_n, size, &args.out, stop.flag())?;
-        write(&args.out, "random.csv", crate::csv::accuracy::random(&r)?)?;
+        let how = stop
+            .signal()
+            .map(|(signal, _)| format!("interrupted by {signal} during the random scenes"));
+        let csv = crate::csv::accuracy::random(&r)?;
+        write(
+            &args.out,
+            "random.csv",
+            crate::csv::marked(csv, how.as_deref()),
+        )?;
         r
     } else {
         Vec::new()
@@ -172,7 +180,7 @@ fn write_reports(
     write(
         &args.out,
         "hard_cases.csv",
-        crate::csv::accuracy::hard_cases(hard_rows)?,
+        crate::csv::marked(crate::csv::accuracy::hard_cases(hard_rows)?, interrupted),
     )?;
     // With the hard cases known, numerics that fail any of them leave the front.
     // (The world-origin column is not a numerical choice of the sweeps: every
@@ -192,7 +200,7 @@ fn write_reports(
     write(
         &args.out,
         "accuracy.csv",
-        crate::csv::accuracy::accuracy(rows)?,
+        crate::csv::marked(crate::csv::accuracy::accuracy(rows)?, interrupted),
     )?;
     let mut plots = Vec::new();
     for (scene_name, _, _) in sweeps::scenes(args.quick) {

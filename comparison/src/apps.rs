@@ -216,10 +216,17 @@ pub fn render(api: Api, args: &RenderArgs, truth: bool) -> anyhow::Result<()> {
         Some(bin) => {
             let mut args = args.clone();
             args.gl_spirv |= api == Api::OpenglSpirv;
-            let status = Command::new(app_path(bin)?)
-                .args(app_args(&args))
-                .status()
-                .with_context(|| format!("starting {bin}"))?;
+            // A signal to this process alone reaches the app too, and the exit
+            // code says which it was, as for a signal that ended the app.
+            let stop = crate::interrupt::Stop::install()?;
+            let mut cmd = Command::new(app_path(bin)?);
+            cmd.args(app_args(&args));
+            let status = match crate::supervisor::status(cmd, bin) {
+                Err(e) if crate::supervisor::is_interrupted(&e) => {
+                    std::process::exit(stop.signal().map_or(1, |(_, code)| code))
+                }
+                other => other?,
+            };
             if !status.success() {
                 // The app already printed its one-line error; keep its exit code.
                 std::process::exit(status.code().unwrap_or(1));
@@ -254,10 +261,9 @@ pub fn run_json(api: Api, args: &RenderArgs) -> anyhow::Result<RunReport> {
     let mut args = args.clone();
     args.json = true;
     args.gl_spirv |= api == Api::OpenglSpirv;
-    let out = Command::new(app_path(bin)?)
-        .args(app_args(&args))
-        .output()
-        .with_context(|| format!("starting {bin}"))?;
+    let mut cmd = Command::new(app_path(bin)?);
+    cmd.args(app_args(&args));
+    let out = crate::supervisor::output(cmd, bin)?;
     if !out.status.success() {
         let stderr = String::from_utf8_lossy(&out.stderr);
         let line = error_line(&stderr).to_string();

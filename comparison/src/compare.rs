@@ -32,13 +32,14 @@ pub struct CompareArgs {
     #[arg(long)]
     pub full: bool,
     /// Output folder.
-    #[arg(long, default_value = "comparison-out")]
+    #[arg(long, default_value = "comparison-out", value_name = "DIR")]
     pub out: PathBuf,
     /// Frames per point (the study: 60; statistics over the last 30).
-    #[arg(long, value_parser = clap::value_parser!(u32).range(1..))]
+    // The apps' own parser: a count they would refuse is refused here, before any run.
+    #[arg(long, value_parser = twinray_common::cli::parse_frames, allow_hyphen_values = true)]
     pub frames: Option<u32>,
     /// Fewer frames for slow points so that one app spends at most about this long on one point.
-    #[arg(long)]
+    #[arg(long, value_parser = twinray_common::cli::parse_seconds, allow_hyphen_values = true)]
     pub seconds_per_point: Option<f64>,
     /// Also run OpenGL on naga's SPIR-V (GL_ARB_gl_spirv): the same binary as Vulkan,
     /// which separates the API from the shader-compiler path.
@@ -352,7 +353,7 @@ fn write_report(
         }
     }
     if let Some(why) = why {
-        crate::report::why_table::write(out, why)?;
+        crate::report::why_table::write(out, why, results.interrupted)?;
     }
     Ok(())
 }
@@ -519,8 +520,8 @@ fn sweep(
             };
             let result = run_json(api, &ra).map_err(|e| format!("{e:#}"));
             if stop.load(Ordering::SeqCst) && result.is_err() {
-                // The child got the Ctrl-C too: this point did not finish.
-                // (A SIGTERM sent to this process alone let it finish: kept.)
+                // The supervisor stopped the child with this process: this
+                // point did not finish, and is not a failed one.
                 break 'points;
             }
             if let Ok(r) = &result {

@@ -9,6 +9,19 @@
 pub mod accuracy;
 pub mod results;
 
+/// A CSV's text, with a last line saying that the run was interrupted
+/// (`how`: "interrupted by SIGTERM during the sweep") when it was: the rows
+/// are the runs that finished, not the whole plan. A comment line after the
+/// rows, so that the header and the columns stay as every reader knows them.
+pub fn marked(mut text: String, how: Option<&str>) -> String {
+    if let Some(how) = how {
+        text.push_str(&format!(
+            "# {how}: the rows above are the runs that finished\n"
+        ));
+    }
+    text
+}
+
 use anyhow::Context;
 use serde::{Serialize, Serializer};
 

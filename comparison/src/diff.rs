@@ -13,18 +13,10 @@ pub fn run(
     heatmap: Option<&Path>,
     exclude: Option<&Path>,
 ) -> anyhow::Result<()> {
-    // Checked first: a bad --heatmap path is said before any image is read.
+    // Checked first: a bad --heatmap path is said before any image is read
+    // (that it names no input, `main` has checked with every command's outputs).
     if let Some(path) = heatmap {
         twinray_common::reference::image_io::check_output_file("--heatmap", path)?;
-        for input in [a, b] {
-            if twinray_common::reference::image_io::same_file(path, input) {
-                return Err(twinray_common::error::bad_input(format!(
-                    "--heatmap '{}' is the input image '{}': writing it would replace an input; choose another file name",
-                    path.display(),
-                    input.display()
-                )));
-            }
-        }
     }
     let (ia, ib) = (load_png(a)?, load_png(b)?);
     let left_out = match exclude {
@@ -40,7 +32,14 @@ pub fn run(
                     ia.height()
                 )));
             }
-            mask_from_image(&mask)
+            let left_out = mask_from_image(&mask);
+            if left_out.iter().all(|&l| l) {
+                return Err(twinray_common::error::bad_input(format!(
+                    "--exclude '{}' names every pixel (white throughout): nothing is left to compare",
+                    path.display()
+                )));
+            }
+            left_out
         }
         None => Vec::new(),
     };

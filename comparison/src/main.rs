@@ -6,7 +6,8 @@
 //! `render`); `compare` is `twinray compare`'s plan and steps, `report` its
 //! report.md and plots; `accuracy` is `twinray accuracy` with its own report;
 //! `diff` is `twinray diff`; `csv` writes every CSV file; `failures` and
-//! `interrupt` are how a long run ends when some run failed or a signal came;
+//! `interrupt` are how a long run ends when some run failed or a signal came,
+//! `supervisor` how every child app is run and, on a signal, stopped;
 //! `summary` is `twinray summary`, the verdict table over compare folders;
 //! `ulp` is `twinray ulp`, the GPU's f32 arithmetic measured; `unsettled` is
 //! `render --unsettled`, the reference's mask of pixels f32 cannot settle.
@@ -20,10 +21,11 @@ mod failures;
 mod interrupt;
 mod report;
 mod summary;
+mod supervisor;
 mod ulp;
 mod unsettled;
 
-use clap::{Parser, Subcommand};
+use clap::{CommandFactory, FromArgMatches, Parser, Subcommand};
 use twinray_common::cli::{named_in_env, RenderArgs};
 use twinray_common::error::exit_with;
 
@@ -96,7 +98,15 @@ enum Command {
 }
 
 fn main() {
-    let cli = match Cli::try_parse() {
+    let cmd = Cli::command();
+    let parsed = cmd.clone().try_get_matches().and_then(|m| {
+        // Before any work: no output of any command may name one of its inputs.
+        if let Err(e) = twinray_common::cli::files::check_command(&cmd, &m) {
+            exit_with("twinray", e);
+        }
+        Cli::from_arg_matches(&m)
+    });
+    let cli = match parsed {
         Ok(c) => c,
         Err(e) => {
             let code = if e.use_stderr() { 2 } else { 0 };
@@ -131,6 +141,27 @@ fn main() {
         }
     };
     if let Err(e) = result {
+        // A signal before anything finished (during the device probe): no
+        // report to write, but the exit code still says which signal it was.
+        if supervisor::is_interrupted(&e) {
+            if let Some((name, code)) = interrupt::Stop::current().and_then(interrupt::Stop::signal)
+            {
+                eprintln!("twinray: interrupted by {name} before any run finished");
+                std::process::exit(code);
+            }
+        }
         exit_with("twinray", e);
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    #[test]
+    fn no_output_of_any_command_may_name_one_of_its_inputs() {
+        use clap::CommandFactory;
+        let dir = std::env::temp_dir().join(format!("twinray-pairs-{}", std::process::id()));
+        let failures = twinray_common::cli::files::every_pair_refused(&super::Cli::command(), &dir);
+        let _ = std::fs::remove_dir_all(&dir);
+        assert!(failures.is_empty(), "{}", failures.join("\n"));
     }
 }

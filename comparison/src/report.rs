@@ -44,7 +44,13 @@ pub fn write_all(out: &Path, results: &Results) -> anyhow::Result<()> {
     let cpu = cpu_model();
     std::fs::write(
         out.join("results.csv"),
-        crate::csv::results::results(results.outcomes, &cpu)?,
+        crate::csv::marked(
+            crate::csv::results::results(results.outcomes, &cpu)?,
+            results
+                .interrupted
+                .map(|i| format!("interrupted by {} during {}", i.signal, i.step))
+                .as_deref(),
+        ),
     )
     .context("writing results.csv")?;
     let study = study::rows();

@@ -29,7 +29,7 @@ pub struct UlpArgs {
     #[arg(long, default_value_t = 1 << 20, value_parser = clap::value_parser!(u32).range(1..=16_000_000))]
     pub inputs: u32,
     /// Output folder: ulp.md and ulp.csv.
-    #[arg(long, default_value = "ulp-out")]
+    #[arg(long, default_value = "ulp-out", value_name = "DIR")]
     pub out: PathBuf,
     /// The operations, comma-separated [default: all].
     #[arg(long, value_enum, value_delimiter = ',', value_name = "OPS")]
@@ -70,6 +70,30 @@ pub fn image_size(results: u64) -> Size {
     }
 }
 
+/// The tallest probe image: 16384 rows (of 2048 pixels), the largest 2D
+/// image lavapipe and llvmpipe accept and GL 4.5's least GL_MAX_TEXTURE_SIZE,
+/// so a run that needs more would only fail in the app, after the others.
+const MAX_ROWS: u32 = 16384;
+
+/// Refuses `--inputs` that some chosen operation cannot fit in one probe
+/// image, before any run, naming the operation and the largest count that fits.
+fn check_inputs(inputs: u32, ops: &[UlpOp]) -> anyhow::Result<()> {
+    use twinray_common::value_name::ValueName;
+    for &op in ops {
+        let results = u64::from(inputs) * u64::from(ops::components(op));
+        let size = image_size(results);
+        if size.height > MAX_ROWS {
+            let fits = u64::from(MAX_ROWS) * 2048 / 2 / u64::from(ops::components(op));
+            return Err(bad_input(format!(
+                "--inputs {inputs}: {} gives {results} results, a {size} image, taller than the {MAX_ROWS} rows every driver renders; give --inputs at most {fits} or leave {} out of --ops",
+                op.name(),
+                op.name()
+            )));
+        }
+    }
+    Ok(())
+}
+
 fn or_default<T: Clone>(chosen: &[T], default: &[T]) -> Vec<T> {
     if chosen.is_empty() { default } else { chosen }.to_vec()
 }
@@ -84,16 +108,30 @@ pub fn run(args: &UlpArgs) -> anyhow::Result<()> {
     }
     let ops = or_default(&args.ops, UlpOp::value_variants());
     let paths = or_default(&args.paths, &[RenderPath::Fragment, RenderPath::Compute]);
+    check_inputs(args.inputs, &ops)?;
     apps::check_present()?;
     prepare_output_dir("--out", &args.out)?;
+    // SIGINT, SIGTERM and SIGHUP end the runs (the supervisor stops the
+    // running app); the finished runs are measured and written, marked.
+    let stop = crate::interrupt::Stop::install()?;
     let scratch = std::env::temp_dir().join(format!("twinray-ulp-{}", std::process::id()));
     std::fs::create_dir_all(&scratch).with_context(|| format!("creating {}", scratch.display()))?;
     let started = Instant::now();
-    let mut runs = Vec::new();
-    for &op in &ops {
+    let mut runs: Vec<Run> = Vec::new();
+    // The CPU's column, op by op as each op's runs end, so that a signal
+    // leaves at most one to compute (all 17 at 2^20 inputs take seconds).
+    let mut baseline: Vec<(UlpOp, ByClass)> = Vec::new();
+    'runs: for &op in &ops {
         for &api in &apis {
             for &path in &paths {
+                if stop.stopped() {
+                    break 'runs;
+                }
                 let run = probe(op, api, path, args.inputs, &scratch);
+                if stop.stopped() && run.stats.is_err() {
+                    // Stopped by the signal, not failed: not a run of the report.
+                    break 'runs;
+                }
                 match &run.stats {
                     Ok(s) => eprintln!(
                         "twinray ulp: {}: max {:.3} ULP ({:.1} s)",
@@ -106,29 +144,40 @@ pub fn run(args: &UlpArgs) -> anyhow::Result<()> {
                 runs.push(run);
             }
         }
+        baseline.push((op, measure::baseline(op, args.inputs)));
     }
     let _ = std::fs::remove_dir_all(&scratch);
-    let baseline: Vec<(UlpOp, ByClass)> = ops
-        .iter()
-        .map(|&op| (op, measure::baseline(op, args.inputs)))
-        .collect();
+    // An op the signal cut short keeps the runs it finished, and its column.
+    if let Some(last) = runs.last().map(|r| r.op) {
+        if !baseline.iter().any(|(op, _)| *op == last) {
+            baseline.push((last, measure::baseline(last, args.inputs)));
+        }
+    }
     let seconds = started.elapsed().as_secs_f64();
-    report::write(&args.out, &runs, &baseline, args.inputs, seconds)?;
+    let interrupted = stop
+        .signal()
+        .map(|(signal, _)| format!("interrupted by {signal}"));
+    let at = (args.inputs, seconds, interrupted.as_deref());
+    report::write(&args.out, &runs, &baseline, at)?;
     eprintln!(
-        "twinray ulp: {} runs in {seconds:.0} s; {} and {}",
+        "twinray ulp: {} runs in {seconds:.0} s{}; {} and {}",
         runs.len(),
+        interrupted.as_deref().map_or(String::new(), |i| format!(
+            " ({i}: the finished runs are kept)"
+        )),
         args.out.join("ulp.md").display(),
         args.out.join("ulp.csv").display()
     );
+    if let Some((_, code)) = stop.signal() {
+        std::process::exit(code);
+    }
     let failed: Vec<(String, String)> = runs
         .iter()
         .filter_map(|r| r.stats.as_ref().err().map(|e| (r.label(), e.clone())))
         .collect();
-    if failed.len() == runs.len() {
-        // Nothing measured: the report says why, and so does the exit code.
-        crate::failures::check(&failed)?;
-    }
-    Ok(())
+    // A run that failed is not a success, as in compare and accuracy: the
+    // report says why, and so does the exit code.
+    crate::failures::check(&failed)
 }
 
 /// One run: the app renders the probe, the PNG is decoded and measured.

@@ -3,10 +3,10 @@
 //! for `twinray diff --exclude`.
 
 use crate::apps::{self, Api};
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use twinray_common::cli::RenderArgs;
 use twinray_common::error::bad_input;
-use twinray_common::reference::image_io::{check_output_file, same_file, write_png};
+use twinray_common::reference::image_io::{check_output_file, write_png};
 use twinray_common::reference::unsettled::{mask_image, unsettled};
 use twinray_common::scene::Scene;
 
@@ -22,13 +22,8 @@ pub fn render(api: Api, args: &RenderArgs, truth: bool, mask: Option<&Path>) -> 
             "--unsettled is the f64 reference's: use it with --api reference",
         ));
     }
+    // That it is neither --out nor an input, `main` has checked with every command's outputs.
     check_output_file("--unsettled", mask)?;
-    if args.out.as_deref().is_some_and(|out| one_file(out, mask)) {
-        return Err(bad_input(format!(
-            "--unsettled '{}' is also --out: the mask would replace the image; choose another file name",
-            mask.display()
-        )));
-    }
     apps::render(api, args, truth)?;
     let scene = Scene::load(&args.scene, &args.overrides()?)?;
     let (w, h) = (args.size.width, args.size.height);
@@ -37,18 +32,4 @@ pub fn render(api: Api, args: &RenderArgs, truth: bool, mask: Option<&Path>) -> 
         "--unsettled",
         mask,
     )
-}
-
-/// Whether two output paths name one file, existing or not: the same file, or
-/// the same name in the same folder however the folder is spelt.
-fn one_file(a: &Path, b: &Path) -> bool {
-    let place = |p: &Path| -> Option<PathBuf> {
-        let dir = p.parent().filter(|d| !d.as_os_str().is_empty());
-        Some(
-            std::fs::canonicalize(dir.unwrap_or(Path::new(".")))
-                .ok()?
-                .join(p.file_name()?),
-        )
-    };
-    same_file(a, b) || place(a).is_some_and(|x| Some(x) == place(b))
 }

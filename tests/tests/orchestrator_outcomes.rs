@@ -240,3 +240,253 @@ fn sigterm_during_the_accuracy_sweeps_keeps_the_finished_runs_and_exits_143() {
         "the finished runs are kept:\n{csv}"
     );
 }
+
+/// Stand-in apps that hang, ignoring every signal, on a run whose command
+/// line matches the shell pattern `hang_on` (after touching `dir/hanging`, so
+/// that a test knows the step has reached it), and fail at once on any
+/// other, so that the orchestrator reaches the step under test quickly.
+fn hanging_apps(dir: &Path, hang_on: &str) -> String {
+    let bin_dir = dir.join("apps");
+    std::fs::create_dir_all(&bin_dir).unwrap();
+    let marker = dir.join("hanging");
+    for app in ["twinray-vk", "twinray-gl"] {
+        let script = format!(
+            "#!/bin/sh\n\
+             case \"$*\" in {hang_on})\n\
+               trap '' TERM INT HUP\n\
+               touch '{}'\n\
+               while :; do sleep 0.05; done ;;\n\
+             esac\n\
+             echo \"error: not a real app ({app})\" >&2\n\
+             exit 2\n",
+            marker.display()
+        );
+        let path = bin_dir.join(app);
+        std::fs::write(&path, script).unwrap();
+        use std::os::unix::fs::PermissionsExt;
+        std::fs::set_permissions(&path, std::fs::Permissions::from_mode(0o755)).unwrap();
+    }
+    bin_dir.to_str().unwrap().to_string()
+}
+
+/// Every process whose command line names `dir`: what a stopped run must not leave.
+fn processes_under(dir: &Path) -> Vec<String> {
+    let dir = dir.to_string_lossy().to_string();
+    std::fs::read_dir("/proc")
+        .unwrap()
+        .filter_map(|e| e.ok()?.file_name().to_str()?.parse::<u32>().ok())
+        .filter_map(|pid| {
+            let cmdline = std::fs::read(format!("/proc/{pid}/cmdline")).ok()?;
+            let cmdline = String::from_utf8_lossy(&cmdline).replace('\0', " ");
+            cmdline.contains(&dir).then(|| format!("{pid}: {cmdline}"))
+        })
+        .collect()
+}
+
+/// One step of one command, with the shell pattern of the run that hangs in
+/// it, the words its report's title gives the step, and its CSV.
+struct Step {
+    command: &'static [&'static str],
+    hang_on: &'static str,
+    during: &'static str,
+    csv: &'static str,
+}
+
+const STEPS: [Step; 9] = [
+    Step {
+        command: &[
+            "compare",
+            "--quick",
+            "--only",
+            "box,accel",
+            "--paths",
+            "fragment",
+        ],
+        hang_on: "*--frames*--accel\\ none*",
+        during: "during the sweep",
+        csv: "results.csv",
+    },
+    Step {
+        command: &[
+            "compare",
+            "--quick",
+            "--only",
+            "box,accel",
+            "--paths",
+            "fragment",
+        ],
+        hang_on: "*--accel\\ bvh*",
+        during: "during the acceleration runs",
+        csv: "results.csv",
+    },
+    Step {
+        command: &["compare", "--quick", "--only", "box", "--paths", "fragment"],
+        hang_on: "*/images/*",
+        during: "during the image agreement",
+        csv: "results.csv",
+    },
+    Step {
+        command: &["compare", "--quick", "--only", "box", "--paths", "fragment"],
+        hang_on: "*--dump-shaders*",
+        during: "during the shader statistics",
+        csv: "results.csv",
+    },
+    Step {
+        command: &["compare", "--quick", "--only", "why", "--paths", "fragment"],
+        hang_on: "*--experiment*",
+        during: "during the why step",
+        csv: "why.csv",
+    },
+    Step {
+        command: &["accuracy", "--quick", "--random", "1"],
+        hang_on: "*",
+        during: "during the sweeps",
+        csv: "accuracy.csv",
+    },
+    Step {
+        command: &["accuracy", "--quick", "--random", "1"],
+        hang_on: "*/hard/*",
+        during: "during the hard cases",
+        csv: "hard_cases.csv",
+    },
+    Step {
+        command: &["accuracy", "--quick", "--no-hard", "--random", "1"],
+        hang_on: "*random:*",
+        during: "during the random scenes",
+        csv: "random.csv",
+    },
+    Step {
+        // Every operation at the default 2^20 inputs: the CPU's column of all
+        // of them, computed after the signal, once took 2.6 s more.
+        command: &["ulp"],
+        hang_on: "*",
+        during: "interrupted by",
+        csv: "ulp.csv",
+    },
+];
+
+/// One step, one signal: the orchestrator ends within 2 s with the signal's
+/// code although the app it runs ignores the signal, writes its report and
+/// CSV marked interrupted, and leaves no app running and no scratch folder.
+fn stop_while_an_app_hangs(n: usize, step: &Step, (name, code): (&str, i32)) -> Result<(), String> {
+    let dir = scratch(&format!("hang-{n}-{name}"));
+    let apps = hanging_apps(&dir, step.hang_on);
+    let out = dir.join("out");
+    let mut args = vec!["--bin-dir", &apps];
+    args.extend(step.command);
+    args.extend(["--out", out.to_str().unwrap()]);
+    let mut child = orchestrator(&args);
+    let at = format!("{:?} with SIG{name}", step.command);
+    let started = Instant::now();
+    while !dir.join("hanging").exists() {
+        if started.elapsed() > Duration::from_secs(120) {
+            let _ = child.kill();
+            let _ = child.wait();
+            return Err(format!(
+                "{at}: never reached the run matching {}",
+                step.hang_on
+            ));
+        }
+        std::thread::sleep(Duration::from_millis(20));
+    }
+    let pid = child.id();
+    signal(&child, name);
+    let sent = Instant::now();
+    let (got, stderr) = finish(child, Duration::from_secs(10));
+    let secs = sent.elapsed().as_secs_f64();
+    let mut faults = Vec::new();
+    if got != Some(code) {
+        faults.push(format!("exit {got:?}, not {code}: {stderr}"));
+    }
+    if secs > 2.0 {
+        faults.push(format!("took {secs:.1} s after the signal"));
+    }
+    let report = if step.csv == "ulp.csv" {
+        "ulp.md"
+    } else {
+        "report.md"
+    };
+    let title = std::fs::read_to_string(out.join(report)).unwrap_or_default();
+    let title = title.lines().next().unwrap_or_default();
+    let stated = format!("interrupted by SIG{name}");
+    if !title.contains(&stated) || !title.contains(step.during) {
+        faults.push(format!(
+            "{report}'s title does not say '{stated} {}': {title}",
+            step.during
+        ));
+    }
+    let csv = std::fs::read_to_string(out.join(step.csv)).unwrap_or_default();
+    if !csv
+        .lines()
+        .last()
+        .is_some_and(|l| l.starts_with(&format!("# {stated}")))
+    {
+        faults.push(format!(
+            "{} does not end marked interrupted:\n{csv}",
+            step.csv
+        ));
+    }
+    let left = processes_under(&dir);
+    if !left.is_empty() {
+        faults.push(format!("apps left running: {left:?}"));
+    }
+    let scratch_dir = std::env::temp_dir().join(format!("twinray-ulp-{pid}"));
+    if scratch_dir.exists() {
+        faults.push(format!("{} left behind", scratch_dir.display()));
+    }
+    let _ = std::fs::remove_dir_all(&dir);
+    match faults.is_empty() {
+        true => Ok(()),
+        false => Err(format!("{at}: {}", faults.join("; "))),
+    }
+}
+
+#[test]
+fn every_signal_in_every_step_ends_the_run_at_once_even_while_an_app_hangs() {
+    // A signal to the orchestrator alone once waited for the app to end (35 s,
+    // 108 s), and forever for an app that hangs; `ulp` had no handler at all.
+    let signals = [("TERM", 143), ("INT", 130), ("HUP", 129)];
+    let failures: Vec<String> = std::thread::scope(|s| {
+        let handles: Vec<_> = STEPS
+            .iter()
+            .enumerate()
+            .flat_map(|(n, step)| signals.iter().map(move |&sig| (n, step, sig)))
+            .map(|(n, step, sig)| s.spawn(move || stop_while_an_app_hangs(n, step, sig)))
+            .collect();
+        handles
+            .into_iter()
+            .filter_map(|h| h.join().unwrap().err())
+            .collect()
+    });
+    assert!(failures.is_empty(), "{}", failures.join("\n"));
+}
+
+#[test]
+fn render_passes_every_signal_on_to_the_app_it_runs() {
+    // `twinray render --api vulkan` waited on its app: a signal to it alone
+    // ended it and left the app running.
+    for (name, code) in [("TERM", 143), ("INT", 130), ("HUP", 129)] {
+        let dir = scratch(&format!("render-{name}"));
+        let apps = hanging_apps(&dir, "*");
+        let child = orchestrator(&["--bin-dir", &apps, "render", "--api", "vulkan"]);
+        let started = Instant::now();
+        while !dir.join("hanging").exists() {
+            assert!(
+                started.elapsed() < Duration::from_secs(30),
+                "the app never started"
+            );
+            std::thread::sleep(Duration::from_millis(20));
+        }
+        signal(&child, name);
+        let sent = Instant::now();
+        let (got, stderr) = finish(child, Duration::from_secs(10));
+        assert_eq!(got, Some(code), "SIG{name}: {stderr}");
+        assert!(
+            sent.elapsed() < Duration::from_secs(2),
+            "SIG{name}: {:?}",
+            sent.elapsed()
+        );
+        assert_eq!(processes_under(&dir), Vec::<String>::new(), "SIG{name}");
+        let _ = std::fs::remove_dir_all(&dir);
+    }
+}

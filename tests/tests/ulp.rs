@@ -195,3 +195,49 @@ fn the_probes_options_are_refused_where_they_cannot_apply() {
     assert_eq!(code, 2, "{stderr}");
     assert!(stderr.contains("--apis reference"), "{stderr}");
 }
+
+#[test]
+fn a_run_in_which_some_apps_fail_exits_1_and_keeps_the_rest() {
+    // 4 of 8 runs failed and `twinray ulp` exited 0: a failure only when all did.
+    let dir = scratch("ulp-some-fail");
+    let apps = dir.join("apps");
+    std::fs::create_dir_all(&apps).unwrap();
+    std::os::unix::fs::symlink(bin("twinray-vk"), apps.join("twinray-vk")).unwrap();
+    let gl = apps.join("twinray-gl");
+    std::fs::write(
+        &gl,
+        "#!/bin/sh\necho \"error: no context here\" >&2\nexit 3\n",
+    )
+    .unwrap();
+    use std::os::unix::fs::PermissionsExt;
+    std::fs::set_permissions(&gl, std::fs::Permissions::from_mode(0o755)).unwrap();
+    let out = dir.join("out");
+    let (code, stderr) = fail(
+        &bin("twinray"),
+        &[
+            "--bin-dir",
+            apps.to_str().unwrap(),
+            "ulp",
+            "--inputs",
+            "64",
+            "--ops",
+            "add",
+            "--paths",
+            "fragment",
+            "--out",
+            out.to_str().unwrap(),
+        ],
+        &[],
+    );
+    assert_eq!(code, 1, "{stderr}");
+    assert!(
+        stderr.contains("1 run failed") && stderr.contains("no context here"),
+        "{stderr}"
+    );
+    let csv = std::fs::read_to_string(out.join("ulp.csv")).unwrap();
+    assert!(
+        csv.lines().any(|l| l.starts_with("add,vulkan,fragment")),
+        "{csv}"
+    );
+    let _ = std::fs::remove_dir_all(&dir);
+}

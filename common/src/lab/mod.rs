@@ -159,6 +159,16 @@ pub const REGISTRY: &[Entry] = &[
     },
 ];
 
+/// Experiments that cannot be combined, each pair with why: the shader has
+/// no variant for both (naga would refuse it, naming a macro the user never
+/// wrote). A pair where one wins (`naga-loop-bounding` over
+/// `no-loop-bounding`) is not here: its entry says which.
+pub const EXCLUSIVE: &[(Experiment, Experiment, &str)] = &[(
+    Experiment::SharedBvhStack,
+    Experiment::LocalBvhStack,
+    "the BVH stack lives either in shared memory or in each walk",
+)];
+
 /// The registry's entry for `e`.
 pub fn entry_of(e: Experiment) -> &'static Entry {
     REGISTRY
@@ -175,6 +185,15 @@ pub fn check(args: &RenderArgs, api: Api) -> anyhow::Result<()> {
         return Err(bad_input(
             "--gl-spirv is an OpenGL option: Vulkan always runs naga's SPIR-V",
         ));
+    }
+    for (a, b, why) in EXCLUSIVE {
+        if args.experiment.contains(a) && args.experiment.contains(b) {
+            return Err(bad_input(format!(
+                "--experiment {} with --experiment {}: {why}; drop one of them",
+                a.name(),
+                b.name()
+            )));
+        }
     }
     for e in &args.experiment {
         let (r, name) = (entry_of(*e), e.name());

@@ -68,7 +68,13 @@ pub fn compare_outside(
         above_1 += (worst > 1) as usize;
         above_8 += (worst > 8) as usize;
     }
-    let n = n.max(1);
+    // Nothing compared is no evidence of a match: an RMSE of 0 over no pixels
+    // read as a perfect one.
+    if n == 0 {
+        return Err(crate::error::bad_input(
+            "the mask leaves out every pixel: nothing is left to compare",
+        ));
+    }
     let rmse = (sq / (n * 3) as f64).sqrt();
     let psnr_db = if rmse == 0.0 {
         f64::INFINITY
@@ -121,6 +127,8 @@ mod tests {
         assert!((m.above_1 - 1.0 / 99.0).abs() < 1e-12);
         assert_eq!(m.above_8, 0.0);
         assert_eq!(compare(&a, &b).unwrap().max_abs, 100);
+        let e = compare_outside(&a, &b, &[true; 100]).unwrap_err();
+        assert_eq!(crate::error::exit_code_of(&e), 2, "{e}");
     }
 
     #[test]

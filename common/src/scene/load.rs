@@ -3,7 +3,6 @@
 
 use crate::error::bad_input;
 use crate::limits::{self, StorageLimit};
-use crate::reference::image_io::same_file;
 use crate::scene::format::SceneFile;
 use crate::scene::mesh::{line_col, read_file, FileSource};
 use crate::scene::overrides::apply_overrides;
@@ -151,16 +150,15 @@ impl Scene {
     }
 }
 
-/// Refuses an output path (`option`, e.g. `--out`) that names the scene file
-/// `name_or_path` or a mesh file it loads: the write would replace an input
-/// with a PNG. Compared as files, so a link or another spelling of the same
-/// path is caught too. Cheap, and meant for before any work: a scene that
-/// cannot be read or parsed is left to `Scene::load` to refuse in its words.
-pub fn check_output_not_input(option: &str, out: &Path, name_or_path: &str) -> anyhow::Result<()> {
+/// The files the scene `name_or_path` reads, each with what names it in a
+/// message: the scene file and the mesh of each `[[meshes]]` entry (none for a
+/// built-in or random scene). Cheap, and meant for before any work: a scene
+/// that cannot be read or parsed is left to `Scene::load` to refuse in its words.
+pub fn scene_inputs(name_or_path: &str) -> Vec<(String, std::path::PathBuf)> {
     if random::seed_of(name_or_path).is_some()
         || BUILTIN_SCENES.iter().any(|(n, _)| *n == name_or_path)
     {
-        return Ok(());
+        return Vec::new();
     }
     let scene = Path::new(name_or_path);
     let mut inputs = vec![("the scene file".to_string(), scene.to_path_buf())];
@@ -175,14 +173,7 @@ pub fn check_output_not_input(option: &str, out: &Path, name_or_path: &str) -> a
             }
         }
     }
-    match inputs.into_iter().find(|(_, input)| same_file(out, input)) {
-        Some((what, input)) => Err(bad_input(format!(
-            "{option} '{}' is {what} '{}': writing it would replace an input; choose another file name",
-            out.display(),
-            input.display()
-        ))),
-        None => Ok(()),
-    }
+    inputs
 }
 
 #[cfg(test)]
@@ -267,6 +258,45 @@ mod tests {
     }
 
     #[test]
+    fn every_obj_element_that_would_become_a_triangle_is_counted_or_refused() {
+        use crate::gpu::layout::GpuTriangle;
+        let dir = scratch("obj-elements");
+        // A device that binds exactly 1000 triangles.
+        let tiny = StorageLimit {
+            bytes: 1000 * size_of::<GpuTriangle>() as u64,
+            name: "a 1000-triangle limit",
+        };
+        let head = "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 1 1 0\n";
+        // 499 quads (998 triangles) and two triangles: the limit exactly.
+        let at_limit = format!("{head}{}f 1 2 3\nf 2 4 3\n", "f 1 2 4 3\n".repeat(499));
+        let scene = obj_scene(&dir, at_limit.as_bytes());
+        let loaded = Scene::load_limited(&scene, &[], &tiny).expect("at the limit");
+        assert_eq!(loaded.triangles.len(), 1000);
+        let over = format!("{at_limit}f 1 2 3\n");
+        let e = message(Scene::load_limited(
+            &obj_scene(&dir, over.as_bytes()),
+            &[],
+            &tiny,
+        ));
+        assert!(e.contains("line 506") && e.contains("1000-triangle"), "{e}");
+        // Each of these became a zero-area triangle that no count saw.
+        for (obj, words) in [
+            ("f 1\n", &["line 5", "one vertex"][..]),
+            ("f 1 2\n", &["line 5", "two vertices"]),
+            ("l 1 2\n", &["line 5", "line element"]),
+            ("l 1 2 3\n", &["line 5", "line element"]),
+            ("f\n", &["line 5", "names no vertex"]),
+        ] {
+            let scene = obj_scene(&dir, format!("{head}{obj}f 1 2 3\n").as_bytes());
+            let e = message(Scene::load(&scene, &[]));
+            for word in words {
+                assert!(e.contains(word), "{obj:?}: lacks '{word}': {e}");
+            }
+        }
+        let _ = std::fs::remove_dir_all(&dir);
+    }
+
+    #[test]
     fn obj_errors_name_their_line_and_a_byte_order_mark_is_read_past() {
         let dir = scratch("obj-lines");
         let tri = "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n";
@@ -306,30 +336,6 @@ mod tests {
                 assert!(e.contains(word), "{obj:?}: lacks '{word}': {e}");
             }
         }
-        let _ = std::fs::remove_dir_all(&dir);
-    }
-
-    #[test]
-    fn an_output_may_not_name_the_scene_or_its_mesh() {
-        let dir = scratch("clobber");
-        let scene = obj_scene(&dir, b"v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n");
-        let other = dir.join("sub/../scene.toml");
-        std::fs::create_dir_all(dir.join("sub")).unwrap();
-        for (out, words) in [
-            (
-                Path::new(&scene).to_path_buf(),
-                ["the scene file", "scene.toml"],
-            ),
-            (other, ["the scene file", "scene.toml"]),
-            (dir.join("mesh.obj"), ["the mesh of meshes[0]", "mesh.obj"]),
-        ] {
-            let e = check_output_not_input("--out", &out, &scene).unwrap_err();
-            for word in words {
-                assert!(e.to_string().contains(word), "{e}");
-            }
-        }
-        assert!(check_output_not_input("--out", &dir.join("image.png"), &scene).is_ok());
-        assert!(check_output_not_input("--out", &dir.join("scene.toml"), "box").is_ok());
         let _ = std::fs::remove_dir_all(&dir);
     }
 

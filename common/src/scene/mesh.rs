@@ -1,6 +1,7 @@
 //! The files a scene names: the built-in ones embedded in the binary, any file
-//! read within its size limit, OBJ meshes (each line checked and every face's
-//! triangles counted here, then read by tobj) and Bezier-patch (.bpt) meshes
+//! read within its size limit, OBJ meshes (every element that becomes a
+//! triangle counted in one streamed pass before the text is read, each line
+//! checked, then read by tobj) and Bezier-patch (.bpt) meshes
 //! tessellated by `teapot` — both counted against the limits before they are made.
 
 use crate::error::bad_input;
@@ -69,11 +70,16 @@ impl Faces {
     }
 }
 
-/// A file's text, refused with a message naming `what` when it is not a regular
-/// file (`/dev/zero`, a pipe, a folder), is larger than `max` bytes, or is not
-/// UTF-8 (with the line and column of the first bad byte).
-pub fn read_file(what: &str, path: &Path, max: u64) -> anyhow::Result<String> {
-    use std::io::Read;
+fn too_big(what: &str, max: u64) -> anyhow::Error {
+    bad_input(format!(
+        "{what} is larger than the limit of {max} bytes ({})",
+        limits::gib(max)
+    ))
+}
+
+/// A file opened for reading and its length, refused as `read_file` says when
+/// it is not a regular file or is larger than `max` bytes.
+fn open_file(what: &str, path: &Path, max: u64) -> anyhow::Result<(std::fs::File, u64)> {
     let cannot = |e: std::io::Error| bad_input(format!("{what} cannot be read: {}", io_reason(&e)));
     let meta = std::fs::metadata(path).map_err(cannot)?;
     if !meta.is_file() {
@@ -81,20 +87,24 @@ pub fn read_file(what: &str, path: &Path, max: u64) -> anyhow::Result<String> {
             "{what} is not a regular file (a folder, device or pipe)"
         )));
     }
-    let too_big = || {
-        bad_input(format!(
-            "{what} is larger than the limit of {max} bytes ({})",
-            limits::gib(max)
-        ))
-    };
     if meta.len() > max {
-        return Err(too_big());
+        return Err(too_big(what, max));
     }
+    let file = std::fs::File::open(path).map_err(cannot)?;
+    Ok((file, meta.len()))
+}
+
+/// A file's text, refused with a message naming `what` when it is not a regular
+/// file (`/dev/zero`, a pipe, a folder), is larger than `max` bytes, or is not
+/// UTF-8 (with the line and column of the first bad byte).
+pub fn read_file(what: &str, path: &Path, max: u64) -> anyhow::Result<String> {
+    use std::io::Read;
+    let (file, len) = open_file(what, path, max)?;
+    let cannot = |e: std::io::Error| bad_input(format!("{what} cannot be read: {}", io_reason(&e)));
+    let too_big = || too_big(what, max);
     // Read at most max + 1 bytes: the file may grow between the check and the read.
-    let mut bytes = Vec::with_capacity(meta.len() as usize);
-    std::fs::File::open(path)
-        .and_then(|f| f.take(max + 1).read_to_end(&mut bytes))
-        .map_err(cannot)?;
+    let mut bytes = Vec::with_capacity(len as usize);
+    file.take(max + 1).read_to_end(&mut bytes).map_err(cannot)?;
     if bytes.len() as u64 > max {
         return Err(too_big());
     }
@@ -184,18 +194,34 @@ pub(super) fn load_bpt(
     Ok(Faces::Indexed(teapot::tessellate(&patches, nu, nv)))
 }
 
-/// An OBJ mesh's triangles. The text is checked line by line first
-/// (`scan_obj`), so that an error names its line and a face's triangles are
-/// counted before tobj expands them; tobj then reads what the scan passed.
+/// An OBJ mesh's triangles. The file is first streamed once (`count_obj`),
+/// so that every element that becomes a triangle is counted before the text is
+/// even read whole; the text is then checked line by line (`scan_obj`), so that
+/// an error names its line, and tobj reads what both passed.
 pub(super) fn load_obj(
     at: &str,
     file: &str,
     (before, limit): (usize, &StorageLimit),
     files: &FileSource,
 ) -> anyhow::Result<Faces> {
-    let text = read_text(&format!("{at}.obj"), file, files)?;
     let what = format!("{at}.obj '{file}'");
-    scan_obj(&what, &text, before, limit)?;
+    let (total, text) = match files {
+        FileSource::Builtin => {
+            let text = read_text(&format!("{at}.obj"), file, files)?;
+            (count_obj(&what, text.as_bytes(), before, limit)?, text)
+        }
+        FileSource::Dir(dir) => {
+            let path = dir.join(file);
+            let (f, _) = open_file(
+                &format!("{at}.obj '{}'", path.display()),
+                &path,
+                limits::MAX_MESH_FILE_BYTES,
+            )?;
+            let total = count_obj(&what, std::io::BufReader::new(f), before, limit)?;
+            (total, read_text(&format!("{at}.obj"), file, files)?)
+        }
+    };
+    scan_obj(&what, &text, total)?;
     let opts = tobj::LoadOptions {
         triangulate: true,
         single_index: true,
@@ -252,28 +278,92 @@ pub(super) fn load_obj(
     Ok(Faces::Soup(out))
 }
 
-/// Checks an OBJ text the way tobj reads it (`v`, `vt`, `vn`, `f` and `l`
-/// lines; others are ignored), naming the line of the first fault, and counts
-/// each face's triangles (a polygon of k vertices gives k - 2) against the
-/// triangle limit and `limit` as it goes. Memory stays within the text's own:
-/// a polygon of 50 million vertices is refused from its vertex count alone,
-/// where tobj would have expanded it to gigabytes first.
-fn scan_obj(what: &str, text: &str, before: usize, limit: &StorageLimit) -> anyhow::Result<()> {
+/// The one pass that counts what an OBJ will become, streamed from `reader`
+/// a line at a time, so that memory stays within its longest line: its `v`,
+/// `vt` and `vn` elements (returned, for `scan_obj`'s index checks) and the
+/// triangles of its faces (a polygon of k vertices gives k - 2), against the
+/// triangle limit and `limit` as it goes. Every element tobj would turn into a
+/// triangle is counted or refused here: tobj makes a face of one or two
+/// vertices, and every line element (`l`), into a zero-area triangle, so 50
+/// million `f 1` lines would otherwise be gigabytes before any limit saw them.
+fn count_obj(
+    what: &str,
+    mut reader: impl std::io::BufRead,
+    before: usize,
+    limit: &StorageLimit,
+) -> anyhow::Result<[usize; 3]> {
     let at = |line: usize, msg: &str| bad_input(format!("{what}, line {line}: {msg}"));
-    // tobj resolves a positive index at the end of its object, so it may name
-    // a vertex further down; relative (negative) ones count back from the line.
     let mut total = [0usize; 3];
-    for line in text.lines() {
-        match line.split_whitespace().next() {
+    let mut triangles = before;
+    let mut bytes = Vec::new();
+    for n in 1.. {
+        bytes.clear();
+        let read = reader
+            .read_until(b'\n', &mut bytes)
+            .map_err(|e| bad_input(format!("{what} cannot be read: {}", io_reason(&e))))?;
+        if read == 0 {
+            break;
+        }
+        // A line that is not UTF-8 is `read_file`'s to refuse, with its column.
+        let Ok(line) = std::str::from_utf8(&bytes) else {
+            continue;
+        };
+        let line = if n == 1 {
+            line.trim_start_matches('\u{feff}')
+        } else {
+            line
+        };
+        let mut words = line.split_whitespace();
+        match words.next() {
             Some("v") => total[0] += 1,
             Some("vt") => total[1] += 1,
             Some("vn") => total[2] += 1,
+            Some("l") => {
+                return Err(at(
+                    n,
+                    "a line element (`l`) is not a surface: it would become a zero-area \
+                     triangle; the tracer draws faces (`f`) of three or more vertices",
+                ))
+            }
+            Some("f") => {
+                // Counted before a single index is parsed: this line may hold millions.
+                let vertices = words.count();
+                match vertices {
+                    // tobj takes a bare `f` for a polygon and refuses it without a line number.
+                    0 => return Err(at(n, "not a valid OBJ file: `f` names no vertex")),
+                    1 | 2 => {
+                        let named = ["", "one vertex", "two vertices"][vertices];
+                        return Err(at(
+                            n,
+                            &format!(
+                                "a face of {named} is not a surface: it would become a \
+                                 zero-area triangle; a face needs three or more vertices"
+                            ),
+                        ));
+                    }
+                    _ => {}
+                }
+                triangles = triangles.saturating_add(vertices - 2);
+                let what =
+                    format!("{what}, line {n}: triangles of its faces with those before them");
+                limits::check_count(&what, triangles, limits::MAX_TRIANGLES)?;
+                limit.check(&what, "triangles", triangles, size_of::<GpuTriangle>())?;
+            }
             _ => {}
         }
     }
+    Ok(total)
+}
+
+/// Checks an OBJ text the way tobj reads it (`v`, `vt`, `vn` and `f` lines;
+/// others are ignored, `l` lines are `count_obj`'s to refuse), naming the line
+/// of the first fault; `total` is `count_obj`'s count of each kind of element.
+fn scan_obj(what: &str, text: &str, total: [usize; 3]) -> anyhow::Result<()> {
+    let at = |line: usize, msg: &str| bad_input(format!("{what}, line {line}: {msg}"));
+    // tobj resolves a positive index at the end of its object, so it may name
+    // a vertex further down; relative (negative) ones count back from the line.
     let mut seen = [0usize; 3];
     let mut zero_normals = HashSet::new();
-    let mut triangles = before;
     for (i, line) in text.lines().enumerate() {
         let n = i + 1;
         let mut words = line.split_whitespace();
@@ -302,25 +392,9 @@ fn scan_obj(what: &str, text: &str, before: usize, limit: &StorageLimit) -> anyh
                 }
                 seen[2] += 1;
             }
-            Some(kind @ ("f" | "l")) => {
-                // tobj takes a bare `f` or `l` for a polygon and refuses it
-                // without a line number.
-                if words.clone().next().is_none() {
-                    return Err(at(
-                        n,
-                        &format!("not a valid OBJ file: `{kind}` names no vertex"),
-                    ));
-                }
-                if kind == "f" {
-                    // Counted before a single index is parsed: this line may hold millions.
-                    triangles = triangles.saturating_add(words.clone().count().saturating_sub(2));
-                    let what =
-                        format!("{what}, line {n}: triangles of its faces with those before them");
-                    limits::check_count(&what, triangles, limits::MAX_TRIANGLES)?;
-                    limit.check(&what, "triangles", triangles, size_of::<GpuTriangle>())?;
-                }
+            Some("f") => {
                 for word in words {
-                    face_vertex(word, &total, &seen, &zero_normals, kind == "f")
+                    face_vertex(word, &total, &seen, &zero_normals)
                         .map_err(|e| at(n, &format!("'{word}': {e}")))?;
                 }
             }
@@ -366,7 +440,6 @@ fn face_vertex(
     total: &[usize; 3],
     seen: &[usize; 3],
     zero_normals: &HashSet<usize>,
-    face: bool,
 ) -> Result<(), String> {
     const KINDS: [&str; 3] = ["vertex", "texture coordinate", "normal"];
     const PLURAL: [&str; 3] = ["vertices", "texture coordinates", "normals"];
@@ -386,7 +459,7 @@ fn face_vertex(
             })?,
         };
         // tobj ignores a texture or normal index when the file has none of them.
-        if index >= total[k] && (k == 0 || total[k] > 0) && face {
+        if index >= total[k] && (k == 0 || total[k] > 0) {
             return Err(format!(
                 "{} {} is beyond the file's {} {}",
                 KINDS[k],
@@ -395,7 +468,7 @@ fn face_vertex(
                 PLURAL[k]
             ));
         }
-        if k == 2 && face && zero_normals.contains(&index) {
+        if k == 2 && zero_normals.contains(&index) {
             return Err(format!("normal {} has zero length", index + 1));
         }
     }

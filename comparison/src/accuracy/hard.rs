@@ -69,7 +69,7 @@ pub fn run_all(
         if stop.load(std::sync::atomic::Ordering::SeqCst) {
             break;
         }
-        rows.extend(run_hard(case, size, out)?);
+        rows.extend(run_hard(case, size, out, stop)?);
     }
     Ok(rows)
 }
@@ -137,7 +137,12 @@ pub fn hard_strategies() -> Vec<HardStrategy> {
     v
 }
 
-fn run_hard(case: &HardCase, size: Size, out: &Path) -> anyhow::Result<Vec<HardRow>> {
+fn run_hard(
+    case: &HardCase,
+    size: Size,
+    out: &Path,
+    stop: &std::sync::atomic::AtomicBool,
+) -> anyhow::Result<Vec<HardRow>> {
     let path = case.path.to_string_lossy().to_string();
     let scene = Scene::load(&path, &[])?;
     let truth = reference::render_truth(&scene, size.width, size.height);
@@ -170,6 +175,10 @@ fn run_hard(case: &HardCase, size: Size, out: &Path) -> anyhow::Result<Vec<HardR
                     (hard::wrong_share(&img, &truth), crack, g.unwrap_or(w), nan)
                 })
                 .map_err(|e| format!("{e:#}"));
+            if stop.load(std::sync::atomic::Ordering::SeqCst) && result.is_err() {
+                // Stopped by the signal, not failed: not a row of the table.
+                return Ok(rows);
+            }
             rows.push(HardRow {
                 case: case.name.clone(),
                 tolerance_pct: case.tolerance_pct,

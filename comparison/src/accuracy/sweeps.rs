@@ -330,7 +330,7 @@ pub fn run_scene(
         "twinray accuracy: {scene_name} at {size}: {} configurations x 2 APIs",
         list.len()
     );
-    for (slot, &(k, repeat)) in order.iter().enumerate() {
+    'runs: for (slot, &(k, repeat)) in order.iter().enumerate() {
         // A signal stops the sweep between runs; the finished rows are kept.
         if stop.load(std::sync::atomic::Ordering::SeqCst) {
             break;
@@ -347,6 +347,7 @@ pub fn run_scene(
                 let png = out.join(format!("images/{scene_name}-{}-repeat.png", api_name(api)));
                 match render_app(api, scene_name, size, s, frames, &png) {
                     Ok((g, w, _, _)) => repeats.push((api, g.unwrap_or(w))),
+                    Err(_) if stop.load(std::sync::atomic::Ordering::SeqCst) => break 'runs,
                     Err(e) => eprintln!(
                         "  {scene_name} default (repeat) {}: FAILED: {e:#}",
                         api_name(api)
@@ -360,6 +361,11 @@ pub fn run_scene(
             let result = render_app(api, scene_name, size, s, frames, &png)
                 .and_then(|(g, w, nan, img)| Ok((g, w, error_of(&img, &truth, &mask)?, nan)))
                 .map_err(|e| format!("{e:#}"));
+            if stop.load(std::sync::atomic::Ordering::SeqCst) && result.is_err() {
+                // Stopped by the signal, not failed: not a row of accuracy.csv.
+                let _ = std::fs::remove_file(&png);
+                break 'runs;
+            }
             if let Err(e) = &result {
                 eprintln!(
                     "  {scene_name} {} {}: FAILED: {e}",

@@ -72,6 +72,10 @@ pub fn acceleration(plan: &Plan, stop: &AtomicBool) -> Vec<AccelRun> {
                     ..RenderArgs::headless(scene, size)
                 };
                 let result = run_json(api, &ra).map_err(|e| format!("{e:#}"));
+                if stop.load(Ordering::SeqCst) && result.is_err() {
+                    // Stopped by the signal, not failed: not a run of the table.
+                    return runs;
+                }
                 runs.push(AccelRun {
                     scene,
                     size,

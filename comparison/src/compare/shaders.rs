@@ -62,6 +62,10 @@ pub fn collect(out: &Path, paths: &[RenderPath], stop: &AtomicBool) -> Vec<Shade
                 let result = run_json(api, &args)
                     .map(|r| (r.variant, r.shader_stats))
                     .map_err(|e| format!("{e:#}"));
+                if stop.load(Ordering::SeqCst) && result.is_err() {
+                    // Stopped by the signal, not failed: not a row of the table.
+                    return rows;
+                }
                 rows.push(ShaderRow {
                     scene,
                     accel,

@@ -333,6 +333,10 @@ fn measure(
                     run_json(run.0, &args).map_err(|e| refused_or_failed(run, &e))
                 }
             };
+            if stop.load(Ordering::SeqCst) && result.is_err() {
+                // Stopped by the signal, not failed: not a measurement.
+                return measured;
+            }
             measured.entry(label).or_default().push(result);
         }
     }

@@ -260,9 +260,16 @@ fn sig(ms: f64) -> String {
     format!("{ms:.digits$}")
 }
 
-/// Writes why.csv and appends the section to the written report.md.
-pub fn write(out: &Path, why: &Why) -> anyhow::Result<()> {
-    std::fs::write(out.join("why.csv"), csv(why)?).context("writing why.csv")?;
+/// Writes why.csv (marked when the run was `interrupted`) and appends the
+/// section to the written report.md.
+pub fn write(
+    out: &Path,
+    why: &Why,
+    interrupted: Option<crate::compare::runs::Interruption>,
+) -> anyhow::Result<()> {
+    let how = interrupted.map(|i| format!("interrupted by {} during {}", i.signal, i.step));
+    let text = crate::csv::marked(csv(why)?, how.as_deref());
+    std::fs::write(out.join("why.csv"), text).context("writing why.csv")?;
     let report = out.join("report.md");
     let mut text = std::fs::read_to_string(&report)
         .with_context(|| format!("reading '{}' back", report.display()))?;

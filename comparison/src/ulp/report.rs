@@ -242,17 +242,27 @@ pub fn write(
     out: &Path,
     runs: &[Run],
     baseline: &[(UlpOp, ByClass)],
-    inputs: u32,
-    seconds: f64,
+    (inputs, seconds, interrupted): (u32, f64, Option<&str>),
 ) -> anyhow::Result<()> {
     write_file(
         "--out",
         &out.join("ulp.csv"),
-        csv(runs, baseline)?.as_bytes(),
+        crate::csv::marked(csv(runs, baseline)?, interrupted).as_bytes(),
     )?;
-    write_file(
-        "--out",
-        &out.join("ulp.md"),
-        markdown(runs, baseline, inputs, seconds).as_bytes(),
-    )
+    let mut md = markdown(runs, baseline, inputs, seconds);
+    if let Some(how) = interrupted {
+        // Said in the title and again before the tables, as compare and accuracy say it.
+        let (title, rest) = md.split_once('\n').unwrap_or((&md, ""));
+        md = format!(
+            "{title} ({how})\n\n> {}: the tables hold the runs that finished.\n{rest}",
+            capital(how)
+        );
+    }
+    write_file("--out", &out.join("ulp.md"), md.as_bytes())
+}
+
+fn capital(s: &str) -> String {
+    let mut c = s.chars();
+    c.next()
+        .map_or(String::new(), |f| f.to_uppercase().chain(c).collect())
 }

@@ -163,3 +163,37 @@ fn an_output_name_of_255_bytes_is_written() {
     left.sort();
     assert_eq!(left.len(), 2, "{left:?}");
 }
+
+#[test]
+fn experiments_that_exclude_each_other_are_named_as_a_pair() {
+    // Both accepted alone; together naga refused a macro the user never wrote
+    // (`Unknown variable: BVH_STACK_DECLARE`), exit 1.
+    for (a, b) in twinray_common::lab::EXCLUSIVE.iter().map(|(a, b, _)| {
+        use twinray_common::value_name::ValueName;
+        (a.name(), b.name())
+    }) {
+        expect_both(
+            &[
+                "--headless",
+                "--size",
+                "16x16",
+                "--scene",
+                "teapot",
+                "--path",
+                "compute",
+                "--accel",
+                "bvh",
+                "--experiment",
+                &a,
+                "--experiment",
+                &b,
+            ],
+            &[],
+            2,
+            &[
+                &format!("--experiment {a} with --experiment {b}"),
+                "drop one",
+            ],
+        );
+    }
+}

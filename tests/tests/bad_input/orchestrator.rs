@@ -89,8 +89,23 @@ fn orchestrator_diff_and_render_errors() {
             "--heatmap",
             input.to_str().unwrap(),
         ];
-        expect_one(&tw, &args, &[], 2, &["--heatmap", "input image"]);
+        expect_one(&tw, &args, &[], 2, &["--heatmap", "replace an input"]);
     }
+    // A mask that leaves out every pixel leaves nothing to compare: it once
+    // gave a perfect match (rmse 0, exit 0) of no pixels.
+    let white = dir.join("white.png");
+    image::RgbImage::from_pixel(4, 4, image::Rgb([255, 255, 255]))
+        .save(&white)
+        .unwrap();
+    let (a_s, c_s) = (a.to_str().unwrap(), c.to_str().unwrap());
+    let args = ["diff", a_s, c_s, "--exclude", white.to_str().unwrap()];
+    expect_one(
+        &tw,
+        &args,
+        &[],
+        2,
+        &["--exclude", "white.png", "every pixel"],
+    );
     // A mask of another size cannot say which pixels to leave out.
     expect_one(
         &tw,
@@ -104,6 +119,78 @@ fn orchestrator_diff_and_render_errors() {
         &[],
         2,
         &["--exclude", "5x4"],
+    );
+}
+
+/// An output that names an input, through any spelling of its path, is
+/// refused before any work and leaves the input as it was: the mask over the
+/// scene, the heatmap over the mask (each once wrote over the other, exit 0).
+#[test]
+fn an_output_never_replaces_an_input() {
+    let dir = scratch("output-over-input");
+    let tw = bin("twinray");
+    let scene = dir.join("scene.toml");
+    std::fs::write(&scene, crate::common::SCENE_HEAD).unwrap();
+    let mask = dir.join("mask.png");
+    image::RgbImage::new(4, 4).save(&mask).unwrap();
+    let a = dir.join("a.png");
+    image::RgbImage::new(4, 4).save(&a).unwrap();
+    std::fs::create_dir_all(dir.join("sub")).unwrap();
+    let spell = |file: &std::path::Path, n: usize| -> Vec<String> {
+        let (hard, sym) = (dir.join(format!("hard{n}")), dir.join(format!("sym{n}")));
+        std::fs::hard_link(file, &hard).unwrap();
+        std::os::unix::fs::symlink(file, &sym).unwrap();
+        let up = dir.join("sub/..").join(file.file_name().unwrap());
+        [file.to_path_buf(), hard, sym, up]
+            .iter()
+            .map(|p| p.to_str().unwrap().to_string())
+            .collect()
+    };
+    let before = (
+        std::fs::read(&scene).unwrap(),
+        std::fs::read(&mask).unwrap(),
+    );
+    let (s, m, a_s) = (
+        scene.to_str().unwrap(),
+        mask.to_str().unwrap(),
+        a.to_str().unwrap(),
+    );
+    for out in spell(&scene, 0) {
+        let args = [
+            "render",
+            "--api",
+            "reference",
+            "--scene",
+            s,
+            "--size",
+            "8x8",
+            "--unsettled",
+            &out,
+        ];
+        expect_one(
+            &tw,
+            &args,
+            &[],
+            2,
+            &["--unsettled", "the scene file", "replace an input"],
+        );
+    }
+    for out in spell(&mask, 1) {
+        let args = ["diff", a_s, a_s, "--exclude", m, "--heatmap", &out];
+        expect_one(
+            &tw,
+            &args,
+            &[],
+            2,
+            &["--heatmap", "--exclude", "replace an input"],
+        );
+    }
+    assert_eq!(
+        before,
+        (
+            std::fs::read(&scene).unwrap(),
+            std::fs::read(&mask).unwrap()
+        )
     );
 }
 
@@ -189,6 +276,40 @@ fn compare_and_accuracy_refuse_before_creating_or_rendering() {
         &[],
         2,
         &["--frames", "'0'"],
+    );
+    // What no app accepts is refused up front, not in every run (it was
+    // accepted: "about NaN s per app per point", then each app refused 200000).
+    for (option, value) in [
+        ("--frames", "200000"),
+        ("--seconds-per-point", "nan"),
+        ("--seconds-per-point", "inf"),
+        ("--seconds-per-point", "0"),
+        ("--seconds-per-point", "-1"),
+        ("--seconds-per-point", "1e300"),
+    ] {
+        let quoted = format!("'{value}'");
+        expect_one(
+            &tw,
+            &["compare", "--quick", option, value, "--out", out_s],
+            &[],
+            2,
+            &[option, &quoted],
+        );
+    }
+    // A probe image no driver renders (2048x46875 for cross) is refused before any run.
+    expect_one(
+        &tw,
+        &[
+            "ulp", "--inputs", "16000000", "--ops", "cross", "--out", out_s,
+        ],
+        &[],
+        2,
+        &[
+            "--inputs 16000000",
+            "cross",
+            "2048x46875",
+            "at most 5592405",
+        ],
     );
     expect_one(
         &tw,

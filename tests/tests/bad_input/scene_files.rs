@@ -153,6 +153,64 @@ fn a_polygon_past_the_triangle_limit_is_refused_from_its_line_in_little_memory()
     let _ = std::fs::remove_dir_all(&dir);
 }
 
+/// `exe args`'s exit code, stderr, seconds and peak resident memory in MB.
+/// GNU time measures it: it forks `exe` from its own small process, where a
+/// child of this test process would inherit, through vfork and exec, the peak
+/// of every test that runs beside it.
+fn measured(exe: &std::path::Path, args: &[&str]) -> (i32, String, f64, f64) {
+    let time = std::path::Path::new("/usr/bin/time");
+    assert!(
+        time.exists(),
+        "GNU time is missing: source scripts/setup.sh installs it"
+    );
+    let mut all = vec!["-f", "peak-kb %M", exe.to_str().unwrap()];
+    all.extend(args);
+    let start = std::time::Instant::now();
+    let (code, stderr) = fail(time, &all, &[]);
+    let secs = start.elapsed().as_secs_f64();
+    let kb: f64 = stderr
+        .lines()
+        .find_map(|l| l.strip_prefix("peak-kb "))
+        .and_then(|v| v.trim().parse().ok())
+        .unwrap_or_else(|| panic!("no peak memory from GNU time: {stderr}"));
+    (code, stderr, secs, kb / 1024.0)
+}
+
+#[test]
+fn fifty_million_points_or_lines_are_refused_from_their_first_line_in_little_memory() {
+    // Each `f 1` and `l 1 2` became a zero-area triangle no count saw: 50
+    // million of them took 5.9 GB and 173 s before an allocation of 10 GB failed.
+    let dir = scratch("points-and-lines");
+    for (name, head, line, words) in [
+        ("points", "v 0 0 0\n", "f 1\n", "one vertex"),
+        ("lines", "v 0 0 0\nv 1 0 0\n", "l 1 2\n", "line element"),
+    ] {
+        let mut obj = head.as_bytes().to_vec();
+        obj.extend(line.as_bytes().repeat(50_000_000));
+        std::fs::write(dir.join(format!("{name}.obj")), &obj).unwrap();
+        drop(obj);
+        let p = scene_file(
+            &dir,
+            &format!("{name}.toml"),
+            &format!("[[meshes]]\nobj = \"{name}.obj\"\nmaterial = \"m\"\n"),
+        );
+        let at = format!("{name}.obj', line {}", head.lines().count() + 1);
+        for (exe, mut args) in three_tools() {
+            args.extend(["--headless", "--size", "8x8", "--scene", &p]);
+            let (code, stderr, secs, mb) = measured(&exe, &args);
+            assert_eq!(code, 2, "{exe:?}: {stderr}");
+            assert!(
+                stderr.contains(&at) && stderr.contains(words),
+                "{exe:?}: {stderr}"
+            );
+            assert!(secs < 2.0, "{exe:?} took {secs:.1} s");
+            assert!(mb < 200.0, "{exe:?} took {mb:.0} MB");
+        }
+        let _ = std::fs::remove_file(dir.join(format!("{name}.obj")));
+    }
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
 #[test]
 fn an_obj_with_a_byte_order_mark_renders() {
     let dir = scratch("bom");
