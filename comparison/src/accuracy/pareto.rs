@@ -149,6 +149,11 @@ mod tests {
                     above_1: 0.0,
                     wrong: 0.0,
                     flip: None,
+                    outside: crate::accuracy::sweeps::Outside {
+                        mask_pixels: 0,
+                        max_abs: 0,
+                        above_8: 0.0,
+                    },
                 },
                 0,
             )),

@@ -122,7 +122,7 @@ pub fn sig3(v: Option<f64>) -> String {
             let decimals = (2 - v.log10().floor() as i32).max(0) as usize;
             format!("{v:.decimals$}")
         }
-        Some(v) if v == 0.0 => "0".into(),
+        Some(0.0) => "0".into(),
         _ => "–".into(),
     }
 }
