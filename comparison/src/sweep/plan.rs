@@ -1,0 +1,461 @@
+//! A sweep's plan file (TOML): what it may say, and every check of it made
+//! before the first run, each refusal one sentence naming the plan and the
+//! line at fault (exit 2). An option set is checked by the very parsers the
+//! apps use (`VulkanCli`, `OpenGlCli`), so an option an app would refuse is
+//! refused here, not in the middle of a sweep.
+
+use crate::apps::Api;
+use clap::{CommandFactory, Parser};
+use serde::Deserialize;
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+use toml::Spanned;
+use twinray_common::cli::{OpenGlCli, RenderArgs, VulkanCli};
+use twinray_common::error::bad_input;
+
+/// The plan as written. `Spanned` keeps where each value is, for the line
+/// a refusal names.
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct PlanFile {
+    builds: BTreeMap<String, Spanned<String>>,
+    apps: Spanned<Vec<String>>,
+    #[serde(default)]
+    axes: BTreeMap<String, Spanned<Vec<toml::Value>>>,
+    #[serde(default)]
+    env_axes: BTreeMap<String, Spanned<Vec<String>>>,
+    #[serde(default)]
+    sets: Vec<Spanned<SetFile>>,
+    #[serde(default)]
+    env: BTreeMap<String, String>,
+    rounds: Spanned<u32>,
+    #[serde(default)]
+    warmup: u32,
+    frames: Option<Spanned<u32>>,
+    settle: Option<Spanned<f64>>,
+    #[serde(default)]
+    ratios: Vec<Spanned<[String; 2]>>,
+}
+
+/// One option set of an explicit `[[sets]]` list.
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct SetFile {
+    name: Option<String>,
+    #[serde(default)]
+    options: BTreeMap<String, Spanned<toml::Value>>,
+    #[serde(default)]
+    env: BTreeMap<String, String>,
+}
+
+/// A named folder of binaries.
+#[derive(Debug, Clone)]
+pub struct Build {
+    pub name: String,
+    pub dir: PathBuf,
+}
+
+/// One option set, checked: the `RenderArgs` both apps parsed from it, the
+/// options that are an app's own knobs (passed on as written), and its
+/// environment.
+#[derive(Debug, Clone)]
+pub struct OptionSet {
+    pub name: String,
+    /// The set's options as the plan gave them, in command-line form.
+    pub options: Vec<String>,
+    pub args: RenderArgs,
+    pub extra: Vec<String>,
+    pub env: Vec<(String, String)>,
+}
+
+/// A ratio the table reports: of two apps (per build and set) or of two
+/// builds (per app and set), the first over the second.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Ratio {
+    Apps(Api, Api),
+    Builds(usize, usize),
+}
+
+/// A checked plan.
+#[derive(Debug)]
+pub struct Plan {
+    pub file: PathBuf,
+    pub builds: Vec<Build>,
+    pub apps: Vec<Api>,
+    pub sets: Vec<OptionSet>,
+    pub rounds: u32,
+    /// Rounds run before the measured ones and left out of the table.
+    pub warmup: u32,
+    pub frames: Option<u32>,
+    pub settle: Option<f64>,
+    pub ratios: Vec<Ratio>,
+}
+
+/// Options the plan sets for every run itself (or that would break the
+/// reading of the report), refused in an option set.
+const RESERVED: &[(&str, &str)] = &[
+    ("json", "every run reports as JSON"),
+    ("headless", "every run is headless"),
+    ("frames", "the plan's top-level `frames` sets it"),
+    ("settle", "the plan's top-level `settle` sets it"),
+    ("out", "a sweep writes no images"),
+    ("dump-shaders", "a sweep writes no shader dumps"),
+    ("explain", "it prints text where the report is read"),
+    ("experiments", "it prints a list instead of rendering"),
+    ("help", "it prints help instead of rendering"),
+    ("version", "it prints the version instead of rendering"),
+];
+
+/// The 1-based line of byte `offset` in `text`.
+fn line_of(text: &str, offset: usize) -> usize {
+    text[..offset.min(text.len())].matches('\n').count() + 1
+}
+
+/// Reads and checks the plan at `file`; nothing is run or written.
+pub fn load(file: &Path) -> anyhow::Result<Plan> {
+    let shown = file.display().to_string();
+    let text = std::fs::read_to_string(file)
+        .map_err(|e| bad_input(format!("the plan '{shown}' cannot be read ({e})")))?;
+    let raw: PlanFile = toml::from_str(&text).map_err(|e| {
+        let line = e.span().map_or(1, |s| line_of(&text, s.start));
+        bad_input(format!(
+            "the plan '{shown}', line {line}: {}",
+            e.message().trim().trim_end_matches('.')
+        ))
+    })?;
+    let at = |span: std::ops::Range<usize>, what: String| {
+        bad_input(format!(
+            "the plan '{shown}', line {}: {what}",
+            line_of(&text, span.start)
+        ))
+    };
+    let whole = |what: &str| bad_input(format!("the plan '{shown}': {what}"));
+    let folder = file.parent().unwrap_or(Path::new("."));
+
+    let apps: Vec<Api> = raw
+        .apps
+        .get_ref()
+        .iter()
+        .map(|name| match <Api as clap::ValueEnum>::from_str(name, false) {
+            Ok(Api::Reference) | Err(_) => Err(at(
+                raw.apps.span(),
+                format!("'{name}' is not an app; use vulkan, opengl or opengl-spirv"),
+            )),
+            Ok(api) => Ok(api),
+        })
+        .collect::<anyhow::Result<_>>()?;
+    if apps.is_empty() {
+        return Err(at(raw.apps.span(), "`apps` names no app".into()));
+    }
+
+    // In the order the plan declares them (the map sorts by name).
+    let mut builds_raw: Vec<_> = raw.builds.iter().collect();
+    builds_raw.sort_by_key(|(_, dir)| dir.span().start);
+    if builds_raw.is_empty() {
+        return Err(whole("[builds] names no build"));
+    }
+    let mut builds = Vec::new();
+    for (name, dir) in builds_raw {
+        let path = folder.join(dir.get_ref());
+        if !path.is_dir() {
+            return Err(at(
+                dir.span(),
+                format!(
+                    "build '{name}' is '{}', which is not a folder",
+                    path.display()
+                ),
+            ));
+        }
+        for api in &apps {
+            let bin = api.binary().expect("an app");
+            if !path.join(bin).is_file() {
+                return Err(at(
+                    dir.span(),
+                    format!("build '{name}' ('{}') holds no {bin}", path.display()),
+                ));
+            }
+        }
+        builds.push(Build {
+            name: name.clone(),
+            dir: path,
+        });
+    }
+
+    if *raw.rounds.get_ref() == 0 {
+        return Err(at(raw.rounds.span(), "`rounds` must be at least 1".into()));
+    }
+    let frames = raw.frames.as_ref().map(|f| *f.get_ref());
+    let settle = raw.settle.as_ref().map(|s| *s.get_ref());
+    let base = Base {
+        apps: &apps,
+        frames,
+        settle,
+    };
+
+    let sets = match (raw.axes.is_empty() && raw.env_axes.is_empty(), raw.sets.is_empty()) {
+        (true, true) => return Err(whole("it names no option set; give [axes] or [[sets]]")),
+        (false, false) => {
+            return Err(at(
+                raw.sets[0].span(),
+                "give either [axes] or [[sets]], not both".into(),
+            ))
+        }
+        (false, true) => product(&raw, &base, &at)?,
+        (true, false) => {
+            let mut sets = Vec::new();
+            for (i, set) in raw.sets.iter().enumerate() {
+                let s = set.get_ref();
+                let mut opts: Vec<_> = s.options.iter().collect();
+                opts.sort_by_key(|(_, v)| v.span().start);
+                let mut options = Vec::new();
+                for (key, value) in &opts {
+                    let tokens = option_tokens(key, value.get_ref())
+                        .map_err(|why| at(value.span(), why))?;
+                    options.extend(tokens);
+                }
+                let name = s.name.clone().unwrap_or_else(|| format!("set {}", i + 1));
+                if sets.iter().any(|o: &OptionSet| o.name == name) {
+                    return Err(at(set.span(), format!("two option sets are named '{name}'")));
+                }
+                let env = merged_env(&raw.env, &s.env);
+                sets.push(
+                    base.check(name, options, env)
+                        .map_err(|why| at(set.span(), why))?,
+                );
+            }
+            sets
+        }
+    };
+
+    let ratios = raw
+        .ratios
+        .iter()
+        .map(|pair| {
+            let [a, b] = pair.get_ref();
+            let app = |n: &str| apps.iter().copied().find(|api| crate::apps::api_name(*api) == n);
+            let build = |n: &str| builds.iter().position(|bd| bd.name == n);
+            match (app(a), app(b), build(a), build(b)) {
+                (Some(x), Some(y), _, _) => Ok(Ratio::Apps(x, y)),
+                (_, _, Some(x), Some(y)) => Ok(Ratio::Builds(x, y)),
+                _ => Err(at(
+                    pair.span(),
+                    format!("the ratio ['{a}', '{b}'] names neither two of the plan's apps nor two of its builds"),
+                )),
+            }
+        })
+        .collect::<anyhow::Result<_>>()?;
+
+    Ok(Plan {
+        file: file.to_path_buf(),
+        builds,
+        apps,
+        sets,
+        rounds: *raw.rounds.get_ref(),
+        warmup: raw.warmup,
+        frames,
+        settle,
+        ratios,
+    })
+}
+
+/// What every option set is checked with.
+struct Base<'a> {
+    apps: &'a [Api],
+    frames: Option<u32>,
+    settle: Option<f64>,
+}
+
+impl Base<'_> {
+    /// Parses `options` as each app would, with the plan's own options, and
+    /// splits them into `RenderArgs` and the app's knobs; the error is why an
+    /// app refused them.
+    fn check(
+        &self,
+        name: String,
+        options: Vec<String>,
+        env: Vec<(String, String)>,
+    ) -> Result<OptionSet, String> {
+        let shared: Vec<String> = RenderArgs::command()
+            .get_arguments()
+            .filter_map(|a| a.get_long().map(|l| format!("--{l}")))
+            .collect();
+        // Options come in `--key [value]` runs: a run whose key is not one of
+        // RenderArgs' own is a knob, passed on after them as written.
+        let (mut render, mut extra) = (Vec::new(), Vec::new());
+        let mut into_extra = false;
+        for token in &options {
+            if token.starts_with("--") {
+                into_extra = !shared.contains(token);
+            }
+            if into_extra {
+                extra.push(token.clone());
+            } else {
+                render.push(token.clone());
+            }
+        }
+        let mut argv = vec!["--headless".to_string(), "--json".to_string()];
+        if let Some(f) = self.frames {
+            argv.extend(["--frames".into(), f.to_string()]);
+        }
+        if let Some(p) = self.settle {
+            argv.extend(["--settle".into(), p.to_string()]);
+        }
+        argv.extend(render);
+        argv.extend(extra.iter().cloned());
+        let mut args = None;
+        for api in self.apps {
+            let bin = api.binary().expect("an app");
+            let argv = std::iter::once(bin.to_string()).chain(argv.iter().cloned());
+            let parsed = match api {
+                Api::Vulkan => VulkanCli::try_parse_from(argv).map(|c| c.render),
+                _ => OpenGlCli::try_parse_from(argv).map(|c| c.render),
+            };
+            let parsed = parsed.map_err(|e| {
+                let message = e.to_string();
+                let first = message.lines().next().unwrap_or("refused");
+                format!(
+                    "{bin} refuses the option set '{name}' ({}): {}",
+                    options.join(" "),
+                    first.trim_start_matches("error: ")
+                )
+            })?;
+            args.get_or_insert(parsed);
+        }
+        Ok(OptionSet {
+            name,
+            options,
+            args: args.expect("a plan has an app"),
+            extra,
+            env,
+        })
+    }
+}
+
+/// `key = value` of an option set as command-line tokens: `true` is the bare
+/// flag, `false` leaves it out, an array repeats the option.
+fn option_tokens(key: &str, value: &toml::Value) -> Result<Vec<String>, String> {
+    if let Some((_, why)) = RESERVED.iter().find(|(k, _)| *k == key) {
+        return Err(format!("an option set may not give '{key}': {why}"));
+    }
+    let flag = format!("--{key}");
+    match value {
+        toml::Value::Boolean(true) => Ok(vec![flag]),
+        toml::Value::Boolean(false) => Ok(Vec::new()),
+        toml::Value::String(s) => Ok(vec![flag, s.clone()]),
+        toml::Value::Integer(i) => Ok(vec![flag, i.to_string()]),
+        toml::Value::Float(x) => Ok(vec![flag, x.to_string()]),
+        toml::Value::Array(items) => items.iter().try_fold(Vec::new(), |mut v, item| {
+            match item {
+                toml::Value::Array(_) | toml::Value::Table(_) => {
+                    return Err(format!("'{key}' holds a nested array or table"))
+                }
+                _ => v.extend(option_tokens(key, item)?),
+            }
+            Ok(v)
+        }),
+        _ => Err(format!(
+            "'{key}' is a {}; give a string, number or boolean",
+            value.type_str()
+        )),
+    }
+}
+
+/// The plan's `[env]` with a set's own on top.
+fn merged_env(all: &BTreeMap<String, String>, own: &BTreeMap<String, String>) -> Vec<(String, String)> {
+    let mut env = all.clone();
+    env.extend(own.iter().map(|(k, v)| (k.clone(), v.clone())));
+    env.into_iter().collect()
+}
+
+/// One value of one axis: its command-line tokens or environment variable,
+/// and its part of the set's name.
+enum Pick {
+    Option(Vec<String>),
+    Env(String, String),
+}
+
+/// The option sets of `[axes]` and `[env_axes]`: every combination, the
+/// first declared axis outermost.
+fn product(
+    raw: &PlanFile,
+    base: &Base,
+    at: &dyn Fn(std::ops::Range<usize>, String) -> anyhow::Error,
+) -> anyhow::Result<Vec<OptionSet>> {
+    // Each axis as (where it is, its values), in the order the plan declares them.
+    let mut axes: Vec<(std::ops::Range<usize>, Vec<(String, Pick)>)> = Vec::new();
+    for (key, values) in &raw.axes {
+        if values.get_ref().is_empty() {
+            return Err(at(values.span(), format!("the axis '{key}' is empty")));
+        }
+        let picks = values
+            .get_ref()
+            .iter()
+            .map(|v| {
+                let tokens = option_tokens(key, v).map_err(|why| at(values.span(), why))?;
+                let shown = match v {
+                    toml::Value::String(s) => s.clone(),
+                    other => other.to_string(),
+                };
+                Ok((format!("{key}={shown}"), Pick::Option(tokens)))
+            })
+            .collect::<anyhow::Result<_>>()?;
+        axes.push((values.span(), picks));
+    }
+    for (var, values) in &raw.env_axes {
+        if values.get_ref().is_empty() {
+            return Err(at(values.span(), format!("the axis '{var}' is empty")));
+        }
+        let picks = values
+            .get_ref()
+            .iter()
+            .map(|v| (format!("{var}={v}"), Pick::Env(var.clone(), v.clone())))
+            .collect();
+        axes.push((values.span(), picks));
+    }
+    axes.sort_by_key(|(span, _)| span.start);
+    // Each option alone first, so that a refusal names the axis that holds it.
+    for (span, picks) in &axes {
+        for (name, pick) in picks {
+            if let Pick::Option(tokens) = pick {
+                base.check(name.clone(), tokens.clone(), Vec::new())
+                    .map_err(|why| at(span.clone(), why))?;
+            }
+        }
+    }
+    let mut combos: Vec<Vec<usize>> = vec![Vec::new()];
+    for (_, picks) in &axes {
+        combos = combos
+            .into_iter()
+            .flat_map(|c| {
+                (0..picks.len()).map(move |i| {
+                    let mut c = c.clone();
+                    c.push(i);
+                    c
+                })
+            })
+            .collect();
+    }
+    combos
+        .into_iter()
+        .map(|combo| {
+            let mut names = Vec::new();
+            let mut options = Vec::new();
+            let mut own_env = BTreeMap::new();
+            for ((_, picks), &i) in axes.iter().zip(&combo) {
+                let (name, pick) = &picks[i];
+                names.push(name.clone());
+                match pick {
+                    Pick::Option(tokens) => options.extend(tokens.iter().cloned()),
+                    Pick::Env(k, v) => {
+                        own_env.insert(k.clone(), v.clone());
+                    }
+                }
+            }
+            let name = names.join(" ");
+            let env = merged_env(&raw.env, &own_env);
+            // The refusal names the first axis: the set is their combination.
+            base.check(name, options, env)
+                .map_err(|why| at(axes[0].0.clone(), why))
+        })
+        .collect()
+}
