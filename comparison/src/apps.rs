@@ -322,7 +322,8 @@ pub fn run_json_with(api: Api, args: &RenderArgs, launch: &Launch) -> anyhow::Re
         .unwrap_or("");
     let report =
         serde_json::from_str(json).with_context(|| format!("reading {bin}'s JSON report"))?;
-    let json = serde_json::from_str(json).with_context(|| format!("reading {bin}'s JSON report"))?;
+    let json =
+        serde_json::from_str(json).with_context(|| format!("reading {bin}'s JSON report"))?;
     Ok(Ran { report, json, pid })
 }
 

@@ -11,7 +11,7 @@
 mod plan;
 mod table;
 
-use crate::apps::{self, Api, Launch};
+use crate::apps::{self, Launch};
 use anyhow::Context;
 use std::io::Write;
 use std::path::{Path, PathBuf};
@@ -24,33 +24,6 @@ pub struct SweepArgs {
     /// The folder for sweep.jsonl and sweep.md.
     #[arg(long, value_name = "DIR")]
     pub out: PathBuf,
-}
-
-/// One cell: which build, app and option set (indices into the plan).
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub struct Cell {
-    pub build: usize,
-    pub app: Api,
-    pub set: usize,
-}
-
-/// A finished run, as the table needs it.
-pub struct Done {
-    pub cell: usize,
-    pub report: twinray_common::report::RunReport,
-}
-
-/// The cells in the order of an even round: builds outermost, then apps, then sets.
-fn cells(plan: &plan::Plan) -> Vec<Cell> {
-    let mut cells = Vec::new();
-    for build in 0..plan.builds.len() {
-        for &app in &plan.apps {
-            for set in 0..plan.sets.len() {
-                cells.push(Cell { build, app, set });
-            }
-        }
-    }
-    cells
 }
 
 /// The order of round `round`'s runs, as indices into the cells: reversed
@@ -69,7 +42,7 @@ pub fn run(args: &SweepArgs) -> anyhow::Result<()> {
     twinray_common::reference::image_io::prepare_output_dir("--out", &args.out)?;
     let stop = crate::interrupt::Stop::install()?;
     let started = std::time::Instant::now();
-    let cells = cells(&plan);
+    let cells = plan.cells();
     let jsonl_path = args.out.join("sweep.jsonl");
     let mut jsonl = std::io::BufWriter::new(
         std::fs::File::create(&jsonl_path)
@@ -120,7 +93,7 @@ pub fn run(args: &SweepArgs) -> anyhow::Result<()> {
                     line["pid"] = ran.pid.into();
                     line["report"] = ran.json;
                     if round >= plan.warmup {
-                        done.push(Done {
+                        done.push(plan::Done {
                             cell: cell_index,
                             report: ran.report,
                         });
@@ -176,4 +149,14 @@ fn append(
     writeln!(jsonl, "{line}")
         .and_then(|_| jsonl.flush())
         .with_context(|| format!("writing {}", path.display()))
+}
+
+#[cfg(test)]
+mod tests {
+    #[test]
+    fn odd_rounds_run_the_cells_backwards() {
+        assert_eq!(super::round_order(3, 0), [0, 1, 2]);
+        assert_eq!(super::round_order(3, 1), [2, 1, 0]);
+        assert_eq!(super::round_order(3, 2), [0, 1, 2]);
+    }
 }

@@ -76,6 +76,20 @@ pub enum Ratio {
     Builds(usize, usize),
 }
 
+/// One cell: which build, app and option set (indices into the plan).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Cell {
+    pub build: usize,
+    pub app: Api,
+    pub set: usize,
+}
+
+/// A finished measured run (warm-up rounds aside), as the table needs it.
+pub struct Done {
+    pub cell: usize,
+    pub report: twinray_common::report::RunReport,
+}
+
 /// A checked plan.
 #[derive(Debug)]
 pub struct Plan {
@@ -111,6 +125,28 @@ fn line_of(text: &str, offset: usize) -> usize {
     text[..offset.min(text.len())].matches('\n').count() + 1
 }
 
+/// Where a refusal points: the plan's name and text, for "line N" sentences.
+struct Source<'a> {
+    shown: String,
+    text: &'a str,
+}
+
+impl Source<'_> {
+    /// A refusal at the value spanning `span`.
+    fn at(&self, span: std::ops::Range<usize>, what: String) -> anyhow::Error {
+        bad_input(format!(
+            "the plan '{}', line {}: {what}",
+            self.shown,
+            line_of(self.text, span.start)
+        ))
+    }
+
+    /// A refusal of the plan as a whole (something it lacks has no line).
+    fn whole(&self, what: &str) -> anyhow::Error {
+        bad_input(format!("the plan '{}': {what}", self.shown))
+    }
+}
+
 /// Reads and checks the plan at `file`; nothing is run or written.
 pub fn load(file: &Path) -> anyhow::Result<Plan> {
     let shown = file.display().to_string();
@@ -123,66 +159,11 @@ pub fn load(file: &Path) -> anyhow::Result<Plan> {
             e.message().trim().trim_end_matches('.')
         ))
     })?;
-    let at = |span: std::ops::Range<usize>, what: String| {
-        bad_input(format!(
-            "the plan '{shown}', line {}: {what}",
-            line_of(&text, span.start)
-        ))
-    };
-    let whole = |what: &str| bad_input(format!("the plan '{shown}': {what}"));
-    let folder = file.parent().unwrap_or(Path::new("."));
-
-    let apps: Vec<Api> = raw
-        .apps
-        .get_ref()
-        .iter()
-        .map(|name| match <Api as clap::ValueEnum>::from_str(name, false) {
-            Ok(Api::Reference) | Err(_) => Err(at(
-                raw.apps.span(),
-                format!("'{name}' is not an app; use vulkan, opengl or opengl-spirv"),
-            )),
-            Ok(api) => Ok(api),
-        })
-        .collect::<anyhow::Result<_>>()?;
-    if apps.is_empty() {
-        return Err(at(raw.apps.span(), "`apps` names no app".into()));
-    }
-
-    // In the order the plan declares them (the map sorts by name).
-    let mut builds_raw: Vec<_> = raw.builds.iter().collect();
-    builds_raw.sort_by_key(|(_, dir)| dir.span().start);
-    if builds_raw.is_empty() {
-        return Err(whole("[builds] names no build"));
-    }
-    let mut builds = Vec::new();
-    for (name, dir) in builds_raw {
-        let path = folder.join(dir.get_ref());
-        if !path.is_dir() {
-            return Err(at(
-                dir.span(),
-                format!(
-                    "build '{name}' is '{}', which is not a folder",
-                    path.display()
-                ),
-            ));
-        }
-        for api in &apps {
-            let bin = api.binary().expect("an app");
-            if !path.join(bin).is_file() {
-                return Err(at(
-                    dir.span(),
-                    format!("build '{name}' ('{}') holds no {bin}", path.display()),
-                ));
-            }
-        }
-        builds.push(Build {
-            name: name.clone(),
-            dir: path,
-        });
-    }
-
+    let src = Source { shown, text: &text };
+    let apps = apps(&raw, &src)?;
+    let builds = builds(&raw, &apps, file.parent().unwrap_or(Path::new(".")), &src)?;
     if *raw.rounds.get_ref() == 0 {
-        return Err(at(raw.rounds.span(), "`rounds` must be at least 1".into()));
+        return Err(src.at(raw.rounds.span(), "`rounds` must be at least 1".into()));
     }
     let frames = raw.frames.as_ref().map(|f| *f.get_ref());
     let settle = raw.settle.as_ref().map(|s| *s.get_ref());
@@ -191,60 +172,21 @@ pub fn load(file: &Path) -> anyhow::Result<Plan> {
         frames,
         settle,
     };
-
-    let sets = match (raw.axes.is_empty() && raw.env_axes.is_empty(), raw.sets.is_empty()) {
-        (true, true) => return Err(whole("it names no option set; give [axes] or [[sets]]")),
+    let sets = match (
+        raw.axes.is_empty() && raw.env_axes.is_empty(),
+        raw.sets.is_empty(),
+    ) {
+        (true, true) => return Err(src.whole("it names no option set; give [axes] or [[sets]]")),
         (false, false) => {
-            return Err(at(
+            return Err(src.at(
                 raw.sets[0].span(),
                 "give either [axes] or [[sets]], not both".into(),
             ))
         }
-        (false, true) => product(&raw, &base, &at)?,
-        (true, false) => {
-            let mut sets = Vec::new();
-            for (i, set) in raw.sets.iter().enumerate() {
-                let s = set.get_ref();
-                let mut opts: Vec<_> = s.options.iter().collect();
-                opts.sort_by_key(|(_, v)| v.span().start);
-                let mut options = Vec::new();
-                for (key, value) in &opts {
-                    let tokens = option_tokens(key, value.get_ref())
-                        .map_err(|why| at(value.span(), why))?;
-                    options.extend(tokens);
-                }
-                let name = s.name.clone().unwrap_or_else(|| format!("set {}", i + 1));
-                if sets.iter().any(|o: &OptionSet| o.name == name) {
-                    return Err(at(set.span(), format!("two option sets are named '{name}'")));
-                }
-                let env = merged_env(&raw.env, &s.env);
-                sets.push(
-                    base.check(name, options, env)
-                        .map_err(|why| at(set.span(), why))?,
-                );
-            }
-            sets
-        }
+        (false, true) => product(&raw, &base, &src)?,
+        (true, false) => listed(&raw, &base, &src)?,
     };
-
-    let ratios = raw
-        .ratios
-        .iter()
-        .map(|pair| {
-            let [a, b] = pair.get_ref();
-            let app = |n: &str| apps.iter().copied().find(|api| crate::apps::api_name(*api) == n);
-            let build = |n: &str| builds.iter().position(|bd| bd.name == n);
-            match (app(a), app(b), build(a), build(b)) {
-                (Some(x), Some(y), _, _) => Ok(Ratio::Apps(x, y)),
-                (_, _, Some(x), Some(y)) => Ok(Ratio::Builds(x, y)),
-                _ => Err(at(
-                    pair.span(),
-                    format!("the ratio ['{a}', '{b}'] names neither two of the plan's apps nor two of its builds"),
-                )),
-            }
-        })
-        .collect::<anyhow::Result<_>>()?;
-
+    let ratios = ratios(&raw, &apps, &builds, &src)?;
     Ok(Plan {
         file: file.to_path_buf(),
         builds,
@@ -256,6 +198,129 @@ pub fn load(file: &Path) -> anyhow::Result<Plan> {
         settle,
         ratios,
     })
+}
+
+fn apps(raw: &PlanFile, src: &Source) -> anyhow::Result<Vec<Api>> {
+    let apps: Vec<Api> = raw
+        .apps
+        .get_ref()
+        .iter()
+        .map(
+            |name| match <Api as clap::ValueEnum>::from_str(name, false) {
+                Ok(Api::Reference) | Err(_) => Err(src.at(
+                    raw.apps.span(),
+                    format!("'{name}' is not an app; use vulkan, opengl or opengl-spirv"),
+                )),
+                Ok(api) => Ok(api),
+            },
+        )
+        .collect::<anyhow::Result<_>>()?;
+    if apps.is_empty() {
+        return Err(src.at(raw.apps.span(), "`apps` names no app".into()));
+    }
+    Ok(apps)
+}
+
+/// The builds in the order the plan declares them (the map sorts by name),
+/// each a folder, relative to the plan's, that holds every app the plan runs.
+fn builds(raw: &PlanFile, apps: &[Api], folder: &Path, src: &Source) -> anyhow::Result<Vec<Build>> {
+    let mut declared: Vec<_> = raw.builds.iter().collect();
+    declared.sort_by_key(|(_, dir)| dir.span().start);
+    if declared.is_empty() {
+        return Err(src.whole("[builds] names no build"));
+    }
+    let mut builds = Vec::new();
+    for (name, dir) in declared {
+        let path = folder.join(dir.get_ref());
+        if !path.is_dir() {
+            return Err(src.at(
+                dir.span(),
+                format!(
+                    "build '{name}' is '{}', which is not a folder",
+                    path.display()
+                ),
+            ));
+        }
+        for api in apps {
+            let bin = api.binary().expect("an app");
+            if !path.join(bin).is_file() {
+                return Err(src.at(
+                    dir.span(),
+                    format!("build '{name}' ('{}') holds no {bin}", path.display()),
+                ));
+            }
+        }
+        builds.push(Build {
+            name: name.clone(),
+            dir: path,
+        });
+    }
+    Ok(builds)
+}
+
+/// The option sets of an explicit `[[sets]]` list.
+fn listed(raw: &PlanFile, base: &Base, src: &Source) -> anyhow::Result<Vec<OptionSet>> {
+    let mut sets: Vec<OptionSet> = Vec::new();
+    for (i, set) in raw.sets.iter().enumerate() {
+        let s = set.get_ref();
+        let mut opts: Vec<_> = s.options.iter().collect();
+        opts.sort_by_key(|(_, v)| v.span().start);
+        let mut options = Vec::new();
+        for (key, value) in &opts {
+            let tokens =
+                option_tokens(key, value.get_ref()).map_err(|why| src.at(value.span(), why))?;
+            options.extend(tokens);
+        }
+        let name = s.name.clone().unwrap_or_else(|| format!("set {}", i + 1));
+        if sets.iter().any(|o| o.name == name) {
+            return Err(src.at(set.span(), format!("two option sets are named '{name}'")));
+        }
+        let env = merged_env(&raw.env, &s.env);
+        sets.push(
+            base.check(name, options, env)
+                .map_err(|why| src.at(set.span(), why))?,
+        );
+    }
+    Ok(sets)
+}
+
+fn ratios(
+    raw: &PlanFile,
+    apps: &[Api],
+    builds: &[Build],
+    src: &Source,
+) -> anyhow::Result<Vec<Ratio>> {
+    raw.ratios
+        .iter()
+        .map(|pair| {
+            let [a, b] = pair.get_ref();
+            let app = |n: &str| apps.iter().copied().find(|api| crate::apps::api_name(*api) == n);
+            let build = |n: &str| builds.iter().position(|bd| bd.name == n);
+            match (app(a), app(b), build(a), build(b)) {
+                (Some(x), Some(y), _, _) => Ok(Ratio::Apps(x, y)),
+                (_, _, Some(x), Some(y)) => Ok(Ratio::Builds(x, y)),
+                _ => Err(src.at(
+                    pair.span(),
+                    format!("the ratio ['{a}', '{b}'] names neither two of the plan's apps nor two of its builds"),
+                )),
+            }
+        })
+        .collect()
+}
+
+impl Plan {
+    /// The cells in the order of an even round: builds outermost, then apps, then sets.
+    pub fn cells(&self) -> Vec<Cell> {
+        let mut cells = Vec::new();
+        for build in 0..self.builds.len() {
+            for &app in &self.apps {
+                for set in 0..self.sets.len() {
+                    cells.push(Cell { build, app, set });
+                }
+            }
+        }
+        cells
+    }
 }
 
 /// What every option set is checked with.
@@ -361,7 +426,10 @@ fn option_tokens(key: &str, value: &toml::Value) -> Result<Vec<String>, String> 
 }
 
 /// The plan's `[env]` with a set's own on top.
-fn merged_env(all: &BTreeMap<String, String>, own: &BTreeMap<String, String>) -> Vec<(String, String)> {
+fn merged_env(
+    all: &BTreeMap<String, String>,
+    own: &BTreeMap<String, String>,
+) -> Vec<(String, String)> {
     let mut env = all.clone();
     env.extend(own.iter().map(|(k, v)| (k.clone(), v.clone())));
     env.into_iter().collect()
@@ -376,11 +444,8 @@ enum Pick {
 
 /// The option sets of `[axes]` and `[env_axes]`: every combination, the
 /// first declared axis outermost.
-fn product(
-    raw: &PlanFile,
-    base: &Base,
-    at: &dyn Fn(std::ops::Range<usize>, String) -> anyhow::Error,
-) -> anyhow::Result<Vec<OptionSet>> {
+fn product(raw: &PlanFile, base: &Base, src: &Source) -> anyhow::Result<Vec<OptionSet>> {
+    let at = |span, what| src.at(span, what);
     // Each axis as (where it is, its values), in the order the plan declares them.
     let mut axes: Vec<(std::ops::Range<usize>, Vec<(String, Pick)>)> = Vec::new();
     for (key, values) in &raw.axes {
@@ -458,4 +523,44 @@ fn product(
                 .map_err(|why| at(axes[0].0.clone(), why))
         })
         .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::{line_of, option_tokens};
+
+    #[test]
+    fn a_value_becomes_the_tokens_an_app_reads() {
+        assert_eq!(
+            option_tokens("scene", &toml::Value::String("box".into())).unwrap(),
+            ["--scene", "box"]
+        );
+        assert_eq!(
+            option_tokens("count-rays", &toml::Value::Boolean(true)).unwrap(),
+            ["--count-rays"]
+        );
+        assert!(option_tokens("count-rays", &toml::Value::Boolean(false))
+            .unwrap()
+            .is_empty());
+        assert_eq!(
+            option_tokens("workgroup", &toml::Value::Integer(8)).unwrap(),
+            ["--workgroup", "8"]
+        );
+        let sets = toml::Value::Array(vec!["a=1".into(), "b=2".into()]);
+        assert_eq!(
+            option_tokens("set", &sets).unwrap(),
+            ["--set", "a=1", "--set", "b=2"]
+        );
+        assert!(option_tokens("frames", &toml::Value::Integer(3))
+            .unwrap_err()
+            .contains("top-level"));
+    }
+
+    #[test]
+    fn lines_count_from_one() {
+        let text = "a = 1\nb = 2\nc = 3\n";
+        assert_eq!(line_of(text, 0), 1);
+        assert_eq!(line_of(text, 6), 2);
+        assert_eq!(line_of(text, text.len() + 10), 4);
+    }
 }

@@ -5,8 +5,7 @@
 //! own 95 % interval, and the cells are written by compare's own
 //! `median_cell` and `ratio_cell`.
 
-use super::plan::{Plan, Ratio};
-use super::{Cell, Done};
+use super::plan::{Cell, Done, Plan, Ratio};
 use crate::apps::api_name;
 use crate::report::cells::{median_cell, ratio_cell};
 use twinray_common::report::RunReport;
@@ -62,7 +61,10 @@ pub fn markdown(plan: &Plan, cells: &[Cell], done: &[Done], interrupted: Option<
         if plan.rounds == 1 { "" } else { "s" },
         match plan.warmup {
             0 => String::new(),
-            w => format!(" after {w} warm-up round{} (left out)", if w == 1 { "" } else { "s" }),
+            w => format!(
+                " after {w} warm-up round{} (left out)",
+                if w == 1 { "" } else { "s" }
+            ),
         },
         plan.frames
             .map_or("the apps' default".to_string(), |f| f.to_string()),
