@@ -2,7 +2,7 @@
 //! links to the same built apps) × two apps × two option sets × two rounds
 //! run in alternating order, one fresh process per run, and sweep.md's
 //! medians are the ones sweep.jsonl gives; a bad plan exits 2 naming its
-//! line before anything runs.
+//! line before anything runs; SIGINT keeps the finished runs in both files.
 
 use std::collections::{BTreeMap, BTreeSet};
 use std::path::Path;
@@ -212,5 +212,73 @@ options = { scene = "box", vk-wait = "fence" }
         plan,
         6,
         "twinray-gl refuses the option set 'fence'",
+    );
+}
+
+#[test]
+fn sigint_keeps_the_finished_runs_and_marks_both_files() {
+    use std::time::{Duration, Instant};
+    let dir = scratch("sweep-sigint");
+    two_builds(&dir);
+    let file = dir.join("plan.toml");
+    std::fs::write(&file, PLAN.replace("rounds = 2", "rounds = 50")).unwrap();
+    let out = dir.join("out");
+    let mut child = std::process::Command::new(bin("twinray"))
+        .args([
+            "sweep",
+            file.to_str().unwrap(),
+            "--out",
+            out.to_str().unwrap(),
+        ])
+        .env(
+            "MESA_SHADER_CACHE_DIR",
+            std::env::temp_dir().join("twinray-mesa-cache"),
+        )
+        .stderr(std::process::Stdio::null())
+        .spawn()
+        .unwrap();
+    // Once two runs are on disk, in the middle of the sweep.
+    let jsonl = out.join("sweep.jsonl");
+    let started = Instant::now();
+    while std::fs::read_to_string(&jsonl).map_or(0, |s| s.lines().count()) < 2 {
+        assert!(
+            started.elapsed() < Duration::from_secs(120),
+            "no run finished"
+        );
+        std::thread::sleep(Duration::from_millis(20));
+    }
+    let killed = std::process::Command::new("kill")
+        .args(["-INT", &child.id().to_string()])
+        .status()
+        .unwrap();
+    assert!(killed.success());
+    let status = loop {
+        if let Some(status) = child.try_wait().unwrap() {
+            break status;
+        }
+        assert!(
+            started.elapsed() < Duration::from_secs(180),
+            "twinray sweep did not stop"
+        );
+        std::thread::sleep(Duration::from_millis(20));
+    };
+    assert_eq!(status.code(), Some(130));
+    let text = std::fs::read_to_string(&jsonl).unwrap();
+    let lines: Vec<serde_json::Value> = text
+        .lines()
+        .map(|l| serde_json::from_str(l).unwrap())
+        .collect();
+    let (mark, runs) = lines.split_last().unwrap();
+    assert_eq!(mark["interrupted"], "SIGINT", "{text}");
+    assert_eq!(mark["runs"], runs.len(), "{text}");
+    assert!(runs.len() >= 2 && runs.len() < 400, "{text}");
+    assert!(
+        runs.iter().all(|r| r["report"]["api"] == r["app"]),
+        "{text}"
+    );
+    let md = std::fs::read_to_string(out.join("sweep.md")).unwrap();
+    assert!(
+        md.lines().next().unwrap().contains("interrupted by SIGINT"),
+        "{md}"
     );
 }
