@@ -442,12 +442,15 @@ enum Pick {
     Env(String, String),
 }
 
+/// An axis: where the plan declares it, and its values with their names.
+type Axis = (std::ops::Range<usize>, Vec<(String, Pick)>);
+
 /// The option sets of `[axes]` and `[env_axes]`: every combination, the
 /// first declared axis outermost.
 fn product(raw: &PlanFile, base: &Base, src: &Source) -> anyhow::Result<Vec<OptionSet>> {
     let at = |span, what| src.at(span, what);
     // Each axis as (where it is, its values), in the order the plan declares them.
-    let mut axes: Vec<(std::ops::Range<usize>, Vec<(String, Pick)>)> = Vec::new();
+    let mut axes: Vec<Axis> = Vec::new();
     for (key, values) in &raw.axes {
         if values.get_ref().is_empty() {
             return Err(at(values.span(), format!("the axis '{key}' is empty")));
