@@ -197,6 +197,9 @@ fn an_option_an_app_refuses_is_refused_at_its_line() {
     // A value an app refuses.
     let plan = PLAN.replace("size = [\"32x24\"]", "size = [\"32y24\"]");
     refused("sweep-value", &plan, 12, "twinray-vk refuses");
+    // The plan's own settle, at its own line.
+    let plan = PLAN.replace("frames = 3\n", "frames = 3\nsettle = 80\n");
+    refused("sweep-settle", &plan, 3, "invalid value '80' for '--settle");
     // A Vulkan knob, in an explicit set: OpenGL refuses it.
     let plan = r#"rounds = 1
 apps = ["vulkan", "opengl"]

@@ -172,6 +172,17 @@ pub fn load(file: &Path) -> anyhow::Result<Plan> {
         frames,
         settle,
     };
+    // The plan's own options alone first, so that a bad `frames` or `settle`
+    // is refused at its own line rather than at an option set's.
+    if let Some(span) = raw
+        .settle
+        .as_ref()
+        .map(|s| s.span())
+        .or_else(|| raw.frames.as_ref().map(|f| f.span()))
+    {
+        base.check("frames and settle".into(), Vec::new(), Vec::new())
+            .map_err(|why| src.at(span, why))?;
+    }
     let sets = match (
         raw.axes.is_empty() && raw.env_axes.is_empty(),
         raw.sets.is_empty(),
@@ -217,6 +228,16 @@ fn apps(raw: &PlanFile, src: &Source) -> anyhow::Result<Vec<Api>> {
         .collect::<anyhow::Result<_>>()?;
     if apps.is_empty() {
         return Err(src.at(raw.apps.span(), "`apps` names no app".into()));
+    }
+    if let Some((_, twice)) = apps
+        .iter()
+        .enumerate()
+        .find(|(i, a)| apps[..*i].contains(a))
+    {
+        return Err(src.at(
+            raw.apps.span(),
+            format!("`apps` names {} twice", crate::apps::api_name(*twice)),
+        ));
     }
     Ok(apps)
 }
@@ -378,9 +399,13 @@ impl Base<'_> {
             let parsed = parsed.map_err(|e| {
                 let message = e.to_string();
                 let first = message.lines().next().unwrap_or("refused");
+                let what = match options.is_empty() {
+                    // The plan's own `frames` and `settle`, checked alone.
+                    true => "it".to_string(),
+                    false => format!("the option set '{name}' ({})", options.join(" ")),
+                };
                 format!(
-                    "{bin} refuses the option set '{name}' ({}): {}",
-                    options.join(" "),
+                    "{bin} refuses {what}: {}",
                     first.trim_start_matches("error: ")
                 )
             })?;
@@ -455,6 +480,14 @@ fn product(raw: &PlanFile, base: &Base, src: &Source) -> anyhow::Result<Vec<Opti
         if values.get_ref().is_empty() {
             return Err(at(values.span(), format!("the axis '{key}' is empty")));
         }
+        // Twice the same value would be two cells the table cannot tell apart.
+        let all = values.get_ref();
+        if let Some((_, v)) = all.iter().enumerate().find(|(i, v)| all[..*i].contains(v)) {
+            return Err(at(
+                values.span(),
+                format!("the axis '{key}' names {v} twice"),
+            ));
+        }
         let picks = values
             .get_ref()
             .iter()
@@ -472,6 +505,13 @@ fn product(raw: &PlanFile, base: &Base, src: &Source) -> anyhow::Result<Vec<Opti
     for (var, values) in &raw.env_axes {
         if values.get_ref().is_empty() {
             return Err(at(values.span(), format!("the axis '{var}' is empty")));
+        }
+        let all = values.get_ref();
+        if let Some((_, v)) = all.iter().enumerate().find(|(i, v)| all[..*i].contains(v)) {
+            return Err(at(
+                values.span(),
+                format!("the axis '{var}' names '{v}' twice"),
+            ));
         }
         let picks = values
             .get_ref()
