@@ -48,11 +48,12 @@ pub fn run(args: &SweepArgs) -> anyhow::Result<()> {
         std::fs::File::create(&jsonl_path)
             .with_context(|| format!("creating {}", jsonl_path.display()))?,
     );
-    let total = (plan.warmup + plan.rounds) as usize * cells.len();
+    let rounds = plan.warmup.saturating_add(plan.rounds);
+    let total = (rounds as usize).saturating_mul(cells.len());
     let mut done = Vec::new();
     let mut failed = Vec::new();
     let mut seq = 0usize;
-    'rounds: for round in 0..plan.warmup + plan.rounds {
+    'rounds: for round in 0..rounds {
         for (order, cell_index) in round_order(cells.len(), round).into_iter().enumerate() {
             if stop.stopped() {
                 break 'rounds;
@@ -116,7 +117,14 @@ pub fn run(args: &SweepArgs) -> anyhow::Result<()> {
         append(&mut jsonl, &mark, &jsonl_path)?;
     }
     let md_path = args.out.join("sweep.md");
-    let md = table::markdown(&plan, &cells, &done, interrupted.map(|(s, _)| s));
+    let mut md = table::markdown(&plan, &cells, &done, interrupted.map(|(s, _)| s));
+    if !failed.is_empty() {
+        // A failed run is missing from its cell's rounds: say so beside the figures.
+        md += &format!(
+            "\n{} of {seq} runs failed and are left out; sweep.jsonl has each error.\n",
+            failed.len()
+        );
+    }
     std::fs::write(&md_path, md).with_context(|| format!("writing {}", md_path.display()))?;
     eprintln!(
         "twinray sweep: {seq} of {total} runs in {:.0} s{}; table: {}",
