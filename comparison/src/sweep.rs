@@ -1,5 +1,6 @@
 //! `twinray sweep PLAN.toml --out DIR`: the laboratory's one measuring loop.
-//! It owns running a plan (`plan` reads and checks it): every cell (build ×
+//! It owns running a plan (`plan` reads and checks it, `options` turns an
+//! option set's values into command-line tokens): every cell (build ×
 //! app × option set) in a fresh process per round, the cell order reversed on
 //! odd rounds so that no build or app always runs first (warm caches, clocks
 //! and thermals favour a fixed order); `sweep.jsonl`, each run's own `--json`
@@ -8,6 +9,7 @@
 //! started, supervised and read exactly as `compare` does (`apps::run_json_with`,
 //! `supervisor`), and the cells are those of compare's report (`report::cells`).
 
+mod options;
 mod plan;
 mod table;
 

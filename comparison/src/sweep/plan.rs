@@ -4,6 +4,7 @@
 //! apps use (`VulkanCli`, `OpenGlCli`), so an option an app would refuse is
 //! refused here, not in the middle of a sweep.
 
+use super::options::option_tokens;
 use crate::apps::Api;
 use clap::{CommandFactory, Parser};
 use serde::Deserialize;
@@ -104,21 +105,6 @@ pub struct Plan {
     pub settle: Option<f64>,
     pub ratios: Vec<Ratio>,
 }
-
-/// Options the plan sets for every run itself (or that would break the
-/// reading of the report), refused in an option set.
-const RESERVED: &[(&str, &str)] = &[
-    ("json", "every run reports as JSON"),
-    ("headless", "every run is headless"),
-    ("frames", "the plan's top-level `frames` sets it"),
-    ("settle", "the plan's top-level `settle` sets it"),
-    ("out", "a sweep writes no images"),
-    ("dump-shaders", "a sweep writes no shader dumps"),
-    ("explain", "it prints text where the report is read"),
-    ("experiments", "it prints a list instead of rendering"),
-    ("help", "it prints help instead of rendering"),
-    ("version", "it prints the version instead of rendering"),
-];
 
 /// The 1-based line of byte `offset` in `text`.
 fn line_of(text: &str, offset: usize) -> usize {
@@ -421,35 +407,6 @@ impl Base<'_> {
     }
 }
 
-/// `key = value` of an option set as command-line tokens: `true` is the bare
-/// flag, `false` leaves it out, an array repeats the option.
-fn option_tokens(key: &str, value: &toml::Value) -> Result<Vec<String>, String> {
-    if let Some((_, why)) = RESERVED.iter().find(|(k, _)| *k == key) {
-        return Err(format!("an option set may not give '{key}': {why}"));
-    }
-    let flag = format!("--{key}");
-    match value {
-        toml::Value::Boolean(true) => Ok(vec![flag]),
-        toml::Value::Boolean(false) => Ok(Vec::new()),
-        toml::Value::String(s) => Ok(vec![flag, s.clone()]),
-        toml::Value::Integer(i) => Ok(vec![flag, i.to_string()]),
-        toml::Value::Float(x) => Ok(vec![flag, x.to_string()]),
-        toml::Value::Array(items) => items.iter().try_fold(Vec::new(), |mut v, item| {
-            match item {
-                toml::Value::Array(_) | toml::Value::Table(_) => {
-                    return Err(format!("'{key}' holds a nested array or table"))
-                }
-                _ => v.extend(option_tokens(key, item)?),
-            }
-            Ok(v)
-        }),
-        _ => Err(format!(
-            "'{key}' is a {}; give a string, number or boolean",
-            value.type_str()
-        )),
-    }
-}
-
 /// The plan's `[env]` with a set's own on top.
 fn merged_env(
     all: &BTreeMap<String, String>,
@@ -570,34 +527,7 @@ fn product(raw: &PlanFile, base: &Base, src: &Source) -> anyhow::Result<Vec<Opti
 
 #[cfg(test)]
 mod tests {
-    use super::{line_of, option_tokens};
-
-    #[test]
-    fn a_value_becomes_the_tokens_an_app_reads() {
-        assert_eq!(
-            option_tokens("scene", &toml::Value::String("box".into())).unwrap(),
-            ["--scene", "box"]
-        );
-        assert_eq!(
-            option_tokens("count-rays", &toml::Value::Boolean(true)).unwrap(),
-            ["--count-rays"]
-        );
-        assert!(option_tokens("count-rays", &toml::Value::Boolean(false))
-            .unwrap()
-            .is_empty());
-        assert_eq!(
-            option_tokens("workgroup", &toml::Value::Integer(8)).unwrap(),
-            ["--workgroup", "8"]
-        );
-        let sets = toml::Value::Array(vec!["a=1".into(), "b=2".into()]);
-        assert_eq!(
-            option_tokens("set", &sets).unwrap(),
-            ["--set", "a=1", "--set", "b=2"]
-        );
-        assert!(option_tokens("frames", &toml::Value::Integer(3))
-            .unwrap_err()
-            .contains("top-level"));
-    }
+    use super::line_of;
 
     #[test]
     fn lines_count_from_one() {
