@@ -256,14 +256,47 @@ pub fn runs_started() -> usize {
 
 /// Runs an app with `--json` and returns its report; a failure carries the app's own message and exit code.
 pub fn run_json(api: Api, args: &RenderArgs) -> anyhow::Result<RunReport> {
+    run_json_with(api, args, &Launch::default()).map(|ran| ran.report)
+}
+
+/// Where and how `run_json_with` starts an app, beyond its `RenderArgs`: a
+/// sweep runs builds side by side, so the binary folder is per call here
+/// rather than the process's one `--bin-dir`.
+#[derive(Debug, Default, Clone)]
+pub struct Launch {
+    /// The folder holding the app; `None` is `app_path`'s folder.
+    pub bin_dir: Option<PathBuf>,
+    /// Options after `RenderArgs`'s own (an app's knobs), already checked by its parser.
+    pub extra: Vec<String>,
+    /// Environment variables set for this run only.
+    pub env: Vec<(String, String)>,
+}
+
+/// One finished `--json` run: the parsed report, the app's JSON as it
+/// printed it (fields this orchestrator does not know are kept), and the
+/// child's process id.
+pub struct Ran {
+    pub report: RunReport,
+    pub json: serde_json::Value,
+    pub pid: u32,
+}
+
+/// [`run_json`] with a [`Launch`]: the one place an app is started for a report.
+pub fn run_json_with(api: Api, args: &RenderArgs, launch: &Launch) -> anyhow::Result<Ran> {
     let bin = api.binary().expect("an app");
     RUNS_STARTED.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
     let mut args = args.clone();
     args.json = true;
     args.gl_spirv |= api == Api::OpenglSpirv;
-    let mut cmd = Command::new(app_path(bin)?);
-    cmd.args(app_args(&args));
-    let out = crate::supervisor::output(cmd, bin)?;
+    let path = match &launch.bin_dir {
+        Some(dir) => dir.join(bin),
+        None => app_path(bin)?,
+    };
+    let mut cmd = Command::new(path);
+    cmd.args(app_args(&args))
+        .args(&launch.extra)
+        .envs(launch.env.iter().map(|(k, v)| (k, v)));
+    let (out, pid) = crate::supervisor::output_with_pid(cmd, bin)?;
     if !out.status.success() {
         let stderr = String::from_utf8_lossy(&out.stderr);
         let line = error_line(&stderr).to_string();
@@ -287,7 +320,11 @@ pub fn run_json(api: Api, args: &RenderArgs) -> anyhow::Result<RunReport> {
         .rev()
         .find(|l| l.starts_with('{'))
         .unwrap_or("");
-    serde_json::from_str(json).with_context(|| format!("reading {bin}'s JSON report"))
+    let report =
+        serde_json::from_str(json).with_context(|| format!("reading {bin}'s JSON report"))?;
+    let json =
+        serde_json::from_str(json).with_context(|| format!("reading {bin}'s JSON report"))?;
+    Ok(Ran { report, json, pid })
 }
 
 /// The API's name in every CSV, table, plot and file name.

@@ -9,6 +9,7 @@
 //! `interrupt` are how a long run ends when some run failed or a signal came,
 //! `supervisor` how every child app is run and, on a signal, stopped;
 //! `summary` is `twinray summary`, the verdict table over compare folders;
+//! `sweep` is `twinray sweep`, a plan file's runs with their jsonl and table;
 //! `ulp` is `twinray ulp`, the GPU's f32 arithmetic measured; `unsettled` is
 //! `render --unsettled`, the reference's mask of pixels f32 cannot settle.
 
@@ -22,6 +23,7 @@ mod interrupt;
 mod report;
 mod summary;
 mod supervisor;
+mod sweep;
 mod ulp;
 mod unsettled;
 
@@ -67,6 +69,8 @@ enum Command {
     },
     /// Side-by-side Vulkan vs OpenGL on the study's three experiments: results.csv, report.md, plots.
     Compare(compare::CompareArgs),
+    /// The laboratory's runner: a plan's builds × apps × option sets, each in a fresh process per round, in alternating order: sweep.jsonl and sweep.md.
+    Sweep(sweep::SweepArgs),
     /// Speed against error: sweeps of depth, offset, triangle and sphere tests against the f64 truth, and the hard cases.
     Accuracy(accuracy::AccuracyArgs),
     /// The GPU's f32 arithmetic: each operation the tracer uses, per API and path, against f64 (ULP error).
@@ -130,6 +134,7 @@ fn main() {
             exclude,
         } => diff::run(&a, &b, json, heatmap.as_deref(), exclude.as_deref()),
         Command::Compare(args) => compare::run(&args),
+        Command::Sweep(args) => sweep::run(&args),
         Command::Summary { dirs } => summary::run(&dirs),
         Command::Accuracy(args) => accuracy::run(&args),
         Command::Ulp(args) => ulp::run(&args),

@@ -49,8 +49,10 @@ fn interrupted(stop: &Stop) -> anyhow::Error {
 }
 
 /// Runs `cmd` to its end with stdout and stderr captured, as
-/// `Command::output` does, unless a stopping signal comes first.
-pub fn output(mut cmd: Command, what: &str) -> anyhow::Result<Output> {
+/// `Command::output` does, unless a stopping signal comes first; with the
+/// child's process id, which `sweep` records to show that every run had a
+/// process of its own.
+pub fn output_with_pid(mut cmd: Command, what: &str) -> anyhow::Result<(Output, u32)> {
     if let Some(stop) = Stop::current().filter(|s| s.stopped()) {
         return Err(interrupted(stop));
     }
@@ -60,6 +62,7 @@ pub fn output(mut cmd: Command, what: &str) -> anyhow::Result<Output> {
         .stderr(Stdio::piped())
         .spawn()
         .with_context(|| format!("starting {what}"))?;
+    let pid = child.id();
     // Read while the child runs: a full pipe would otherwise block it forever.
     let drain = |pipe: Option<Box<dyn Read + Send>>| {
         std::thread::spawn(move || {
@@ -84,11 +87,14 @@ pub fn output(mut cmd: Command, what: &str) -> anyhow::Result<Output> {
     );
     let collect = |h: std::thread::JoinHandle<Vec<u8>>| h.join().unwrap_or_default();
     match wait(&mut child, what)? {
-        Waited::Exited(status) => Ok(Output {
-            status,
-            stdout: collect(stdout),
-            stderr: collect(stderr),
-        }),
+        Waited::Exited(status) => Ok((
+            Output {
+                status,
+                stdout: collect(stdout),
+                stderr: collect(stderr),
+            },
+            pid,
+        )),
         // The readers are not waited for: a process the app started may
         // still hold the pipes, and they end by themselves when it lets go.
         Waited::Stopped(e) => Err(e),

@@ -1,0 +1,539 @@
+//! A sweep's plan file (TOML): what it may say, and every check of it made
+//! before the first run, each refusal one sentence naming the plan and the
+//! line at fault (exit 2). An option set is checked by the very parsers the
+//! apps use (`VulkanCli`, `OpenGlCli`), so an option an app would refuse is
+//! refused here, not in the middle of a sweep.
+
+use super::options::option_tokens;
+use crate::apps::Api;
+use clap::{CommandFactory, Parser};
+use serde::Deserialize;
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+use toml::Spanned;
+use twinray_common::cli::{OpenGlCli, RenderArgs, VulkanCli};
+use twinray_common::error::bad_input;
+
+/// The plan as written. `Spanned` keeps where each value is, for the line
+/// a refusal names.
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct PlanFile {
+    builds: BTreeMap<String, Spanned<String>>,
+    apps: Spanned<Vec<String>>,
+    #[serde(default)]
+    axes: BTreeMap<String, Spanned<Vec<toml::Value>>>,
+    #[serde(default)]
+    env_axes: BTreeMap<String, Spanned<Vec<String>>>,
+    #[serde(default)]
+    sets: Vec<Spanned<SetFile>>,
+    #[serde(default)]
+    env: BTreeMap<String, String>,
+    rounds: Spanned<u32>,
+    #[serde(default)]
+    warmup: u32,
+    frames: Option<Spanned<u32>>,
+    settle: Option<Spanned<f64>>,
+    #[serde(default)]
+    ratios: Vec<Spanned<[String; 2]>>,
+}
+
+/// One option set of an explicit `[[sets]]` list.
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct SetFile {
+    name: Option<String>,
+    #[serde(default)]
+    options: BTreeMap<String, Spanned<toml::Value>>,
+    #[serde(default)]
+    env: BTreeMap<String, String>,
+}
+
+/// A named folder of binaries.
+#[derive(Debug, Clone)]
+pub struct Build {
+    pub name: String,
+    pub dir: PathBuf,
+}
+
+/// One option set, checked: the `RenderArgs` both apps parsed from it, the
+/// options that are an app's own knobs (passed on as written), and its
+/// environment.
+#[derive(Debug, Clone)]
+pub struct OptionSet {
+    pub name: String,
+    /// The set's options as the plan gave them, in command-line form.
+    pub options: Vec<String>,
+    pub args: RenderArgs,
+    pub extra: Vec<String>,
+    pub env: Vec<(String, String)>,
+}
+
+/// A ratio the table reports: of two apps (per build and set) or of two
+/// builds (per app and set), the first over the second.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Ratio {
+    Apps(Api, Api),
+    Builds(usize, usize),
+}
+
+/// One cell: which build, app and option set (indices into the plan).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Cell {
+    pub build: usize,
+    pub app: Api,
+    pub set: usize,
+}
+
+/// A finished measured run (warm-up rounds aside), as the table needs it.
+pub struct Done {
+    pub cell: usize,
+    pub report: twinray_common::report::RunReport,
+}
+
+/// A checked plan.
+#[derive(Debug)]
+pub struct Plan {
+    pub file: PathBuf,
+    pub builds: Vec<Build>,
+    pub apps: Vec<Api>,
+    pub sets: Vec<OptionSet>,
+    pub rounds: u32,
+    /// Rounds run before the measured ones and left out of the table.
+    pub warmup: u32,
+    pub frames: Option<u32>,
+    pub settle: Option<f64>,
+    pub ratios: Vec<Ratio>,
+}
+
+/// The 1-based line of byte `offset` in `text`.
+fn line_of(text: &str, offset: usize) -> usize {
+    text[..offset.min(text.len())].matches('\n').count() + 1
+}
+
+/// Where a refusal points: the plan's name and text, for "line N" sentences.
+struct Source<'a> {
+    shown: String,
+    text: &'a str,
+}
+
+impl Source<'_> {
+    /// A refusal at the value spanning `span`.
+    fn at(&self, span: std::ops::Range<usize>, what: String) -> anyhow::Error {
+        bad_input(format!(
+            "the plan '{}', line {}: {what}",
+            self.shown,
+            line_of(self.text, span.start)
+        ))
+    }
+
+    /// A refusal of the plan as a whole (something it lacks has no line).
+    fn whole(&self, what: &str) -> anyhow::Error {
+        bad_input(format!("the plan '{}': {what}", self.shown))
+    }
+}
+
+/// Reads and checks the plan at `file`; nothing is run or written.
+pub fn load(file: &Path) -> anyhow::Result<Plan> {
+    let shown = file.display().to_string();
+    let text = std::fs::read_to_string(file)
+        .map_err(|e| bad_input(format!("the plan '{shown}' cannot be read ({e})")))?;
+    let raw: PlanFile = toml::from_str(&text).map_err(|e| {
+        let line = e.span().map_or(1, |s| line_of(&text, s.start));
+        bad_input(format!(
+            "the plan '{shown}', line {line}: {}",
+            e.message().trim().trim_end_matches('.')
+        ))
+    })?;
+    let src = Source { shown, text: &text };
+    let apps = apps(&raw, &src)?;
+    let builds = builds(&raw, &apps, file.parent().unwrap_or(Path::new(".")), &src)?;
+    if *raw.rounds.get_ref() == 0 {
+        return Err(src.at(raw.rounds.span(), "`rounds` must be at least 1".into()));
+    }
+    let frames = raw.frames.as_ref().map(|f| *f.get_ref());
+    let settle = raw.settle.as_ref().map(|s| *s.get_ref());
+    let base = Base {
+        apps: &apps,
+        frames,
+        settle,
+    };
+    // The plan's own options alone first, so that a bad `frames` or `settle`
+    // is refused at its own line rather than at an option set's.
+    if let Some(span) = raw
+        .settle
+        .as_ref()
+        .map(|s| s.span())
+        .or_else(|| raw.frames.as_ref().map(|f| f.span()))
+    {
+        base.check("frames and settle".into(), Vec::new(), Vec::new())
+            .map_err(|why| src.at(span, why))?;
+    }
+    let sets = match (
+        raw.axes.is_empty() && raw.env_axes.is_empty(),
+        raw.sets.is_empty(),
+    ) {
+        (true, true) => return Err(src.whole("it names no option set; give [axes] or [[sets]]")),
+        (false, false) => {
+            return Err(src.at(
+                raw.sets[0].span(),
+                "give either [axes] or [[sets]], not both".into(),
+            ))
+        }
+        (false, true) => product(&raw, &base, &src)?,
+        (true, false) => listed(&raw, &base, &src)?,
+    };
+    let ratios = ratios(&raw, &apps, &builds, &src)?;
+    Ok(Plan {
+        file: file.to_path_buf(),
+        builds,
+        apps,
+        sets,
+        rounds: *raw.rounds.get_ref(),
+        warmup: raw.warmup,
+        frames,
+        settle,
+        ratios,
+    })
+}
+
+fn apps(raw: &PlanFile, src: &Source) -> anyhow::Result<Vec<Api>> {
+    let apps: Vec<Api> = raw
+        .apps
+        .get_ref()
+        .iter()
+        .map(
+            |name| match <Api as clap::ValueEnum>::from_str(name, false) {
+                Ok(Api::Reference) | Err(_) => Err(src.at(
+                    raw.apps.span(),
+                    format!("'{name}' is not an app; use vulkan, opengl or opengl-spirv"),
+                )),
+                Ok(api) => Ok(api),
+            },
+        )
+        .collect::<anyhow::Result<_>>()?;
+    if apps.is_empty() {
+        return Err(src.at(raw.apps.span(), "`apps` names no app".into()));
+    }
+    if let Some((_, twice)) = apps
+        .iter()
+        .enumerate()
+        .find(|(i, a)| apps[..*i].contains(a))
+    {
+        return Err(src.at(
+            raw.apps.span(),
+            format!("`apps` names {} twice", crate::apps::api_name(*twice)),
+        ));
+    }
+    Ok(apps)
+}
+
+/// The builds in the order the plan declares them (the map sorts by name),
+/// each a folder, relative to the plan's, that holds every app the plan runs.
+fn builds(raw: &PlanFile, apps: &[Api], folder: &Path, src: &Source) -> anyhow::Result<Vec<Build>> {
+    let mut declared: Vec<_> = raw.builds.iter().collect();
+    declared.sort_by_key(|(_, dir)| dir.span().start);
+    if declared.is_empty() {
+        return Err(src.whole("[builds] names no build"));
+    }
+    let mut builds = Vec::new();
+    for (name, dir) in declared {
+        let path = folder.join(dir.get_ref());
+        if !path.is_dir() {
+            return Err(src.at(
+                dir.span(),
+                format!(
+                    "build '{name}' is '{}', which is not a folder",
+                    path.display()
+                ),
+            ));
+        }
+        for api in apps {
+            let bin = api.binary().expect("an app");
+            if !path.join(bin).is_file() {
+                return Err(src.at(
+                    dir.span(),
+                    format!("build '{name}' ('{}') holds no {bin}", path.display()),
+                ));
+            }
+        }
+        builds.push(Build {
+            name: name.clone(),
+            dir: path,
+        });
+    }
+    Ok(builds)
+}
+
+/// The option sets of an explicit `[[sets]]` list.
+fn listed(raw: &PlanFile, base: &Base, src: &Source) -> anyhow::Result<Vec<OptionSet>> {
+    let mut sets: Vec<OptionSet> = Vec::new();
+    for (i, set) in raw.sets.iter().enumerate() {
+        let s = set.get_ref();
+        let mut opts: Vec<_> = s.options.iter().collect();
+        opts.sort_by_key(|(_, v)| v.span().start);
+        let mut options = Vec::new();
+        for (key, value) in &opts {
+            let tokens =
+                option_tokens(key, value.get_ref()).map_err(|why| src.at(value.span(), why))?;
+            options.extend(tokens);
+        }
+        let name = s.name.clone().unwrap_or_else(|| format!("set {}", i + 1));
+        if sets.iter().any(|o| o.name == name) {
+            return Err(src.at(set.span(), format!("two option sets are named '{name}'")));
+        }
+        let env = merged_env(&raw.env, &s.env);
+        sets.push(
+            base.check(name, options, env)
+                .map_err(|why| src.at(set.span(), why))?,
+        );
+    }
+    Ok(sets)
+}
+
+fn ratios(
+    raw: &PlanFile,
+    apps: &[Api],
+    builds: &[Build],
+    src: &Source,
+) -> anyhow::Result<Vec<Ratio>> {
+    raw.ratios
+        .iter()
+        .map(|pair| {
+            let [a, b] = pair.get_ref();
+            let app = |n: &str| apps.iter().copied().find(|api| crate::apps::api_name(*api) == n);
+            let build = |n: &str| builds.iter().position(|bd| bd.name == n);
+            match (app(a), app(b), build(a), build(b)) {
+                (Some(x), Some(y), _, _) => Ok(Ratio::Apps(x, y)),
+                (_, _, Some(x), Some(y)) => Ok(Ratio::Builds(x, y)),
+                _ => Err(src.at(
+                    pair.span(),
+                    format!("the ratio ['{a}', '{b}'] names neither two of the plan's apps nor two of its builds"),
+                )),
+            }
+        })
+        .collect()
+}
+
+impl Plan {
+    /// The cells in the order of an even round: builds outermost, then apps, then sets.
+    pub fn cells(&self) -> Vec<Cell> {
+        let mut cells = Vec::new();
+        for build in 0..self.builds.len() {
+            for &app in &self.apps {
+                for set in 0..self.sets.len() {
+                    cells.push(Cell { build, app, set });
+                }
+            }
+        }
+        cells
+    }
+}
+
+/// What every option set is checked with.
+struct Base<'a> {
+    apps: &'a [Api],
+    frames: Option<u32>,
+    settle: Option<f64>,
+}
+
+impl Base<'_> {
+    /// Parses `options` as each app would, with the plan's own options, and
+    /// splits them into `RenderArgs` and the app's knobs; the error is why an
+    /// app refused them.
+    fn check(
+        &self,
+        name: String,
+        options: Vec<String>,
+        env: Vec<(String, String)>,
+    ) -> Result<OptionSet, String> {
+        let shared: Vec<String> = RenderArgs::command()
+            .get_arguments()
+            .filter_map(|a| a.get_long().map(|l| format!("--{l}")))
+            .collect();
+        // Options come in `--key [value]` runs: a run whose key is not one of
+        // RenderArgs' own is a knob, passed on after them as written.
+        let (mut render, mut extra) = (Vec::new(), Vec::new());
+        let mut into_extra = false;
+        for token in &options {
+            if token.starts_with("--") {
+                into_extra = !shared.contains(token);
+            }
+            if into_extra {
+                extra.push(token.clone());
+            } else {
+                render.push(token.clone());
+            }
+        }
+        let mut argv = vec!["--headless".to_string(), "--json".to_string()];
+        if let Some(f) = self.frames {
+            argv.extend(["--frames".into(), f.to_string()]);
+        }
+        if let Some(p) = self.settle {
+            argv.extend(["--settle".into(), p.to_string()]);
+        }
+        argv.extend(render);
+        argv.extend(extra.iter().cloned());
+        let mut args = None;
+        for api in self.apps {
+            let bin = api.binary().expect("an app");
+            let argv = std::iter::once(bin.to_string()).chain(argv.iter().cloned());
+            let parsed = match api {
+                Api::Vulkan => VulkanCli::try_parse_from(argv).map(|c| c.render),
+                _ => OpenGlCli::try_parse_from(argv).map(|c| c.render),
+            };
+            let parsed = parsed.map_err(|e| {
+                let message = e.to_string();
+                let first = message.lines().next().unwrap_or("refused");
+                let what = match options.is_empty() {
+                    // The plan's own `frames` and `settle`, checked alone.
+                    true => "it".to_string(),
+                    false => format!("the option set '{name}' ({})", options.join(" ")),
+                };
+                format!(
+                    "{bin} refuses {what}: {}",
+                    first.trim_start_matches("error: ")
+                )
+            })?;
+            args.get_or_insert(parsed);
+        }
+        Ok(OptionSet {
+            name,
+            options,
+            args: args.expect("a plan has an app"),
+            extra,
+            env,
+        })
+    }
+}
+
+/// The plan's `[env]` with a set's own on top.
+fn merged_env(
+    all: &BTreeMap<String, String>,
+    own: &BTreeMap<String, String>,
+) -> Vec<(String, String)> {
+    let mut env = all.clone();
+    env.extend(own.iter().map(|(k, v)| (k.clone(), v.clone())));
+    env.into_iter().collect()
+}
+
+/// One value of one axis: its command-line tokens or environment variable,
+/// and its part of the set's name.
+enum Pick {
+    Option(Vec<String>),
+    Env(String, String),
+}
+
+/// An axis: where the plan declares it, and its values with their names.
+type Axis = (std::ops::Range<usize>, Vec<(String, Pick)>);
+
+/// The option sets of `[axes]` and `[env_axes]`: every combination, the
+/// first declared axis outermost.
+fn product(raw: &PlanFile, base: &Base, src: &Source) -> anyhow::Result<Vec<OptionSet>> {
+    let at = |span, what| src.at(span, what);
+    // Each axis as (where it is, its values), in the order the plan declares them.
+    let mut axes: Vec<Axis> = Vec::new();
+    for (key, values) in &raw.axes {
+        if values.get_ref().is_empty() {
+            return Err(at(values.span(), format!("the axis '{key}' is empty")));
+        }
+        // Twice the same value would be two cells the table cannot tell apart.
+        let all = values.get_ref();
+        if let Some((_, v)) = all.iter().enumerate().find(|(i, v)| all[..*i].contains(v)) {
+            return Err(at(
+                values.span(),
+                format!("the axis '{key}' names {v} twice"),
+            ));
+        }
+        let picks = values
+            .get_ref()
+            .iter()
+            .map(|v| {
+                let tokens = option_tokens(key, v).map_err(|why| at(values.span(), why))?;
+                let shown = match v {
+                    toml::Value::String(s) => s.clone(),
+                    other => other.to_string(),
+                };
+                Ok((format!("{key}={shown}"), Pick::Option(tokens)))
+            })
+            .collect::<anyhow::Result<_>>()?;
+        axes.push((values.span(), picks));
+    }
+    for (var, values) in &raw.env_axes {
+        if values.get_ref().is_empty() {
+            return Err(at(values.span(), format!("the axis '{var}' is empty")));
+        }
+        let all = values.get_ref();
+        if let Some((_, v)) = all.iter().enumerate().find(|(i, v)| all[..*i].contains(v)) {
+            return Err(at(
+                values.span(),
+                format!("the axis '{var}' names '{v}' twice"),
+            ));
+        }
+        let picks = values
+            .get_ref()
+            .iter()
+            .map(|v| (format!("{var}={v}"), Pick::Env(var.clone(), v.clone())))
+            .collect();
+        axes.push((values.span(), picks));
+    }
+    axes.sort_by_key(|(span, _)| span.start);
+    // Each option alone first, so that a refusal names the axis that holds it.
+    for (span, picks) in &axes {
+        for (name, pick) in picks {
+            if let Pick::Option(tokens) = pick {
+                base.check(name.clone(), tokens.clone(), Vec::new())
+                    .map_err(|why| at(span.clone(), why))?;
+            }
+        }
+    }
+    let mut combos: Vec<Vec<usize>> = vec![Vec::new()];
+    for (_, picks) in &axes {
+        combos = combos
+            .into_iter()
+            .flat_map(|c| {
+                (0..picks.len()).map(move |i| {
+                    let mut c = c.clone();
+                    c.push(i);
+                    c
+                })
+            })
+            .collect();
+    }
+    combos
+        .into_iter()
+        .map(|combo| {
+            let mut names = Vec::new();
+            let mut options = Vec::new();
+            let mut own_env = BTreeMap::new();
+            for ((_, picks), &i) in axes.iter().zip(&combo) {
+                let (name, pick) = &picks[i];
+                names.push(name.clone());
+                match pick {
+                    Pick::Option(tokens) => options.extend(tokens.iter().cloned()),
+                    Pick::Env(k, v) => {
+                        own_env.insert(k.clone(), v.clone());
+                    }
+                }
+            }
+            let name = names.join(" ");
+            let env = merged_env(&raw.env, &own_env);
+            // The refusal names the first axis: the set is their combination.
+            base.check(name, options, env)
+                .map_err(|why| at(axes[0].0.clone(), why))
+        })
+        .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::line_of;
+
+    #[test]
+    fn lines_count_from_one() {
+        let text = "a = 1\nb = 2\nc = 3\n";
+        assert_eq!(line_of(text, 0), 1);
+        assert_eq!(line_of(text, 6), 2);
+        assert_eq!(line_of(text, text.len() + 10), 4);
+    }
+}
