@@ -1,6 +1,8 @@
 //! Helpers for the end-to-end tests in tests/tests/: locating the built apps,
 //! running them the way a user does, and reading back their PNG + JSON.
 
+pub mod markdown;
+
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 use twinray_common::report::RunReport;

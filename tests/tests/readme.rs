@@ -8,6 +8,7 @@
 //! newcomer to install is the one cargo enforces.
 
 use std::path::{Path, PathBuf};
+use twinray_tests::markdown::{anchors, broken, links, slug};
 
 const MAX_README_LINES: usize = 150;
 
@@ -37,105 +38,6 @@ fn root() -> PathBuf {
 
 fn read(path: &Path) -> String {
     std::fs::read_to_string(path).unwrap_or_else(|e| panic!("{}: {e}", path.display()))
-}
-
-/// The lines of a Markdown text outside fenced code blocks.
-fn prose(text: &str) -> Vec<&str> {
-    let mut in_block = false;
-    let mut lines = Vec::new();
-    for line in text.lines() {
-        if line.trim_start().starts_with("```") {
-            in_block = !in_block;
-        } else if !in_block {
-            lines.push(line);
-        }
-    }
-    lines
-}
-
-/// The anchor GitHub gives a heading: lower case, everything but letters,
-/// digits, spaces, `-` and `_` dropped, each space a hyphen.
-fn slug(heading: &str) -> String {
-    heading
-        .trim()
-        .to_lowercase()
-        .chars()
-        .filter(|c| c.is_alphanumeric() || matches!(c, ' ' | '-' | '_'))
-        .map(|c| if c == ' ' { '-' } else { c })
-        .collect()
-}
-
-/// The anchors of a page's headings; a repeated heading gets `-1`, `-2`, …
-/// as on GitHub.
-fn anchors(text: &str) -> Vec<String> {
-    let mut found: Vec<String> = Vec::new();
-    for line in prose(text) {
-        let Some(heading) = line.strip_prefix('#') else {
-            continue;
-        };
-        let heading = heading.trim_start_matches('#');
-        if !heading.starts_with(' ') {
-            continue;
-        }
-        let base = slug(heading);
-        let numbered = |a: &str| {
-            a.strip_prefix(&format!("{base}-"))
-                .is_some_and(|n| n.parse::<u32>().is_ok())
-        };
-        let repeats = found.iter().filter(|a| **a == base || numbered(a)).count();
-        found.push(if repeats == 0 {
-            base
-        } else {
-            format!("{base}-{repeats}")
-        });
-    }
-    found
-}
-
-/// The targets of a page's Markdown links and images, `[text](target)`,
-/// outside code blocks.
-fn links(text: &str) -> Vec<String> {
-    let mut targets = Vec::new();
-    for line in prose(text) {
-        for part in line.split("](").skip(1) {
-            if let Some(end) = part.find(')') {
-                targets.push(part[..end].to_string());
-            }
-        }
-    }
-    targets
-}
-
-/// Why `target`, linked from the page `from`, leads nowhere; `None` where it
-/// resolves. Web addresses are not followed.
-fn broken(from: &Path, target: &str) -> Option<String> {
-    if target.contains("://") || target.starts_with("mailto:") {
-        return None;
-    }
-    let (path, anchor) = match target.split_once('#') {
-        Some((p, a)) => (p, Some(a)),
-        None => (target, None),
-    };
-    let file = if path.is_empty() {
-        from.to_path_buf()
-    } else {
-        from.parent().unwrap().join(path)
-    };
-    if !file.exists() {
-        return Some(format!("{target}: no file {}", file.display()));
-    }
-    let anchor = anchor?;
-    if file.extension().is_none_or(|e| e != "md") {
-        return Some(format!(
-            "{target}: an anchor into a file that is not Markdown"
-        ));
-    }
-    if !anchors(&read(&file)).iter().any(|a| a == anchor) {
-        return Some(format!(
-            "{target}: no heading with the anchor #{anchor} in {path}"
-        ));
-    }
-    None
 }
 
 fn code_files(dir: &Path, out: &mut Vec<PathBuf>) {
