@@ -8,9 +8,14 @@
 //! median table and the ratios the plan asks for (`table`). The apps are
 //! started, supervised and read exactly as `compare` does (`apps::run_json_with`,
 //! `supervisor`), and the cells are those of compare's report (`report::cells`).
+//! After the rounds come the plan's device-side steps (`steps`: shader
+//! statistics, images against a reference or another build), and `env`
+//! checks the plan's environment variables when it is read.
 
+mod env;
 mod options;
 mod plan;
+mod steps;
 mod table;
 
 use crate::apps::{self, Launch};
@@ -113,6 +118,14 @@ pub fn run(args: &SweepArgs) -> anyhow::Result<()> {
             seq += 1;
         }
     }
+    // The device-side steps follow the measured rounds, so that dumping and
+    // writing images never share a GPU with a timed run.
+    let steps_md = if stop.stopped() {
+        String::new()
+    } else {
+        let mut write = |line: &serde_json::Value| append(&mut jsonl, line, &jsonl_path);
+        steps::run(&plan, &cells, &args.out, &stop, &mut write, &mut failed)?
+    };
     let interrupted = stop.signal();
     if let Some((signal, _)) = interrupted {
         let mark = serde_json::json!({ "interrupted": signal, "runs": seq, "of": total });
@@ -120,6 +133,7 @@ pub fn run(args: &SweepArgs) -> anyhow::Result<()> {
     }
     let md_path = args.out.join("sweep.md");
     let mut md = table::markdown(&plan, &cells, &done, interrupted.map(|(s, _)| s));
+    md += &steps_md;
     if !failed.is_empty() {
         // A failed run is missing from its cell's rounds: say so beside the figures.
         md += &format!(

@@ -28,7 +28,7 @@ struct PlanFile {
     #[serde(default)]
     sets: Vec<Spanned<SetFile>>,
     #[serde(default)]
-    env: BTreeMap<String, String>,
+    env: BTreeMap<String, Spanned<String>>,
     rounds: Spanned<u32>,
     #[serde(default)]
     warmup: u32,
@@ -36,6 +36,10 @@ struct PlanFile {
     settle: Option<Spanned<f64>>,
     #[serde(default)]
     ratios: Vec<Spanned<[String; 2]>>,
+    /// The device-side steps after the timed rounds (`steps`).
+    #[serde(default)]
+    shaders: bool,
+    images: Option<Spanned<String>>,
 }
 
 /// One option set of an explicit `[[sets]]` list.
@@ -46,7 +50,7 @@ struct SetFile {
     #[serde(default)]
     options: BTreeMap<String, Spanned<toml::Value>>,
     #[serde(default)]
-    env: BTreeMap<String, String>,
+    env: BTreeMap<String, Spanned<String>>,
 }
 
 /// A named folder of binaries.
@@ -104,6 +108,26 @@ pub struct Plan {
     pub frames: Option<u32>,
     pub settle: Option<f64>,
     pub ratios: Vec<Ratio>,
+    /// Each cell once more after the rounds with `--dump-shaders`.
+    pub shaders: bool,
+    /// Each cell's image, and what it is compared with.
+    pub images: Option<Images>,
+}
+
+/// What each cell's image is compared with (`images = "..."`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Images {
+    /// The first build's, same app and set: byte for byte, with the reports
+    /// compared too (timings aside), so that a redesign can be shown to
+    /// change no output.
+    Builds,
+    /// The first app's, same build and set.
+    Apps,
+    /// The f64 CPU reference of the set's scene, size, `--set` and `--accel`.
+    Reference,
+    /// The f64 truth of the set's scene, size and `--set`, as the hard
+    /// cases are measured against.
+    Truth,
 }
 
 /// The 1-based line of byte `offset` in `text`.
@@ -146,6 +170,7 @@ pub fn load(file: &Path) -> anyhow::Result<Plan> {
         ))
     })?;
     let src = Source { shown, text: &text };
+    check_env(&raw, &src)?;
     let apps = apps(&raw, &src)?;
     let builds = builds(&raw, &apps, file.parent().unwrap_or(Path::new(".")), &src)?;
     if *raw.rounds.get_ref() == 0 {
@@ -184,6 +209,31 @@ pub fn load(file: &Path) -> anyhow::Result<Plan> {
         (true, false) => listed(&raw, &base, &src)?,
     };
     let ratios = ratios(&raw, &apps, &builds, &src)?;
+    let images = match &raw.images {
+        None => None,
+        Some(v) => Some(match v.get_ref().as_str() {
+            "builds" if builds.len() > 1 => Images::Builds,
+            "apps" if apps.len() > 1 => Images::Apps,
+            "reference" => Images::Reference,
+            "truth" => Images::Truth,
+            "builds" | "apps" => {
+                return Err(src.at(
+                    v.span(),
+                    format!(
+                        "`images = \"{}\"` needs two {} at least",
+                        v.get_ref(),
+                        v.get_ref()
+                    ),
+                ))
+            }
+            other => {
+                return Err(src.at(
+                    v.span(),
+                    format!("`images` is '{other}'; use builds, apps, reference or truth"),
+                ))
+            }
+        }),
+    };
     Ok(Plan {
         file: file.to_path_buf(),
         builds,
@@ -194,7 +244,23 @@ pub fn load(file: &Path) -> anyhow::Result<Plan> {
         frames,
         settle,
         ratios,
+        shaders: raw.shaders,
+        images,
     })
+}
+
+/// Every environment value of the plan, through `env::check`, at its line.
+fn check_env(raw: &PlanFile, src: &Source) -> anyhow::Result<()> {
+    let sets = raw.sets.iter().flat_map(|s| s.get_ref().env.iter());
+    for (var, value) in raw.env.iter().chain(sets) {
+        super::env::check(var, value.get_ref()).map_err(|why| src.at(value.span(), why))?;
+    }
+    for (var, values) in &raw.env_axes {
+        for value in values.get_ref() {
+            super::env::check(var, value).map_err(|why| src.at(values.span(), why))?;
+        }
+    }
+    Ok(())
 }
 
 fn apps(raw: &PlanFile, src: &Source) -> anyhow::Result<Vec<Api>> {
@@ -282,7 +348,8 @@ fn listed(raw: &PlanFile, base: &Base, src: &Source) -> anyhow::Result<Vec<Optio
         if sets.iter().any(|o| o.name == name) {
             return Err(src.at(set.span(), format!("two option sets are named '{name}'")));
         }
-        let env = merged_env(&raw.env, &s.env);
+        let own = s.env.iter().map(|(k, v)| (k.clone(), v.get_ref().clone()));
+        let env = merged_env(&raw.env, &own.collect());
         sets.push(
             base.check(name, options, env)
                 .map_err(|why| src.at(set.span(), why))?,
@@ -409,10 +476,13 @@ impl Base<'_> {
 
 /// The plan's `[env]` with a set's own on top.
 fn merged_env(
-    all: &BTreeMap<String, String>,
+    all: &BTreeMap<String, Spanned<String>>,
     own: &BTreeMap<String, String>,
 ) -> Vec<(String, String)> {
-    let mut env = all.clone();
+    let mut env: BTreeMap<String, String> = all
+        .iter()
+        .map(|(k, v)| (k.clone(), v.get_ref().clone()))
+        .collect();
     env.extend(own.iter().map(|(k, v)| (k.clone(), v.clone())));
     env.into_iter().collect()
 }
