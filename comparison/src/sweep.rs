@@ -12,6 +12,7 @@
 //! statistics, images against a reference or another build), and `env`
 //! checks the plan's environment variables when it is read.
 
+mod axes;
 mod env;
 mod options;
 mod plan;
@@ -31,6 +32,10 @@ pub struct SweepArgs {
     /// The folder for sweep.jsonl and sweep.md.
     #[arg(long, value_name = "DIR")]
     pub out: PathBuf,
+    /// Read and check the plan, print its cells, and run nothing (what CI
+    /// does to every committed plan, so that a stale one fails there).
+    #[arg(long)]
+    pub dry_run: bool,
 }
 
 /// The order of round `round`'s runs, as indices into the cells: reversed
@@ -46,6 +51,19 @@ pub fn round_order(cells: usize, round: u32) -> Vec<usize> {
 pub fn run(args: &SweepArgs) -> anyhow::Result<()> {
     // The whole plan is checked first: a bad one creates nothing and runs nothing.
     let plan = plan::load(&args.plan)?;
+    if args.dry_run {
+        for cell in plan.cells() {
+            let set = &plan.sets[cell.set];
+            println!(
+                "{}\t{}\t{}\t{}",
+                plan.builds[cell.build].name,
+                apps::api_name(cell.app),
+                set.name,
+                set.options.join(" ")
+            );
+        }
+        return Ok(());
+    }
     twinray_common::reference::image_io::prepare_output_dir("--out", &args.out)?;
     let stop = crate::interrupt::Stop::install()?;
     let started = std::time::Instant::now();

@@ -4,6 +4,7 @@
 //! apps use (`VulkanCli`, `OpenGlCli`), so an option an app would refuse is
 //! refused here, not in the middle of a sweep.
 
+use super::axes::product;
 use super::options::option_tokens;
 use crate::apps::Api;
 use clap::{CommandFactory, Parser};
@@ -18,17 +19,17 @@ use twinray_common::error::bad_input;
 /// a refusal names.
 #[derive(Deserialize)]
 #[serde(deny_unknown_fields)]
-struct PlanFile {
+pub(super) struct PlanFile {
     builds: BTreeMap<String, Spanned<String>>,
     apps: Spanned<Vec<String>>,
     #[serde(default)]
-    axes: BTreeMap<String, Spanned<Vec<toml::Value>>>,
+    pub(super) axes: BTreeMap<String, Spanned<Vec<toml::Value>>>,
     #[serde(default)]
-    env_axes: BTreeMap<String, Spanned<Vec<String>>>,
+    pub(super) env_axes: BTreeMap<String, Spanned<Vec<String>>>,
     #[serde(default)]
     sets: Vec<Spanned<SetFile>>,
     #[serde(default)]
-    env: BTreeMap<String, Spanned<String>>,
+    pub(super) env: BTreeMap<String, Spanned<String>>,
     rounds: Spanned<u32>,
     #[serde(default)]
     warmup: u32,
@@ -136,14 +137,14 @@ fn line_of(text: &str, offset: usize) -> usize {
 }
 
 /// Where a refusal points: the plan's name and text, for "line N" sentences.
-struct Source<'a> {
+pub(super) struct Source<'a> {
     shown: String,
     text: &'a str,
 }
 
 impl Source<'_> {
     /// A refusal at the value spanning `span`.
-    fn at(&self, span: std::ops::Range<usize>, what: String) -> anyhow::Error {
+    pub(super) fn at(&self, span: std::ops::Range<usize>, what: String) -> anyhow::Error {
         bad_input(format!(
             "the plan '{}', line {}: {what}",
             self.shown,
@@ -200,10 +201,9 @@ pub fn load(file: &Path) -> anyhow::Result<Plan> {
     ) {
         (true, true) => return Err(src.whole("it names no option set; give [axes] or [[sets]]")),
         (false, false) => {
-            return Err(src.at(
-                raw.sets[0].span(),
-                "give either [axes] or [[sets]], not both".into(),
-            ))
+            let (listed, axes) = (listed(&raw, &base, &src)?, product(&raw, &base, &src)?);
+            super::axes::each_with_each(&listed, &axes, &base)
+                .map_err(|why| src.at(raw.sets[0].span(), why))?
         }
         (false, true) => product(&raw, &base, &src)?,
         (true, false) => listed(&raw, &base, &src)?,
@@ -398,7 +398,7 @@ impl Plan {
 }
 
 /// What every option set is checked with.
-struct Base<'a> {
+pub(super) struct Base<'a> {
     apps: &'a [Api],
     frames: Option<u32>,
     settle: Option<f64>,
@@ -408,7 +408,7 @@ impl Base<'_> {
     /// Parses `options` as each app would, with the plan's own options, and
     /// splits them into `RenderArgs` and the app's knobs; the error is why an
     /// app refused them.
-    fn check(
+    pub(super) fn check(
         &self,
         name: String,
         options: Vec<String>,
@@ -475,7 +475,7 @@ impl Base<'_> {
 }
 
 /// The plan's `[env]` with a set's own on top.
-fn merged_env(
+pub(super) fn merged_env(
     all: &BTreeMap<String, Spanned<String>>,
     own: &BTreeMap<String, String>,
 ) -> Vec<(String, String)> {
@@ -485,114 +485,6 @@ fn merged_env(
         .collect();
     env.extend(own.iter().map(|(k, v)| (k.clone(), v.clone())));
     env.into_iter().collect()
-}
-
-/// One value of one axis: its command-line tokens or environment variable,
-/// and its part of the set's name.
-enum Pick {
-    Option(Vec<String>),
-    Env(String, String),
-}
-
-/// An axis: where the plan declares it, and its values with their names.
-type Axis = (std::ops::Range<usize>, Vec<(String, Pick)>);
-
-/// The option sets of `[axes]` and `[env_axes]`: every combination, the
-/// first declared axis outermost.
-fn product(raw: &PlanFile, base: &Base, src: &Source) -> anyhow::Result<Vec<OptionSet>> {
-    let at = |span, what| src.at(span, what);
-    // Each axis as (where it is, its values), in the order the plan declares them.
-    let mut axes: Vec<Axis> = Vec::new();
-    for (key, values) in &raw.axes {
-        if values.get_ref().is_empty() {
-            return Err(at(values.span(), format!("the axis '{key}' is empty")));
-        }
-        // Twice the same value would be two cells the table cannot tell apart.
-        let all = values.get_ref();
-        if let Some((_, v)) = all.iter().enumerate().find(|(i, v)| all[..*i].contains(v)) {
-            return Err(at(
-                values.span(),
-                format!("the axis '{key}' names {v} twice"),
-            ));
-        }
-        let picks = values
-            .get_ref()
-            .iter()
-            .map(|v| {
-                let tokens = option_tokens(key, v).map_err(|why| at(values.span(), why))?;
-                let shown = match v {
-                    toml::Value::String(s) => s.clone(),
-                    other => other.to_string(),
-                };
-                Ok((format!("{key}={shown}"), Pick::Option(tokens)))
-            })
-            .collect::<anyhow::Result<_>>()?;
-        axes.push((values.span(), picks));
-    }
-    for (var, values) in &raw.env_axes {
-        if values.get_ref().is_empty() {
-            return Err(at(values.span(), format!("the axis '{var}' is empty")));
-        }
-        let all = values.get_ref();
-        if let Some((_, v)) = all.iter().enumerate().find(|(i, v)| all[..*i].contains(v)) {
-            return Err(at(
-                values.span(),
-                format!("the axis '{var}' names '{v}' twice"),
-            ));
-        }
-        let picks = values
-            .get_ref()
-            .iter()
-            .map(|v| (format!("{var}={v}"), Pick::Env(var.clone(), v.clone())))
-            .collect();
-        axes.push((values.span(), picks));
-    }
-    axes.sort_by_key(|(span, _)| span.start);
-    // Each option alone first, so that a refusal names the axis that holds it.
-    for (span, picks) in &axes {
-        for (name, pick) in picks {
-            if let Pick::Option(tokens) = pick {
-                base.check(name.clone(), tokens.clone(), Vec::new())
-                    .map_err(|why| at(span.clone(), why))?;
-            }
-        }
-    }
-    let mut combos: Vec<Vec<usize>> = vec![Vec::new()];
-    for (_, picks) in &axes {
-        combos = combos
-            .into_iter()
-            .flat_map(|c| {
-                (0..picks.len()).map(move |i| {
-                    let mut c = c.clone();
-                    c.push(i);
-                    c
-                })
-            })
-            .collect();
-    }
-    combos
-        .into_iter()
-        .map(|combo| {
-            let mut names = Vec::new();
-            let mut options = Vec::new();
-            let mut own_env = BTreeMap::new();
-            for ((_, picks), &i) in axes.iter().zip(&combo) {
-                let (name, pick) = &picks[i];
-                names.push(name.clone());
-                match pick {
-                    Pick::Option(tokens) => options.extend(tokens.iter().cloned()),
-                    Pick::Env(k, v) => {
-                        own_env.insert(k.clone(), v.clone());
-                    }
-                }
-            }
-            let name = names.join(" ");
-            let env = merged_env(&raw.env, &own_env);
-            // The refusal names the first axis: the set is their combination.
-            base.check(name, options, env)
-                .map_err(|why| at(axes[0].0.clone(), why))
-        })
-        .collect()
 }
 
 #[cfg(test)]
