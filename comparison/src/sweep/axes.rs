@@ -134,4 +134,3 @@ pub fn product(raw: &PlanFile, base: &Base, src: &Source) -> anyhow::Result<Vec<
         })
         .collect()
 }
-
