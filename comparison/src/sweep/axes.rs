@@ -37,6 +37,18 @@ enum Pick {
 /// An axis: where the plan declares it, and its values with their names.
 type Axis = (std::ops::Range<usize>, Vec<(String, Pick)>);
 
+/// Why an axis's values cannot be its cells: none, or one twice (two cells
+/// the table could not tell apart).
+fn distinct<T: PartialEq>(key: &str, all: &[T], show: impl Fn(&T) -> String) -> Result<(), String> {
+    if all.is_empty() {
+        return Err(format!("the axis '{key}' is empty"));
+    }
+    match all.iter().enumerate().find(|(i, v)| all[..*i].contains(v)) {
+        Some((_, v)) => Err(format!("the axis '{key}' names {} twice", show(v))),
+        None => Ok(()),
+    }
+}
+
 /// The option sets of `[axes]` and `[env_axes]`: every combination, the
 /// first declared axis outermost.
 pub fn product(raw: &PlanFile, base: &Base, src: &Source) -> anyhow::Result<Vec<OptionSet>> {
@@ -44,17 +56,7 @@ pub fn product(raw: &PlanFile, base: &Base, src: &Source) -> anyhow::Result<Vec<
     // Each axis as (where it is, its values), in the order the plan declares them.
     let mut axes: Vec<Axis> = Vec::new();
     for (key, values) in &raw.axes {
-        if values.get_ref().is_empty() {
-            return Err(at(values.span(), format!("the axis '{key}' is empty")));
-        }
-        // Twice the same value would be two cells the table cannot tell apart.
-        let all = values.get_ref();
-        if let Some((_, v)) = all.iter().enumerate().find(|(i, v)| all[..*i].contains(v)) {
-            return Err(at(
-                values.span(),
-                format!("the axis '{key}' names {v} twice"),
-            ));
-        }
+        distinct(key, values.get_ref(), |v| v.to_string()).map_err(|why| at(values.span(), why))?;
         let picks = values
             .get_ref()
             .iter()
@@ -70,16 +72,8 @@ pub fn product(raw: &PlanFile, base: &Base, src: &Source) -> anyhow::Result<Vec<
         axes.push((values.span(), picks));
     }
     for (var, values) in &raw.env_axes {
-        if values.get_ref().is_empty() {
-            return Err(at(values.span(), format!("the axis '{var}' is empty")));
-        }
-        let all = values.get_ref();
-        if let Some((_, v)) = all.iter().enumerate().find(|(i, v)| all[..*i].contains(v)) {
-            return Err(at(
-                values.span(),
-                format!("the axis '{var}' names '{v}' twice"),
-            ));
-        }
+        distinct(var, values.get_ref(), |v| format!("'{v}'"))
+            .map_err(|why| at(values.span(), why))?;
         let picks = values
             .get_ref()
             .iter()
