@@ -16,6 +16,7 @@ mod axes;
 mod env;
 mod options;
 mod plan;
+mod sets;
 mod steps;
 mod table;
 
@@ -52,16 +53,7 @@ pub fn run(args: &SweepArgs) -> anyhow::Result<()> {
     // The whole plan is checked first: a bad one creates nothing and runs nothing.
     let plan = plan::load(&args.plan)?;
     if args.dry_run {
-        for cell in plan.cells() {
-            let set = &plan.sets[cell.set];
-            println!(
-                "{}\t{}\t{}\t{}",
-                plan.builds[cell.build].name,
-                apps::api_name(cell.app),
-                set.name,
-                set.options.join(" ")
-            );
-        }
+        print_cells(&plan);
         return Ok(());
     }
     twinray_common::reference::image_io::prepare_output_dir("--out", &args.out)?;
@@ -138,12 +130,8 @@ pub fn run(args: &SweepArgs) -> anyhow::Result<()> {
     }
     // The device-side steps follow the measured rounds, so that dumping and
     // writing images never share a GPU with a timed run.
-    let steps_md = if stop.stopped() {
-        String::new()
-    } else {
-        let mut write = |line: &serde_json::Value| append(&mut jsonl, line, &jsonl_path);
-        steps::run(&plan, &cells, &args.out, &stop, &mut write, &mut failed)?
-    };
+    let mut write = |line: &serde_json::Value| append(&mut jsonl, line, &jsonl_path);
+    let steps_md = steps::run(&plan, &cells, &args.out, &stop, &mut write, &mut failed)?;
     let interrupted = stop.signal();
     if let Some((signal, _)) = interrupted {
         let mark = serde_json::json!({ "interrupted": signal, "runs": seq, "of": total });
@@ -178,6 +166,20 @@ pub fn run(args: &SweepArgs) -> anyhow::Result<()> {
             "{} of {seq} runs failed (sweep.jsonl has each error); the first: {first}",
             failed.len()
         )),
+    }
+}
+
+/// `--dry-run`'s output: one line a cell, build, app, set and its options.
+fn print_cells(plan: &plan::Plan) {
+    for cell in plan.cells() {
+        let set = &plan.sets[cell.set];
+        println!(
+            "{}\t{}\t{}\t{}",
+            plan.builds[cell.build].name,
+            apps::api_name(cell.app),
+            set.name,
+            set.options.join(" ")
+        );
     }
 }
 

@@ -4,7 +4,11 @@
 //! a study, say, each on both paths).
 
 use super::options::option_tokens;
-use super::plan::{merged_env, Base, OptionSet, PlanFile, Source};
+use super::sets::{merged_env, Base, OptionSet};
+use toml::Spanned;
+
+/// A refusal at the plan's line holding a span.
+type At<'a> = &'a dyn Fn(std::ops::Range<usize>, String) -> anyhow::Error;
 use std::collections::BTreeMap;
 
 /// Each listed set with each combination of the axes: the listed set's
@@ -51,11 +55,16 @@ fn distinct<T: PartialEq>(key: &str, all: &[T], show: impl Fn(&T) -> String) -> 
 
 /// The option sets of `[axes]` and `[env_axes]`: every combination, the
 /// first declared axis outermost.
-pub fn product(raw: &PlanFile, base: &Base, src: &Source) -> anyhow::Result<Vec<OptionSet>> {
-    let at = |span, what| src.at(span, what);
+pub fn product(
+    option_axes: &BTreeMap<String, Spanned<Vec<toml::Value>>>,
+    env_axes: &BTreeMap<String, Spanned<Vec<String>>>,
+    env: &BTreeMap<String, Spanned<String>>,
+    base: &Base,
+    at: At,
+) -> anyhow::Result<Vec<OptionSet>> {
     // Each axis as (where it is, its values), in the order the plan declares them.
     let mut axes: Vec<Axis> = Vec::new();
-    for (key, values) in &raw.axes {
+    for (key, values) in option_axes {
         distinct(key, values.get_ref(), |v| v.to_string()).map_err(|why| at(values.span(), why))?;
         let picks = values
             .get_ref()
@@ -71,7 +80,7 @@ pub fn product(raw: &PlanFile, base: &Base, src: &Source) -> anyhow::Result<Vec<
             .collect::<anyhow::Result<_>>()?;
         axes.push((values.span(), picks));
     }
-    for (var, values) in &raw.env_axes {
+    for (var, values) in env_axes {
         distinct(var, values.get_ref(), |v| format!("'{v}'"))
             .map_err(|why| at(values.span(), why))?;
         let picks = values
@@ -121,7 +130,7 @@ pub fn product(raw: &PlanFile, base: &Base, src: &Source) -> anyhow::Result<Vec<
                 }
             }
             let name = names.join(" ");
-            let env = merged_env(&raw.env, &own_env);
+            let env = merged_env(env, &own_env);
             // The refusal names the first axis: the set is their combination.
             base.check(name, options, env)
                 .map_err(|why| at(axes[0].0.clone(), why))

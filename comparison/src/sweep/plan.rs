@@ -6,13 +6,13 @@
 
 use super::axes::product;
 use super::options::option_tokens;
+pub use super::sets::OptionSet;
+use super::sets::{merged_env, Base};
 use crate::apps::Api;
-use clap::{CommandFactory, Parser};
 use serde::Deserialize;
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 use toml::Spanned;
-use twinray_common::cli::{OpenGlCli, RenderArgs, VulkanCli};
 use twinray_common::error::bad_input;
 
 /// The plan as written. `Spanned` keeps where each value is, for the line
@@ -59,19 +59,6 @@ struct SetFile {
 pub struct Build {
     pub name: String,
     pub dir: PathBuf,
-}
-
-/// One option set, checked: the `RenderArgs` both apps parsed from it, the
-/// options that are an app's own knobs (passed on as written), and its
-/// environment.
-#[derive(Debug, Clone)]
-pub struct OptionSet {
-    pub name: String,
-    /// The set's options as the plan gave them, in command-line form.
-    pub options: Vec<String>,
-    pub args: RenderArgs,
-    pub extra: Vec<String>,
-    pub env: Vec<(String, String)>,
 }
 
 /// A ratio the table reports: of two apps (per build and set) or of two
@@ -201,11 +188,11 @@ pub fn load(file: &Path) -> anyhow::Result<Plan> {
     ) {
         (true, true) => return Err(src.whole("it names no option set; give [axes] or [[sets]]")),
         (false, false) => {
-            let (listed, axes) = (listed(&raw, &base, &src)?, product(&raw, &base, &src)?);
+            let (listed, axes) = (listed(&raw, &base, &src)?, axis_sets(&raw, &base, &src)?);
             super::axes::each_with_each(&listed, &axes, &base)
                 .map_err(|why| src.at(raw.sets[0].span(), why))?
         }
-        (false, true) => product(&raw, &base, &src)?,
+        (false, true) => axis_sets(&raw, &base, &src)?,
         (true, false) => listed(&raw, &base, &src)?,
     };
     let ratios = ratios(&raw, &apps, &builds, &src)?;
@@ -246,6 +233,13 @@ pub fn load(file: &Path) -> anyhow::Result<Plan> {
         ratios,
         shaders: raw.shaders,
         images,
+    })
+}
+
+/// The option sets of the plan's axes (`axes::product`).
+fn axis_sets(raw: &PlanFile, base: &Base, src: &Source) -> anyhow::Result<Vec<OptionSet>> {
+    product(&raw.axes, &raw.env_axes, &raw.env, base, &|span, why| {
+        src.at(span, why)
     })
 }
 
@@ -395,96 +389,6 @@ impl Plan {
         }
         cells
     }
-}
-
-/// What every option set is checked with.
-pub(super) struct Base<'a> {
-    apps: &'a [Api],
-    frames: Option<u32>,
-    settle: Option<f64>,
-}
-
-impl Base<'_> {
-    /// Parses `options` as each app would, with the plan's own options, and
-    /// splits them into `RenderArgs` and the app's knobs; the error is why an
-    /// app refused them.
-    pub(super) fn check(
-        &self,
-        name: String,
-        options: Vec<String>,
-        env: Vec<(String, String)>,
-    ) -> Result<OptionSet, String> {
-        let shared: Vec<String> = RenderArgs::command()
-            .get_arguments()
-            .filter_map(|a| a.get_long().map(|l| format!("--{l}")))
-            .collect();
-        // Options come in `--key [value]` runs: a run whose key is not one of
-        // RenderArgs' own is a knob, passed on after them as written.
-        let (mut render, mut extra) = (Vec::new(), Vec::new());
-        let mut into_extra = false;
-        for token in &options {
-            if token.starts_with("--") {
-                into_extra = !shared.contains(token);
-            }
-            if into_extra {
-                extra.push(token.clone());
-            } else {
-                render.push(token.clone());
-            }
-        }
-        let mut argv = vec!["--headless".to_string(), "--json".to_string()];
-        if let Some(f) = self.frames {
-            argv.extend(["--frames".into(), f.to_string()]);
-        }
-        if let Some(p) = self.settle {
-            argv.extend(["--settle".into(), p.to_string()]);
-        }
-        argv.extend(render);
-        argv.extend(extra.iter().cloned());
-        let mut args = None;
-        for api in self.apps {
-            let bin = api.binary().expect("an app");
-            let argv = std::iter::once(bin.to_string()).chain(argv.iter().cloned());
-            let parsed = match api {
-                Api::Vulkan => VulkanCli::try_parse_from(argv).map(|c| c.render),
-                _ => OpenGlCli::try_parse_from(argv).map(|c| c.render),
-            };
-            let parsed = parsed.map_err(|e| {
-                let message = e.to_string();
-                let first = message.lines().next().unwrap_or("refused");
-                let what = match options.is_empty() {
-                    // The plan's own `frames` and `settle`, checked alone.
-                    true => "it".to_string(),
-                    false => format!("the option set '{name}' ({})", options.join(" ")),
-                };
-                format!(
-                    "{bin} refuses {what}: {}",
-                    first.trim_start_matches("error: ")
-                )
-            })?;
-            args.get_or_insert(parsed);
-        }
-        Ok(OptionSet {
-            name,
-            options,
-            args: args.expect("a plan has an app"),
-            extra,
-            env,
-        })
-    }
-}
-
-/// The plan's `[env]` with a set's own on top.
-pub(super) fn merged_env(
-    all: &BTreeMap<String, Spanned<String>>,
-    own: &BTreeMap<String, String>,
-) -> Vec<(String, String)> {
-    let mut env: BTreeMap<String, String> = all
-        .iter()
-        .map(|(k, v)| (k.clone(), v.get_ref().clone()))
-        .collect();
-    env.extend(own.iter().map(|(k, v)| (k.clone(), v.clone())));
-    env.into_iter().collect()
 }
 
 #[cfg(test)]

@@ -70,7 +70,7 @@ pub fn run(
     append: &mut dyn FnMut(&serde_json::Value) -> anyhow::Result<()>,
     failed: &mut Vec<String>,
 ) -> anyhow::Result<String> {
-    if !plan.shaders && plan.images.is_none() {
+    if stop.stopped() || (!plan.shaders && plan.images.is_none()) {
         return Ok(String::new());
     }
     let mut ran: Vec<Option<Ran>> = Vec::new();
