@@ -9,25 +9,16 @@
 )]
 #[serde(rename_all = "kebab-case")]
 pub enum Experiment {
-    NagaZeroInit,
     NagaLoopBounding,
     NoLoopBounding,
     SharedBvhStack,
-    UnpairedBvhStack,
     LocalBvhStack,
     SplitRayStack,
-    StorageCounts,
     UniformCounts,
     NoContraction,
     FloatControls,
     Glslang,
-    Quad,
-    LoadClear,
-    Rgba8,
-    ComputeQueue,
-    DynamicViewport,
     NagaAliasing,
-    RobustAccess,
     WarpProbe,
     Ulp,
 }

@@ -10,7 +10,8 @@
 use crate::cli::{RenderPath, Workgroup};
 use crate::shader::post::{
     float_controls_spirv, no_contraction_spirv, precise_float_locals_glsl, restrict_resources_glsl,
-    strip_local_array_zero_init_glsl, strip_local_array_zero_init_spirv, warp_probe_glsl,
+    spirv_for_opengl, strip_local_array_zero_init_glsl, strip_local_array_zero_init_spirv,
+    warp_probe_glsl,
 };
 use crate::shader::variant::{Entry, SpirvCompiler, Variant, SPEC_CONSTANTS};
 use anyhow::{anyhow, Context};
@@ -187,6 +188,21 @@ pub struct ComputeShader {
     pub stage: Stage,
 }
 
+impl Shaders {
+    /// The fragment stage as `--gl-spirv` loads it, with the variant's
+    /// `Restrict` decorations (`post::spirv_for_opengl`).
+    pub fn fragment_spirv_for_opengl(&self) -> Vec<u32> {
+        spirv_for_opengl(&self.fragment.spirv, self.variant.passes.restrict)
+    }
+}
+
+impl ComputeShader {
+    /// The stage as `--gl-spirv` loads it, likewise.
+    pub fn spirv_for_opengl(&self) -> Vec<u32> {
+        spirv_for_opengl(&self.stage.spirv, self.variant.passes.restrict)
+    }
+}
+
 /// The shaders of one entry point: the fullscreen pair, or the compute
 /// shader with its workgroup. Each path compiles only what it runs.
 #[derive(Debug, Clone)]
@@ -300,11 +316,7 @@ pub fn to_spirv(
     };
     let words = spv::write_vec(module, info, &options, Some(&pipeline))
         .with_context(|| format!("writing {stage:?} SPIR-V"))?;
-    Ok(if variant.passes.strip_zero_init {
-        strip_local_array_zero_init_spirv(&words)
-    } else {
-        words
-    })
+    Ok(strip_local_array_zero_init_spirv(&words))
 }
 
 pub fn to_glsl(
@@ -354,9 +366,7 @@ pub fn to_glsl(
         .write()
         .with_context(|| format!("writing {stage:?} GLSL"))?;
     let passes = variant.passes;
-    if passes.strip_zero_init {
-        out = strip_local_array_zero_init_glsl(&out);
-    }
+    out = strip_local_array_zero_init_glsl(&out);
     if passes.restrict {
         out = restrict_resources_glsl(&out);
     }
@@ -436,7 +446,6 @@ fn glslang_spirv(source: &str, stage: ShaderStage, variant: &Variant) -> anyhow:
 mod tests {
     use super::*;
     use crate::scene::Scene;
-    use crate::shader::post::spirv_for_opengl;
 
     #[test]
     fn spec_constant_table_matches_the_shader() {
