@@ -9,6 +9,7 @@
 )]
 #[serde(rename_all = "kebab-case")]
 pub enum Experiment {
+    NagaZeroInit,
     NagaLoopBounding,
     NoLoopBounding,
     SharedBvhStack,

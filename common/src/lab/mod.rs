@@ -59,6 +59,9 @@ const VULKAN_ALIASING: &str =
 /// Every experiment, in the order of `Experiment` (which is the order of the
 /// label's tags). A test holds the two to the same list.
 pub const REGISTRY: &[Entry] = &[
+    entry(Experiment::NagaZeroInit, "Keep naga's zero initialisers on function-local arrays.", |c| {
+        c.passes.strip_zero_init = false
+    }),
     entry(Experiment::NagaLoopBounding, "Keep naga's loop bounding (a 64-bit counter in every SPIR-V loop) on the BVH variants too.", |c| {
         c.passes.loop_bounding = Some(true)
     }),

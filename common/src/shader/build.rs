@@ -316,7 +316,11 @@ pub fn to_spirv(
     };
     let words = spv::write_vec(module, info, &options, Some(&pipeline))
         .with_context(|| format!("writing {stage:?} SPIR-V"))?;
-    Ok(strip_local_array_zero_init_spirv(&words))
+    Ok(if variant.passes.strip_zero_init {
+        strip_local_array_zero_init_spirv(&words)
+    } else {
+        words
+    })
 }
 
 pub fn to_glsl(
@@ -366,7 +370,9 @@ pub fn to_glsl(
         .write()
         .with_context(|| format!("writing {stage:?} GLSL"))?;
     let passes = variant.passes;
-    out = strip_local_array_zero_init_glsl(&out);
+    if passes.strip_zero_init {
+        out = strip_local_array_zero_init_glsl(&out);
+    }
     if passes.restrict {
         out = restrict_resources_glsl(&out);
     }

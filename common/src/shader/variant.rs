@@ -122,6 +122,8 @@ pub enum SpirvCompiler {
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct Passes {
     pub compiler: SpirvCompiler,
+    /// naga's zero initialisers on function-local arrays are taken out.
+    pub strip_zero_init: bool,
     /// naga's loop bounding, where the laboratory forces it on or off
     /// (`None`: the build decides, see `build::loop_bounding`).
     pub loop_bounding: Option<bool>,
@@ -140,6 +142,7 @@ impl Default for Passes {
     fn default() -> Passes {
         Passes {
             compiler: SpirvCompiler::Naga,
+            strip_zero_init: true,
             loop_bounding: None,
             no_contraction: false,
             float_controls: false,
