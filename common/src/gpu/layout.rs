@@ -309,7 +309,7 @@ pub mod binding {
     // 8 held the parent links of a stackless traversal, measured and rejected
     // (docs/findings/bvh.md#tried-and-not-kept).
     // 9 held the counts of `--experiment storage-counts`, retired
-    // (docs/findings/software-drivers.md#lavapipe-and-the-loop-bounds).
+    // (docs/findings/software-drivers.md#a-shader-per-draw).
     /// The counting variant's per-pixel ray counts (`GpuRayCount`), written
     /// only by the untimed counting frame; no other variant declares it.
     pub const RAY_COUNTS: u32 = 10;
