@@ -141,8 +141,25 @@ fn experiments_passed(text: &str) -> Vec<String> {
         .collect()
 }
 
+/// The quoted names on a plan's `experiment` lines (`experiment = [false,
+/// "glslang"]`, `options = { experiment = "no-contraction" }`).
+fn plan_experiments(text: &str) -> Vec<String> {
+    text.lines()
+        .filter(|line| {
+            line.trim_start().contains("experiment") && !line.trim_start().starts_with('#')
+        })
+        .flat_map(|line| line.split('"').skip(1).step_by(2).map(str::to_string))
+        .collect()
+}
+
 #[test]
 fn experiments_are_found_however_they_are_passed() {
+    assert_eq!(
+        plan_experiments(
+            "# experiment \"x\"\nexperiment = [false, \"glslang\", \"ulp\"]\nscene = \"box\"\n"
+        ),
+        ["glslang", "ulp"]
+    );
     let text = "args: [\"--experiment\", \"split-ray-stack\"]\n\
                 run --experiment ulp --ulp-op div; --experiment=glslang\n\
                 options = ['--experiment', 'naga-aliasing'] --experiments";
@@ -182,7 +199,11 @@ fn every_experiment_in_the_registry_has_a_runner() {
     assert!(files.len() > 20, "the test files were found");
     let mut passed = Vec::new();
     for f in &files {
-        passed.extend(experiments_passed(&std::fs::read_to_string(f).unwrap()));
+        let text = std::fs::read_to_string(f).unwrap();
+        passed.extend(experiments_passed(&text));
+        if f.extension().is_some_and(|x| x == "toml") {
+            passed.extend(plan_experiments(&text));
+        }
     }
     let unrun: Vec<String> = Experiment::value_variants()
         .iter()
