@@ -214,6 +214,8 @@ fn why_table_has_a_verdict_per_gap_and_experiment(report: &str, out: &std::path:
         "naga-aliasing",
         "no-contraction",
         "float-controls",
+        "first-of-equals",
+        "workgroup 4x8",
     ] {
         assert!(experiments.contains(e), "no why row for {e}");
     }

@@ -22,6 +22,8 @@ pub struct Changes {
     pub passes: Passes,
     /// Where the loops' counts come from, if not baked in.
     pub counts: Option<Counts>,
+    /// The wide collapse opens the first of equal-area boxes.
+    pub first_of_equals: bool,
     /// The experiments' names in registry order, for the variant's label.
     pub tags: Vec<String>,
 }
@@ -76,6 +78,9 @@ pub const REGISTRY: &[Entry] = &[
     }),
     entry(Experiment::SplitRayStack, "The ray stack as four arrays (origin, direction, weight, depth) instead of two of vec4 pairs.", |c| {
         c.knobs.split_ray_stack = true
+    }),
+    entry(Experiment::FirstOfEquals, "The wide tree's collapse opens the first of equal-area boxes, as it did until the shallowest was preferred: the sphere list's identical spheres then give a 4-wide tree of 16 levels at 100k spheres instead of 10, and a BVH stack of 368 B instead of 224 B, past what lets NVIDIA's OpenGL use every multiprocessor.", |c| {
+        c.first_of_equals = true
     }),
     entry(Experiment::UniformCounts, "Read the primitive and light counts from the Frame uniform instead of baking them into the shader (what made lavapipe grow per frame).", |c| {
         c.counts = Some(Counts::Uniform)

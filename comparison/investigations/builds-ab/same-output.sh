@@ -12,7 +12,7 @@ mkdir -p "$out"
 here=$(cd "$(dirname "$0")/../../.." && pwd)
 runs=()
 for scene in teapot box spherelist "$here/scenes/hard/nested-glass.toml"; do
-    for accel in none bvh; do
+    for accel in none bvh bvh4; do
         for path in fragment compute; do
             for app in vk gl; do
                 runs+=("$app --scene $scene --accel $accel --path $path --size 48x36")
@@ -21,19 +21,22 @@ for scene in teapot box spherelist "$here/scenes/hard/nested-glass.toml"; do
     done
 done
 runs+=(
-    "vk --scene teapot --size 40x30 --experiment naga-zero-init --experiment unpaired-bvh-stack"
-    "vk --scene box --size 40x30 --experiment quad --experiment load-clear --experiment rgba8 --experiment dynamic-viewport"
-    "gl --scene box --size 40x30 --experiment quad --experiment rgba8 --experiment naga-aliasing"
-    "vk --scene spherelist --size 40x30 --experiment storage-counts --experiment uniform-counts"
+    "vk --scene teapot --size 40x30 --experiment naga-zero-init --experiment local-bvh-stack --accel bvh"
+    "gl --scene box --size 40x30 --experiment naga-aliasing"
+    "vk --scene spherelist --size 40x30 --experiment uniform-counts"
     "gl --scene spherelist --size 40x30 --experiment uniform-counts --experiment split-ray-stack"
     "vk --scene box --size 40x30 --generic"
     "gl --scene box --size 40x30 --specialize"
     "vk --scene teapot --size 40x30 --specialize --count-rays"
+    "vk --scene box --size 40x30 --count-rays"
+    "gl --scene box --size 40x30 --count-rays"
     "gl --scene teapot --size 40x30 --path compute --count-rays --workgroup 8x8"
     "vk --scene box --size 40x30 --experiment no-contraction --experiment float-controls --experiment naga-loop-bounding"
     "gl --scene box --size 40x30 --gl-spirv --experiment no-loop-bounding"
-    "vk --scene teapot --size 40x30 --path compute --shared-pad 4 --experiment robust-access"
-    "gl --scene box --size 40x30 --path compute --experiment robust-access"
+    "gl --scene teapot --size 40x30 --gl-spirv --path compute --accel bvh"
+    "vk --scene teapot --size 40x30 --path compute --shared-pad 4 --experiment shared-bvh-stack --accel bvh"
+    "vk --scene box --size 40x30 --vk-memory host --vk-wait idle"
+    "vk --scene box --size 40x30 --experiment ulp --ulp-op div"
 )
 n=0 differ=0
 for r in "${runs[@]}"; do

@@ -124,6 +124,11 @@ pub enum GapMeasure {
 pub struct Gap {
     pub name: &'static str,
     pub scene: &'static str,
+    /// Scene values (`--set KEY=VALUE`) the gap's point takes.
+    pub set: &'static [&'static str],
+    /// At the preset's large frame (`WhyPlan::large_frame`, 1080p in the
+    /// full preset) instead of its square side for the scene.
+    pub large_frame: bool,
     pub accel: Accel,
     pub path: RenderPath,
     pub measure: GapMeasure,
@@ -137,6 +142,8 @@ pub struct Case {
     pub vulkan: &'static [Experiment],
     pub opengl: &'static [Experiment],
     pub opengl_api: Api,
+    /// Both APIs at this one compute workgroup instead of each at its own.
+    pub workgroup: Option<(u32, u32)>,
 }
 
 /// A gap's figure (VK/GL ratio or % of pixels within 1/255) by default and

@@ -11,7 +11,7 @@ use std::collections::BTreeMap;
 use std::ffi::OsStr;
 use std::path::Path;
 use std::sync::atomic::{AtomicBool, Ordering};
-use twinray_common::cli::{RenderArgs, RenderPath, Size};
+use twinray_common::cli::{RenderArgs, RenderPath, Size, Workgroup};
 use twinray_common::error::{Failure, FailureKind};
 use twinray_common::lab::experiment::Experiment;
 use twinray_common::reference::image_io::load_png;
@@ -23,6 +23,8 @@ use twinray_common::value_name::ValueName;
 const BOX_FRAGMENT: Gap = Gap {
     name: "box brute fragment",
     scene: "box",
+    set: &[],
+    large_frame: false,
     accel: Accel::None,
     path: RenderPath::Fragment,
     measure: GapMeasure::Ratio,
@@ -30,6 +32,8 @@ const BOX_FRAGMENT: Gap = Gap {
 const BOX_COMPUTE: Gap = Gap {
     name: "box brute compute",
     scene: "box",
+    set: &[],
+    large_frame: false,
     accel: Accel::None,
     path: RenderPath::Compute,
     measure: GapMeasure::Ratio,
@@ -37,20 +41,37 @@ const BOX_COMPUTE: Gap = Gap {
 const TEAPOT_FRAGMENT: Gap = Gap {
     name: "teapot brute fragment",
     scene: "teapot",
+    set: &[],
+    large_frame: false,
     accel: Accel::None,
     path: RenderPath::Fragment,
     measure: GapMeasure::Ratio,
 };
+/// Through the tree every user gets (`--accel auto`: the 4-wide one).
 const TEAPOT_BVH_COMPUTE: Gap = Gap {
     name: "teapot BVH compute",
     scene: "teapot",
-    accel: Accel::Bvh,
+    set: &[],
+    large_frame: false,
+    accel: Accel::Auto,
+    path: RenderPath::Compute,
+    measure: GapMeasure::Ratio,
+};
+/// The sphere list at its largest: the deepest tree of the study's scenes.
+const SPHERELIST_BVH_COMPUTE: Gap = Gap {
+    name: "sphere list BVH compute",
+    scene: "spherelist",
+    set: &["extra_spheres=100000"],
+    large_frame: true,
+    accel: Accel::Auto,
     path: RenderPath::Compute,
     measure: GapMeasure::Ratio,
 };
 const BOX_IMAGES: Gap = Gap {
     name: "box image agreement",
     scene: "box",
+    set: &[],
+    large_frame: false,
     accel: Accel::None,
     path: RenderPath::Fragment,
     measure: GapMeasure::Agreement,
@@ -68,6 +89,17 @@ const fn case(
         vulkan,
         opengl,
         opengl_api,
+        workgroup: None,
+    }
+}
+
+/// Both APIs at one workgroup: OpenGL's default for BVH walks (4x8), where
+/// Vulkan's own (8x16) lets its driver hold the ray's constants in shared
+/// memory and the tracer in fewer registers.
+const fn one_workgroup(gap: &'static Gap) -> Case {
+    Case {
+        workgroup: Some((4, 8)),
+        ..case(gap, &[], &[], Api::Opengl)
     }
 }
 
@@ -105,6 +137,11 @@ pub const CASES: &[Case] = &[
     both(&TEAPOT_BVH_COMPUTE, &[Experiment::LocalBvhStack]),
     opengl(&TEAPOT_BVH_COMPUTE, &[Experiment::NagaAliasing]),
     gl_spirv(&TEAPOT_BVH_COMPUTE),
+    one_workgroup(&TEAPOT_BVH_COMPUTE),
+    both(&SPHERELIST_BVH_COMPUTE, &[Experiment::FirstOfEquals]),
+    both(&SPHERELIST_BVH_COMPUTE, &[Experiment::LocalBvhStack]),
+    gl_spirv(&SPHERELIST_BVH_COMPUTE),
+    one_workgroup(&SPHERELIST_BVH_COMPUTE),
     both(&BOX_IMAGES, &[Experiment::NoContraction]),
     vulkan(&BOX_IMAGES, &[Experiment::NoContraction]),
     vulkan(&BOX_IMAGES, &[Experiment::FloatControls]),
@@ -118,6 +155,8 @@ pub struct WhyPlan {
     pub teapot_side: u32,
     /// The brute-force teapot's side: its frames cost seconds at 1000².
     pub teapot_brute_side: u32,
+    /// The frame of the gaps measured where users trace large frames.
+    pub large_frame: (u32, u32),
     /// Frames per run at most; each stops once settled (`settle`, per cent).
     pub frames: u32,
     pub settle: f64,
@@ -125,18 +164,23 @@ pub struct WhyPlan {
     pub rounds: u32,
 }
 
-/// One process to run at a gap: an API with its experiments.
-type Run = (Api, &'static [Experiment]);
+/// One process to run at a gap: an API with its experiments, and the
+/// workgroup it is held to (None: its own).
+type Run = (Api, &'static [Experiment], Option<(u32, u32)>);
 
 /// What `case` runs: its Vulkan run and its OpenGL run.
 fn runs_of(case: &Case) -> [Run; 2] {
-    [(Api::Vulkan, case.vulkan), (case.opengl_api, case.opengl)]
+    [
+        (Api::Vulkan, case.vulkan, case.workgroup),
+        (case.opengl_api, case.opengl, case.workgroup),
+    ]
 }
 
 /// A run's label in file names and messages: `vulkan`, `opengl-glslang`...
 pub fn run_label(run: Run) -> String {
     std::iter::once(api_name(run.0).to_string())
         .chain(run.1.iter().map(|e| e.name()))
+        .chain(run.2.map(|(x, y)| format!("{x}x{y}")))
         .collect::<Vec<_>>()
         .join("-")
 }
@@ -194,17 +238,19 @@ pub fn run(out: &Path, plan: &WhyPlan, paths: &[RenderPath], stop: &AtomicBool) 
             ("teapot", _) => plan.teapot_side,
             _ => plan.box_side,
         };
-        let size = Size {
-            width: side,
-            height: side,
+        let (width, height) = if gap.large_frame {
+            plan.large_frame
+        } else {
+            (side, side)
         };
+        let size = Size { width, height };
         let cases: Vec<Case> = CASES
             .iter()
             .filter(|c| std::ptr::eq(c.gap, gap))
             .copied()
             .collect();
         // Every case is read against the defaults, whether a case runs them or not.
-        let mut order: Vec<Run> = vec![(Api::Vulkan, &[]), (Api::Opengl, &[])];
+        let mut order: Vec<Run> = vec![(Api::Vulkan, &[], None), (Api::Opengl, &[], None)];
         for run in cases.iter().flat_map(runs_of) {
             if !order.contains(&run) {
                 order.push(run);
@@ -275,6 +321,7 @@ fn measure(
     let base = RenderArgs {
         accel: gap.accel,
         path: gap.path,
+        set: gap.set.iter().map(|s| s.to_string()).collect(),
         ..RenderArgs::headless(gap.scene, size)
     };
     let frames = if images {
@@ -321,6 +368,7 @@ fn measure(
                         settle: (!images).then_some(plan.settle),
                         out: images.then(|| dir.join(format!("{}-{label}.png", gap.scene))),
                         experiment: run.1.to_vec(),
+                        workgroup: run.2.map(|(x, y)| Workgroup { x, y }),
                         ..base.clone()
                     };
                     run_json(run.0, &args).map_err(|e| refused_or_failed(run, &e))
@@ -364,7 +412,7 @@ fn median_ms(reports: &[Result<RunReport, String>], gpu: bool) -> Result<f64, St
 /// The case's figures from the runs at its gap.
 fn figures(gap: &Gap, case: &Case, measured: &Measured, dir: &Path) -> Result<WhyFigures, String> {
     let [vk, gl] = runs_of(case);
-    let default = [(Api::Vulkan, &[][..]), (Api::Opengl, &[][..])];
+    let default = [(Api::Vulkan, &[][..], None), (Api::Opengl, &[][..], None)];
     let four = [default[0], default[1], vk, gl];
     let reports = |run: Run| -> Result<&Vec<Result<RunReport, String>>, String> {
         measured
@@ -458,9 +506,9 @@ mod tests {
             .into()
         };
         let order: Vec<Run> = vec![
-            (Api::Vulkan, &[]),
-            (Api::Opengl, &[]),
-            (Api::OpenglSpirv, &[]),
+            (Api::Vulkan, &[], None),
+            (Api::Opengl, &[], None),
+            (Api::OpenglSpirv, &[], None),
         ];
         let title = |why: &Why| {
             crate::report::title(why.vulkan_device.as_deref(), why.opengl_device.as_deref())
@@ -491,15 +539,15 @@ mod tests {
             );
         }
         assert_eq!(
-            tool_needed((Api::Vulkan, &[Experiment::Glslang])),
+            tool_needed((Api::Vulkan, &[Experiment::Glslang], None)),
             Some("glslangValidator")
         );
         assert_eq!(
-            tool_needed((Api::Vulkan, &[Experiment::NoLoopBounding])),
+            tool_needed((Api::Vulkan, &[Experiment::NoLoopBounding], None)),
             None
         );
         assert_eq!(
-            run_label((Api::Opengl, &[Experiment::NoContraction])),
+            run_label((Api::Opengl, &[Experiment::NoContraction], None)),
             "opengl-no-contraction"
         );
     }

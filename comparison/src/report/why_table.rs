@@ -117,6 +117,9 @@ fn change(case: &Case) -> String {
     };
     let (vk, gl) = (names(case.vulkan), names(case.opengl));
     let gl_api = api_name(case.opengl_api);
+    if let Some((x, y)) = case.workgroup {
+        return format!("both at workgroup {x}x{y}");
+    }
     match (vk.is_empty(), gl.is_empty()) {
         (true, true) => format!("{gl_api} (as shipped)"),
         (false, true) => format!("vulkan: {vk}"),

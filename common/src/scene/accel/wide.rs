@@ -47,6 +47,9 @@ pub(super) const PARALLEL_LEVELS: u32 = 4;
 struct Collapse<'a> {
     binary: &'a [GpuBvhNode],
     width: usize,
+    /// Of equal areas open the first, not the shallowest: the collapse as it
+    /// was, for `--experiment first-of-equals` (lab/mod.rs).
+    first_of_equals: bool,
 }
 
 /// A run of the wide tree's nodes, in the order the tree lays them out.
@@ -84,8 +87,9 @@ impl Collapse<'_> {
             let mut open: Option<(usize, f64, u32)> = None;
             for (i, &(b, c)) in kids.0[..kids.1].iter().enumerate() {
                 let a = area(b);
+                let shallower = |l| !self.first_of_equals && level[i] < l;
                 let better =
-                    |(_, best, l): (usize, f64, u32)| a > best || (a == best && level[i] < l);
+                    |(_, best, l): (usize, f64, u32)| a > best || (a == best && shallower(l));
                 if child_ref::as_leaf(c).is_none() && open.is_none_or(better) {
                     open = Some((i, a, level[i]));
                 }
@@ -212,11 +216,22 @@ impl Bvh {
         self.widen_on(width, PARALLEL_LEVELS)
     }
 
+    /// `widen` opening the first of equal-area boxes instead of the
+    /// shallowest (`--experiment first-of-equals`): the sphere list's tree
+    /// as it was before, 16 levels deep at 100k spheres.
+    pub fn widen_first_of_equals(self, width: u32) -> Bvh {
+        self.collapse(width, PARALLEL_LEVELS, true)
+    }
+
     /// `widen` with the top `levels` levels made first and the subtrees
     /// below them collapsed in parallel, then laid out in the order a
     /// depth-first collapse writes them: the same tree for every `levels`
     /// (0: the whole tree one subtree, on this thread), which a test holds.
-    pub(super) fn widen_on(mut self, width: u32, levels: u32) -> Bvh {
+    pub(super) fn widen_on(self, width: u32, levels: u32) -> Bvh {
+        self.collapse(width, levels, false)
+    }
+
+    fn collapse(mut self, width: u32, levels: u32, first_of_equals: bool) -> Bvh {
         debug_assert!(WIDTHS.contains(&width), "width {width}");
         if width <= 2 || self.nodes.is_empty() {
             return self;
@@ -225,6 +240,7 @@ impl Bvh {
         let c = Collapse {
             binary: &self.nodes,
             width: width as usize,
+            first_of_equals,
         };
         let mut pieces = Vec::new();
         c.top(0, 0, levels, &mut pieces);
