@@ -303,12 +303,20 @@ pub fn run(args: &CompareArgs) -> anyhow::Result<()> {
     };
     write_report(&args.out, &results, &shader_rows, why.as_ref(), only_why)?;
     let failed = failures(&results, &shader_rows, why.as_ref());
+    // A run with no sweep (--only why) says nothing of one.
+    let planned = plan.points.len() * runs.len();
+    let sweep = if planned == 0 {
+        String::new()
+    } else {
+        format!(
+            "; the sweep's {} of {planned} runs done",
+            outcomes.iter().filter(|o| o.result.is_ok()).count()
+        )
+    };
     eprintln!(
-        "twinray compare: {} app runs in {:.0} s; the sweep's {} of {} runs done{}; report: {}",
+        "twinray compare: {} app runs in {:.0} s{sweep}{}; report: {}",
         cost.0,
         cost.1,
-        outcomes.iter().filter(|o| o.result.is_ok()).count(),
-        plan.points.len() * runs.len(),
         match interrupted {
             Some(i) => format!(
                 " (interrupted by {} during {}: the finished points are kept)",
