@@ -2,6 +2,7 @@
 //! running them the way a user does, and reading back their PNG + JSON.
 
 pub mod markdown;
+pub mod repo;
 
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};

@@ -1,13 +1,10 @@
 //! Reading Markdown as the page tests do: prose outside code blocks, the
 //! anchors GitHub gives headings, the targets of links, and whether a
-//! relative link leads anywhere. One reader for readme.rs and findings.rs,
+//! relative link leads anywhere. One reader for the page tests,
 //! so that the two cannot disagree on what a link or a heading is.
 
+use crate::repo::read;
 use std::path::Path;
-
-fn read(path: &Path) -> String {
-    std::fs::read_to_string(path).unwrap_or_else(|e| panic!("{}: {e}", path.display()))
-}
 
 /// A line without its inline code spans (`like this`).
 pub fn without_code_spans(line: &str) -> String {
@@ -26,6 +23,14 @@ pub fn prose(text: &str) -> Vec<&str> {
         }
     }
     lines
+}
+
+/// The inline code spans of a text's prose, e.g. `vk/src/device.rs::Device::new`.
+pub fn code_spans(text: &str) -> Vec<String> {
+    prose(text)
+        .iter()
+        .flat_map(|line| line.split('`').skip(1).step_by(2).map(str::to_string))
+        .collect()
 }
 
 /// The anchor GitHub gives a heading: lower case, everything but letters,

@@ -12,6 +12,7 @@ use std::collections::{BTreeMap, BTreeSet, HashMap};
 use std::path::{Path, PathBuf};
 use syn::spanned::Spanned;
 use syn::visit::Visit;
+use twinray_tests::repo::{files_under, root};
 
 const CRATES: [&str; 5] = ["common", "vk", "gl", "comparison", "tests"];
 const MAX_FILE_LINES: usize = 600;
@@ -19,35 +20,12 @@ const MAX_FN_LINES: usize = 120;
 const FILE_MARKER: &str = "//! Long file:";
 const FN_MARKER: &str = "Long function:";
 
-fn root() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR"))
-        .parent()
-        .unwrap()
-        .to_path_buf()
-}
-
-fn rust_files(dir: &Path, out: &mut Vec<PathBuf>) {
-    let Ok(entries) = std::fs::read_dir(dir) else {
-        return;
-    };
-    let mut entries: Vec<PathBuf> = entries.map(|e| e.unwrap().path()).collect();
-    entries.sort();
-    for path in entries {
-        if path.is_dir() {
-            rust_files(&path, out);
-        } else if path.extension().is_some_and(|e| e == "rs") {
-            out.push(path);
-        }
-    }
-}
-
 /// Every .rs file of a crate: its library or binary sources and its tests.
 fn crate_files(krate: &str) -> Vec<PathBuf> {
-    let mut files = Vec::new();
-    for sub in ["src", "tests", "benches", "examples"] {
-        rust_files(&root().join(krate).join(sub), &mut files);
-    }
-    files
+    ["src", "tests", "benches", "examples"]
+        .iter()
+        .flat_map(|sub| files_under(&root().join(krate).join(sub), &["rs"]))
+        .collect()
 }
 
 fn every_file() -> Vec<PathBuf> {
@@ -306,8 +284,7 @@ fn cycles(graph: &BTreeMap<Vec<String>, BTreeSet<Vec<String>>>) -> Vec<Vec<Vec<S
 fn crate_cycles(krate: &str) -> Vec<String> {
     let src = root().join(krate).join("src");
     let has_lib = src.join("lib.rs").is_file();
-    let mut files = Vec::new();
-    rust_files(&src, &mut files);
+    let files = files_under(&src, &["rs"]);
     let mut modules = BTreeMap::new();
     for file in files {
         let Some(module) = module_path(&src, &file, has_lib) else {

@@ -6,19 +6,8 @@
 //! mean, and the runs are clean under synchronisation validation with images
 //! byte-identical between the two recordings.
 
-use std::path::{Path, PathBuf};
+use twinray_tests::repo::{assert_scan, root, WALKTHROUGH};
 use twinray_vk::barrier::{self, Access, Barrier, Guards, Recording};
-
-fn root() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR"))
-        .parent()
-        .unwrap()
-        .to_path_buf()
-}
-
-fn page_path() -> PathBuf {
-    root().join("docs/vulkan-walkthrough.md")
-}
 
 const SYNC_VALIDATION: (&str, &str) = (
     "VK_LAYER_ENABLES",
@@ -57,14 +46,12 @@ fn no_stage_access_or_layout_outside_the_barrier_module() {
             }
         }
     }
-    assert!(
-        outside.is_empty(),
-        "stage masks, access masks or layouts outside vk/src/barrier.rs: name the accesses instead\n{}",
-        outside.join("\n")
-    );
-    assert!(
-        inside >= 10,
-        "only {inside} mask lines seen in barrier.rs: is the search still reading it?"
+    assert_scan(
+        "stage masks, access masks or layouts outside vk/src/barrier.rs: name the accesses instead",
+        &outside,
+        inside,
+        10,
+        "mask lines in barrier.rs",
     );
 }
 
@@ -135,7 +122,7 @@ fn page_holds(name: &str, expected: &str) {
     // The two table tests run at once; a rewrite must not undo the other's.
     static PAGE: std::sync::Mutex<()> = std::sync::Mutex::new(());
     let _only_one = PAGE.lock().unwrap_or_else(|e| e.into_inner());
-    let path = page_path();
+    let path = root().join(WALKTHROUGH);
     let doc = std::fs::read_to_string(&path).unwrap();
     let (begin, end) = (
         format!("<!-- {name}:begin -->\n"),

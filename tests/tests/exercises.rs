@@ -5,14 +5,8 @@
 //! request: it rebuilds twinray-vk six times), and the fixed code survives what
 //! exercise 3 breaks.
 
-use std::path::{Path, PathBuf};
-
-fn root() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR"))
-        .parent()
-        .unwrap()
-        .to_path_buf()
-}
+use std::path::Path;
+use twinray_tests::repo::{root, text, WALKTHROUGH};
 
 /// The page's exercise `n`: its numbered item, up to the next one.
 fn exercise_on_the_page(doc: &str, n: u32) -> String {
@@ -32,8 +26,8 @@ fn exercise_on_the_page(doc: &str, n: u32) -> String {
 
 #[test]
 fn the_script_checks_the_outcome_each_exercise_promises() {
-    let doc = std::fs::read_to_string(root().join("docs/vulkan-walkthrough.md")).unwrap();
-    let script = std::fs::read_to_string(root().join("tests/exercises.sh")).unwrap();
+    let doc = text(WALKTHROUGH);
+    let script = text("tests/exercises.sh");
     let mut graded = 0;
     let mut wrong = Vec::new();
     for line in script.lines() {

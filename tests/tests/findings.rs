@@ -14,25 +14,14 @@
 
 use std::collections::BTreeMap;
 use std::io::Write;
-use std::path::{Path, PathBuf};
 use std::process::{Command, Stdio};
 use twinray_tests::markdown::{anchors, broken, links, prose, without_code_spans};
+use twinray_tests::repo::{assert_scan, read, root};
 
 const FINDINGS: &str = "docs/findings";
 const INDEX: &str = "README.md";
 const MAX_PAGE_LINES: usize = 300;
 const MAX_VERDICT_LINES: usize = 10;
-
-fn root() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR"))
-        .parent()
-        .unwrap()
-        .to_path_buf()
-}
-
-fn read(path: &Path) -> String {
-    std::fs::read_to_string(path).unwrap_or_else(|e| panic!("{}: {e}", path.display()))
-}
 
 /// `git ARGS` in the repository's root; its stdout, or `None` where git is
 /// missing or this is no git checkout.
@@ -227,14 +216,12 @@ fn every_relative_link_of_the_markdown_resolves() {
             }
         }
     }
-    assert!(
-        broken_links.is_empty(),
-        "links that lead nowhere:\n{}",
-        broken_links.join("\n")
-    );
-    assert!(
-        checked >= 100,
-        "only {checked} links found in the tracked Markdown: is the parser still reading it?"
+    assert_scan(
+        "links that lead nowhere",
+        &broken_links,
+        checked,
+        100,
+        "links in the tracked Markdown",
     );
 }
 
@@ -317,14 +304,12 @@ fn no_figure_is_stated_on_two_findings_pages() {
         .filter(|(_, on)| on.len() > 1)
         .map(|(figure, on)| format!("{figure}: {}", on.join(", ")))
         .collect();
-    assert!(
-        twice.is_empty(),
-        "figures stated on more than one findings page (keep each on one, link from the others):\n{}",
-        twice.join("\n")
-    );
-    assert!(
-        total >= 50,
-        "only {total} figures found on the findings pages: is the scan still reading them?"
+    assert_scan(
+        "figures stated on more than one findings page (keep each on one, link from the others)",
+        &twice,
+        total,
+        50,
+        "figures on the findings pages",
     );
 }
 
