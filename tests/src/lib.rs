@@ -169,6 +169,22 @@ pub fn refused(app: App, args: &[&str], sentence: &str) {
     );
 }
 
+/// The arguments of a windowed run of the box scene at `size` for `frames`
+/// frames, then `extra`: the windowed tests' common start.
+pub fn box_window<'a>(size: &'a str, frames: &'a str, extra: &[&'a str]) -> Vec<&'a str> {
+    let mut args = vec!["--scene", "box", "--size", size, "--frames", frames];
+    args.extend_from_slice(extra);
+    args
+}
+
+/// The validation layer's synchronisation validation (hazards between
+/// commands, submits and presents), on top of `--validate`'s core checks; the
+/// GL app ignores it.
+pub const SYNC_VALIDATION: (&str, &str) = (
+    "VK_LAYER_ENABLES",
+    "VK_VALIDATION_FEATURE_ENABLE_SYNCHRONIZATION_VALIDATION_EXT",
+);
+
 /// A private X server for one windowed test (Debian's `xvfb`; tests/run.sh
 /// installs it). `-displayfd` lets Xvfb pick a free display number itself, so
 /// tests running in parallel never collide. `-fbdir` keeps the screen in a

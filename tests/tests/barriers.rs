@@ -7,12 +7,8 @@
 //! byte-identical between the two recordings.
 
 use twinray_tests::repo::{assert_scan, root, WALKTHROUGH};
+use twinray_tests::{box_window, SYNC_VALIDATION};
 use twinray_vk::barrier::{self, Access, Barrier, Guards, Recording};
-
-const SYNC_VALIDATION: (&str, &str) = (
-    "VK_LAYER_ENABLES",
-    "VK_VALIDATION_FEATURE_ENABLE_SYNCHRONIZATION_VALIDATION_EXT",
-);
 
 fn sync2_env(recording: Recording) -> (&'static str, &'static str) {
     let on = match recording {
@@ -388,16 +384,7 @@ fn explain_prints_each_window_barrier_as_recorded() {
     for recording in RECORDINGS {
         let dir = twinray_tests::scratch(&format!("barriers-window-{recording:?}"));
         // Two frames on the fragment path (`R` changes nothing), then `C`: the compute path.
-        let args = [
-            "--scene",
-            "box",
-            "--size",
-            "64x48",
-            "--frames",
-            "5",
-            "--validate",
-            "--explain",
-        ];
+        let args = box_window("64x48", "5", &["--validate", "--explain"]);
         let env = [
             SYNC_VALIDATION,
             sync2_env(recording),
@@ -485,18 +472,7 @@ fn both_recordings_survive_resizes_under_sync_validation() {
     for recording in RECORDINGS {
         for path in ["fragment", "compute"] {
             let dir = twinray_tests::scratch(&format!("barriers-resize-{path}-{recording:?}"));
-            let args = [
-                "--scene",
-                "box",
-                "--size",
-                "64x48",
-                "--frames",
-                "100",
-                "--path",
-                path,
-                "--validate",
-                "--explain",
-            ];
+            let args = box_window("64x48", "100", &["--path", path, "--validate", "--explain"]);
             let env = [
                 SYNC_VALIDATION,
                 sync2_env(recording),

@@ -6,6 +6,7 @@
 //! exercise 3 breaks.
 
 use std::path::Path;
+use twinray_tests::box_window;
 use twinray_tests::repo::{root, text, WALKTHROUGH};
 
 /// The page's exercise `n`: its numbered item, up to the next one.
@@ -93,18 +94,7 @@ fn the_window_survives_an_out_of_date_acquire() {
     let dir = twinray_tests::scratch("out-of-date");
     let app = twinray_tests::bin("twinray-vk");
     let app = app.to_str().unwrap();
-    let args = [
-        "60",
-        app,
-        "--scene",
-        "box",
-        "--size",
-        "64x48",
-        "--frames",
-        "10",
-        "--validate",
-        "--explain",
-    ];
+    let args = box_window("64x48", "10", &["60", app, "--validate", "--explain"]);
     let out = xvfb.run(
         Path::new("timeout"),
         &args,

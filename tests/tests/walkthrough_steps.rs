@@ -4,6 +4,7 @@
 //! objects of a headless run with the page's step numbers in the order the
 //! page states, and the main path, before the appendix, reads in one sitting.
 
+use twinray_tests::box_window;
 use twinray_tests::repo::{assert_scan, root, text, WALKTHROUGH};
 
 /// One `## N. Title` section of the page.
@@ -256,15 +257,7 @@ fn the_pages_drop_order_is_the_windows() {
     let xvfb = twinray_tests::Xvfb::start();
     let dir = twinray_tests::scratch("drop-order");
     let app = twinray_tests::bin("twinray-vk");
-    let args = [
-        "--scene",
-        "box",
-        "--size",
-        "64x48",
-        "--frames",
-        "3",
-        "--explain",
-    ];
+    let args = box_window("64x48", "3", &["--explain"]);
     let out = xvfb.run(&app, &args, &[], &dir);
     let stderr = String::from_utf8_lossy(&out.stderr);
     assert!(out.status.success(), "the window failed:\n{stderr}");

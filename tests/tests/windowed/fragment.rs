@@ -3,23 +3,14 @@
 //! equals the headless image.
 
 use crate::common::{assert_resized, clean_report, stderr};
-use twinray_tests::{render, scratch, App, Xvfb};
+use twinray_tests::{box_window, render, scratch, App, Xvfb};
 
 #[test]
 fn both_apps_open_a_window_render_30_frames_and_exit_cleanly() {
     let x = Xvfb::start();
     let dir = scratch("window-30");
     for app in App::BOTH {
-        let args = [
-            "--scene",
-            "box",
-            "--size",
-            "128x96",
-            "--frames",
-            "30",
-            "--validate",
-            "--json",
-        ];
+        let args = box_window("128x96", "30", &["--validate", "--json"]);
         let o = x.run(&app.exe(), &args, &[], &dir);
         let r = clean_report(app, &o);
         assert_eq!(r.frames.len(), 30, "{app:?}");
@@ -32,16 +23,7 @@ fn fifty_resizes_and_minimize_restore_cause_no_crash_and_no_message() {
     let x = Xvfb::start();
     let dir = scratch("window-resize");
     for app in App::BOTH {
-        let args = [
-            "--scene",
-            "box",
-            "--size",
-            "120x90",
-            "--frames",
-            "150",
-            "--validate",
-            "--json",
-        ];
+        let args = box_window("120x90", "150", &["--validate", "--json"]);
         let o = x.run(&app.exe(), &args, &[("TWINRAY_TEST_RESIZE", "1")], &dir);
         clean_report(app, &o);
         let err = stderr(&o);
@@ -58,16 +40,7 @@ fn every_key_action_works_with_zero_messages() {
     // to 1 (same shader), reset, screenshot, and Esc last.
     let keys = "3,2,+,+,-,-,-,-,-,-,r,p,esc";
     for app in App::BOTH {
-        let args = [
-            "--scene",
-            "box",
-            "--size",
-            "96x72",
-            "--frames",
-            "100",
-            "--validate",
-            "--json",
-        ];
+        let args = box_window("96x72", "100", &["--validate", "--json"]);
         let o = x.run(&app.exe(), &args, &[("TWINRAY_TEST_KEYS", keys)], &dir);
         let r = clean_report(app, &o);
         assert_eq!(
@@ -102,17 +75,11 @@ fn windowed_out_equals_the_headless_image() {
     let dir = scratch("window-out");
     for app in App::BOTH {
         let win = dir.join("window.png");
-        let args = [
-            "--scene",
-            "box",
-            "--size",
+        let args = box_window(
             "100x80",
-            "--frames",
             "3",
-            "--validate",
-            "--out",
-            win.to_str().unwrap(),
-        ];
+            &["--validate", "--out", win.to_str().unwrap()],
+        );
         let o = x.run(&app.exe(), &args, &[], &dir);
         assert!(o.status.success(), "{app:?}: {}", stderr(&o));
         let (_, headless) = render(app, "box", "100x80", &[], &dir.join("headless.png"));
