@@ -146,6 +146,51 @@ pub fn render(
     (report, img)
 }
 
+/// `twinray render --api API --scene SCENE --size SIZE EXTRA --out OUT` as a
+/// user runs it, which must succeed; the image it wrote.
+pub fn orchestrator_render(
+    api: &str,
+    scene: &str,
+    size: &str,
+    extra: &[&str],
+    out: &Path,
+) -> image::RgbImage {
+    let mut args = vec!["render", "--api", api, "--scene", scene, "--size", size];
+    args.extend_from_slice(extra);
+    args.extend(["--out", out.to_str().unwrap()]);
+    let o = run(&bin("twinray"), &args, &[]);
+    assert!(
+        o.status.success(),
+        "twinray {args:?}: {}",
+        String::from_utf8_lossy(&o.stderr)
+    );
+    twinray_common::reference::image_io::load_png(out).unwrap()
+}
+
+/// A render that is clean: no validation message (or GL debug error) and no
+/// NaN/Inf pixel before quantisation.
+pub fn assert_clean(report: &RunReport, what: &str) {
+    assert_eq!(report.validation_messages, 0, "{what}: validation messages");
+    assert_eq!(
+        report.nonfinite_pixels, 0,
+        "{what}: NaN/Inf pixels before quantisation"
+    );
+}
+
+/// Two images agree: at least the share `min` of their pixels within 1/255
+/// of each other. The share is printed as well, so that a passing run still
+/// shows its margin.
+pub fn assert_within_1(a: &image::RgbImage, b: &image::RgbImage, min: f64, what: &str) {
+    let m = twinray_common::reference::metrics::compare(a, b).unwrap();
+    let within = 100.0 * m.within_1();
+    println!("{what}: {within:.4}% within 1/255, max {}", m.max_abs);
+    assert!(
+        m.within_1() >= min,
+        "{what}: only {within:.4}% within 1/255 (at least {}% expected)",
+        100.0 * min
+    );
+}
+
 /// The exit code and stderr of a run that is expected to fail.
 pub fn fail(program: &Path, args: &[&str], env: &[(&str, &str)]) -> (i32, String) {
     let o = run(program, args, env);

@@ -4,7 +4,7 @@
 //! within 1/255, in both APIs.
 
 use twinray_common::reference::metrics::compare;
-use twinray_tests::{render, scratch, App};
+use twinray_tests::{assert_within_1, orchestrator_render, render, scratch, App};
 
 const SCENES: [(&str, &str, &[&str]); 3] = [
     ("box", "96x72", &[]),
@@ -20,13 +20,11 @@ fn agree(app: App, scene: &str, size: &str, a: &[&str], b: &[&str], what: &str) 
         ra.variant, rb.variant,
         "{what}: the two runs must use different shaders"
     );
-    let m = compare(&ia, &ib).unwrap();
-    assert!(
-        m.within_1() >= 0.9999,
-        "{app:?} {scene} {what} ({} vs {}): {:.4}% within 1/255",
-        ra.variant,
-        rb.variant,
-        100.0 * m.within_1()
+    assert_within_1(
+        &ia,
+        &ib,
+        0.9999,
+        &format!("{app:?} {scene} {what} ({} vs {})", ra.variant, rb.variant),
     );
     std::fs::remove_dir_all(dir).ok();
 }
@@ -63,12 +61,7 @@ fn wide_bvhs_and_brute_force_give_the_same_image() {
                     assert!(r.variant.contains(&format!("/wide{width}/bvh")), "{what}");
                     assert_eq!(r.bvh_width, Some(width), "{what}: the JSON's width");
                     assert_ne!(r.variant, rn.variant);
-                    let m = compare(&brute, &img).unwrap();
-                    assert!(
-                        m.within_1() >= 0.9999,
-                        "{what}: {:.4}% within 1/255 of brute force",
-                        100.0 * m.within_1()
-                    );
+                    assert_within_1(&brute, &img, 0.9999, &format!("{what} vs brute force"));
                 }
             }
             std::fs::remove_dir_all(dir).ok();
@@ -156,25 +149,13 @@ fn a_bvh_deeper_than_the_small_fixed_stacks_renders_every_primitive() {
     let scene = deep_bvh_scene(&dir);
     let scene = scene.to_str().unwrap();
     let reference = dir.join("ref.png");
-    let r = twinray_tests::run(
-        &twinray_tests::bin("twinray"),
-        &[
-            "render",
-            "--api",
-            "reference",
-            "--scene",
-            scene,
-            "--size",
-            "64x48",
-            "--accel",
-            "none",
-            "--out",
-            reference.to_str().unwrap(),
-        ],
-        &[],
+    let truth = orchestrator_render(
+        "reference",
+        scene,
+        "64x48",
+        &["--accel", "none"],
+        &reference,
     );
-    assert!(r.status.success(), "{}", String::from_utf8_lossy(&r.stderr));
-    let truth = twinray_common::reference::image_io::load_png(&reference).unwrap();
     for app in App::BOTH {
         for path in ["fragment", "compute"] {
             let (report, img) = render(

@@ -5,9 +5,8 @@
 use twinray_common::gpu::layout::GpuTriangle;
 use twinray_common::gpu::upload::UPLOAD_CHUNK_BYTES;
 use twinray_common::reference;
-use twinray_common::reference::metrics::compare;
 use twinray_common::scene::Scene;
-use twinray_tests::{render, scratch, App};
+use twinray_tests::{assert_clean, assert_within_1, render, scratch, App};
 
 fn check(scene: &str, size: &str, set: &[(&str, &str)]) {
     let kv: Vec<String> = set.iter().map(|(k, v)| format!("{k}={v}")).collect();
@@ -30,40 +29,23 @@ fn check(scene: &str, size: &str, set: &[(&str, &str)]) {
     let mut images = Vec::new();
     for app in App::BOTH {
         let (report, img) = render(app, scene, size, &extra, &dir.join(format!("{app:?}.png")));
-        assert_eq!(
-            report.validation_messages, 0,
-            "{scene} {app:?}: validation messages"
-        );
-        assert_eq!(
-            report.nonfinite_pixels, 0,
-            "{scene} {app:?}: NaN/Inf pixels before quantisation"
-        );
+        assert_clean(&report, &format!("{scene} {app:?}"));
         assert_eq!((report.width, report.height), (sz.width, sz.height));
         assert_eq!(report.scene.triangles, sc.triangles.len());
         assert_eq!(report.scene.spheres, sc.spheres.len());
-        let m = compare(&img, &reference).unwrap();
-        println!(
-            "{scene} {app:?} vs reference: {:.4}% within 1/255, max {}",
-            100.0 * m.within_1(),
-            m.max_abs
-        );
-        assert!(
-            m.within_1() >= 0.995,
-            "{scene} {app:?} vs reference: only {:.4}% within 1/255",
-            100.0 * m.within_1()
+        assert_within_1(
+            &img,
+            &reference,
+            0.995,
+            &format!("{scene} {app:?} vs reference"),
         );
         images.push(img);
     }
-    let m = compare(&images[0], &images[1]).unwrap();
-    println!(
-        "{scene} Vulkan vs OpenGL: {:.4}% within 1/255, max {}",
-        100.0 * m.within_1(),
-        m.max_abs
-    );
-    assert!(
-        m.within_1() >= 0.999,
-        "{scene} Vulkan vs OpenGL: only {:.4}% within 1/255",
-        100.0 * m.within_1()
+    assert_within_1(
+        &images[0],
+        &images[1],
+        0.999,
+        &format!("{scene} Vulkan vs OpenGL"),
     );
     std::fs::remove_dir_all(dir).ok();
 }
@@ -105,11 +87,11 @@ fn generic_shader_renders_the_same_as_the_variant() {
         let (_, variant) = render(app, "box", "96x72", &[], &dir.join("v.png"));
         let (report, generic) = render(app, "box", "96x72", &["--generic"], &dir.join("g.png"));
         assert!(report.variant.contains("stack17"), "{}", report.variant);
-        let m = compare(&variant, &generic).unwrap();
-        assert!(
-            m.within_1() >= 0.9999,
-            "{app:?}: generic vs variant {:.4}%",
-            100.0 * m.within_1()
+        assert_within_1(
+            &variant,
+            &generic,
+            0.9999,
+            &format!("{app:?}: generic vs variant"),
         );
     }
 }
@@ -128,11 +110,6 @@ fn opengl_running_naga_spirv_matches_its_glsl() {
             &dir.join("spirv.png"),
         );
         assert!(report.variant.ends_with("(SPIR-V)"), "{}", report.variant);
-        let m = compare(&glsl, &spirv).unwrap();
-        assert!(
-            m.within_1() >= 0.9999,
-            "{scene}: SPIR-V vs GLSL {:.4}%",
-            100.0 * m.within_1()
-        );
+        assert_within_1(&glsl, &spirv, 0.9999, &format!("{scene}: SPIR-V vs GLSL"));
     }
 }

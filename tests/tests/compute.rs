@@ -3,9 +3,8 @@
 //! NaN, zero validation messages / GL debug errors; every measured workgroup
 //! size, and image sizes that are not a multiple of the workgroup, included.
 
-use twinray_common::reference::metrics::compare;
 use twinray_common::value_name::ValueName;
-use twinray_tests::{render, scratch, App};
+use twinray_tests::{assert_clean, assert_within_1, render, scratch, App};
 
 fn check(scene: &str, size: &str, extra: &[&str]) {
     let dir = scratch(&format!("compute-{scene}"));
@@ -24,24 +23,12 @@ fn check(scene: &str, size: &str, extra: &[&str]) {
             report.workgroup.is_some(),
             "{app:?}: the report names the workgroup"
         );
-        assert_eq!(
-            report.validation_messages, 0,
-            "{scene} {app:?} compute: validation messages"
-        );
-        assert_eq!(
-            report.nonfinite_pixels, 0,
-            "{scene} {app:?} compute: NaN/Inf pixels"
-        );
-        let m = compare(&compute, &fragment).unwrap();
-        println!(
-            "{scene} {app:?} compute vs fragment: {:.4}% within 1/255, max {}",
-            100.0 * m.within_1(),
-            m.max_abs
-        );
-        assert!(
-            m.within_1() >= 0.9999,
-            "{scene} {app:?}: compute vs fragment only {:.4}% within 1/255",
-            100.0 * m.within_1()
+        assert_clean(&report, &format!("{scene} {app:?} compute"));
+        assert_within_1(
+            &compute,
+            &fragment,
+            0.9999,
+            &format!("{scene} {app:?}: compute vs fragment"),
         );
     }
     std::fs::remove_dir_all(dir).ok();
@@ -78,12 +65,7 @@ fn every_measured_workgroup_covers_an_odd_sized_image() {
             );
             assert_eq!(report.workgroup.as_deref(), Some(wg));
             assert_eq!(report.validation_messages, 0);
-            let m = compare(&img, &fragment).unwrap();
-            assert!(
-                m.within_1() >= 0.9999,
-                "{app:?} {wg}: {:.4}% within 1/255",
-                100.0 * m.within_1()
-            );
+            assert_within_1(&img, &fragment, 0.9999, &format!("{app:?} {wg}"));
         }
     }
 }
