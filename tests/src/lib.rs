@@ -230,6 +230,29 @@ pub const SYNC_VALIDATION: (&str, &str) = (
     "VK_VALIDATION_FEATURE_ENABLE_SYNCHRONIZATION_VALIDATION_EXT",
 );
 
+/// Writes an executable shell script `name` into `dir`: a stand-in for an
+/// app, for tests of how the orchestrator takes an app's failure.
+pub fn stand_in(dir: &Path, name: &str, script: &str) -> PathBuf {
+    use std::os::unix::fs::PermissionsExt;
+    let path = dir.join(name);
+    std::fs::write(&path, script).unwrap();
+    std::fs::set_permissions(&path, std::fs::Permissions::from_mode(0o755)).unwrap();
+    path
+}
+
+/// All of a finished child's piped stderr.
+pub fn stderr_of(child: &mut std::process::Child) -> String {
+    use std::io::Read;
+    let mut stderr = Vec::new();
+    child
+        .stderr
+        .take()
+        .expect("stderr piped")
+        .read_to_end(&mut stderr)
+        .unwrap();
+    String::from_utf8_lossy(&stderr).into_owned()
+}
+
 /// A private X server for one windowed test (Debian's `xvfb`; tests/run.sh
 /// installs it). `-displayfd` lets Xvfb pick a free display number itself, so
 /// tests running in parallel never collide. `-fbdir` keeps the screen in a

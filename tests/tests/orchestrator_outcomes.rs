@@ -7,7 +7,7 @@
 use std::path::Path;
 use std::process::{Child, Command, Stdio};
 use std::time::{Duration, Instant};
-use twinray_tests::{bin, scratch};
+use twinray_tests::{bin, scratch, stand_in, stderr_of};
 
 /// Two stand-in apps that fail every run the way a real one fails on bad
 /// input (clap's `error:` line, then its "For more information" line), and
@@ -25,10 +25,7 @@ fn failing_apps(dir: &Path, slow_s: u32) -> String {
              echo \"For more information, try '--help'.\" >&2\n\
              exit 2\n"
         );
-        let path = bin_dir.join(app);
-        std::fs::write(&path, script).unwrap();
-        use std::os::unix::fs::PermissionsExt;
-        std::fs::set_permissions(&path, std::fs::Permissions::from_mode(0o755)).unwrap();
+        stand_in(&bin_dir, app, &script);
     }
     bin_dir.to_str().unwrap().to_string()
 }
@@ -102,15 +99,7 @@ fn finish(mut child: Child, limit: Duration) -> (Option<i32>, String) {
     let started = Instant::now();
     loop {
         if let Some(status) = child.try_wait().unwrap() {
-            let mut stderr = String::new();
-            use std::io::Read;
-            child
-                .stderr
-                .take()
-                .unwrap()
-                .read_to_string(&mut stderr)
-                .unwrap();
-            return (status.code(), stderr);
+            return (status.code(), stderr_of(&mut child));
         }
         if started.elapsed() > limit {
             let _ = child.kill();
@@ -261,10 +250,7 @@ fn hanging_apps(dir: &Path, hang_on: &str) -> String {
              exit 2\n",
             marker.display()
         );
-        let path = bin_dir.join(app);
-        std::fs::write(&path, script).unwrap();
-        use std::os::unix::fs::PermissionsExt;
-        std::fs::set_permissions(&path, std::fs::Permissions::from_mode(0o755)).unwrap();
+        stand_in(&bin_dir, app, &script);
     }
     bin_dir.to_str().unwrap().to_string()
 }

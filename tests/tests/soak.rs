@@ -12,7 +12,7 @@
 
 use std::process::{Command, Stdio};
 use std::time::{Duration, Instant};
-use twinray_tests::App;
+use twinray_tests::{stderr_of, App};
 
 const FRAMES: &str = "2000";
 const MAX_GROWTH_KB: u64 = 2 * 1024;
@@ -87,14 +87,7 @@ fn soak(app: App, path: &str, frames: &str, extra: &[&str]) -> (u64, u64, usize)
         );
         std::thread::sleep(Duration::from_millis(50));
     };
-    let mut stderr = String::new();
-    use std::io::Read;
-    child
-        .stderr
-        .take()
-        .unwrap()
-        .read_to_string(&mut stderr)
-        .ok();
+    let stderr = stderr_of(&mut child);
     assert!(status.success(), "{app:?} {path}: {status}: {stderr}");
     let total = start.elapsed();
     let after: Vec<u64> = samples
