@@ -287,18 +287,8 @@ fn naga_layout_matches_rust_for_the_ray_counts() {
 fn every_builtin_variant_and_the_generic_one_compile_for_both_apis() {
     let mut variants = vec![Variant::generic(Default::default())];
     // Every numerical choice must compile too.
-    use twinray_common::scene::numerics::{Numerics, Offset, SphereTest, TriangleTest};
-    for offset in Offset::ALL {
-        for triangle in TriangleTest::ALL {
-            for sphere in SphereTest::ALL {
-                variants.push(Variant::generic(Numerics {
-                    offset,
-                    triangle,
-                    sphere,
-                }));
-            }
-        }
-    }
+    use twinray_common::scene::numerics::Numerics;
+    variants.extend(Numerics::all().map(Variant::generic));
     let scene = twinray_common::scene::Scene::load("box", &[]).unwrap();
     for width in [2, 4, 8] {
         let bvh = twinray_common::plan::build_bvh(&scene).widen(width);

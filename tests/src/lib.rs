@@ -191,6 +191,17 @@ pub fn assert_within_1(a: &image::RgbImage, b: &image::RgbImage, min: f64, what:
     );
 }
 
+/// Nothing went wrong; otherwise the test fails naming `problem`, how many
+/// there are, and each of them.
+pub fn assert_none(problem: &str, wrong: &[String]) {
+    assert!(
+        wrong.is_empty(),
+        "{problem} ({}):\n{}",
+        wrong.len(),
+        wrong.join("\n")
+    );
+}
+
 /// The exit code and stderr of a run that is expected to fail.
 pub fn fail(program: &Path, args: &[&str], env: &[(&str, &str)]) -> (i32, String) {
     let o = run(program, args, env);

@@ -63,7 +63,7 @@ pub fn rust_sources(dirs: &[&str]) -> String {
 /// least `min` things `checked`, so that a scan that has stopped finding what
 /// it reads cannot pass by finding nothing wrong.
 pub fn assert_scan(problem: &str, wrong: &[String], checked: usize, min: usize, what: &str) {
-    assert!(wrong.is_empty(), "{problem}:\n{}", wrong.join("\n"));
+    crate::assert_none(problem, wrong);
     assert!(
         checked >= min,
         "only {checked} {what} found (at least {min} expected): is the scan still reading them?"

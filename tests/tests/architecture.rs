@@ -12,6 +12,7 @@ use std::collections::{BTreeMap, BTreeSet, HashMap};
 use std::path::{Path, PathBuf};
 use syn::spanned::Spanned;
 use syn::visit::Visit;
+use twinray_tests::assert_none;
 use twinray_tests::repo::{files_under, root};
 
 const CRATES: [&str; 5] = ["common", "vk", "gl", "comparison", "tests"];
@@ -347,12 +348,7 @@ fn crate_cycles(krate: &str) -> Vec<String> {
 #[test]
 fn no_import_cycle_between_the_files_of_a_crate() {
     let found: Vec<String> = CRATES.iter().flat_map(|c| crate_cycles(c)).collect();
-    assert!(
-        found.is_empty(),
-        "{} import cycle(s); give each pair one direction (move what both need into a module both import):\n{}",
-        found.len(),
-        found.join("\n")
-    );
+    assert_none("import cycle(s); give each pair one direction (move what both need into a module both import)", &found);
 }
 
 #[test]
@@ -415,12 +411,7 @@ fn no_file_over_600_lines_without_a_reason() {
             offenders.push(format!("{}: {lines} lines", relative(&file)));
         }
     }
-    assert!(
-        offenders.is_empty(),
-        "{} file(s) over {MAX_FILE_LINES} lines: split them, or open them with `{FILE_MARKER} <reason>`:\n{}",
-        offenders.len(),
-        offenders.join("\n")
-    );
+    assert_none(&format!("file(s) over {MAX_FILE_LINES} lines: split them, or open them with `{FILE_MARKER} <reason>`"), &offenders);
 }
 
 /// Every function with a body: free, in an impl, default in a trait, nested.
@@ -507,12 +498,7 @@ fn no_function_over_120_lines_without_a_reason() {
         }
     }
     assert!(checked > 300, "only {checked} functions found");
-    assert!(
-        offenders.is_empty(),
-        "{} function(s) over {MAX_FN_LINES} lines: split them, or put `// {FN_MARKER} <reason>` directly above:\n{}",
-        offenders.len(),
-        offenders.join("\n")
-    );
+    assert_none(&format!("function(s) over {MAX_FN_LINES} lines: split them, or put `// {FN_MARKER} <reason>` directly above"), &offenders);
 }
 
 #[test]
@@ -564,9 +550,5 @@ fn the_orchestrator_links_no_winit() {
             chains.push(chain.into_iter().rev().collect::<Vec<_>>().join("\n"));
         }
     }
-    assert!(
-        chains.is_empty(),
-        "`cargo tree -p twinray -e normal` lists a window system; keep the windowed code behind the apps' feature:\n{}",
-        chains.join("\n")
-    );
+    assert_none("`cargo tree -p twinray -e normal` lists a window system; keep the windowed code behind the apps' feature", &chains);
 }

@@ -7,7 +7,7 @@
 //! byte-identical between the two recordings.
 
 use twinray_tests::repo::{assert_scan, root, WALKTHROUGH};
-use twinray_tests::{box_window, SYNC_VALIDATION};
+use twinray_tests::{assert_none, box_window, SYNC_VALIDATION};
 use twinray_vk::barrier::{self, Access, Barrier, Guards, Recording};
 
 fn sync2_env(recording: Recording) -> (&'static str, &'static str) {
@@ -369,11 +369,7 @@ fn explain_prints_each_headless_barrier_as_recorded() {
             }
         }
     }
-    assert!(
-        wrong.is_empty(),
-        "--explain's barriers:\n{}",
-        wrong.join("\n")
-    );
+    assert_none("--explain's barriers", &wrong);
 }
 
 #[test]
@@ -418,11 +414,7 @@ fn explain_prints_each_window_barrier_as_recorded() {
             ));
         }
     }
-    assert!(
-        wrong.is_empty(),
-        "--explain's barriers in the window:\n{}",
-        wrong.join("\n")
-    );
+    assert_none("--explain's barriers in the window", &wrong);
 }
 
 #[test]

@@ -15,6 +15,7 @@
 use std::collections::BTreeMap;
 use std::io::Write;
 use std::process::{Command, Stdio};
+use twinray_tests::assert_none;
 use twinray_tests::markdown::{anchors, broken, links, prose, without_code_spans};
 use twinray_tests::repo::{assert_scan, read, root};
 
@@ -196,11 +197,7 @@ fn every_cited_commit_path_opens() {
         .filter(|(_, answer)| answer.ends_with(" missing") || answer.ends_with(" ambiguous"))
         .map(|((citation, places), _)| format!("{citation} (cited at {})", places.join(", ")))
         .collect();
-    assert!(
-        missing.is_empty(),
-        "cited COMMIT:PATHs that `git show` cannot open:\n{}",
-        missing.join("\n")
-    );
+    assert_none("cited COMMIT:PATHs that `git show` cannot open", &missing);
 }
 
 #[test]

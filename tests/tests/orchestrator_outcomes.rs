@@ -109,6 +109,16 @@ fn finish(mut child: Child, limit: Duration) -> (Option<i32>, String) {
     }
 }
 
+/// The report an interrupted run wrote to `out`, whose title holds `title`
+/// and whose text holds `says`.
+fn interrupted_report(out: &Path, title: &str, says: &str) -> String {
+    let report = std::fs::read_to_string(out.join("report.md")).unwrap();
+    let first = report.lines().next().unwrap_or_default();
+    assert!(first.contains(title), "{first}");
+    assert!(report.contains(says), "{report}");
+    report
+}
+
 #[test]
 fn a_comparison_in_which_runs_failed_fails_quoting_the_apps_error() {
     let dir = scratch("orch-failed-runs");
@@ -147,15 +157,10 @@ fn sigterm_during_the_sweep_keeps_the_finished_points_and_exits_143() {
     signal(&child, "TERM");
     let (code, stderr) = finish(child, Duration::from_secs(30));
     assert_eq!(code, Some(143), "{stderr}");
-    let report = std::fs::read_to_string(out.join("report.md")).unwrap();
-    let title = report.lines().next().unwrap_or_default();
-    assert!(
-        title.contains("(interrupted by SIGTERM during the sweep)"),
-        "{title}"
-    );
-    assert!(
-        report.contains("> Interrupted by SIGTERM during the sweep"),
-        "{report}"
+    let report = interrupted_report(
+        &out,
+        "(interrupted by SIGTERM during the sweep)",
+        "> Interrupted by SIGTERM during the sweep",
     );
     assert!(report.contains("## Points not run"), "{report}");
     let csv = std::fs::read_to_string(out.join("results.csv")).unwrap();
@@ -178,14 +183,10 @@ fn sighup_and_sigint_after_the_sweep_are_stated_and_exit_129_and_130() {
         let (got, stderr) = finish(child, Duration::from_secs(30));
         // Interrupted, not failed: the signal's code, though every run failed.
         assert_eq!(got, Some(code), "SIG{name}: {stderr}");
-        let report = std::fs::read_to_string(out.join("report.md")).unwrap();
-        let stated = format!("interrupted by SIG{name} during the shader statistics");
-        assert!(report.lines().next().unwrap().contains(&stated), "{report}");
-        assert!(
-            report.contains(&format!(
-                "> Interrupted by SIG{name} during the shader statistics"
-            )),
-            "{report}"
+        interrupted_report(
+            &out,
+            &format!("interrupted by SIG{name} during the shader statistics"),
+            &format!("> Interrupted by SIG{name} during the shader statistics"),
         );
         assert!(out.join("results.csv").is_file());
     }
@@ -213,15 +214,10 @@ fn sigterm_during_the_accuracy_sweeps_keeps_the_finished_runs_and_exits_143() {
     signal(&child, "TERM");
     let (code, stderr) = finish(child, Duration::from_secs(60));
     assert_eq!(code, Some(143), "{stderr}");
-    let report = std::fs::read_to_string(out.join("report.md")).unwrap();
-    let title = report.lines().next().unwrap_or_default();
-    assert!(
-        title.contains("(interrupted by SIGTERM during the sweeps)"),
-        "{title}"
-    );
-    assert!(
-        report.contains("The run was interrupted by SIGTERM"),
-        "{report}"
+    interrupted_report(
+        &out,
+        "(interrupted by SIGTERM during the sweeps)",
+        "The run was interrupted by SIGTERM",
     );
     let csv = std::fs::read_to_string(out.join("accuracy.csv")).unwrap();
     assert!(

@@ -4,8 +4,8 @@
 //! objects of a headless run with the page's step numbers in the order the
 //! page states, and the main path, before the appendix, reads in one sitting.
 
-use twinray_tests::box_window;
 use twinray_tests::repo::{assert_scan, root, text, WALKTHROUGH};
+use twinray_tests::{assert_none, box_window};
 
 /// One `## N. Title` section of the page.
 struct Step {
@@ -211,11 +211,7 @@ fn explain_prints_the_pages_steps_in_the_pages_order() {
             }
         }
     }
-    assert!(
-        wrong.is_empty(),
-        "--explain and the walkthrough disagree:\n{}",
-        wrong.join("\n")
-    );
+    assert_none("--explain and the walkthrough disagree", &wrong);
 }
 
 #[test]
