@@ -20,49 +20,27 @@ fn missing_and_unknown_scenes() {
     );
 }
 
-#[test]
-fn malformed_scene_names_line_and_column() {
-    let dir = scratch("malformed");
-    let p = scene_file(
-        &dir,
-        "bad.toml",
-        "[[spheres]]\ncenter = [0.0, 0.0\nradius = 1.0\n",
-    );
-    expect_both(
-        &strs(&headless(&p)),
-        &[],
-        2,
-        &["bad.toml", "line 12, column"],
-    );
-}
+/// Scene files with one fault each, and what the refusal (exit 2) must name:
+/// the file, then the line and column, the key, or the field.
+const BAD_FILES: [(&str, &str, &[&str]); 6] = [
+    ("bad.toml", "[[spheres]]\ncenter = [0.0, 0.0\nradius = 1.0\n", &["line 12, column"]),
+    ("k.toml", "[[spheres]]\ncenter = [0.0, 0.0, 0.0]\nradius = 1.0\nmaterial = \"m\"\nglow = 2.0\n", &["glow", "line 14"]),
+    ("nan.toml", "[[spheres]]\ncenter = [nan, 0.0, 0.0]\nradius = 1.0\nmaterial = \"m\"\n", &["spheres[0].center"]),
+    ("neg.toml", "[[spheres]]\ncenter = [0.0, 0.0, 0.0]\nradius = -2.0\nmaterial = \"m\"\n", &["spheres[0].radius = -2"]),
+    (
+        "normal.toml",
+        "[[triangles]]\nvertices = [[0.0,0.0,0.0],[1.0,0.0,0.0],[0.0,1.0,0.0]]\nnormals = [[0.0,0.0,0.0],[0.0,0.0,1.0],[0.0,0.0,1.0]]\nmaterial = \"m\"\n",
+        &["triangles[0].normals[0]"],
+    ),
+    ("mat.toml", "[[spheres]]\ncenter = [0.0, 0.0, 0.0]\nradius = 1.0\nmaterial = \"unobtainium\"\n", &["'unobtainium'"]),
+];
 
 #[test]
-fn unknown_key_is_named() {
-    let dir = scratch("unknown-key");
-    let p = scene_file(
-        &dir,
-        "k.toml",
-        "[[spheres]]\ncenter = [0.0, 0.0, 0.0]\nradius = 1.0\nmaterial = \"m\"\nglow = 2.0\n",
-    );
-    expect_both(&strs(&headless(&p)), &[], 2, &["k.toml", "glow", "line 14"]);
-}
-
-#[test]
-fn bad_values_are_named() {
-    let dir = scratch("bad-values");
-    let cases = [
-        ("nan.toml", "[[spheres]]\ncenter = [nan, 0.0, 0.0]\nradius = 1.0\nmaterial = \"m\"\n", "spheres[0].center"),
-        ("neg.toml", "[[spheres]]\ncenter = [0.0, 0.0, 0.0]\nradius = -2.0\nmaterial = \"m\"\n", "spheres[0].radius = -2"),
-        (
-            "normal.toml",
-            "[[triangles]]\nvertices = [[0.0,0.0,0.0],[1.0,0.0,0.0],[0.0,1.0,0.0]]\nnormals = [[0.0,0.0,0.0],[0.0,0.0,1.0],[0.0,0.0,1.0]]\nmaterial = \"m\"\n",
-            "triangles[0].normals[0]",
-        ),
-        ("mat.toml", "[[spheres]]\ncenter = [0.0, 0.0, 0.0]\nradius = 1.0\nmaterial = \"unobtainium\"\n", "'unobtainium'"),
-    ];
-    for (file, body, what) in cases {
+fn bad_scene_files_are_named_by_file_and_line_or_field() {
+    let dir = scratch("bad-scene-files");
+    for (file, body, words) in BAD_FILES {
         let p = scene_file(&dir, file, body);
-        expect_both(&strs(&headless(&p)), &[], 2, &[file, what]);
+        expect_both(&strs(&headless(&p)), &[], 2, &[&[file], words].concat());
     }
 }
 
