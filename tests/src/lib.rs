@@ -93,6 +93,19 @@ pub fn run(program: &Path, args: &[&str], env: &[(&str, &str)]) -> Output {
         .unwrap_or_else(|e| panic!("starting {}: {e}", program.display()))
 }
 
+/// Runs a command as [`run`] does and expects it to succeed; its output.
+pub fn run_ok(program: &Path, args: &[&str], env: &[(&str, &str)]) -> Output {
+    let o = run(program, args, env);
+    assert!(
+        o.status.success(),
+        "{} {args:?} failed ({}): {}",
+        program.display(),
+        o.status,
+        String::from_utf8_lossy(&o.stderr)
+    );
+    o
+}
+
 /// Which app to run.
 #[derive(Clone, Copy, Debug)]
 pub enum App {

@@ -191,12 +191,7 @@ fn the_readme_verdict_is_what_twinray_summary_prints() {
     let mut args = vec!["summary".to_string()];
     args.extend(dirs.iter().map(|d| d.display().to_string()));
     let args: Vec<&str> = args.iter().map(String::as_str).collect();
-    let out = twinray_tests::run(&twinray_tests::bin("twinray"), &args, &[]);
-    assert!(
-        out.status.success(),
-        "twinray summary failed: {}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+    let out = twinray_tests::run_ok(&twinray_tests::bin("twinray"), &args, &[]);
     let printed = String::from_utf8(out.stdout).unwrap();
     assert_eq!(
         &readme[b + begin.len()..e],

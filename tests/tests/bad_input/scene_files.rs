@@ -193,12 +193,7 @@ fn an_obj_with_a_byte_order_mark_renders() {
     .unwrap();
     let p = obj_scene(&dir, "bom.toml", "bom.obj");
     for (exe, args) in three_tools(&p) {
-        let o = twinray_tests::run(&exe, &args, &[]);
-        assert!(
-            o.status.success(),
-            "{exe:?}: {}",
-            String::from_utf8_lossy(&o.stderr)
-        );
+        twinray_tests::run_ok(&exe, &args, &[]);
     }
 }
 
