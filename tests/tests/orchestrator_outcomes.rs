@@ -274,77 +274,45 @@ struct Step {
     csv: &'static str,
 }
 
+const fn step(
+    command: &'static [&'static str],
+    hang_on: &'static str,
+    during: &'static str,
+    csv: &'static str,
+) -> Step {
+    Step {
+        command,
+        hang_on,
+        during,
+        csv,
+    }
+}
+
+const COMPARE_ACCEL: &[&str] = &[
+    "compare",
+    "--quick",
+    "--only",
+    "box,accel",
+    "--paths",
+    "fragment",
+];
+const COMPARE_BOX: &[&str] = &["compare", "--quick", "--only", "box", "--paths", "fragment"];
+const COMPARE_WHY: &[&str] = &["compare", "--quick", "--only", "why", "--paths", "fragment"];
+const ACCURACY: &[&str] = &["accuracy", "--quick", "--random", "1"];
+
+#[rustfmt::skip]
 const STEPS: [Step; 9] = [
-    Step {
-        command: &[
-            "compare",
-            "--quick",
-            "--only",
-            "box,accel",
-            "--paths",
-            "fragment",
-        ],
-        hang_on: "*--frames*--accel\\ none*",
-        during: "during the sweep",
-        csv: "results.csv",
-    },
-    Step {
-        command: &[
-            "compare",
-            "--quick",
-            "--only",
-            "box,accel",
-            "--paths",
-            "fragment",
-        ],
-        hang_on: "*--accel\\ bvh*",
-        during: "during the acceleration runs",
-        csv: "results.csv",
-    },
-    Step {
-        command: &["compare", "--quick", "--only", "box", "--paths", "fragment"],
-        hang_on: "*/images/*",
-        during: "during the image agreement",
-        csv: "results.csv",
-    },
-    Step {
-        command: &["compare", "--quick", "--only", "box", "--paths", "fragment"],
-        hang_on: "*--dump-shaders*",
-        during: "during the shader statistics",
-        csv: "results.csv",
-    },
-    Step {
-        command: &["compare", "--quick", "--only", "why", "--paths", "fragment"],
-        hang_on: "*--experiment*",
-        during: "during the why step",
-        csv: "why.csv",
-    },
-    Step {
-        command: &["accuracy", "--quick", "--random", "1"],
-        hang_on: "*",
-        during: "during the sweeps",
-        csv: "accuracy.csv",
-    },
-    Step {
-        command: &["accuracy", "--quick", "--random", "1"],
-        hang_on: "*/hard/*",
-        during: "during the hard cases",
-        csv: "hard_cases.csv",
-    },
-    Step {
-        command: &["accuracy", "--quick", "--no-hard", "--random", "1"],
-        hang_on: "*random:*",
-        during: "during the random scenes",
-        csv: "random.csv",
-    },
-    Step {
-        // Every operation at the default 2^20 inputs: the CPU's column of all
-        // of them, computed after the signal, once took 2.6 s more.
-        command: &["ulp"],
-        hang_on: "*",
-        during: "interrupted by",
-        csv: "ulp.csv",
-    },
+    step(COMPARE_ACCEL, "*--frames*--accel\\ none*", "during the sweep", "results.csv"),
+    step(COMPARE_ACCEL, "*--accel\\ bvh*", "during the acceleration runs", "results.csv"),
+    step(COMPARE_BOX, "*/images/*", "during the image agreement", "results.csv"),
+    step(COMPARE_BOX, "*--dump-shaders*", "during the shader statistics", "results.csv"),
+    step(COMPARE_WHY, "*--experiment*", "during the why step", "why.csv"),
+    step(ACCURACY, "*", "during the sweeps", "accuracy.csv"),
+    step(ACCURACY, "*/hard/*", "during the hard cases", "hard_cases.csv"),
+    step(&["accuracy", "--quick", "--no-hard", "--random", "1"], "*random:*", "during the random scenes", "random.csv"),
+    // Every operation at the default 2^20 inputs: the CPU's column of all
+    // of them, computed after the signal, once took 2.6 s more.
+    step(&["ulp"], "*", "interrupted by", "ulp.csv"),
 ];
 
 /// One step, one signal: the orchestrator ends within 2 s with the signal's
