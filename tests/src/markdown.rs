@@ -3,7 +3,7 @@
 //! relative link leads anywhere. One reader for the page tests,
 //! so that the two cannot disagree on what a link or a heading is.
 
-use crate::repo::read;
+use crate::repo::{assert_scan, read, root};
 use std::path::Path;
 
 /// A line without its inline code spans (`like this`).
@@ -117,4 +117,22 @@ pub fn broken(from: &Path, target: &str) -> Option<String> {
         ));
     }
     None
+}
+
+/// Every relative link of the `pages` (relative to the root) leads somewhere,
+/// and at least `min` links were read.
+pub fn assert_links_resolve<S: AsRef<str>>(pages: &[S], min: usize, what: &str) {
+    let mut broken_links = Vec::new();
+    let mut checked = 0;
+    for page in pages {
+        let page = page.as_ref();
+        let path = root().join(page);
+        for target in links(&read(&path)) {
+            checked += 1;
+            if let Some(why) = broken(&path, &target) {
+                broken_links.push(format!("{page}: {why}"));
+            }
+        }
+    }
+    assert_scan("links that lead nowhere", &broken_links, checked, min, what);
 }

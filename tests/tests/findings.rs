@@ -16,7 +16,7 @@ use std::collections::BTreeMap;
 use std::io::Write;
 use std::process::{Command, Stdio};
 use twinray_tests::assert_none;
-use twinray_tests::markdown::{anchors, broken, links, prose, without_code_spans};
+use twinray_tests::markdown::{anchors, assert_links_resolve, links, prose, without_code_spans};
 use twinray_tests::repo::{assert_scan, read, root};
 
 const FINDINGS: &str = "docs/findings";
@@ -202,24 +202,7 @@ fn every_cited_commit_path_opens() {
 
 #[test]
 fn every_relative_link_of_the_markdown_resolves() {
-    let mut broken_links = Vec::new();
-    let mut checked = 0;
-    for file in tracked_markdown() {
-        let path = root().join(&file);
-        for target in links(&read(&path)) {
-            checked += 1;
-            if let Some(why) = broken(&path, &target) {
-                broken_links.push(format!("{file}: {why}"));
-            }
-        }
-    }
-    assert_scan(
-        "links that lead nowhere",
-        &broken_links,
-        checked,
-        100,
-        "links in the tracked Markdown",
-    );
+    assert_links_resolve(&tracked_markdown(), 100, "links in the tracked Markdown");
 }
 
 #[test]

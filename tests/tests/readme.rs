@@ -8,7 +8,7 @@
 //! newcomer to install is the one cargo enforces.
 
 use std::path::PathBuf;
-use twinray_tests::markdown::{anchors, broken, links, slug};
+use twinray_tests::markdown::{anchors, assert_links_resolve, broken, links, slug};
 use twinray_tests::repo::{assert_scan, files_under, read, root};
 
 const MAX_README_LINES: usize = 150;
@@ -50,24 +50,7 @@ fn the_readme_is_a_five_minute_read() {
 
 #[test]
 fn every_link_of_the_front_pages_resolves() {
-    let mut broken_links = Vec::new();
-    let mut checked = 0;
-    for page in FRONT_PAGES {
-        let path = root().join(page);
-        for target in links(&read(&path)) {
-            checked += 1;
-            if let Some(why) = broken(&path, &target) {
-                broken_links.push(format!("{page}: {why}"));
-            }
-        }
-    }
-    assert_scan(
-        "links that lead nowhere",
-        &broken_links,
-        checked,
-        20,
-        "links on the front pages",
-    );
+    assert_links_resolve(&FRONT_PAGES, 20, "links on the front pages");
 }
 
 #[test]
