@@ -177,7 +177,7 @@ pub fn scene_inputs(name_or_path: &str) -> Vec<(String, std::path::PathBuf)> {
 }
 
 #[cfg(test)]
-mod tests {
+pub(crate) mod tests {
     use super::*;
     use std::time::Instant;
 
@@ -228,7 +228,9 @@ mod tests {
         assert!(Scene::load("spherelist", &set).is_ok());
     }
 
-    fn obj_scene(dir: &Path, obj: &[u8]) -> String {
+    /// Writes `dir`/mesh.obj with `obj` and `dir`/scene.toml whose one mesh
+    /// it is; the scene file's path.
+    pub(crate) fn obj_scene(dir: &Path, obj: &[u8]) -> String {
         std::fs::write(dir.join("mesh.obj"), obj).unwrap();
         let scene = dir.join("scene.toml");
         std::fs::write(
