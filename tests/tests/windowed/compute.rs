@@ -4,7 +4,8 @@
 //! its path, under the validation layer's synchronisation validation.
 
 use crate::common::{
-    assert_resized, clean_report, escape_delivered, stderr, xdotool_failed, xdotool_retrying, FOCUS,
+    assert_resized, clean_box_run, clean_report, escape_delivered, stderr, xdotool_failed,
+    xdotool_retrying, FOCUS,
 };
 use std::path::Path;
 use twinray_common::cli::RenderPath;
@@ -73,17 +74,10 @@ fn compute_path_window_and_live_switch_screenshots_equal_headless() {
         // Live: C to compute, P, C back to fragment, P, C, 3 (spherelist on
         // the compute path), P, Esc: one action per frame.
         let keys = "c,p,c,p,c,3,p,esc";
-        let args = box_window("64x48", "100", &["--validate", "--json"]);
-        let o = x.run(
-            &app.exe(),
-            &args,
-            &[("TWINRAY_TEST_KEYS", keys), SYNC_VALIDATION],
-            &dir,
-        );
-        let r = clean_report(app, &o);
+        let env = [("TWINRAY_TEST_KEYS", keys), SYNC_VALIDATION];
+        let (r, err) = clean_box_run(&x, app, ("64x48", "100"), &[], &env, &dir);
         assert_eq!(r.frames.len(), 8, "{app:?}: Esc after the 8th frame");
         assert_eq!(r.path, RenderPath::Compute, "{app:?}: the path at exit");
-        let err = stderr(&o);
         let switches: Vec<&str> = err.lines().filter(|l| l.contains(": path ")).collect();
         assert_eq!(switches.len(), 3, "{app:?}: {err}");
         assert!(switches[0].ends_with("path compute") && switches[1].ends_with("path fragment"));
@@ -113,20 +107,14 @@ fn compute_path_survives_a_resize_storm_with_scene_and_path_switches() {
     // Scene and path switches in the first frames, while the window resizes.
     let keys = "3,c,c,2,c,c";
     for app in App::BOTH {
-        let args = box_window(
-            "64x48",
-            "70",
-            &["--path", "compute", "--validate", "--json"],
-        );
         let env = [
             ("TWINRAY_TEST_RESIZE", "1"),
             ("TWINRAY_TEST_KEYS", keys),
             SYNC_VALIDATION,
         ];
-        let o = x.run(&app.exe(), &args, &env, &dir);
-        let r = clean_report(app, &o);
+        let compute = ["--path", "compute"];
+        let (r, err) = clean_box_run(&x, app, ("64x48", "70"), &compute, &env, &dir);
         assert_eq!(r.path, RenderPath::Compute, "{app:?}");
-        let err = stderr(&o);
         assert_eq!(err.matches(": path ").count(), 4, "{app:?}: {err}");
         assert_resized(app, &err, 25);
     }
