@@ -8,7 +8,7 @@
 
 use std::path::{Path, PathBuf};
 use twinray_tests::markdown::code_spans;
-use twinray_tests::repo::{assert_scan, root, rust_sources, text, WALKTHROUGH};
+use twinray_tests::repo::{assert_scan, files_under, root, rust_sources, text, WALKTHROUGH};
 
 /// Every README and document of the project.
 fn documents() -> Vec<PathBuf> {
@@ -316,22 +316,11 @@ fn code_lines(file: &Path) -> usize {
 
 fn count(crate_dir: &str) -> Vec<(String, usize)> {
     let dir = root().join(crate_dir).join("src");
-    let mut files: Vec<PathBuf> = std::fs::read_dir(&dir)
-        .unwrap()
-        .map(|e| e.unwrap().path())
-        .filter(|p| p.extension().is_some_and(|e| e == "rs"))
-        .collect();
-    files.sort();
-    files
+    files_under(&dir, &["rs"])
         .iter()
         .map(|f| {
-            (
-                format!(
-                    "{crate_dir}/src/{}",
-                    f.file_name().unwrap().to_string_lossy()
-                ),
-                code_lines(f),
-            )
+            let shown = f.strip_prefix(&dir).unwrap().display();
+            (format!("{crate_dir}/src/{shown}"), code_lines(f))
         })
         .collect()
 }
