@@ -372,26 +372,41 @@ fn explain_prints_each_headless_barrier_as_recorded() {
     assert_none("--explain's barriers", &wrong);
 }
 
+/// twinray-vk's box window at 64x48 for `frames` frames with `args`,
+/// validated and explained, in `recording`, under synchronisation validation
+/// and with `env`: its stderr, the run having succeeded.
+fn in_window(
+    xvfb: &twinray_tests::Xvfb,
+    recording: Recording,
+    (frames, args): (&str, &[&str]),
+    env: (&str, &str),
+    name: &str,
+) -> String {
+    let dir = twinray_tests::scratch(&format!("barriers-{name}-{recording:?}"));
+    let args = box_window(
+        "64x48",
+        frames,
+        &[args, &["--validate", "--explain"]].concat(),
+    );
+    let env = [SYNC_VALIDATION, sync2_env(recording), env];
+    let app = twinray_tests::bin("twinray-vk");
+    let out = xvfb.run(&app, &args, &env, &dir);
+    let stderr = String::from_utf8_lossy(&out.stderr).into_owned();
+    assert!(
+        out.status.success(),
+        "the window {args:?} failed ({recording:?}):\n{stderr}"
+    );
+    stderr
+}
+
 #[test]
 fn explain_prints_each_window_barrier_as_recorded() {
     let xvfb = twinray_tests::Xvfb::start();
-    let app = twinray_tests::bin("twinray-vk");
     let mut wrong = Vec::new();
     for recording in RECORDINGS {
-        let dir = twinray_tests::scratch(&format!("barriers-window-{recording:?}"));
         // Two frames on the fragment path (`R` changes nothing), then `C`: the compute path.
-        let args = box_window("64x48", "5", &["--validate", "--explain"]);
-        let env = [
-            SYNC_VALIDATION,
-            sync2_env(recording),
-            ("TWINRAY_TEST_KEYS", "r,r,c"),
-        ];
-        let out = xvfb.run(&app, &args, &env, &dir);
-        let stderr = String::from_utf8_lossy(&out.stderr);
-        assert!(
-            out.status.success(),
-            "the window failed ({recording:?}):\n{stderr}"
-        );
+        let keys = ("TWINRAY_TEST_KEYS", "r,r,c");
+        let stderr = in_window(&xvfb, recording, ("5", &[]), keys, "window");
         let mut printed = check_printed(&stderr, recording, &mut wrong);
         printed.sort();
         printed.dedup();
@@ -460,19 +475,11 @@ fn both_recordings_make_the_same_image_under_sync_validation() {
 #[test]
 fn both_recordings_survive_resizes_under_sync_validation() {
     let xvfb = twinray_tests::Xvfb::start();
-    let app = twinray_tests::bin("twinray-vk");
     for recording in RECORDINGS {
         for path in ["fragment", "compute"] {
-            let dir = twinray_tests::scratch(&format!("barriers-resize-{path}-{recording:?}"));
-            let args = box_window("64x48", "100", &["--path", path, "--validate", "--explain"]);
-            let env = [
-                SYNC_VALIDATION,
-                sync2_env(recording),
-                ("TWINRAY_TEST_RESIZE", "1"),
-            ];
-            let out = xvfb.run(&app, &args, &env, &dir);
-            let stderr = String::from_utf8_lossy(&out.stderr);
-            assert!(out.status.success(), "{path}, {recording:?}:\n{stderr}");
+            let resize = ("TWINRAY_TEST_RESIZE", "1");
+            let run = ("100", &["--path", path][..]);
+            let stderr = in_window(&xvfb, recording, run, resize, &format!("resize-{path}"));
             assert!(
                 !stderr.contains("twinray-vk: validation"),
                 "{path}, {recording:?}:\n{stderr}"
