@@ -124,6 +124,23 @@ impl App {
     }
 }
 
+/// The standard scenes as the image-agreement tests render them: (scene,
+/// size, `--set` overrides). The sphere list with 100 more spheres, hidden in
+/// the visible one, so that a wrong sphere count shows.
+pub const STANDARD_SCENES: [(&str, &str, &[(&str, &str)]); 3] = [
+    ("box", "160x120", &[]),
+    ("teapot", "64x48", &[]),
+    ("spherelist", "160x120", &[("extra_spheres", "100")]),
+];
+
+/// `--set KEY=VALUE` for each of `overrides`.
+pub fn set_args(overrides: &[(&str, &str)]) -> Vec<String> {
+    overrides
+        .iter()
+        .flat_map(|(k, v)| ["--set".to_string(), format!("{k}={v}")])
+        .collect()
+}
+
 /// A successful validated headless render: its report and its 8-bit image.
 pub fn render(
     app: App,

@@ -6,16 +6,15 @@ use twinray_common::gpu::layout::GpuTriangle;
 use twinray_common::gpu::upload::UPLOAD_CHUNK_BYTES;
 use twinray_common::reference;
 use twinray_common::scene::Scene;
-use twinray_tests::{assert_clean, assert_within_1, render, scratch, App};
+use twinray_tests::{
+    assert_clean, assert_within_1, render, scratch, set_args, App, STANDARD_SCENES,
+};
 
 fn check(scene: &str, size: &str, set: &[(&str, &str)]) {
-    let kv: Vec<String> = set.iter().map(|(k, v)| format!("{k}={v}")).collect();
+    let args = set_args(set);
     // Named by the overrides too: tests of one scene run in parallel.
-    let dir = scratch(&format!("agree-{scene}{}", kv.concat()));
-    let mut extra = Vec::new();
-    for s in &kv {
-        extra.extend(["--set", s.as_str()]);
-    }
+    let dir = scratch(&format!("agree-{scene}{}", args.concat()));
+    let extra: Vec<&str> = args.iter().map(String::as_str).collect();
     let sz = twinray_common::cli::parse_size(size).unwrap();
     let overrides: Vec<(String, String)> = set
         .iter()
@@ -51,13 +50,10 @@ fn check(scene: &str, size: &str, set: &[(&str, &str)]) {
 }
 
 #[test]
-fn box_agrees() {
-    check("box", "160x120", &[]);
-}
-
-#[test]
-fn teapot_agrees_at_a_small_size() {
-    check("teapot", "64x48", &[]);
+fn the_standard_scenes_agree() {
+    for (scene, size, set) in STANDARD_SCENES {
+        check(scene, size, set);
+    }
 }
 
 /// A teapot whose triangle buffer is larger than one upload chunk: each app
@@ -73,11 +69,6 @@ fn teapot_larger_than_one_upload_chunk_agrees() {
         "{triangles} triangles fit in one upload chunk"
     );
     check("teapot", "64x48", &set);
-}
-
-#[test]
-fn spherelist_with_100_extra_spheres_agrees() {
-    check("spherelist", "160x120", &[("extra_spheres", "100")]);
 }
 
 #[test]

@@ -4,7 +4,9 @@
 //! size, and image sizes that are not a multiple of the workgroup, included.
 
 use twinray_common::value_name::ValueName;
-use twinray_tests::{assert_clean, assert_within_1, render, scratch, App};
+use twinray_tests::{
+    assert_clean, assert_within_1, render, scratch, set_args, App, STANDARD_SCENES,
+};
 
 fn check(scene: &str, size: &str, extra: &[&str]) {
     let dir = scratch(&format!("compute-{scene}"));
@@ -35,18 +37,15 @@ fn check(scene: &str, size: &str, extra: &[&str]) {
 }
 
 #[test]
-fn box_compute_matches_fragment() {
-    check("box", "160x120", &[]);
-}
-
-#[test]
-fn teapot_compute_matches_fragment_at_a_small_size() {
-    check("teapot", "64x48", &[]);
-}
-
-#[test]
-fn spherelist_with_100_extra_spheres_compute_matches_fragment() {
-    check("spherelist", "160x120", &["--set", "extra_spheres=100"]);
+fn the_standard_scenes_compute_matches_fragment() {
+    for (scene, size, set) in STANDARD_SCENES {
+        let args = set_args(set);
+        check(
+            scene,
+            size,
+            &args.iter().map(String::as_str).collect::<Vec<_>>(),
+        );
+    }
 }
 
 #[test]
