@@ -116,13 +116,17 @@ fn failing(apps: &Path, app: &str, words: &str) {
     stand_in(apps, app, &script);
 }
 
-/// `twinray ulp` on 64 inputs with the apps in `apps`, expected to fail: its
-/// exit code and stderr.
-fn ulp_failing(apps: &Path, out: &Path, extra: &[&str]) -> (i32, String) {
+/// `twinray ulp` on 64 inputs with the apps in `dir`/apps, writing to
+/// `dir`/out, expected to fail saying each of `words`: its exit code and
+/// stderr.
+fn ulp_failing(dir: &Path, extra: &[&str], words: &[&str]) -> (i32, String) {
+    let (apps, out) = (dir.join("apps"), dir.join("out"));
     let mut args = vec!["--bin-dir", apps.to_str().unwrap(), "ulp", "--inputs", "64"];
     args.extend_from_slice(extra);
     args.extend(["--out", out.to_str().unwrap()]);
-    fail(&bin("twinray"), &args, &[])
+    let (code, stderr) = fail(&bin("twinray"), &args, &[]);
+    assert!(words.iter().all(|w| stderr.contains(w)), "{stderr}");
+    (code, stderr)
 }
 
 #[test]
@@ -133,14 +137,10 @@ fn a_run_in_which_every_app_fails_is_a_failure_and_says_why() {
     for app in ["twinray-vk", "twinray-gl"] {
         failing(&apps, app, "no device here");
     }
-    let out = dir.join("out");
-    let (code, stderr) = ulp_failing(&apps, &out, &["--ops", "div"]);
+    let words = ["4 runs failed", "no device here"];
+    let (code, stderr) = ulp_failing(&dir, &["--ops", "div"], &words);
     assert_ne!(code, 0, "{stderr}");
-    assert!(
-        stderr.contains("4 runs failed") && stderr.contains("no device here"),
-        "{stderr}"
-    );
-    let md = std::fs::read_to_string(out.join("ulp.md")).unwrap();
+    let md = std::fs::read_to_string(dir.join("out/ulp.md")).unwrap();
     assert!(
         md.contains("## Failed runs") && md.contains("| `div` | failed | failed |"),
         "{md}"
@@ -198,14 +198,10 @@ fn a_run_in_which_some_apps_fail_exits_1_and_keeps_the_rest() {
     std::fs::create_dir_all(&apps).unwrap();
     std::os::unix::fs::symlink(bin("twinray-vk"), apps.join("twinray-vk")).unwrap();
     failing(&apps, "twinray-gl", "no context here");
-    let out = dir.join("out");
-    let (code, stderr) = ulp_failing(&apps, &out, &["--ops", "add", "--paths", "fragment"]);
+    let add = ["--ops", "add", "--paths", "fragment"];
+    let (code, stderr) = ulp_failing(&dir, &add, &["1 run failed", "no context here"]);
     assert_eq!(code, 1, "{stderr}");
-    assert!(
-        stderr.contains("1 run failed") && stderr.contains("no context here"),
-        "{stderr}"
-    );
-    let csv = std::fs::read_to_string(out.join("ulp.csv")).unwrap();
+    let csv = std::fs::read_to_string(dir.join("out/ulp.csv")).unwrap();
     assert!(
         csv.lines().any(|l| l.starts_with("add,vulkan,fragment")),
         "{csv}"
