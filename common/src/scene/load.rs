@@ -228,6 +228,14 @@ pub(crate) mod tests {
         assert!(Scene::load("spherelist", &set).is_ok());
     }
 
+    /// A scene whose mesh is `obj` is refused in words that hold each of `words`.
+    fn obj_refused(dir: &Path, obj: &str, words: &[&str]) {
+        let e = message(Scene::load(&obj_scene(dir, obj.as_bytes()), &[]));
+        for word in words {
+            assert!(e.contains(word), "{obj:?}: lacks '{word}': {e}");
+        }
+    }
+
     /// Writes `dir`/mesh.obj with `obj` and `dir`/scene.toml whose one mesh
     /// it is; the scene file's path.
     pub(crate) fn obj_scene(dir: &Path, obj: &[u8]) -> String {
@@ -289,11 +297,7 @@ pub(crate) mod tests {
             ("l 1 2 3\n", &["line 5", "line element"]),
             ("f\n", &["line 5", "names no vertex"]),
         ] {
-            let scene = obj_scene(&dir, format!("{head}{obj}f 1 2 3\n").as_bytes());
-            let e = message(Scene::load(&scene, &[]));
-            for word in words {
-                assert!(e.contains(word), "{obj:?}: lacks '{word}': {e}");
-            }
+            obj_refused(&dir, &format!("{head}{obj}f 1 2 3\n"), words);
         }
         let _ = std::fs::remove_dir_all(&dir);
     }
@@ -332,11 +336,7 @@ pub(crate) mod tests {
                 &["line 4", "'1/2/3/4'"],
             ),
         ] {
-            let scene = obj_scene(&dir, obj.as_bytes());
-            let e = message(Scene::load(&scene, &[]));
-            for word in words {
-                assert!(e.contains(word), "{obj:?}: lacks '{word}': {e}");
-            }
+            obj_refused(&dir, obj, words);
         }
         let _ = std::fs::remove_dir_all(&dir);
     }
