@@ -339,12 +339,13 @@ impl ComputePipeline {
         spirv: &[u32],
     ) -> Result<ComputePipeline> {
         let d = &device.device;
+        // Owned from here on, so that an error below frees the layout (dropping
+        // a null pipeline does nothing).
         let mut this = ComputePipeline {
             device: d.clone(),
-            layout: vk::PipelineLayout::null(),
+            layout: crate::pipeline::layout(d, set_layout, "compute")?,
             pipeline: vk::Pipeline::null(),
         };
-        this.layout = crate::pipeline::layout(d, set_layout, "compute")?;
         // Dropped after the pipeline is made: it keeps its own copy of the code.
         let module = crate::pipeline::module(d, spirv, "compute")?;
         let stage = vk::PipelineShaderStageCreateInfo::default()
