@@ -124,10 +124,13 @@ impl App {
     }
 }
 
+/// `--set` overrides as (key, value) pairs.
+pub type Overrides = &'static [(&'static str, &'static str)];
+
 /// The standard scenes as the image-agreement tests render them: (scene,
 /// size, `--set` overrides). The sphere list with 100 more spheres, hidden in
 /// the visible one, so that a wrong sphere count shows.
-pub const STANDARD_SCENES: [(&str, &str, &[(&str, &str)]); 3] = [
+pub const STANDARD_SCENES: [(&str, &str, Overrides); 3] = [
     ("box", "160x120", &[]),
     ("teapot", "64x48", &[]),
     ("spherelist", "160x120", &[("extra_spheres", "100")]),

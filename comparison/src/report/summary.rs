@@ -211,9 +211,9 @@ fn ratios(exp: &str, path: RenderPath, outcomes: &[Outcome], study: &[StudyRow])
         let vk = report_of(&rows, v, Api::Vulkan, path);
         let gl = report_of(&rows, v, Api::Opengl, path);
         let wall = |r: &RunReport| r.wall_ms;
-        push_ratio((vk, gl), wall, (&mut r.wall, &mut r.wall_iv));
+        push_ratio((vk, gl), wall, &mut r.wall, &mut r.wall_iv);
         let gpu = |r: &RunReport| r.gpu_ms;
-        push_ratio((vk, gl), gpu, (&mut r.gpu, &mut r.gpu_iv));
+        push_ratio((vk, gl), gpu, &mut r.gpu, &mut r.gpu_iv);
         let glspv = report_of(&rows, v, Api::OpenglSpirv, path);
         if let Some(x) = ratio(
             vk.and_then(|r| r.gpu_ms).map(|s| s.median),
@@ -233,7 +233,8 @@ fn ratios(exp: &str, path: RenderPath, outcomes: &[Outcome], study: &[StudyRow])
 fn push_ratio(
     (vk, gl): (Option<&RunReport>, Option<&RunReport>),
     time: impl Fn(&RunReport) -> Option<Summary>,
-    (ratios, intervals): (&mut Vec<f64>, &mut Vec<Option<(f64, f64)>>),
+    ratios: &mut Vec<f64>,
+    intervals: &mut Vec<Option<(f64, f64)>>,
 ) {
     let (vk, gl) = (vk.and_then(&time), gl.and_then(&time));
     if let Some(x) = ratio(vk.map(|s| s.median), gl.map(|s| s.median)) {
