@@ -6,7 +6,7 @@
 mod accel;
 mod agreement;
 pub(crate) mod runs;
-mod shaders;
+pub(crate) mod shaders;
 pub(crate) mod study;
 pub(crate) mod why;
 

@@ -8,9 +8,16 @@
 //! median table and the ratios the plan asks for (`table`). The apps are
 //! started, supervised and read exactly as `compare` does (`apps::run_json_with`,
 //! `supervisor`), and the cells are those of compare's report (`report::cells`).
+//! After the rounds come the plan's device-side steps (`steps`: shader
+//! statistics, images against a reference or another build), and `env`
+//! checks the plan's environment variables when it is read.
 
+mod axes;
+mod env;
 mod options;
 mod plan;
+mod sets;
+mod steps;
 mod table;
 
 use crate::apps::{self, Launch};
@@ -26,6 +33,10 @@ pub struct SweepArgs {
     /// The folder for sweep.jsonl and sweep.md.
     #[arg(long, value_name = "DIR")]
     pub out: PathBuf,
+    /// Read and check the plan, print its cells, and run nothing (what CI
+    /// does to every committed plan, so that a stale one fails there).
+    #[arg(long)]
+    pub dry_run: bool,
 }
 
 /// The order of round `round`'s runs, as indices into the cells: reversed
@@ -41,6 +52,10 @@ pub fn round_order(cells: usize, round: u32) -> Vec<usize> {
 pub fn run(args: &SweepArgs) -> anyhow::Result<()> {
     // The whole plan is checked first: a bad one creates nothing and runs nothing.
     let plan = plan::load(&args.plan)?;
+    if args.dry_run {
+        print_cells(&plan);
+        return Ok(());
+    }
     twinray_common::reference::image_io::prepare_output_dir("--out", &args.out)?;
     let stop = crate::interrupt::Stop::install()?;
     let started = std::time::Instant::now();
@@ -113,6 +128,10 @@ pub fn run(args: &SweepArgs) -> anyhow::Result<()> {
             seq += 1;
         }
     }
+    // The device-side steps follow the measured rounds, so that dumping and
+    // writing images never share a GPU with a timed run.
+    let mut write = |line: &serde_json::Value| append(&mut jsonl, line, &jsonl_path);
+    let steps_md = steps::run(&plan, &cells, &args.out, &stop, &mut write, &mut failed)?;
     let interrupted = stop.signal();
     if let Some((signal, _)) = interrupted {
         let mark = serde_json::json!({ "interrupted": signal, "runs": seq, "of": total });
@@ -120,6 +139,7 @@ pub fn run(args: &SweepArgs) -> anyhow::Result<()> {
     }
     let md_path = args.out.join("sweep.md");
     let mut md = table::markdown(&plan, &cells, &done, interrupted.map(|(s, _)| s));
+    md += &steps_md;
     if !failed.is_empty() {
         // A failed run is missing from its cell's rounds: say so beside the figures.
         md += &format!(
@@ -146,6 +166,20 @@ pub fn run(args: &SweepArgs) -> anyhow::Result<()> {
             "{} of {seq} runs failed (sweep.jsonl has each error); the first: {first}",
             failed.len()
         )),
+    }
+}
+
+/// `--dry-run`'s output: one line a cell, build, app, set and its options.
+fn print_cells(plan: &plan::Plan) {
+    for cell in plan.cells() {
+        let set = &plan.sets[cell.set];
+        println!(
+            "{}\t{}\t{}\t{}",
+            plan.builds[cell.build].name,
+            apps::api_name(cell.app),
+            set.name,
+            set.options.join(" ")
+        );
     }
 }
 

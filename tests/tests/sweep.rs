@@ -285,3 +285,156 @@ fn sigint_keeps_the_finished_runs_and_marks_both_files() {
         "{md}"
     );
 }
+
+/// sweep.jsonl's lines of one step ("device" or "images").
+fn step_lines(dir: &Path, step: &str) -> Vec<serde_json::Value> {
+    std::fs::read_to_string(dir.join("out/sweep.jsonl"))
+        .unwrap()
+        .lines()
+        .map(|l| serde_json::from_str::<serde_json::Value>(l).unwrap())
+        .filter(|l| l["step"] == step)
+        .collect()
+}
+
+#[test]
+fn the_device_side_steps_dump_shaders_and_compare_two_builds_images() {
+    let dir = scratch("sweep-steps");
+    two_builds(&dir);
+    let plan = PLAN
+        .replace(
+            "rounds = 2",
+            "rounds = 1\nshaders = true\nimages = \"builds\"",
+        )
+        .replace("path = [\"fragment\", \"compute\"]", "path = [\"compute\"]");
+    let o = sweep(&dir, &plan);
+    let stderr = String::from_utf8_lossy(&o.stderr);
+    assert!(o.status.success(), "{stderr}");
+    // One device-side run per cell, after the timed ones, each with its dump and image.
+    let device = step_lines(&dir, "device");
+    assert_eq!(device.len(), 4, "{device:?}");
+    for line in &device {
+        assert_eq!(line["report"]["api"], line["app"], "{line}");
+        assert_eq!(
+            line["report"]["frames"].as_array().map(Vec::len),
+            Some(1),
+            "{line}"
+        );
+        let image = Path::new(line["image"].as_str().unwrap());
+        assert!(image.is_file(), "{line}");
+    }
+    let dumps: Vec<_> = std::fs::read_dir(dir.join("out/shaders"))
+        .unwrap()
+        .collect();
+    assert_eq!(dumps.len(), 4);
+    for d in dumps {
+        let d = d.unwrap().path();
+        assert!(
+            std::fs::read_dir(&d).unwrap().count() > 0,
+            "{} is empty",
+            d.display()
+        );
+    }
+    // Build b against build a: the same binaries, so the same bytes and reports.
+    let images = step_lines(&dir, "images");
+    assert_eq!(images.len(), 2, "{images:?}");
+    for line in &images {
+        assert_eq!(line["build"], "b");
+        assert_eq!(line["against"], "build a");
+        assert_eq!(line["same_bytes"], true, "{line}");
+        assert_eq!(line["same_report"], true, "{line}");
+        assert_eq!(line["diff"]["max_abs"], 0, "{line}");
+    }
+    let md = std::fs::read_to_string(dir.join("out/sweep.md")).unwrap();
+    assert!(md.contains("## What the drivers compiled"), "{md}");
+    assert!(
+        md.contains("| a | opengl | scene=box size=32x24 path=compute |"),
+        "{md}"
+    );
+    assert!(
+        md.contains("| b | vulkan | scene=box size=32x24 path=compute | build a | identical | 0 |"),
+        "{md}"
+    );
+}
+
+#[test]
+fn images_against_the_reference_render_it_from_the_sets_scene_options() {
+    let dir = scratch("sweep-reference");
+    two_builds(&dir);
+    let plan = r#"rounds = 1
+frames = 2
+apps = ["vulkan", "opengl"]
+images = "reference"
+
+[builds]
+a = "a"
+
+[[sets]]
+name = "shallow"
+options = { scene = "spherelist", size = "24x16", set = ["max_depth=1"] }
+"#;
+    let o = sweep(&dir, plan);
+    let stderr = String::from_utf8_lossy(&o.stderr);
+    assert!(o.status.success(), "{stderr}");
+    let images = step_lines(&dir, "images");
+    assert_eq!(images.len(), 2, "{images:?}");
+    let reference = Path::new(images[0]["a"].as_str().unwrap());
+    let img = image::open(reference).unwrap();
+    assert_eq!((img.width(), img.height()), (24, 16));
+    for line in &images {
+        assert_eq!(line["against"], "reference", "{line}");
+        assert!(line["same_report"].is_null(), "{line}");
+        // Mesa's f32 is within a few steps of the f64 reference on this scene.
+        assert!(line["diff"]["max_abs"].as_u64().unwrap() < 64, "{line}");
+    }
+    let md = std::fs::read_to_string(dir.join("out/sweep.md")).unwrap();
+    assert!(md.contains("| a | opengl | shallow | reference |"), "{md}");
+}
+
+#[test]
+fn a_bad_environment_value_is_refused_at_its_line() {
+    let plan = format!("{PLAN}\n[env]\nTWINRAY_VK_WAIT = \"idel\"\n");
+    refused(
+        "sweep-env-value",
+        &plan,
+        16,
+        "twinray-vk refuses TWINRAY_VK_WAIT = 'idel', its --vk-wait",
+    );
+    let plan = format!("{PLAN}\n[env_axes]\nTWINRAY_VK_WIAT = [\"fence\", \"idle\"]\n");
+    refused(
+        "sweep-env-name",
+        &plan,
+        16,
+        "no app reads TWINRAY_VK_WIAT (the apps read",
+    );
+    let plan = r#"rounds = 1
+apps = ["vulkan"]
+[builds]
+a = "a"
+
+[[sets]]
+options = { scene = "box" }
+env = { TWINRAY_VK_SYNC2 = "perhaps" }
+"#;
+    refused(
+        "sweep-env-set",
+        plan,
+        8,
+        "twinray-vk refuses TWINRAY_VK_SYNC2 = 'perhaps'",
+    );
+}
+
+#[test]
+fn a_bad_step_is_refused_at_its_line() {
+    let plan = PLAN.replace("rounds = 2", "rounds = 2\nimages = \"mirror\"");
+    refused("sweep-images", &plan, 2, "`images` is 'mirror'");
+    let plan = PLAN
+        .replace("rounds = 2", "rounds = 2\nimages = \"builds\"")
+        .replace("b = \"b\"\n", "")
+        .replace(", [\"a\", \"b\"]", "");
+    refused("sweep-images-one", &plan, 2, "needs two builds at least");
+    let plan = PLAN.replace(
+        "size = [\"32x24\"]",
+        "size = [\"32x24\"]\ndump-shaders = [\"d\"]",
+    );
+    refused("sweep-dump", &plan, 13, "the plan's top-level `shaders`");
+}

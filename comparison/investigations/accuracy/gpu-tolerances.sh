@@ -25,9 +25,8 @@ mkdir -p "$out/img"
 csv="$out/tolerances.csv"
 errors="$out/tolerances.log"
 : > "$errors"
-# shellcheck source=comparison/investigations/lib.sh
-source "$here/comparison/investigations/lib.sh"
-gpu_info
+# Which machine the folder came from (nothing where nvidia-smi is missing).
+nvidia-smi --query-gpu=name,driver_version --format=csv > "$out/gpu.txt" 2>&1 || true
 mapfile -t runs < <("$bin/twinray" hard-runs)
 if [ ${#runs[@]} -eq 0 ]; then
     echo "$bin/twinray hard-runs printed no runs" >&2

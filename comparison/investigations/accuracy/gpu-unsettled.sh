@@ -20,9 +20,8 @@ seeds=${3:-100}
 mkdir -p "$out/img"
 log="$out/unsettled.jsonl"
 errors="$out/unsettled.log"
-# shellcheck source=comparison/investigations/lib.sh
-source "$(dirname "$0")/../lib.sh"
-gpu_info
+# Which machine the folder came from (nothing where nvidia-smi is missing).
+nvidia-smi --query-gpu=name,driver_version --format=csv > "$out/gpu.txt" 2>&1 || true
 : > "$log"
 # compare LABEL REF MASK IMG: the image against the reference, whole and less the mask.
 compare() {

@@ -82,7 +82,7 @@ pub fn collect(out: &Path, paths: &[RenderPath], stop: &AtomicBool) -> Vec<Shade
 /// The figures worth a column: registers and local memory, whatever the
 /// driver calls them. NVIDIA's Vulkan driver sets bit 36 of its local-memory
 /// figure; the bytes are the low 32 bits.
-fn figures(stats: &[ShaderStats]) -> String {
+pub(crate) fn figures(stats: &[ShaderStats]) -> String {
     let mut parts = Vec::new();
     for s in stats {
         if s.stage == "VS" || s.stage.to_ascii_lowercase().contains("vertex") {

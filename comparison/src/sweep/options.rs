@@ -8,8 +8,14 @@ const RESERVED: &[(&str, &str)] = &[
     ("headless", "every run is headless"),
     ("frames", "the plan's top-level `frames` sets it"),
     ("settle", "the plan's top-level `settle` sets it"),
-    ("out", "a sweep writes no images"),
-    ("dump-shaders", "a sweep writes no shader dumps"),
+    (
+        "out",
+        "the plan's top-level `images` writes each cell's image",
+    ),
+    (
+        "dump-shaders",
+        "the plan's top-level `shaders` dumps each cell's",
+    ),
     ("explain", "it prints text where the report is read"),
     ("experiments", "it prints a list instead of rendering"),
     ("help", "it prints help instead of rendering"),

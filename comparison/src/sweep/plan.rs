@@ -4,31 +4,32 @@
 //! apps use (`VulkanCli`, `OpenGlCli`), so an option an app would refuse is
 //! refused here, not in the middle of a sweep.
 
+use super::axes::product;
 use super::options::option_tokens;
+pub use super::sets::OptionSet;
+use super::sets::{merged_env, Base};
 use crate::apps::Api;
-use clap::{CommandFactory, Parser};
 use serde::Deserialize;
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 use toml::Spanned;
-use twinray_common::cli::{OpenGlCli, RenderArgs, VulkanCli};
 use twinray_common::error::bad_input;
 
 /// The plan as written. `Spanned` keeps where each value is, for the line
 /// a refusal names.
 #[derive(Deserialize)]
 #[serde(deny_unknown_fields)]
-struct PlanFile {
+pub(super) struct PlanFile {
     builds: BTreeMap<String, Spanned<String>>,
     apps: Spanned<Vec<String>>,
     #[serde(default)]
-    axes: BTreeMap<String, Spanned<Vec<toml::Value>>>,
+    pub(super) axes: BTreeMap<String, Spanned<Vec<toml::Value>>>,
     #[serde(default)]
-    env_axes: BTreeMap<String, Spanned<Vec<String>>>,
+    pub(super) env_axes: BTreeMap<String, Spanned<Vec<String>>>,
     #[serde(default)]
     sets: Vec<Spanned<SetFile>>,
     #[serde(default)]
-    env: BTreeMap<String, String>,
+    pub(super) env: BTreeMap<String, Spanned<String>>,
     rounds: Spanned<u32>,
     #[serde(default)]
     warmup: u32,
@@ -36,6 +37,10 @@ struct PlanFile {
     settle: Option<Spanned<f64>>,
     #[serde(default)]
     ratios: Vec<Spanned<[String; 2]>>,
+    /// The device-side steps after the timed rounds (`steps`).
+    #[serde(default)]
+    shaders: bool,
+    images: Option<Spanned<String>>,
 }
 
 /// One option set of an explicit `[[sets]]` list.
@@ -46,7 +51,7 @@ struct SetFile {
     #[serde(default)]
     options: BTreeMap<String, Spanned<toml::Value>>,
     #[serde(default)]
-    env: BTreeMap<String, String>,
+    env: BTreeMap<String, Spanned<String>>,
 }
 
 /// A named folder of binaries.
@@ -54,19 +59,6 @@ struct SetFile {
 pub struct Build {
     pub name: String,
     pub dir: PathBuf,
-}
-
-/// One option set, checked: the `RenderArgs` both apps parsed from it, the
-/// options that are an app's own knobs (passed on as written), and its
-/// environment.
-#[derive(Debug, Clone)]
-pub struct OptionSet {
-    pub name: String,
-    /// The set's options as the plan gave them, in command-line form.
-    pub options: Vec<String>,
-    pub args: RenderArgs,
-    pub extra: Vec<String>,
-    pub env: Vec<(String, String)>,
 }
 
 /// A ratio the table reports: of two apps (per build and set) or of two
@@ -104,6 +96,26 @@ pub struct Plan {
     pub frames: Option<u32>,
     pub settle: Option<f64>,
     pub ratios: Vec<Ratio>,
+    /// Each cell once more after the rounds with `--dump-shaders`.
+    pub shaders: bool,
+    /// Each cell's image, and what it is compared with.
+    pub images: Option<Images>,
+}
+
+/// What each cell's image is compared with (`images = "..."`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Images {
+    /// The first build's, same app and set: byte for byte, with the reports
+    /// compared too (timings aside), so that a redesign can be shown to
+    /// change no output.
+    Builds,
+    /// The first app's, same build and set.
+    Apps,
+    /// The f64 CPU reference of the set's scene, size, `--set` and `--accel`.
+    Reference,
+    /// The f64 truth of the set's scene, size and `--set`, as the hard
+    /// cases are measured against.
+    Truth,
 }
 
 /// The 1-based line of byte `offset` in `text`.
@@ -112,14 +124,14 @@ fn line_of(text: &str, offset: usize) -> usize {
 }
 
 /// Where a refusal points: the plan's name and text, for "line N" sentences.
-struct Source<'a> {
+pub(super) struct Source<'a> {
     shown: String,
     text: &'a str,
 }
 
 impl Source<'_> {
     /// A refusal at the value spanning `span`.
-    fn at(&self, span: std::ops::Range<usize>, what: String) -> anyhow::Error {
+    pub(super) fn at(&self, span: std::ops::Range<usize>, what: String) -> anyhow::Error {
         bad_input(format!(
             "the plan '{}', line {}: {what}",
             self.shown,
@@ -146,6 +158,7 @@ pub fn load(file: &Path) -> anyhow::Result<Plan> {
         ))
     })?;
     let src = Source { shown, text: &text };
+    check_env(&raw, &src)?;
     let apps = apps(&raw, &src)?;
     let builds = builds(&raw, &apps, file.parent().unwrap_or(Path::new(".")), &src)?;
     if *raw.rounds.get_ref() == 0 {
@@ -175,15 +188,39 @@ pub fn load(file: &Path) -> anyhow::Result<Plan> {
     ) {
         (true, true) => return Err(src.whole("it names no option set; give [axes] or [[sets]]")),
         (false, false) => {
-            return Err(src.at(
-                raw.sets[0].span(),
-                "give either [axes] or [[sets]], not both".into(),
-            ))
+            let (listed, axes) = (listed(&raw, &base, &src)?, axis_sets(&raw, &base, &src)?);
+            super::axes::each_with_each(&listed, &axes, &base)
+                .map_err(|why| src.at(raw.sets[0].span(), why))?
         }
-        (false, true) => product(&raw, &base, &src)?,
+        (false, true) => axis_sets(&raw, &base, &src)?,
         (true, false) => listed(&raw, &base, &src)?,
     };
     let ratios = ratios(&raw, &apps, &builds, &src)?;
+    let images = match &raw.images {
+        None => None,
+        Some(v) => Some(match v.get_ref().as_str() {
+            "builds" if builds.len() > 1 => Images::Builds,
+            "apps" if apps.len() > 1 => Images::Apps,
+            "reference" => Images::Reference,
+            "truth" => Images::Truth,
+            "builds" | "apps" => {
+                return Err(src.at(
+                    v.span(),
+                    format!(
+                        "`images = \"{}\"` needs two {} at least",
+                        v.get_ref(),
+                        v.get_ref()
+                    ),
+                ))
+            }
+            other => {
+                return Err(src.at(
+                    v.span(),
+                    format!("`images` is '{other}'; use builds, apps, reference or truth"),
+                ))
+            }
+        }),
+    };
     Ok(Plan {
         file: file.to_path_buf(),
         builds,
@@ -194,7 +231,30 @@ pub fn load(file: &Path) -> anyhow::Result<Plan> {
         frames,
         settle,
         ratios,
+        shaders: raw.shaders,
+        images,
     })
+}
+
+/// The option sets of the plan's axes (`axes::product`).
+fn axis_sets(raw: &PlanFile, base: &Base, src: &Source) -> anyhow::Result<Vec<OptionSet>> {
+    product(&raw.axes, &raw.env_axes, &raw.env, base, &|span, why| {
+        src.at(span, why)
+    })
+}
+
+/// Every environment value of the plan, through `env::check`, at its line.
+fn check_env(raw: &PlanFile, src: &Source) -> anyhow::Result<()> {
+    let sets = raw.sets.iter().flat_map(|s| s.get_ref().env.iter());
+    for (var, value) in raw.env.iter().chain(sets) {
+        super::env::check(var, value.get_ref()).map_err(|why| src.at(value.span(), why))?;
+    }
+    for (var, values) in &raw.env_axes {
+        for value in values.get_ref() {
+            super::env::check(var, value).map_err(|why| src.at(values.span(), why))?;
+        }
+    }
+    Ok(())
 }
 
 fn apps(raw: &PlanFile, src: &Source) -> anyhow::Result<Vec<Api>> {
@@ -282,7 +342,8 @@ fn listed(raw: &PlanFile, base: &Base, src: &Source) -> anyhow::Result<Vec<Optio
         if sets.iter().any(|o| o.name == name) {
             return Err(src.at(set.span(), format!("two option sets are named '{name}'")));
         }
-        let env = merged_env(&raw.env, &s.env);
+        let own = s.env.iter().map(|(k, v)| (k.clone(), v.get_ref().clone()));
+        let env = merged_env(&raw.env, &own.collect());
         sets.push(
             base.check(name, options, env)
                 .map_err(|why| src.at(set.span(), why))?,
@@ -328,201 +389,6 @@ impl Plan {
         }
         cells
     }
-}
-
-/// What every option set is checked with.
-struct Base<'a> {
-    apps: &'a [Api],
-    frames: Option<u32>,
-    settle: Option<f64>,
-}
-
-impl Base<'_> {
-    /// Parses `options` as each app would, with the plan's own options, and
-    /// splits them into `RenderArgs` and the app's knobs; the error is why an
-    /// app refused them.
-    fn check(
-        &self,
-        name: String,
-        options: Vec<String>,
-        env: Vec<(String, String)>,
-    ) -> Result<OptionSet, String> {
-        let shared: Vec<String> = RenderArgs::command()
-            .get_arguments()
-            .filter_map(|a| a.get_long().map(|l| format!("--{l}")))
-            .collect();
-        // Options come in `--key [value]` runs: a run whose key is not one of
-        // RenderArgs' own is a knob, passed on after them as written.
-        let (mut render, mut extra) = (Vec::new(), Vec::new());
-        let mut into_extra = false;
-        for token in &options {
-            if token.starts_with("--") {
-                into_extra = !shared.contains(token);
-            }
-            if into_extra {
-                extra.push(token.clone());
-            } else {
-                render.push(token.clone());
-            }
-        }
-        let mut argv = vec!["--headless".to_string(), "--json".to_string()];
-        if let Some(f) = self.frames {
-            argv.extend(["--frames".into(), f.to_string()]);
-        }
-        if let Some(p) = self.settle {
-            argv.extend(["--settle".into(), p.to_string()]);
-        }
-        argv.extend(render);
-        argv.extend(extra.iter().cloned());
-        let mut args = None;
-        for api in self.apps {
-            let bin = api.binary().expect("an app");
-            let argv = std::iter::once(bin.to_string()).chain(argv.iter().cloned());
-            let parsed = match api {
-                Api::Vulkan => VulkanCli::try_parse_from(argv).map(|c| c.render),
-                _ => OpenGlCli::try_parse_from(argv).map(|c| c.render),
-            };
-            let parsed = parsed.map_err(|e| {
-                let message = e.to_string();
-                let first = message.lines().next().unwrap_or("refused");
-                let what = match options.is_empty() {
-                    // The plan's own `frames` and `settle`, checked alone.
-                    true => "it".to_string(),
-                    false => format!("the option set '{name}' ({})", options.join(" ")),
-                };
-                format!(
-                    "{bin} refuses {what}: {}",
-                    first.trim_start_matches("error: ")
-                )
-            })?;
-            args.get_or_insert(parsed);
-        }
-        Ok(OptionSet {
-            name,
-            options,
-            args: args.expect("a plan has an app"),
-            extra,
-            env,
-        })
-    }
-}
-
-/// The plan's `[env]` with a set's own on top.
-fn merged_env(
-    all: &BTreeMap<String, String>,
-    own: &BTreeMap<String, String>,
-) -> Vec<(String, String)> {
-    let mut env = all.clone();
-    env.extend(own.iter().map(|(k, v)| (k.clone(), v.clone())));
-    env.into_iter().collect()
-}
-
-/// One value of one axis: its command-line tokens or environment variable,
-/// and its part of the set's name.
-enum Pick {
-    Option(Vec<String>),
-    Env(String, String),
-}
-
-/// An axis: where the plan declares it, and its values with their names.
-type Axis = (std::ops::Range<usize>, Vec<(String, Pick)>);
-
-/// The option sets of `[axes]` and `[env_axes]`: every combination, the
-/// first declared axis outermost.
-fn product(raw: &PlanFile, base: &Base, src: &Source) -> anyhow::Result<Vec<OptionSet>> {
-    let at = |span, what| src.at(span, what);
-    // Each axis as (where it is, its values), in the order the plan declares them.
-    let mut axes: Vec<Axis> = Vec::new();
-    for (key, values) in &raw.axes {
-        if values.get_ref().is_empty() {
-            return Err(at(values.span(), format!("the axis '{key}' is empty")));
-        }
-        // Twice the same value would be two cells the table cannot tell apart.
-        let all = values.get_ref();
-        if let Some((_, v)) = all.iter().enumerate().find(|(i, v)| all[..*i].contains(v)) {
-            return Err(at(
-                values.span(),
-                format!("the axis '{key}' names {v} twice"),
-            ));
-        }
-        let picks = values
-            .get_ref()
-            .iter()
-            .map(|v| {
-                let tokens = option_tokens(key, v).map_err(|why| at(values.span(), why))?;
-                let shown = match v {
-                    toml::Value::String(s) => s.clone(),
-                    other => other.to_string(),
-                };
-                Ok((format!("{key}={shown}"), Pick::Option(tokens)))
-            })
-            .collect::<anyhow::Result<_>>()?;
-        axes.push((values.span(), picks));
-    }
-    for (var, values) in &raw.env_axes {
-        if values.get_ref().is_empty() {
-            return Err(at(values.span(), format!("the axis '{var}' is empty")));
-        }
-        let all = values.get_ref();
-        if let Some((_, v)) = all.iter().enumerate().find(|(i, v)| all[..*i].contains(v)) {
-            return Err(at(
-                values.span(),
-                format!("the axis '{var}' names '{v}' twice"),
-            ));
-        }
-        let picks = values
-            .get_ref()
-            .iter()
-            .map(|v| (format!("{var}={v}"), Pick::Env(var.clone(), v.clone())))
-            .collect();
-        axes.push((values.span(), picks));
-    }
-    axes.sort_by_key(|(span, _)| span.start);
-    // Each option alone first, so that a refusal names the axis that holds it.
-    for (span, picks) in &axes {
-        for (name, pick) in picks {
-            if let Pick::Option(tokens) = pick {
-                base.check(name.clone(), tokens.clone(), Vec::new())
-                    .map_err(|why| at(span.clone(), why))?;
-            }
-        }
-    }
-    let mut combos: Vec<Vec<usize>> = vec![Vec::new()];
-    for (_, picks) in &axes {
-        combos = combos
-            .into_iter()
-            .flat_map(|c| {
-                (0..picks.len()).map(move |i| {
-                    let mut c = c.clone();
-                    c.push(i);
-                    c
-                })
-            })
-            .collect();
-    }
-    combos
-        .into_iter()
-        .map(|combo| {
-            let mut names = Vec::new();
-            let mut options = Vec::new();
-            let mut own_env = BTreeMap::new();
-            for ((_, picks), &i) in axes.iter().zip(&combo) {
-                let (name, pick) = &picks[i];
-                names.push(name.clone());
-                match pick {
-                    Pick::Option(tokens) => options.extend(tokens.iter().cloned()),
-                    Pick::Env(k, v) => {
-                        own_env.insert(k.clone(), v.clone());
-                    }
-                }
-            }
-            let name = names.join(" ");
-            let env = merged_env(&raw.env, &own_env);
-            // The refusal names the first axis: the set is their combination.
-            base.check(name, options, env)
-                .map_err(|why| at(axes[0].0.clone(), why))
-        })
-        .collect()
 }
 
 #[cfg(test)]

@@ -295,3 +295,46 @@ fn auto_picks_the_width_the_crossover_measured() {
     assert_eq!(Accel::Bvh4.width(), 4);
     assert_eq!(Accel::Bvh8.width(), 8);
 }
+
+/// NVIDIA's OpenGL runs a compute program on fewer multiprocessors once its
+/// local memory passes about 254 B an invocation (docs/findings/opengl-compute.md),
+/// and the BVH stack is all of that memory: two entries to a 16-byte slot.
+/// The collapse must keep it within 256 B for the study's scenes, the sphere
+/// list included, whose identical hidden spheres give boxes of equal area at
+/// every level: opened first-of-equals they made a 4-wide tree of 16 levels
+/// (45 entries, 368 B: 90 of 132 multiprocessors on an H200) where 10 do.
+#[test]
+fn the_study_scenes_stacks_fit_opengls_local_memory_budget() {
+    let stack_bytes = |b: &Bvh| b.stack_entries().div_ceil(2) * 16;
+    for (name, set) in [
+        ("teapot", vec![]),
+        (
+            "spherelist",
+            vec![("extra_spheres".to_string(), "1000".to_string())],
+        ),
+        (
+            "spherelist",
+            vec![("extra_spheres".to_string(), "10000".to_string())],
+        ),
+        (
+            "spherelist",
+            vec![("extra_spheres".to_string(), "100000".to_string())],
+        ),
+    ] {
+        let binary = Bvh::build(&Scene::load(name, &set).unwrap());
+        let depth = binary.depth;
+        let wide = binary.widen(4);
+        assert!(
+            stack_bytes(&wide) <= 256,
+            "{name} {set:?}: {} stack entries, {} B",
+            wide.stack_entries(),
+            stack_bytes(&wide)
+        );
+        // A 4-wide node spans two binary levels where the areas allow it.
+        assert!(
+            wide.depth <= depth / 2 + 2,
+            "{name} {set:?}: depth {depth} → {}",
+            wide.depth
+        );
+    }
+}

@@ -4,7 +4,11 @@
 //! A wide node starts from its binary node's two children and keeps opening
 //! the interior child with the largest box, the one a ray is likeliest to
 //! enter, until it has `width` children or only leaves (the greedy collapse
-//! of Embree's wide BVHs). The leaves are the binary tree's, primitives and
+//! of Embree's wide BVHs). Of boxes of equal area it opens the one fewest
+//! binary levels down, so that equal boxes (the sphere list's identical
+//! spheres) still give a node two binary levels: first-of-equals made that
+//! tree 16 levels deep instead of 10, and its stack too large for OpenGL to
+//! use every multiprocessor (docs/findings/opengl-compute.md). The leaves are the binary tree's, primitives and
 //! order alike, so the leaf primitive array is shared and only the nodes differ.
 //!
 //! Like the builder it depends only on the binary tree, so the wide tree is
@@ -72,22 +76,30 @@ impl Collapse<'_> {
         if n.left == n.right && child_ref::as_leaf(n.left).is_some() {
             kids.1 = 1;
         }
+        // How many binary levels below this node each child is.
+        let mut level = [1u32; 8];
         while kids.1 < self.width {
-            // The interior child with the largest box; the first of equals.
-            let mut open: Option<(usize, f64)> = None;
+            // The interior child with the largest box; of equals, the one
+            // fewest levels down, then the first.
+            let mut open: Option<(usize, f64, u32)> = None;
             for (i, &(b, c)) in kids.0[..kids.1].iter().enumerate() {
                 let a = area(b);
-                if child_ref::as_leaf(c).is_none() && open.is_none_or(|(_, best)| a > best) {
-                    open = Some((i, a));
+                let better =
+                    |(_, best, l): (usize, f64, u32)| a > best || (a == best && level[i] < l);
+                if child_ref::as_leaf(c).is_none() && open.is_none_or(better) {
+                    open = Some((i, a, level[i]));
                 }
             }
-            let Some((i, _)) = open else { break };
+            let Some((i, _, l)) = open else { break };
             let n = &self.binary[kids.0[i].1 as usize];
             // Its two children take its place, in order, so that a node's
             // children stay in the binary tree's left-to-right order.
             kids.0.copy_within(i + 1..kids.1, i + 2);
+            level.copy_within(i + 1..kids.1, i + 2);
             kids.0[i] = ((n.left_min, n.left_max), n.left);
             kids.0[i + 1] = ((n.right_min, n.right_max), n.right);
+            level[i] = l + 1;
+            level[i + 1] = l + 1;
             kids.1 += 1;
         }
         kids
