@@ -5,6 +5,7 @@
 //! on either path; and the tracer itself gives no array an initialiser, so the
 //! post-passes only ever remove naga's.
 
+use twinray_common::cli::RenderArgs;
 use twinray_common::plan::build_bvh;
 use twinray_common::plan::requests::Api;
 use twinray_common::scene::load::BUILTIN_SCENES;
@@ -105,9 +106,11 @@ fn no_local_array_keeps_an_initialiser() {
 #[test]
 fn the_experiment_puts_the_initialisers_back() {
     // Proves the checks above can fail: naga's own output has them.
+    use clap::Parser;
+    let args = RenderArgs::try_parse_from(["twinray", "--experiment", "naga-zero-init"]).unwrap();
     let scene = Scene::load("teapot", &[]).unwrap();
     let mut v = Variant::for_scene(&scene, Some(&build_bvh(&scene)));
-    v.passes.strip_zero_init = false;
+    v.passes = twinray_common::lab::changes(&args).passes;
     let s = build::build(&v).unwrap();
     assert!(initialised_local_arrays(&s.fragment.spirv) > 0);
     assert!(!initialised_glsl_arrays(&s.fragment.glsl).is_empty());

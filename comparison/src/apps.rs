@@ -403,7 +403,7 @@ mod tests {
             path: RenderPath::Compute,
             workgroup: Some(Workgroup { x: 8, y: 4 }),
             shared_pad: Some(24),
-            experiment: vec![Experiment::NagaZeroInit, Experiment::UnpairedBvhStack],
+            experiment: vec![Experiment::NagaLoopBounding, Experiment::LocalBvhStack],
             ulp_op: Some(UlpOp::Refract),
             experiments: true,
             dump_shaders: Some(PathBuf::from("dump")),

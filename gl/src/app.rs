@@ -30,7 +30,6 @@ use twinray_common::report::{
     dump_shaders, timed_frames, DeviceInfo, FrameTime, RunReport, ShaderStats,
 };
 use twinray_common::shader::build::{ComputeShader, PathShaders, Shaders};
-use twinray_common::shader::post::spirv_for_opengl;
 
 /// `started` is taken first thing in main, so `setup_ms` includes process,
 /// driver and shader start-up, as in the Vulkan app.
@@ -81,7 +80,7 @@ fn render(
 ) -> Result<(RunReport, FloatImage)> {
     let args = planner.args();
     let (width, height) = (args.size.width, args.size.height);
-    let mut ctx = Gl::headless(args.validate, planner.device().robust_access, knobs)?;
+    let mut ctx = Gl::headless(args.validate, knobs)?;
     let log = DebugLog::install(&mut ctx.gl);
     let ctx = &ctx;
     let gl = &ctx.gl;
@@ -99,7 +98,6 @@ fn render(
         log: &log,
         info: &info,
         plan: &plan,
-        planner,
         started,
     };
     let (rendered, shader_stats) = match &plan.shaders {
@@ -114,7 +112,7 @@ fn render(
     let mut report = planner.report(&plan, api, (frames, setup_ms), &image, shader_stats)?;
     if args.count_rays {
         let gpu = plan.gpu();
-        let counting = plan.counting(&gpu, planner.pass(), width, height);
+        let counting = plan.counting(&gpu, width, height);
         report.add_rays(count_rays(gl, &counting)?);
         log.check(gl, "after the ray count");
     }
@@ -130,7 +128,6 @@ struct HeadlessRun<'a> {
     log: &'a DebugLog,
     info: &'a DeviceInfo,
     plan: &'a RunPlan,
-    planner: &'a Planner,
     /// `setup_ms` runs from here to the first frame.
     started: Instant,
 }
@@ -189,7 +186,7 @@ fn render_fragment(run: &HeadlessRun, shaders: &Shaders) -> Result<(Rendered, Ve
     let (ctx, gl) = (run.ctx, &run.ctx.gl);
     let (width, height) = (run.args.size.width, run.args.size.height);
     let program = if run.args.gl_spirv {
-        let fs = spirv_for_opengl(&shaders.fragment.spirv, shaders.variant.passes.restrict);
+        let fs = shaders.fragment_spirv_for_opengl();
         Program::from_spirv(
             gl,
             &|name| ctx.proc_address(name),
@@ -201,22 +198,16 @@ fn render_fragment(run: &HeadlessRun, shaders: &Shaders) -> Result<(Rendered, Ve
     };
     let stats = run.dump_binary(program.raw())?;
     let _buffers = SceneBuffers::new(gl, &run.plan.gpu())?;
-    let pass = run.planner.pass();
-    let target = Target::new(gl, width, height, &pass)?;
+    let target = Target::new(gl, width, height)?;
     let vao = EmptyVertexArray::new(gl)?;
     let timer = Timer::new(gl, &run.info.device)?;
     program.bind(&vao);
     // SAFETY: program, VAO, buffers and FBO are bound and alive.
-    let draw = || unsafe {
-        if pass.clear {
-            gl.clear(glow::COLOR_BUFFER_BIT);
-        }
-        gl.draw_arrays(glow::TRIANGLES, 0, pass.vertices() as i32);
-    };
+    let draw = || unsafe { gl.draw_arrays(glow::TRIANGLES, 0, 3) };
     let (frames, setup_ms) = run.frames(&timer, &|| {}, &draw)?;
     let pixels = target.read();
     explain::numbered(11, "Readback", || {
-        format!("{width}x{height} {}, top row first", pass.format_name())
+        format!("{width}x{height} RGBA32F, top row first")
     });
     Ok(((frames, setup_ms, pixels), stats))
 }

@@ -20,7 +20,6 @@ use twinray_common::explain;
 use twinray_common::gpu::layout::binding;
 use twinray_common::plan::requests::ComputeLimits;
 use twinray_common::shader::build::ComputeShader;
-use twinray_common::shader::post::spirv_for_opengl;
 
 /// The compute program, the storage texture and the dispatch grid.
 pub struct Compute<'gl> {
@@ -56,7 +55,7 @@ impl<'gl> Compute<'gl> {
                 gl,
                 proc_address,
                 glow::COMPUTE_SHADER,
-                &spirv_for_opengl(&shader.stage.spirv, shader.variant.passes.restrict),
+                &shader.spirv_for_opengl(),
                 "compute",
             )?,
             // SAFETY: the context is current (the caller made it so).

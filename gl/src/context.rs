@@ -34,9 +34,8 @@ impl Gl {
     }
 
     /// Creates the context on the preferred device (or `knobs`'s); `debug` asks
-    /// for a debug context so that KHR_debug reports everything the driver checks;
-    /// `robust` one with bounds-checked buffer access.
-    pub fn headless(debug: bool, robust: bool, knobs: &OpenGlKnobs) -> anyhow::Result<Gl> {
+    /// for a debug context so that KHR_debug reports everything the driver checks.
+    pub fn headless(debug: bool, knobs: &OpenGlKnobs) -> anyhow::Result<Gl> {
         // No libEGL, or one without the device extensions, is a missing driver
         // for the user, not a bug: glutin's error alone would not say what to install.
         let devices: Vec<Device> = Device::query_devices()
@@ -62,7 +61,7 @@ impl Gl {
         });
         let mut failures = Vec::new();
         for (index, device) in candidates(&devices, knobs.device)? {
-            match create(index, device, debug, robust) {
+            match create(index, device, debug) {
                 Ok(gl) => {
                     // A run that fell back to another device must say so: its
                     // timings would otherwise pass for the skipped device's.
@@ -101,7 +100,7 @@ fn candidates(devices: &[Device], wanted: Option<usize>) -> anyhow::Result<Vec<(
     Ok(hard.into_iter().chain(soft).collect())
 }
 
-fn create(index: usize, device: &Device, debug: bool, robust: bool) -> anyhow::Result<Gl> {
+fn create(index: usize, device: &Device, debug: bool) -> anyhow::Result<Gl> {
     let what = format!(
         "EGL device {index} ({})",
         device.name().unwrap_or("unnamed")
@@ -119,14 +118,9 @@ fn create(index: usize, device: &Device, debug: bool, robust: bool) -> anyhow::R
         .with_context(|| format!("listing EGL configs on {what}"))?
         .next()
         .with_context(|| format!("{what} has no OpenGL EGL config"))?;
-    let robustness = if robust {
-        Robustness::RobustNoResetNotification
-    } else {
-        Robustness::NotRobust
-    };
     let attributes = ContextAttributesBuilder::new()
         .with_debug(debug)
-        .with_robustness(robustness)
+        .with_robustness(Robustness::NotRobust)
         .with_profile(GlProfile::Core)
         .with_context_api(ContextApi::OpenGl(Some(Version::new(4, 5))))
         .build(None);
@@ -140,9 +134,8 @@ fn create(index: usize, device: &Device, debug: bool, robust: bool) -> anyhow::R
         "EGL display + config + context, made current without a surface",
         || {
             format!(
-                "{what}: OpenGL 4.5 core{}{}, surfaceless (renders into our own FBO)",
-                if debug { ", debug" } else { "" },
-                if robust { ", robust access" } else { "" }
+                "{what}: OpenGL 4.5 core{}, surfaceless (renders into our own FBO)",
+                if debug { ", debug" } else { "" }
             )
         },
     );

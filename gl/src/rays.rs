@@ -32,13 +32,11 @@ pub fn count_rays(gl: &glow::Context, run: &CountingRun) -> anyhow::Result<RayKi
     match PathShaders::build(&run.variant)? {
         PathShaders::Fragment(shaders) => {
             let program = Program::new(gl, &shaders.vertex.glsl, &shaders.fragment.glsl)?;
-            // The run's own fragment pass (it may draw two triangles).
-            let pass = run.pass;
-            let _target = Target::new(gl, width, height, &pass)?;
+            let _target = Target::new(gl, width, height)?;
             let vao = EmptyVertexArray::new(gl)?;
             program.bind(&vao);
             // SAFETY: program, VAO, buffers and FBO are bound and alive.
-            unsafe { gl.draw_arrays(glow::TRIANGLES, 0, pass.vertices() as i32) };
+            unsafe { gl.draw_arrays(glow::TRIANGLES, 0, 3) };
         }
         PathShaders::Compute(shader) => {
             let compute = Compute::new(gl, &shader, None, width, height)?;

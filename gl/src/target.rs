@@ -1,12 +1,11 @@
 //! The offscreen render target: an FBO with one RGBA32F colour renderbuffer
-//! (float, so the PNG is quantised exactly as for Vulkan and the reference;
-//! RGBA8 where the pass asks for it), the device's size limits, and the readback.
+//! (float, so the PNG is quantised exactly as for Vulkan and the reference),
+//! the device's size limits, and the readback.
 
 use anyhow::{anyhow, bail, Context as _};
 use glow::HasContext;
 use twinray_common::error::bad_input;
 use twinray_common::explain;
-use twinray_common::plan::requests::FragmentPass;
 
 pub struct Target<'gl> {
     gl: &'gl glow::Context,
@@ -59,13 +58,8 @@ pub fn out_of_memory(
 
 impl<'gl> Target<'gl> {
     /// Creates the FBO and leaves it bound for drawing and reading.
-    pub fn new(
-        gl: &'gl glow::Context,
-        width: u32,
-        height: u32,
-        pass: &FragmentPass,
-    ) -> anyhow::Result<Target<'gl>> {
-        let format = pass.format_name();
+    pub fn new(gl: &'gl glow::Context, width: u32, height: u32) -> anyhow::Result<Target<'gl>> {
+        let format = "RGBA32F";
         // SAFETY: fresh objects on the current context; sizes were checked by `check_size`.
         unsafe {
             let colour = gl
@@ -87,12 +81,12 @@ impl<'gl> Target<'gl> {
                 height,
             };
             gl.bind_renderbuffer(glow::RENDERBUFFER, Some(colour));
-            let internal = if pass.rgba8 {
-                glow::RGBA8
-            } else {
-                glow::RGBA32F
-            };
-            gl.renderbuffer_storage(glow::RENDERBUFFER, internal, width as i32, height as i32);
+            gl.renderbuffer_storage(
+                glow::RENDERBUFFER,
+                glow::RGBA32F,
+                width as i32,
+                height as i32,
+            );
             out_of_memory(gl, "render target", width, height)?;
             gl.bind_framebuffer(glow::FRAMEBUFFER, Some(fbo));
             gl.framebuffer_renderbuffer(
@@ -127,7 +121,7 @@ impl<'gl> Target<'gl> {
         }
     }
 
-    /// RGBA pixels as floats (an RGBA8 target's converted by GL: c / 255).
+    /// RGBA pixels as floats.
     /// GL's first row is the bottom one, and the shader treats
     /// +y as down, so that first row is the image's TOP: no flip needed.
     pub fn read(&self) -> Vec<f32> {

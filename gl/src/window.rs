@@ -45,7 +45,6 @@ use twinray_common::explain;
 use twinray_common::gpu::layout::GpuFrame;
 use twinray_common::gpu::upload::GpuScene;
 use twinray_common::limits::StorageLimit;
-use twinray_common::plan::requests::FragmentPass;
 use twinray_common::plan::{CountingRun, Planner};
 use twinray_common::rays::RayKinds;
 use twinray_common::reference::image_io::FloatImage;
@@ -397,7 +396,7 @@ impl Renderer for GlWindow<'_> {
         };
         program.bind(&self.vao);
         let pixels = {
-            let fbo = Target::new(gl, width, height, &FragmentPass::default())?;
+            let fbo = Target::new(gl, width, height)?;
             // SAFETY: the FBO is bound for drawing; program and buffers are bound.
             unsafe { gl.draw_arrays(glow::TRIANGLES, 0, 3) };
             fbo.read()

@@ -15,10 +15,10 @@ const uint SPHERE_BIT = 0x80000000u;
 // (common/src/shader/variant.rs): the traversal pushes at most one child per level of
 // the current path, so no push is ever dropped and no slot is wasted.
 //
-// Experiments (--experiment, common/src/cli.rs): BVH_STACK_UNPAIRED keeps
-// one uvec2 per element; BVH_STACK_LOCAL gives each walk a local stack of its
-// own; BVH_STACK_SHARED (compute only, where it fits) keeps the stack in
-// shared memory, entry-major so that a warp's pushes hit distinct banks.
+// Experiments (--experiment, docs/experiments.md): BVH_STACK_LOCAL gives
+// each walk a local stack of its own; BVH_STACK_SHARED (compute only, where
+// it fits) keeps the stack in shared memory, entry-major so that a warp's
+// pushes hit distinct banks.
 #ifndef BVH_STACK
 // Only a source compiled without the build's defines (an external compiler
 // checking trace.glsl on its own) gets here: the apps always size the stack
@@ -31,15 +31,6 @@ const uint SPHERE_BIT = 0x80000000u;
 shared uvec2 bvh_stack[BVH_STACK * WG_X * WG_Y];
 #define BVH_PUSH(i, e) bvh_stack[(i) * uint(WG_X * WG_Y) + gl_LocalInvocationIndex] = (e)
 #define BVH_POP(i) bvh_stack[(i) * uint(WG_X * WG_Y) + gl_LocalInvocationIndex]
-#elif defined(BVH_STACK_UNPAIRED)
-#if BVH_STACK < 2
-// At least two elements, for the reason given below.
-#define BVH_STACK_DECLARE uvec2 stack[2]
-#else
-#define BVH_STACK_DECLARE uvec2 stack[BVH_STACK]
-#endif
-#define BVH_PUSH(i, e) stack[i] = (e)
-#define BVH_POP(i) stack[i]
 #else
 #if BVH_STACK <= 2
 // Never a one-element array: Mesa 22.3's GLSL front end (llvmpipe, OpenGL)

@@ -89,22 +89,10 @@ layout(std140, set = 0, binding = 0) uniform Frame {
     uint pad;
 } frame;
 
-// The counts as a storage buffer: read at run time, yet no driver inlines
-// them into a new shader the way lavapipe does with uniform values.
-layout(std430, set = 0, binding = 9) readonly buffer Counts {
-    uint spheres;
-    uint triangles;
-    uint lights;
-} count_buf;
-
-// Every variant an app runs bakes the counts in (shader.rs, Variant::chosen)
-// or reads them from Counts; only the scene-independent generic variant of the
-// tests reads them from the uniform.
-#if defined(COUNTS_FROM_STORAGE)
-#define SPHERE_COUNT count_buf.spheres
-#define TRIANGLE_COUNT count_buf.triangles
-#define LIGHT_COUNT count_buf.lights
-#elif !defined(SPHERE_COUNT)
+// Every variant an app runs bakes the counts in (Variant::with_scene_data);
+// only the scene-independent generic variant of the tests, and
+// --experiment uniform-counts, read them from the uniform.
+#ifndef SPHERE_COUNT
 #define SPHERE_COUNT frame.sphere_count
 #define TRIANGLE_COUNT frame.triangle_count
 #define LIGHT_COUNT frame.light_count

@@ -21,7 +21,7 @@ use twinray_common::scene::numerics::Numerics;
 use twinray_common::scene::{Features, Scene};
 use twinray_common::shader::build::{self, build_compute, compute_source, fragment_source};
 use twinray_common::shader::post::spirv_for_opengl;
-use twinray_common::shader::variant::{SpirvCompiler, Variant, QUAD_DEFINE};
+use twinray_common::shader::variant::{SpirvCompiler, Variant};
 use twinray_common::value_name::ValueName;
 use twinray_tests::{assert_none, scratch};
 
@@ -110,24 +110,14 @@ fn variants() -> Vec<(String, Variant)> {
             chosen(d, accel, false, vec![]),
         ));
         v.push((
-            format!("generic+{label} unpaired,local stack"),
-            chosen(
-                d,
-                accel,
-                true,
-                vec![Experiment::UnpairedBvhStack, Experiment::LocalBvhStack],
-            ),
+            format!("generic+{label} local stack"),
+            chosen(d, accel, true, vec![Experiment::LocalBvhStack]),
         ));
     }
     use Experiment::*;
     for experiments in [
-        vec![
-            NagaZeroInit,
-            NagaLoopBounding,
-            SharedBvhStack,
-            UniformCounts,
-        ],
-        vec![NoLoopBounding, UnpairedBvhStack, StorageCounts],
+        vec![NagaLoopBounding, SharedBvhStack, UniformCounts],
+        vec![NoLoopBounding],
         vec![NagaAliasing, LocalBvhStack, SplitRayStack],
         vec![NoContraction],
         vec![Glslang],
@@ -173,24 +163,17 @@ fn glslang_and_spirv_val_accept_every_variant() {
     }
     let dir = scratch("external-validators");
     let mut jobs = Vec::new();
-    // The fullscreen triangle, and `--experiment quad`'s two triangles (naga's
-    // output of them goes through the validation layer in
-    // tests/tests/fragment_experiments.rs).
-    let quad = format!("-D{QUAD_DEFINE}=1");
-    for (name, define) in [("fullscreen", None), ("fullscreen-quad", Some(&quad))] {
-        let file = write(
-            &dir.join(format!("{name}.vert")),
-            build::FULLSCREEN_VERT.as_bytes(),
-        );
-        let mut args = vec!["-V".into(), "--target-env".into(), "vulkan1.0".into()];
-        args.extend(define.cloned());
-        jobs.push(Job {
-            what: format!("vertex source {name}"),
-            program: "glslangValidator",
-            args,
-            file,
-        });
-    }
+    // The fullscreen triangle.
+    let file = write(
+        &dir.join("fullscreen.vert"),
+        build::FULLSCREEN_VERT.as_bytes(),
+    );
+    jobs.push(Job {
+        what: "vertex source fullscreen".into(),
+        program: "glslangValidator",
+        args: vec!["-V".into(), "--target-env".into(), "vulkan1.0".into()],
+        file,
+    });
     let list = variants();
     let mut fragment_sources = 0;
     let mut compute_sources = 0;

@@ -5,8 +5,9 @@
 //! renders the default image bit for bit, with the validation layer / GL debug
 //! context silent. `local-bvh-stack` and `split-ray-stack` put back the old
 //! stacks, `naga-aliasing` naga's declarations without `restrict`,
-//! `robust-access` bounds-checked buffers, `--shared-pad` unused workgroup
-//! memory, and `--gl-spirv` loads the SPIR-V that `Restrict` now decorates.
+//! `naga-loop-bounding` naga's loop counters on the BVH variants too,
+//! `--shared-pad` unused workgroup memory, and `--gl-spirv` loads the SPIR-V
+//! that `Restrict` now decorates.
 //! Every run that cannot honour one exits 2 with one sentence saying why, and
 //! `--dump-shaders` with `--gl-spirv` no longer crashes Mesa.
 
@@ -77,7 +78,7 @@ const VARIANTS: &[Variant] = &[
         "split-ray-stack",
     ]),
     everywhere(&["--experiment", "naga-aliasing"]),
-    everywhere(&["--experiment", "robust-access"]),
+    everywhere(&["--experiment", "naga-loop-bounding"]),
     // Mesa's GLSL and SPIR-V compilers may round a pixel differently (they
     // did on the box before `Restrict` existed), so the SPIR-V with `Restrict`
     // is held to the SPIR-V without it.
@@ -149,12 +150,6 @@ fn runs_that_cannot_honour_a_measurement_refuse_it() {
         for kib in ["0", "33", "eight"] {
             refused(app, &with(&["--shared-pad", kib]), "--shared-pad");
         }
-        // Refused before any window opens: no display is needed to see it.
-        refused(
-            app,
-            &["--experiment", "robust-access"],
-            "--experiment robust-access is a headless measurement; run it with --headless",
-        );
     }
 }
 

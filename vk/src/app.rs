@@ -97,7 +97,6 @@ fn render(
         args,
         device: &device,
         plan: &plan,
-        planner,
         idle_wait: knobs.wait == FrameWait::Idle,
         process_start,
     };
@@ -113,7 +112,7 @@ fn render(
     let mut report = planner.report(&plan, api, (frames, setup_ms), &image, stats)?;
     if args.count_rays {
         let gpu = plan.gpu();
-        let counting = plan.counting(&gpu, planner.pass(), width, height);
+        let counting = plan.counting(&gpu, width, height);
         report.add_rays(count_rays(&device, &counting)?);
     }
     Ok((report, image))
@@ -125,7 +124,6 @@ struct HeadlessRun<'a> {
     args: &'a RenderArgs,
     device: &'a Device,
     plan: &'a RunPlan,
-    planner: &'a Planner,
     /// vkQueueWaitIdle + vkDeviceWaitIdle after each frame, as the 2018 study
     /// did, instead of the frame's fence (`--vk-wait idle`).
     idle_wait: bool,
@@ -167,15 +165,13 @@ type Rendered = (Vec<FrameTime>, f64, FloatImage);
 fn render_fragment(run: &HeadlessRun, shaders: &Shaders) -> Result<Rendered> {
     let device = run.device;
     let (width, height) = (run.args.size.width, run.args.size.height);
-    let pass = run.planner.pass();
     let (frame, storage) = scene_buffers(device, &run.plan.gpu())?;
     let descriptors = Descriptors::new(device, &frame, &storage)?;
-    let render_pass = RenderPass::offscreen(device, &pass)?;
+    let render_pass = RenderPass::offscreen(device)?;
     let rp = render_pass.render_pass;
-    // None: a pipeline whose viewport and scissor are set while recording.
-    let fixed_size = (!pass.dynamic_viewport).then_some((width, height));
+    let fixed_size = Some((width, height));
     let pipeline = Pipeline::new(device, descriptors.set_layout, shaders, rp, fixed_size)?;
-    let target = Target::new(device, rp, width, height, &pass)?;
+    let target = Target::new(device, rp, width, height)?;
     let timestamps = Timestamps::new(device)?;
     let commands = Commands::record(
         device,
@@ -184,14 +180,13 @@ fn render_fragment(run: &HeadlessRun, shaders: &Shaders) -> Result<Rendered> {
         &descriptors,
         &target,
         timestamps.as_ref(),
-        &pass,
     )?;
     let (frames, setup_ms) = run.frames(&commands, timestamps.as_ref())?;
     let image = target.read_back(device)?;
     explain::numbered(
         11,
         "Readback: vkCmdCopyImageToBuffer + HOST barrier, then map",
-        || format!("{width}x{height} {}, top row first", pass.format_name()),
+        || format!("{width}x{height} RGBA32F, top row first"),
     );
     Ok((frames, setup_ms, image))
 }

@@ -271,14 +271,6 @@ pub const SCENE_UPLOAD: Barrier = barrier(
     &[FragmentShaderRead, ComputeShaderRead],
     Guards::Buffers,
 );
-/// The same on a queue without GRAPHICS, which has no fragment stage to wait at.
-pub const SCENE_UPLOAD_COMPUTE_QUEUE: Barrier = barrier(
-    "scene upload, compute-only queue",
-    5,
-    &[CopyWrite],
-    &[ComputeShaderRead],
-    Guards::Buffers,
-);
 /// Into the headless render pass: this frame's colour writes after the last frame's.
 pub const OFFSCREEN_PASS_IN: Barrier = barrier(
     "offscreen render pass in",
@@ -403,9 +395,8 @@ pub const SWAPCHAIN_TO_PRESENT: Barrier = barrier(
 );
 
 /// Every barrier twinray-vk records, in the page's order: what its table holds.
-pub const ALL: [Barrier; 18] = [
+pub const ALL: [Barrier; 17] = [
     SCENE_UPLOAD,
-    SCENE_UPLOAD_COMPUTE_QUEUE,
     OFFSCREEN_PASS_IN,
     WINDOW_PASS_IN,
     OFFSCREEN_PASS_OUT,

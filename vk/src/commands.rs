@@ -18,7 +18,6 @@ use crate::timestamps::Timestamps;
 use anyhow::{Context, Result};
 use ash::vk;
 use twinray_common::explain;
-use twinray_common::plan::requests::FragmentPass;
 
 pub struct Commands {
     device: ash::Device,
@@ -38,15 +37,12 @@ impl Commands {
         descriptors: &Descriptors,
         target: &Target,
         timestamps: Option<&Timestamps>,
-        pass: &FragmentPass,
     ) -> Result<Commands> {
-        // Read only by a pass whose load op is CLEAR (the pass asks for a clear).
-        let clear = [vk::ClearValue::default()];
         let extent = vk::Extent2D {
             width: target.width,
             height: target.height,
         };
-        let (viewport, scissor) = crate::pipeline::whole(extent);
+        let (_, scissor) = crate::pipeline::whole(extent);
         let this = Commands::record_with(device, |d, cmd| {
             if let Some(t) = timestamps {
                 t.record_reset(cmd);
@@ -55,16 +51,10 @@ impl Commands {
             let begin = vk::RenderPassBeginInfo::default()
                 .render_pass(render_pass)
                 .framebuffer(target.framebuffer)
-                .render_area(scissor)
-                .clear_values(if pass.clear { &clear } else { &[] });
+                .render_area(scissor);
             // SAFETY: every handle is alive and `cmd` is recording.
             unsafe {
                 d.cmd_begin_render_pass(cmd, &begin, vk::SubpassContents::INLINE);
-                // A pass with a dynamic viewport: the pipeline left them dynamic.
-                if pass.dynamic_viewport {
-                    d.cmd_set_viewport(cmd, 0, &[viewport]);
-                    d.cmd_set_scissor(cmd, 0, &[scissor]);
-                }
                 d.cmd_bind_pipeline(cmd, vk::PipelineBindPoint::GRAPHICS, pipeline.pipeline);
                 d.cmd_bind_descriptor_sets(
                     cmd,
@@ -75,8 +65,8 @@ impl Commands {
                     &[],
                 );
                 // No vertex buffer: the vertex shader makes the fullscreen
-                // triangle (or a quad pass's two) from the vertex index.
-                d.cmd_draw(cmd, pass.vertices(), 1, 0, 0);
+                // triangle from the vertex index.
+                d.cmd_draw(cmd, 3, 1, 0, 0);
                 d.cmd_end_render_pass(cmd);
             }
             if let Some(t) = timestamps {
@@ -92,8 +82,8 @@ impl Commands {
                 } else {
                     ""
                 };
-                format!("{ts}begin render pass {}x{}, bind pipeline, bind descriptor set 0, draw {} vertices, end pass{}",
-                target.width, target.height, pass.vertices(), if timestamps.is_some() { ", timestamp BOTTOM_OF_PIPE" } else { "" })
+                format!("{ts}begin render pass {}x{}, bind pipeline, bind descriptor set 0, draw 3 vertices, end pass{}",
+                target.width, target.height, if timestamps.is_some() { ", timestamp BOTTOM_OF_PIPE" } else { "" })
             },
         );
         Ok(this)

@@ -28,9 +28,6 @@ pub struct Device {
     /// "driverName driverInfo" where Vulkan 1.2 can tell us, else the raw driverVersion.
     pub driver: String,
     pub queue_family: u32,
-    /// What the queue family can do: without GRAPHICS (a compute-only queue)
-    /// no barrier may name a graphics stage.
-    pub queue_flags: vk::QueueFlags,
     /// The queue family's timestampValidBits: 0 means no timestamps on this queue.
     pub timestamp_valid_bits: u32,
     pub device: ash::Device,
@@ -55,19 +52,15 @@ struct Candidate {
     /// The first queue family that can draw and dispatch (and present, for a window), with
     /// its timestampValidBits and flags.
     graphics_family: Option<(u32, u32, vk::QueueFlags)>,
-    /// The first family that dispatches but cannot draw, likewise
-    /// (a run that asks for a compute-only queue).
-    compute_family: Option<(u32, u32, vk::QueueFlags)>,
 }
 
 impl Device {
     /// `surface` is the window's, in windowed mode: the queue must also present
     /// to it, and the device must offer VK_KHR_swapchain. `knobs` may name the
     /// device and say where scene buffers go. `request` is what the run plan
-    /// asks of the device: a queue from a family without GRAPHICS
-    /// (`compute_only_queue`); fragmentStoresAndAtomics, which the ray-counting
+    /// asks of the device: fragmentStoresAndAtomics, which the ray-counting
     /// frame needs on the fragment path (`count_rays`; the timed runs get the
-    /// device they always had); robustBufferAccess's bounds checks (`robust_access`).
+    /// device they always had).
     // Long function: the walkthrough's device step read top to bottom (pick a GPU, a queue family, features, extensions, create); each block is one choice.
     pub fn new(
         instance: &Instance,
@@ -75,11 +68,7 @@ impl Device {
         knobs: &VulkanKnobs,
         request: &DeviceRequest,
     ) -> Result<Device> {
-        let DeviceRequest {
-            compute_only_queue,
-            count_rays,
-            robust_access,
-        } = *request;
+        let DeviceRequest { count_rays } = *request;
         let vk_instance = &instance.instance;
         // SAFETY: `instance` is alive for the whole call (borrowed) and is used from this thread
         // only.
@@ -107,13 +96,6 @@ impl Device {
                     .find(|&(i, f)| f.queue_flags.contains(abilities) && presents(i))
                     .filter(|_| surface.is_none() || has_swapchain(vk_instance, physical))
                     .map(|(i, f)| (i, f.timestamp_valid_bits, f.queue_flags));
-                let compute_family = (0u32..)
-                    .zip(&families)
-                    .find(|(_, f)| {
-                        f.queue_flags.contains(vk::QueueFlags::COMPUTE)
-                            && !f.queue_flags.contains(vk::QueueFlags::GRAPHICS)
-                    })
-                    .map(|(i, f)| (i, f.timestamp_valid_bits, f.queue_flags));
                 let name = properties
                     .device_name_as_c_str()
                     .unwrap_or(c"?")
@@ -124,22 +106,12 @@ impl Device {
                     properties,
                     name,
                     graphics_family,
-                    compute_family,
                 }
             })
             .collect();
         let chosen = choose(&candidates, knobs.device())?;
-        let graphics = chosen.graphics_family.expect("choose() checks this");
-        let (queue_family, timestamp_valid_bits, flags) = if compute_only_queue {
-            chosen.compute_family.ok_or_else(|| {
-                bad_input(format!(
-                    "the run asks for a compute-only queue, but the Vulkan device '{}' has no compute-only queue family (one with COMPUTE but not GRAPHICS)",
-                    chosen.name
-                ))
-            })?
-        } else {
-            graphics
-        };
+        let (queue_family, timestamp_valid_bits, flags) =
+            chosen.graphics_family.expect("choose() checks this");
         explain::numbered(3, "VkPhysicalDevice chosen", || {
             let mut s = String::new();
             for (i, c) in candidates.iter().enumerate() {
@@ -201,10 +173,8 @@ queue family {queue_family}: {flags:?}, timestampValidBits {timestamp_valid_bits
         // SAFETY: a query on the chosen physical device of the live instance.
         let offered = unsafe { vk_instance.get_physical_device_features(chosen.physical) };
         let fragment_stores = offered.fragment_stores_and_atomics == vk::TRUE;
-        // Every Vulkan 1.0 device offers robustBufferAccess.
         let features = vk::PhysicalDeviceFeatures::default()
-            .fragment_stores_and_atomics(fragment_stores && count_rays)
-            .robust_buffer_access(robust_access && offered.robust_buffer_access == vk::TRUE);
+            .fragment_stores_and_atomics(fragment_stores && count_rays);
         let recording = recording(knobs, instance, &chosen.properties)?;
         let mut vulkan_1_3 = vk::PhysicalDeviceVulkan13Features::default().synchronization2(true);
         let mut info = vk::DeviceCreateInfo::default()
@@ -235,10 +205,10 @@ queue family {queue_family}: {flags:?}, timestampValidBits {timestamp_valid_bits
                 } else {
                     "none"
                 };
-                let features = match (fragment_stores && count_rays, robust_access) {
-                    (true, _) => "fragmentStoresAndAtomics (--count-rays)",
-                    (false, true) => "robustBufferAccess (bounds checks)",
-                    (false, false) => "no optional features",
+                let features = if fragment_stores && count_rays {
+                    "fragmentStoresAndAtomics (--count-rays)"
+                } else {
+                    "no optional features"
                 };
                 let features = match recording {
                     Recording::Synchronization2 => {
@@ -262,7 +232,6 @@ queue family {queue_family}: {flags:?}, timestampValidBits {timestamp_valid_bits
             name: chosen.name.clone(),
             driver: driver_description(instance, chosen),
             queue_family,
-            queue_flags: flags,
             timestamp_valid_bits,
             device,
             queue,

@@ -292,12 +292,8 @@ impl<'a> Uploads<'a> {
     pub fn finish(self) -> Result<Vec<Buffer>> {
         // Read after write: the fragment (or compute) shader of every later
         // submission reads what the copies wrote; queue order alone does not
-        // order memory. A compute-only queue runs no fragment stage to wait for.
-        let barrier = if self.device.queue_flags.contains(vk::QueueFlags::GRAPHICS) {
-            barrier::SCENE_UPLOAD
-        } else {
-            barrier::SCENE_UPLOAD_COMPUTE_QUEUE
-        };
+        // order memory.
+        let barrier = barrier::SCENE_UPLOAD;
         let buffers: Vec<vk::Buffer> = self.filled.iter().map(|b| b.buffer).collect();
         self.device.run_once("uploading the scene", |cmd| {
             // SAFETY: `cmd` is run_once's, recording; every buffer is in

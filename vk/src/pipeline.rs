@@ -21,22 +21,11 @@ use crate::device::Device;
 use anyhow::{Context, Result};
 use ash::vk;
 use twinray_common::explain;
-use twinray_common::plan::requests::FragmentPass;
 use twinray_common::shader::build::Shaders;
 
 /// Float output, so the NaN count and the 8-bit rounding happen on the CPU,
 /// identically for both APIs. Every Vulkan device can render to it.
 pub const COLOR_FORMAT: vk::Format = vk::Format::R32G32B32A32_SFLOAT;
-
-/// The headless target's format: COLOR_FORMAT, or where the pass asks for it
-/// 8-bit UNORM (also mandatory as a colour attachment and copy source).
-pub fn target_format(pass: &FragmentPass) -> vk::Format {
-    if pass.rgba8 {
-        vk::Format::R8G8B8A8_UNORM
-    } else {
-        COLOR_FORMAT
-    }
-}
 
 pub struct RenderPass {
     device: ash::Device,
@@ -44,29 +33,16 @@ pub struct RenderPass {
 }
 
 impl RenderPass {
-    /// The headless pass: RGBA32F (or as `pass` asks), left in
-    /// TRANSFER_SRC_OPTIMAL for the readback.
-    pub fn offscreen(device: &Device, pass: &FragmentPass) -> Result<RenderPass> {
-        let load = if pass.clear {
-            vk::AttachmentLoadOp::CLEAR
-        } else {
-            vk::AttachmentLoadOp::DONT_CARE
-        };
+    /// The headless pass: RGBA32F, left in TRANSFER_SRC_OPTIMAL for the readback.
+    pub fn offscreen(device: &Device) -> Result<RenderPass> {
         let out = Some(barrier::OFFSCREEN_PASS_OUT);
-        RenderPass::new(
-            device,
-            target_format(pass),
-            barrier::OFFSCREEN_PASS_IN,
-            out,
-            load,
-        )
+        RenderPass::new(device, COLOR_FORMAT, barrier::OFFSCREEN_PASS_IN, out)
     }
 
     /// The windowed pass: the swapchain's format, left in PRESENT_SRC_KHR.
     pub fn for_swapchain(device: &Device, format: vk::Format) -> Result<RenderPass> {
-        let load = vk::AttachmentLoadOp::DONT_CARE;
         // Presenting needs no dependency out: the submit's semaphore covers it.
-        RenderPass::new(device, format, barrier::WINDOW_PASS_IN, None, load)
+        RenderPass::new(device, format, barrier::WINDOW_PASS_IN, None)
     }
 
     /// A pass whose dependency `incoming` orders its colour writes after what
@@ -77,13 +53,14 @@ impl RenderPass {
         format: vk::Format,
         incoming: Barrier,
         outgoing: Option<Barrier>,
-        load: vk::AttachmentLoadOp,
     ) -> Result<RenderPass> {
         let d = &device.device;
         let next = outgoing.map_or(Access::Present, |b| b.after[0]);
         let final_layout = barrier::layout_for(next);
-        // The fullscreen triangle writes every pixel, so the old contents are not
-        // loaded (DONT_CARE) unless the pass asks for a CLEAR.
+        // The fullscreen triangle writes every pixel, so the old contents are
+        // not loaded (DONT_CARE); a CLEAR took as long
+        // (docs/findings/fragment-gap.md).
+        let load = vk::AttachmentLoadOp::DONT_CARE;
         let attachment = vk::AttachmentDescription::default()
             .format(format)
             .samples(vk::SampleCountFlags::TYPE_1)

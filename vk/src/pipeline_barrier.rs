@@ -239,7 +239,7 @@ fn explain_call(call: &str, barriers: &[(Barrier, On)], recorded: &[String]) {
             format!("{}: {} ({what})", b.name, b.words())
         })
         .collect();
-    // The upload's seven buffer barriers are one line, "7 x ...".
+    // The upload's six buffer barriers are one line, "6 x ...".
     let mut counted: Vec<(usize, &String)> = Vec::new();
     for line in recorded {
         match counted.last_mut() {

@@ -46,16 +46,13 @@ pub fn count_rays(device: &Device, run: &CountingRun) -> Result<RayKinds> {
                         device.name
                     )));
             }
-            // The run's own fragment pass (it may draw two triangles).
-            let pass = run.pass;
-            let render_pass = RenderPass::offscreen(device, &pass)?;
+            let render_pass = RenderPass::offscreen(device)?;
             let rp = render_pass.render_pass;
             let descriptors = Descriptors::new(device, &frame, &storage)?;
-            let size = (!pass.dynamic_viewport).then_some((width, height));
+            let size = Some((width, height));
             let pipeline = Pipeline::new(device, descriptors.set_layout, &shaders, rp, size)?;
-            let target = Target::new(device, rp, width, height, &pass)?;
-            let commands =
-                Commands::record(device, rp, &pipeline, &descriptors, &target, None, &pass)?;
+            let target = Target::new(device, rp, width, height)?;
+            let commands = Commands::record(device, rp, &pipeline, &descriptors, &target, None)?;
             commands.submit()?;
             commands.wait(false)?;
         }

@@ -12,13 +12,12 @@
 use crate::barrier;
 use crate::device::Device;
 use crate::memory::{self, Buffer};
-use crate::pipeline::target_format;
+use crate::pipeline::COLOR_FORMAT;
 use crate::pipeline_barrier::{self, On};
 use anyhow::{Context, Result};
 use ash::vk;
 use ash::vk::MemoryPropertyFlags as Flags;
 use twinray_common::explain;
-use twinray_common::plan::requests::FragmentPass;
 use twinray_common::reference::image_io::FloatImage;
 
 pub struct Target {
@@ -30,8 +29,6 @@ pub struct Target {
     pub width: u32,
     pub height: u32,
     readback: Buffer,
-    /// An RGBA8 pass: the image and the readback hold 8-bit UNORM texels.
-    rgba8: bool,
 }
 
 impl Target {
@@ -40,10 +37,10 @@ impl Target {
         render_pass: vk::RenderPass,
         width: u32,
         height: u32,
-        pass: &FragmentPass,
     ) -> Result<Target> {
         let d = &device.device;
-        let readback = sized_readback(device, width as u64 * height as u64 * pass.texel_bytes())?;
+        // One RGBA32F texel, 16 bytes, per pixel.
+        let readback = sized_readback(device, width as u64 * height as u64 * 16)?;
         let bytes = readback.size;
         explain::numbered(9, "VkBuffer + VkDeviceMemory: readback buffer", || {
             format!(
@@ -60,9 +57,8 @@ impl Target {
             width,
             height,
             readback,
-            rgba8: pass.rgba8,
         };
-        let format = target_format(pass);
+        let format = COLOR_FORMAT;
         let image_bytes = create_image_with_view(
             device,
             format,
@@ -108,14 +104,6 @@ impl Target {
                 self.height,
             );
         })?;
-        if self.rgba8 {
-            let rgba: Vec<u8> = self
-                .readback
-                .read()
-                .context("reading the readback buffer")?;
-            let rgba: Vec<f32> = rgba.iter().map(|&c| c as f32 / 255.0).collect();
-            return Ok(FloatImage::from_rgba(self.width, self.height, &rgba));
-        }
         read_image(&self.readback, self.width, self.height)
     }
 }

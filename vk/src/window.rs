@@ -36,7 +36,6 @@ use twinray_common::explain;
 use twinray_common::gpu::layout::GpuFrame;
 use twinray_common::gpu::upload::GpuScene;
 use twinray_common::limits::StorageLimit;
-use twinray_common::plan::requests::FragmentPass;
 use twinray_common::plan::{CountingRun, Planner};
 use twinray_common::rays::RayKinds;
 use twinray_common::reference::image_io::FloatImage;
@@ -362,8 +361,7 @@ impl Renderer for VkWindow {
                 return compute.read_back(device);
             }
         };
-        let pass = FragmentPass::default();
-        let render_pass = RenderPass::offscreen(device, &pass)?;
+        let render_pass = RenderPass::offscreen(device)?;
         let set_layout = scene.descriptors.set_layout;
         let pipeline = Pipeline::new(
             device,
@@ -372,7 +370,7 @@ impl Renderer for VkWindow {
             render_pass.render_pass,
             Some((width, height)),
         )?;
-        let target = Target::new(device, render_pass.render_pass, width, height, &pass)?;
+        let target = Target::new(device, render_pass.render_pass, width, height)?;
         let commands = Commands::record(
             device,
             render_pass.render_pass,
@@ -380,7 +378,6 @@ impl Renderer for VkWindow {
             &scene.descriptors,
             &target,
             None,
-            &pass,
         )?;
         commands.submit()?;
         commands.wait(false)?;

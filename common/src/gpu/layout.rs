@@ -308,9 +308,8 @@ pub mod binding {
     pub const BVH_PRIMS: u32 = 7;
     // 8 held the parent links of a stackless traversal, measured and rejected
     // (docs/findings/bvh.md#tried-and-not-kept).
-    /// The sphere, triangle and light counts, where the shader reads them at
-    /// run time (`--experiment storage-counts`) instead of baking them in.
-    pub const COUNTS: u32 = 9;
+    // 9 held the counts of `--experiment storage-counts`, retired
+    // (docs/findings/software-drivers.md#a-shader-per-draw).
     /// The counting variant's per-pixel ray counts (`GpuRayCount`), written
     /// only by the untimed counting frame; no other variant declares it.
     pub const RAY_COUNTS: u32 = 10;
@@ -319,9 +318,7 @@ pub mod binding {
     /// which only that experiment's GLSL declares (`shader::post::warp_probe_glsl`).
     pub const WARP_PROBE: u32 = 11;
     /// The storage buffers in binding order.
-    pub const STORAGE: [u32; 7] = [
-        SPHERES, TRIANGLES, MATERIALS, LIGHTS, BVH_NODES, BVH_PRIMS, COUNTS,
-    ];
+    pub const STORAGE: [u32; 6] = [SPHERES, TRIANGLES, MATERIALS, LIGHTS, BVH_NODES, BVH_PRIMS];
 }
 
 /// A flattened BVH: the nodes the shader walks (binding 6) and the primitive

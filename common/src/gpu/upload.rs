@@ -25,8 +25,6 @@ pub struct GpuScene<'a> {
     pub spheres: Vec<GpuSphere>,
     pub materials: Vec<GpuMaterial>,
     pub lights: Vec<GpuLight>,
-    /// Spheres, triangles, lights, and a pad word.
-    pub counts: [u32; 4],
     /// The scene's triangles, in world coordinates.
     triangles: &'a [Triangle],
     /// Subtracted from every triangle vertex (`camera::local_origin`).
@@ -116,12 +114,6 @@ impl<'a> GpuScene<'a> {
                     ..Default::default()
                 })
                 .collect(),
-            counts: [
-                world.spheres.len() as u32,
-                world.triangles.len() as u32,
-                world.lights.len() as u32,
-                0,
-            ],
             triangles: &world.triangles,
             origin,
             bvh_nodes: bvh.map_or(&[], |b| &b.nodes),
@@ -205,7 +197,6 @@ impl<'a> GpuScene<'a> {
             }
             binding::BVH_NODES => (0, size_of::<GpuBvhNode>()),
             binding::BVH_PRIMS => (self.bvh_codes.len(), size_of::<GpuBvhPrim>()),
-            binding::COUNTS => (1, size_of::<[u32; 4]>()),
             _ => panic!("binding {binding} is not a storage buffer"),
         };
         count.max(1) * size
@@ -227,7 +218,6 @@ impl<'a> GpuScene<'a> {
             binding::SPHERES => copy_elements(&self.spheres, offset, out),
             binding::MATERIALS => copy_elements(&self.materials, offset, out),
             binding::LIGHTS => copy_elements(&self.lights, offset, out),
-            binding::COUNTS => copy_elements(&self.counts, offset, out),
             binding::BVH_NODES if !self.bvh_wide_nodes.is_empty() => convert(offset, out, |i| {
                 gpu_node(self.bvh_wide_nodes, i, |n| n.on_gpu())
             }),
@@ -325,7 +315,6 @@ pub fn storage_name(binding: u32) -> &'static str {
         binding::LIGHTS => "lights",
         binding::BVH_NODES => "BVH node",
         binding::BVH_PRIMS => "BVH primitive",
-        binding::COUNTS => "counts",
         _ => "frame",
     }
 }
@@ -387,7 +376,7 @@ mod tests {
                 .spheres
                 .iter()
                 .map(|x| x.center)
-                .chain((0..g.counts[1] as usize).map(|i| g.triangle(i).p0))
+                .chain((0..s.triangles.len()).map(|i| g.triangle(i).p0))
                 .chain(std::iter::once(g.frame.eye))
                 .flat_map(|v| v.map(f32::abs))
                 .fold(0.0f32, f32::max);

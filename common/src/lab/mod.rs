@@ -1,7 +1,6 @@
 //! The laboratory: every experiment as one entry of one registry — its name,
 //! the API, path and mode it applies to, and what it does to the run plan
-//! (shader knobs, passes over naga's output, the loops' counts, device or
-//! pass requests) — plus the measurement options that only the laboratory
+//! (shader knobs, passes over naga's output, the loops' counts) — plus the measurement options that only the laboratory
 //! uses. One check (`check`) refuses what a run cannot do; one function
 //! (`changes`) says what the chosen experiments change; `page` writes
 //! docs/experiments.md from the registry. The apps never read the list of
@@ -11,7 +10,7 @@ pub mod experiment;
 
 use crate::cli::{OpenGlKnobs, RenderArgs, RenderPath, VulkanKnobs};
 use crate::error::bad_input;
-use crate::plan::requests::{Api, DeviceRequest, FragmentPass};
+use crate::plan::requests::Api;
 use crate::shader::variant::{Counts, Passes, ShaderKnobs, SpirvCompiler};
 use crate::value_name::ValueName;
 use experiment::Experiment;
@@ -23,8 +22,6 @@ pub struct Changes {
     pub passes: Passes,
     /// Where the loops' counts come from, if not baked in.
     pub counts: Option<Counts>,
-    pub pass: FragmentPass,
-    pub device: DeviceRequest,
     /// The experiments' names in registry order, for the variant's label.
     pub tags: Vec<String>,
 }
@@ -54,16 +51,6 @@ const fn entry(experiment: Experiment, what: &'static str, apply: fn(&mut Change
     }
 }
 
-const fn pass_entry(experiment: Experiment, what: &'static str, apply: fn(&mut Changes)) -> Entry {
-    Entry {
-        path: Some(RenderPath::Fragment),
-        headless: true,
-        ..entry(experiment, what, apply)
-    }
-}
-
-const OPENGL_VIEWPORT: &str = "OpenGL's viewport is always state set before the draw";
-const OPENGL_QUEUES: &str = "OpenGL has no queues to choose from";
 const VULKAN_OCCUPANCY: &str =
     "Vulkan reports the register count that fixes its occupancy (--dump-shaders)";
 const VULKAN_ALIASING: &str =
@@ -84,20 +71,14 @@ pub const REGISTRY: &[Entry] = &[
     entry(Experiment::SharedBvhStack, "Compute path: put the BVH stack in shared memory wherever it fits in 32 KiB per workgroup (the default keeps it local).", |c| {
         c.knobs.shared_bvh_stack = true
     }),
-    entry(Experiment::UnpairedBvhStack, "One BVH stack entry per array element (uvec2) instead of two per uvec4.", |c| {
-        c.knobs.unpaired_bvh_stack = true
-    }),
     entry(Experiment::LocalBvhStack, "A BVH stack local to each walk (closest hit, any hit) instead of one at module scope that both share.", |c| {
         c.knobs.local_bvh_stack = true
     }),
     entry(Experiment::SplitRayStack, "The ray stack as four arrays (origin, direction, weight, depth) instead of two of vec4 pairs.", |c| {
         c.knobs.split_ray_stack = true
     }),
-    entry(Experiment::StorageCounts, "Read the primitive and light counts from a storage buffer instead of baking them into the shader.", |c| {
-        c.counts = Some(Counts::Storage)
-    }),
-    entry(Experiment::UniformCounts, "Read the primitive and light counts from the Frame uniform instead of baking them into the shader (what made lavapipe grow per frame); storage-counts wins if both are given.", |c| {
-        c.counts.get_or_insert(Counts::Uniform);
+    entry(Experiment::UniformCounts, "Read the primitive and light counts from the Frame uniform instead of baking them into the shader (what made lavapipe grow per frame).", |c| {
+        c.counts = Some(Counts::Uniform)
     }),
     entry(Experiment::NoContraction, "Forbid the driver to fuse or reassociate float arithmetic: a NoContraction decoration on every float operation of the SPIR-V and `precise` on every float local of the GLSL.", |c| {
         c.passes.no_contraction = true
@@ -108,40 +89,10 @@ pub const REGISTRY: &[Entry] = &[
     entry(Experiment::Glslang, "The SPIR-V (what Vulkan runs) from Khronos' reference compiler, glslangValidator (on PATH; Debian's glslang-tools), given the same GLSL and defines, instead of from naga.", |c| {
         c.passes.compiler = SpirvCompiler::Glslang
     }),
-    pass_entry(Experiment::Quad, "The fullscreen pass as two triangles (6 vertices) instead of one oversized triangle.", |c| {
-        c.knobs.quad = true;
-        c.pass.quad = true;
-    }),
-    pass_entry(Experiment::LoadClear, "Clear the colour target at the start of the pass (Vulkan: load op CLEAR instead of DONT_CARE; OpenGL: glClear before the draw).", |c| {
-        c.pass.clear = true
-    }),
-    pass_entry(Experiment::Rgba8, "An RGBA8 UNORM render target instead of RGBA32F (the GPU rounds to 8 bits; the PNG stays within 1/255).", |c| {
-        c.pass.rgba8 = true
-    }),
-    Entry {
-        only: Some((Api::Vulkan, OPENGL_QUEUES)),
-        path: Some(RenderPath::Compute),
-        headless: true,
-        ..entry(Experiment::ComputeQueue, "Dispatch on a queue family with COMPUTE but not GRAPHICS (refused where the device has none).", |c| {
-            c.device.compute_only_queue = true
-        })
-    },
-    Entry {
-        only: Some((Api::Vulkan, OPENGL_VIEWPORT)),
-        ..pass_entry(Experiment::DynamicViewport, "The viewport and scissor as dynamic state set in the command buffer (as OpenGL always has them) instead of baked into the pipeline.", |c| {
-            c.pass.dynamic_viewport = true
-        })
-    },
     Entry {
         only: Some((Api::OpenGl, VULKAN_ALIASING)),
         ..entry(Experiment::NagaAliasing, "naga's buffer and image declarations as naga writes them, without the `restrict` (GLSL) or `Restrict` (SPIR-V) that tells the driver no two of them alias, which Vulkan's SPIR-V assumes anyway.", |c| {
             c.passes.restrict = false
-        })
-    },
-    Entry {
-        headless: true,
-        ..entry(Experiment::RobustAccess, "Bounds-checked buffer access (Vulkan's robustBufferAccess feature; OpenGL a robust-access context).", |c| {
-            c.device.robust_access = true
         })
     },
     Entry {
@@ -243,8 +194,8 @@ pub fn check(args: &RenderArgs, api: Api) -> anyhow::Result<()> {
 }
 
 /// `--experiment ulp` and `--ulp-op` go together, and the probe's image must
-/// reach the PNG as the shader wrote it: an RGBA32F target, no counting frame
-/// (the probe writes no ray counts), an even width (two pixels per result).
+/// reach the PNG as the shader wrote it: no counting frame (the probe writes
+/// no ray counts), an even width (two pixels per result).
 fn check_ulp(args: &RenderArgs) -> anyhow::Result<()> {
     let probe = args.experiment.contains(&Experiment::Ulp);
     match (probe, args.ulp_op) {
@@ -256,11 +207,6 @@ fn check_ulp(args: &RenderArgs) -> anyhow::Result<()> {
             ))
         }
         (true, Some(_)) => {}
-    }
-    if args.experiment.contains(&Experiment::Rgba8) {
-        return Err(bad_input(
-            "--experiment ulp with --experiment rgba8: the probe's bytes need the RGBA32F target; drop rgba8",
-        ));
     }
     if args.count_rays {
         return Err(bad_input(

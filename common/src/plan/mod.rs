@@ -1,6 +1,6 @@
 //! One plan per run. `Planner::new` reads the options once — the laboratory's
 //! check and changes, the workgroup, the outputs — and says what the run asks
-//! of the device and of the fragment pass, before a device exists. Then
+//! of the device, before a device exists. Then
 //! `prepare` gives everything the GPU receives: the scene, its BVH (built once,
 //! timed as a step of its own), the typed shader variant, the buffers' bytes
 //! (checked against the device's storage limit) and the compiled shaders of
@@ -22,7 +22,7 @@ use crate::scene::camera::local_origin;
 use crate::scene::Scene;
 use crate::shader::build::PathShaders;
 use crate::shader::variant::{Entry, Variant};
-use requests::{Api, DeviceRequest, FragmentPass};
+use requests::{Api, DeviceRequest};
 use std::time::Instant;
 
 /// The run's options, checked and turned into choices; makes the plans.
@@ -56,7 +56,6 @@ pub struct CountingRun<'a> {
     pub gpu: &'a GpuScene<'a>,
     /// The counting variant, on the path that is drawing.
     pub variant: Variant,
-    pub pass: FragmentPass,
     pub width: u32,
     pub height: u32,
 }
@@ -81,8 +80,7 @@ impl Planner {
         lab::check(args, api)?;
         let workgroup = args.compute_workgroup()?;
         args.check_outputs()?;
-        let mut changes = lab::changes(args);
-        changes.device.count_rays = args.count_rays;
+        let changes = lab::changes(args);
         Ok(Planner {
             args: args.clone(),
             api,
@@ -97,12 +95,9 @@ impl Planner {
 
     /// What the device must offer.
     pub fn device(&self) -> DeviceRequest {
-        self.changes.device
-    }
-
-    /// The fragment path's pass.
-    pub fn pass(&self) -> FragmentPass {
-        self.changes.pass
+        DeviceRequest {
+            count_rays: self.args.count_rays,
+        }
     }
 
     /// The compute path's workgroup for a tracer that walks `bvh` or none:
@@ -277,17 +272,10 @@ impl RunPlan {
 
     /// The counting frame of this plan on its own path, at `width`×`height`
     /// (the window's size may differ from the plan's), with `gpu` as its buffers.
-    pub fn counting<'a>(
-        &self,
-        gpu: &'a GpuScene<'a>,
-        pass: FragmentPass,
-        width: u32,
-        height: u32,
-    ) -> CountingRun<'a> {
+    pub fn counting<'a>(&self, gpu: &'a GpuScene<'a>, width: u32, height: u32) -> CountingRun<'a> {
         CountingRun {
             gpu,
             variant: self.variant.counting(),
-            pass,
             width,
             height,
         }

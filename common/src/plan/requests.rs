@@ -1,63 +1,12 @@
-//! What a run asks of the API outside the shader: of the device (a queue, a
-//! feature, a counter) and of the fragment path's pass (its vertices, clear and
-//! target format). The laboratory fills these in; both apps read them, so
-//! Vulkan and OpenGL draw, clear and read back alike.
+//! What a run asks of the API outside the shader: of the device (the
+//! atomics the counting frame needs), and which app is asking. Both apps
+//! read these, so Vulkan and OpenGL ask alike.
 
-/// What the device must offer. All off in the product, except `count_rays`.
+/// What the device must offer beyond what every run needs.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub struct DeviceRequest {
-    /// Vulkan: dispatch on a queue family with COMPUTE but not GRAPHICS.
-    pub compute_only_queue: bool,
     /// The atomics the counting frame needs (`--count-rays`).
     pub count_rays: bool,
-    /// Bounds-checked buffer access (Vulkan's robustBufferAccess; an OpenGL
-    /// robust-access context).
-    pub robust_access: bool,
-}
-
-/// What the fragment path's draw looks like outside the shaders.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
-pub struct FragmentPass {
-    /// Two triangles covering the viewport exactly, instead of one oversized
-    /// triangle clipped to it.
-    pub quad: bool,
-    /// The colour target cleared at the start of every frame's pass, instead
-    /// of its old contents left undefined (every pixel is written anyway).
-    pub clear: bool,
-    /// An RGBA8 UNORM target (the GPU rounds to 8 bits) instead of RGBA32F.
-    pub rgba8: bool,
-    /// Vulkan: the viewport and scissor set while recording instead of fixed
-    /// in the pipeline (OpenGL has no other kind).
-    pub dynamic_viewport: bool,
-}
-
-impl FragmentPass {
-    /// The vertices of the draw, which the vertex shader makes from their index.
-    pub fn vertices(&self) -> u32 {
-        if self.quad {
-            6
-        } else {
-            3
-        }
-    }
-
-    /// The render target's bytes per pixel.
-    pub fn texel_bytes(&self) -> u64 {
-        if self.rgba8 {
-            4
-        } else {
-            16
-        }
-    }
-
-    /// The render target's format as `--explain` and errors name it.
-    pub fn format_name(&self) -> &'static str {
-        if self.rgba8 {
-            "RGBA8"
-        } else {
-            "RGBA32F"
-        }
-    }
 }
 
 /// Which app is running: the one place a run's rules differ by API.

@@ -10,7 +10,8 @@
 use crate::cli::{RenderPath, Workgroup};
 use crate::shader::post::{
     float_controls_spirv, no_contraction_spirv, precise_float_locals_glsl, restrict_resources_glsl,
-    strip_local_array_zero_init_glsl, strip_local_array_zero_init_spirv, warp_probe_glsl,
+    spirv_for_opengl, strip_local_array_zero_init_glsl, strip_local_array_zero_init_spirv,
+    warp_probe_glsl,
 };
 use crate::shader::variant::{Entry, SpirvCompiler, Variant, SPEC_CONSTANTS};
 use anyhow::{anyhow, Context};
@@ -185,6 +186,21 @@ pub struct ComputeShader {
     pub variant: Variant,
     pub workgroup: Workgroup,
     pub stage: Stage,
+}
+
+impl Shaders {
+    /// The fragment stage as `--gl-spirv` loads it, with the variant's
+    /// `Restrict` decorations (`post::spirv_for_opengl`).
+    pub fn fragment_spirv_for_opengl(&self) -> Vec<u32> {
+        spirv_for_opengl(&self.fragment.spirv, self.variant.passes.restrict)
+    }
+}
+
+impl ComputeShader {
+    /// The stage as `--gl-spirv` loads it, likewise.
+    pub fn spirv_for_opengl(&self) -> Vec<u32> {
+        spirv_for_opengl(&self.stage.spirv, self.variant.passes.restrict)
+    }
 }
 
 /// The shaders of one entry point: the fullscreen pair, or the compute
@@ -436,7 +452,6 @@ fn glslang_spirv(source: &str, stage: ShaderStage, variant: &Variant) -> anyhow:
 mod tests {
     use super::*;
     use crate::scene::Scene;
-    use crate::shader::post::spirv_for_opengl;
 
     #[test]
     fn spec_constant_table_matches_the_shader() {

@@ -66,8 +66,6 @@ pub enum Counts {
     },
     /// Read from the `Frame` uniform.
     Uniform,
-    /// Read from a storage buffer.
-    Storage,
 }
 
 /// The tracer's entry point.
@@ -98,16 +96,12 @@ impl Entry {
 /// Changes to the shader source that only the laboratory asks for.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub struct ShaderKnobs {
-    /// One BVH stack entry per array element instead of two per uvec4.
-    pub unpaired_bvh_stack: bool,
     /// A BVH stack per walk instead of one at module scope.
     pub local_bvh_stack: bool,
     /// Compute: the BVH stack in shared memory where it fits.
     pub shared_bvh_stack: bool,
     /// The ray stack as four arrays instead of two of vec4 pairs.
     pub split_ray_stack: bool,
-    /// The fullscreen pass as two triangles.
-    pub quad: bool,
     /// Compute: KiB of workgroup memory the tracer does not need.
     pub shared_pad_kib: Option<u32>,
     /// The arithmetic probe (shaders/lab/ulp.glsl) in place of the tracer's
@@ -167,9 +161,6 @@ pub const SPEC_CONSTANTS: [(&str, u16); 4] = [
     ("SPEC_MIRROR", 2),
     ("SPEC_GLASS", 3),
 ];
-
-/// The define under which shaders/fullscreen.vert emits two triangles.
-pub const QUAD_DEFINE: &str = "FULLSCREEN_QUAD";
 
 /// The most shared memory the compute path's BVH stack may take: OpenGL
 /// guarantees a workgroup 32 KiB (Vulkan only 16 KiB, but lavapipe, llvmpipe
@@ -322,11 +313,8 @@ impl Variant {
         let bvh = self.bvh_stack.is_some();
         flag(bvh, "USE_BVH");
         flag(bvh && self.bvh_width > 2, "USE_BVH_WIDE");
-        flag(bvh && k.unpaired_bvh_stack, "BVH_STACK_UNPAIRED");
         flag(bvh && k.local_bvh_stack, "BVH_STACK_LOCAL");
         flag(k.split_ray_stack, "RAY_STACK_SPLIT");
-        flag(self.counts == Counts::Storage, "COUNTS_FROM_STORAGE");
-        flag(k.quad, QUAD_DEFINE);
         flag(self.count_rays, "COUNT_RAYS");
         flag(self.bvh_stack_in_shared_memory(), "BVH_STACK_SHARED");
         for n in self.numerics.defines() {

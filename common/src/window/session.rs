@@ -324,7 +324,7 @@ impl<R: Renderer> Session<R> {
         let plan = &self.plan;
         let mut gpu = plan.gpu_at(width, height);
         gpu.frame = self.frame_uniform();
-        let run = plan.counting(&gpu, self.planner.pass(), width, height);
+        let run = plan.counting(&gpu, width, height);
         if let Some(r) = self.renderer.as_mut() {
             self.rays = Some(r.count_rays(&run, &plan.shaders)?.total());
         }

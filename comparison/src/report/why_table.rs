@@ -110,7 +110,7 @@ fn verdict(measure: GapMeasure, before: f64, after: f64) -> Verdict {
     }
 }
 
-/// What the case changes, in words: `vulkan: glslang`, `both: unpaired-bvh-stack`, `opengl-spirv`.
+/// What the case changes, in words: `vulkan: glslang`, `both: shared-bvh-stack`, `opengl-spirv`.
 fn change(case: &Case) -> String {
     let names = |e: &[twinray_common::lab::experiment::Experiment]| {
         e.iter().map(|e| e.name()).collect::<Vec<_>>().join("+")

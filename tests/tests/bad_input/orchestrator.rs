@@ -45,7 +45,7 @@ fn orchestrator_diff_and_render_errors() {
     // What the reference cannot honour is refused, not ignored.
     for (option, value) in [
         ("--gl-spirv", None),
-        ("--experiment", Some("naga-zero-init")),
+        ("--experiment", Some("naga-loop-bounding")),
         ("--dump-shaders", Some("shaders")),
         ("--path", Some("compute")),
     ] {
