@@ -33,6 +33,23 @@ pub fn code_spans(text: &str) -> Vec<String> {
         .collect()
 }
 
+/// Every `COMMIT:PATH` a line cites: an abbreviated or full commit (7 to 40
+/// hexadecimal digits), a colon, and a path.
+pub fn citations(line: &str) -> Vec<String> {
+    line.split(|c: char| c.is_whitespace() || "()\"'`,;<>[]*".contains(c))
+        .filter_map(|word| {
+            let word = word.trim_end_matches(['.', ':']);
+            let (commit, path) = word.split_once(':')?;
+            let hex = (7..=40).contains(&commit.len())
+                && commit
+                    .chars()
+                    .all(|c| c.is_ascii_hexdigit() && !c.is_ascii_uppercase());
+            (hex && !path.is_empty() && !path.contains(':') && !path.starts_with('/'))
+                .then(|| word.to_string())
+        })
+        .collect()
+}
+
 /// The anchor GitHub gives a heading: lower case, everything but letters,
 /// digits, spaces, `-` and `_` dropped, each space a hyphen.
 pub fn slug(heading: &str) -> String {

@@ -16,7 +16,9 @@ use std::collections::BTreeMap;
 use std::io::Write;
 use std::process::{Command, Stdio};
 use twinray_tests::assert_none;
-use twinray_tests::markdown::{anchors, assert_links_resolve, links, prose, without_code_spans};
+use twinray_tests::markdown::{
+    anchors, assert_links_resolve, citations, links, prose, without_code_spans,
+};
 use twinray_tests::repo::{assert_scan, read, root};
 
 const FINDINGS: &str = "docs/findings";
@@ -53,23 +55,6 @@ fn tracked_markdown() -> Vec<String> {
         .lines()
         .filter(|f| root().join(f).is_file())
         .map(str::to_string)
-        .collect()
-}
-
-/// Every `COMMIT:PATH` a line cites: an abbreviated or full commit (7 to 40
-/// hexadecimal digits), a colon, and a path.
-fn citations(line: &str) -> Vec<String> {
-    line.split(|c: char| c.is_whitespace() || "()\"'`,;<>[]*".contains(c))
-        .filter_map(|word| {
-            let word = word.trim_end_matches(['.', ':']);
-            let (commit, path) = word.split_once(':')?;
-            let hex = (7..=40).contains(&commit.len())
-                && commit
-                    .chars()
-                    .all(|c| c.is_ascii_hexdigit() && !c.is_ascii_uppercase());
-            (hex && !path.is_empty() && !path.contains(':') && !path.starts_with('/'))
-                .then(|| word.to_string())
-        })
         .collect()
 }
 
