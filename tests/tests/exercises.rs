@@ -94,7 +94,8 @@ fn the_window_survives_an_out_of_date_acquire() {
     let dir = twinray_tests::scratch("out-of-date");
     let app = twinray_tests::bin("twinray-vk");
     let app = app.to_str().unwrap();
-    let args = box_window("64x48", "10", &["60", app, "--validate", "--explain"]);
+    let window = box_window("64x48", "10", &["--validate", "--explain"]);
+    let args = [&["60", app][..], &window].concat();
     let out = xvfb.run(
         Path::new("timeout"),
         &args,
