@@ -67,20 +67,46 @@ fn block(
     (var.ty, elem)
 }
 
-macro_rules! rust_offsets {
-    ($t:ty { $($field:tt $( [$idx:expr] )?),* $(,)? }) => {
-        vec![$( offset_of!($t, $field) as u32 $( + $idx * 4 )? ),*]
+/// A Rust struct's layout as the checks take it: its name, the offsets of
+/// the fields listed (`pad[1]`: the second u32 of an array field), its size.
+struct RustLayout {
+    name: &'static str,
+    offsets: Vec<u32>,
+    size: usize,
+}
+
+macro_rules! rust_layout {
+    ($t:ident { $($field:tt $( [$idx:expr] )?),* $(,)? }) => {
+        RustLayout {
+            name: stringify!($t),
+            offsets: vec![$( offset_of!($t, $field) as u32 $( + $idx * 4 )? ),*],
+            size: size_of::<$t>(),
+        }
     };
 }
 
-fn check(name: &str, naga: (Vec<(String, u32)>, u32), rust_offsets: Vec<u32>, rust_size: usize) {
+fn check(naga: (Vec<(String, u32)>, u32), rust: RustLayout) {
     let (members, span) = naga;
+    let name = rust.name;
     let offsets: Vec<u32> = members.iter().map(|m| m.1).collect();
     assert_eq!(
-        offsets, rust_offsets,
+        offsets, rust.offsets,
         "{name}: member offsets differ (naga members {members:?})"
     );
-    assert_eq!(span as usize, rust_size, "{name}: size differs");
+    assert_eq!(span as usize, rust.size, "{name}: size differs");
+}
+
+/// How naga spells out a struct's members: `naga_members` or `naga_elements`.
+type Members = fn(&naga::Module, naga::Handle<naga::Type>) -> (Vec<(String, u32)>, u32);
+
+/// The storage buffer at `binding` is a runtime array of `rust`: its stride
+/// is the struct's size, and its element the struct's layout.
+fn check_array(module: &naga::Module, binding: u32, members: Members, rust: RustLayout) {
+    let (_, elem) = block(module, binding);
+    let (ty, stride) =
+        elem.unwrap_or_else(|| panic!("binding {binding} ({}) is no runtime array", rust.name));
+    assert_eq!(stride as usize, rust.size, "{} stride", rust.name);
+    check(members(module, ty), rust);
 }
 
 /// The all-features variant's module: it declares every struct but the ray counts.
@@ -100,9 +126,8 @@ fn naga_layout_matches_rust_for_every_shader_struct() {
 
     let (frame_ty, _) = block(&module, binding::FRAME);
     check(
-        "Frame",
         naga_members(&module, frame_ty),
-        rust_offsets!(GpuFrame {
+        rust_layout!(GpuFrame {
             eye,
             min_weight,
             top_left,
@@ -118,26 +143,20 @@ fn naga_layout_matches_rust_for_every_shader_struct() {
             height,
             pad
         }),
-        size_of::<GpuFrame>(),
     );
 
-    let (_, sphere) = block(&module, binding::SPHERES);
-    let (ty, stride) = sphere.expect("spheres is a runtime array");
-    assert_eq!(stride as usize, size_of::<GpuSphere>(), "Sphere stride");
-    check(
-        "Sphere",
-        naga_members(&module, ty),
-        rust_offsets!(GpuSphere { center, radius, material, pad[0], pad[1], pad[2] }),
-        size_of::<GpuSphere>(),
+    check_array(
+        &module,
+        binding::SPHERES,
+        naga_members,
+        rust_layout!(GpuSphere { center, radius, material, pad[0], pad[1], pad[2] }),
     );
 
-    let (_, tri) = block(&module, binding::TRIANGLES);
-    let (ty, stride) = tri.expect("triangles is a runtime array");
-    assert_eq!(stride as usize, size_of::<GpuTriangle>(), "Triangle stride");
-    check(
-        "Triangle",
-        naga_members(&module, ty),
-        rust_offsets!(GpuTriangle {
+    check_array(
+        &module,
+        binding::TRIANGLES,
+        naga_members,
+        rust_layout!(GpuTriangle {
             p0,
             material,
             p1,
@@ -151,34 +170,27 @@ fn naga_layout_matches_rust_for_every_shader_struct() {
             n2,
             pad4
         }),
-        size_of::<GpuTriangle>(),
     );
 
-    let (_, mat) = block(&module, binding::MATERIALS);
-    let (ty, stride) = mat.expect("materials is a runtime array");
-    assert_eq!(stride as usize, size_of::<GpuMaterial>(), "Material stride");
-    check(
-        "Material",
-        naga_members(&module, ty),
-        rust_offsets!(GpuMaterial {
+    check_array(
+        &module,
+        binding::MATERIALS,
+        naga_members,
+        rust_layout!(GpuMaterial {
             ambient, reflectivity, diffuse, transparency, specular, shininess, ior, pad[0], pad[1], pad[2]
         }),
-        size_of::<GpuMaterial>(),
     );
 
-    let (_, light) = block(&module, binding::LIGHTS);
-    let (ty, stride) = light.expect("lights is a runtime array");
-    assert_eq!(stride as usize, size_of::<GpuLight>(), "Light stride");
-    check(
-        "Light",
-        naga_members(&module, ty),
-        rust_offsets!(GpuLight {
+    check_array(
+        &module,
+        binding::LIGHTS,
+        naga_members,
+        rust_layout!(GpuLight {
             position,
             pad0,
             color,
             pad1
         }),
-        size_of::<GpuLight>(),
     );
 }
 
@@ -187,13 +199,11 @@ fn naga_layout_matches_rust_for_every_shader_struct() {
 #[test]
 fn naga_layout_matches_rust_for_the_bvh() {
     let module = generic_module();
-    let (_, node) = block(&module, binding::BVH_NODES);
-    let (ty, stride) = node.expect("BVH nodes are a runtime array");
-    assert_eq!(stride as usize, size_of::<GpuBvhNode>(), "BvhNode stride");
-    check(
-        "BvhNode",
-        naga_members(&module, ty),
-        rust_offsets!(GpuBvhNode {
+    check_array(
+        &module,
+        binding::BVH_NODES,
+        naga_members,
+        rust_layout!(GpuBvhNode {
             left_min,
             left,
             left_max,
@@ -203,15 +213,12 @@ fn naga_layout_matches_rust_for_the_bvh() {
             right_max,
             pad1
         }),
-        size_of::<GpuBvhNode>(),
     );
-    let (_, prim) = block(&module, binding::BVH_PRIMS);
-    let (ty, stride) = prim.expect("BVH primitives are a runtime array");
-    assert_eq!(stride as usize, size_of::<GpuBvhPrim>(), "BvhPrim stride");
-    check(
-        "BvhPrim",
-        naga_members(&module, ty),
-        rust_offsets!(GpuBvhPrim {
+    check_array(
+        &module,
+        binding::BVH_PRIMS,
+        naga_members,
+        rust_layout!(GpuBvhPrim {
             a,
             code,
             b,
@@ -219,7 +226,6 @@ fn naga_layout_matches_rust_for_the_bvh() {
             c,
             pad1
         }),
-        size_of::<GpuBvhPrim>(),
     );
 }
 
@@ -232,18 +238,12 @@ fn naga_layout_matches_rust_for_the_wide_bvh() {
         variant.bvh_stack = Some(4);
         variant.bvh_width = width;
         let (module, _) = parse(&fragment_source(), naga::ShaderStage::Fragment, &variant).unwrap();
-        let (_, node) = block(&module, binding::BVH_NODES);
-        let (ty, stride) = node.expect("wide BVH nodes are a runtime array");
-        assert_eq!(
-            stride as usize,
-            size_of::<GpuBvhWideNode>(),
-            "BvhWideNode stride"
-        );
         // The GLSL's `vec4 bounds[6]` is the six corner fields, in their order.
-        check(
-            "BvhWideNode",
-            naga_elements(&module, ty),
-            rust_offsets!(GpuBvhWideNode {
+        check_array(
+            &module,
+            binding::BVH_NODES,
+            naga_elements,
+            rust_layout!(GpuBvhWideNode {
                 min_x,
                 min_y,
                 min_z,
@@ -252,7 +252,6 @@ fn naga_layout_matches_rust_for_the_wide_bvh() {
                 max_z,
                 child
             }),
-            size_of::<GpuBvhWideNode>(),
         );
     }
 }
@@ -266,20 +265,17 @@ fn naga_layout_matches_rust_for_the_ray_counts() {
         &Variant::generic(Default::default()).counting(),
     )
     .unwrap();
-    let (_, count) = block(&counting, binding::RAY_COUNTS);
-    let (ty, stride) = count.expect("ray counts are a runtime array");
-    assert_eq!(stride as usize, size_of::<GpuRayCount>(), "RayCount stride");
-    check(
-        "RayCount",
-        naga_members(&counting, ty),
-        rust_offsets!(GpuRayCount {
+    check_array(
+        &counting,
+        binding::RAY_COUNTS,
+        naga_members,
+        rust_layout!(GpuRayCount {
             primary,
             shadow,
             mirror,
             glass_reflected,
             glass_refracted
         }),
-        size_of::<GpuRayCount>(),
     );
 }
 
@@ -287,18 +283,8 @@ fn naga_layout_matches_rust_for_the_ray_counts() {
 fn every_builtin_variant_and_the_generic_one_compile_for_both_apis() {
     let mut variants = vec![Variant::generic(Default::default())];
     // Every numerical choice must compile too.
-    use twinray_common::scene::numerics::{Numerics, Offset, SphereTest, TriangleTest};
-    for offset in Offset::ALL {
-        for triangle in TriangleTest::ALL {
-            for sphere in SphereTest::ALL {
-                variants.push(Variant::generic(Numerics {
-                    offset,
-                    triangle,
-                    sphere,
-                }));
-            }
-        }
-    }
+    use twinray_common::scene::numerics::Numerics;
+    variants.extend(Numerics::all().map(Variant::generic));
     let scene = twinray_common::scene::Scene::load("box", &[]).unwrap();
     for width in [2, 4, 8] {
         let bvh = twinray_common::plan::build_bvh(&scene).widen(width);
@@ -354,19 +340,21 @@ fn shader_constant(module: &naga::Module, name: &str) -> naga::Literal {
 #[test]
 fn the_bvh_encodings_match_rust() {
     let module = bvh_module();
-    let constant = |name: &str| -> u32 {
-        match shader_constant(&module, name) {
-            naga::Literal::U32(v) => v,
-            other => panic!("{name} is {other:?}, not a u32"),
-        }
-    };
-    assert_eq!(constant("SPHERE_BIT"), PRIM_SPHERE_BIT);
-    assert_eq!(constant("LEAF_BIT"), child_ref::LEAF_BIT);
-    assert_eq!(constant("LEAF_FIRST_SHIFT"), child_ref::LEAF_FIRST_SHIFT);
-    assert_eq!(constant("GPU_ROOT"), child_ref::GPU_ROOT);
+    let constant = |name: &str| shader_constant(&module, name);
+    use naga::Literal::U32;
+    assert_eq!(constant("SPHERE_BIT"), U32(PRIM_SPHERE_BIT));
+    assert_eq!(constant("LEAF_BIT"), U32(child_ref::LEAF_BIT));
+    assert_eq!(
+        constant("LEAF_FIRST_SHIFT"),
+        U32(child_ref::LEAF_FIRST_SHIFT)
+    );
+    assert_eq!(constant("GPU_ROOT"), U32(child_ref::GPU_ROOT));
     // NO_CHILD decodes to a leaf past the most primitives a tree may hold.
-    let (first, _) =
-        child_ref::as_leaf(constant("NO_CHILD")).expect("NO_CHILD is a leaf reference");
+    let no_child = constant("NO_CHILD");
+    let U32(no_child) = no_child else {
+        panic!("NO_CHILD is {no_child:?}, not a u32");
+    };
+    let (first, _) = child_ref::as_leaf(no_child).expect("NO_CHILD is a leaf reference");
     assert!(first >= twinray_common::limits::MAX_BVH_PRIMITIVES);
 }
 

@@ -11,12 +11,15 @@ fn set(kv: &[(&str, &str)]) -> Vec<(String, String)> {
         .collect()
 }
 
+/// Triangles, spheres and lights.
+fn counts(s: &Scene) -> (usize, usize, usize) {
+    (s.triangles.len(), s.spheres.len(), s.lights.len())
+}
+
 #[test]
 fn teapot_has_the_study_counts_and_its_sphere_is_out_of_view() {
     let s = Scene::load("teapot", &[]).unwrap();
-    assert_eq!(s.triangles.len(), 19_200);
-    assert_eq!(s.spheres.len(), 1);
-    assert_eq!(s.lights.len(), 3);
+    assert_eq!(counts(&s), (19_200, 1, 3));
     let f = Frustum::new(&RayFrame::new(&s.camera, 800, 600), 800, 600);
     let sp = &s.spheres[0];
     assert!(
@@ -28,9 +31,7 @@ fn teapot_has_the_study_counts_and_its_sphere_is_out_of_view() {
 #[test]
 fn box_has_30_triangles_a_mirror_and_a_glass_sphere_and_one_light() {
     let s = Scene::load("box", &[]).unwrap();
-    assert_eq!(s.triangles.len(), 30);
-    assert_eq!(s.spheres.len(), 2);
-    assert_eq!(s.lights.len(), 1);
+    assert_eq!(counts(&s), (30, 2, 1));
     let mats: Vec<_> = s
         .spheres
         .iter()
@@ -64,16 +65,9 @@ fn err_of(text: &str) -> (i32, String) {
     (exit_code_of(&e), format!("{e}"))
 }
 
-const OK: &str = r#"
-[camera]
-eye = [0.0, 0.0, 5.0]
-look_at = [0.0, 0.0, 0.0]
-[[materials]]
-name = "m"
-diffuse = [0.5, 0.5, 0.5]
-[[lights]]
-position = [0.0, 5.0, 5.0]
-"#;
+/// A scene that loads, which each bad input completes (shared with the apps'
+/// bad-input tests).
+const OK: &str = include_str!("../../tests/data/scene_head.toml");
 
 #[test]
 fn a_minimal_scene_loads() {
@@ -94,61 +88,39 @@ fn malformed_toml_names_line_and_column() {
     assert!(msg.contains("line 2, column"), "{msg}");
 }
 
-#[test]
-fn unknown_key_is_named_with_its_line() {
-    let (code, msg) = err_of(&format!(
-        "{OK}[[spheres]]\ncenter=[0.0,0.0,0.0]\nradius=1.0\nmaterial=\"m\"\ncolour=1\n"
-    ));
-    assert_eq!(code, 2);
-    assert!(msg.contains("colour") && msg.contains("line 14"), "{msg}");
-}
+/// Scene text with one fault each, and the words its refusal (exit 2) must say.
+const BAD_SCENES: [(&str, &[&str]); 5] = [
+    (
+        "[[spheres]]\ncenter=[0.0,0.0,0.0]\nradius=1.0\nmaterial=\"m\"\ncolour=1\n",
+        &["colour", "line 14"],
+    ),
+    (
+        "[[spheres]]\ncenter=[nan,0.0,0.0]\nradius=1.0\nmaterial=\"m\"\n",
+        &["spheres[0].center", "not finite"],
+    ),
+    (
+        "[[spheres]]\ncenter=[0.0,0.0,0.0]\nradius=-1.0\nmaterial=\"m\"\n",
+        &["spheres[0].radius = -1", "positive"],
+    ),
+    (
+        "[[triangles]]\nvertices=[[0.0,0.0,0.0],[1.0,0.0,0.0],[0.0,1.0,0.0]]\nnormals=[[0.0,0.0,1.0],[0.0,0.0,0.0],[0.0,0.0,1.0]]\nmaterial=\"m\"\n",
+        &["triangles[0].normals[1]", "zero length"],
+    ),
+    (
+        "[[spheres]]\ncenter=[0.0,0.0,0.0]\nradius=1.0\nmaterial=\"gold\"\n",
+        &["'gold'", "not a defined material"],
+    ),
+];
 
+/// An unknown key (with its line), a NaN, a negative radius, a zero-length
+/// normal and an unknown material are each refused, naming what is wrong.
 #[test]
-fn nan_value_is_refused() {
-    let (code, msg) = err_of(&format!(
-        "{OK}[[spheres]]\ncenter=[nan,0.0,0.0]\nradius=1.0\nmaterial=\"m\"\n"
-    ));
-    assert_eq!(code, 2);
-    assert!(
-        msg.contains("spheres[0].center") && msg.contains("not finite"),
-        "{msg}"
-    );
-}
-
-#[test]
-fn negative_radius_is_refused() {
-    let (code, msg) = err_of(&format!(
-        "{OK}[[spheres]]\ncenter=[0.0,0.0,0.0]\nradius=-1.0\nmaterial=\"m\"\n"
-    ));
-    assert_eq!(code, 2);
-    assert!(
-        msg.contains("spheres[0].radius = -1") && msg.contains("positive"),
-        "{msg}"
-    );
-}
-
-#[test]
-fn zero_length_normal_is_refused() {
-    let (code, msg) = err_of(&format!(
-        "{OK}[[triangles]]\nvertices=[[0.0,0.0,0.0],[1.0,0.0,0.0],[0.0,1.0,0.0]]\nnormals=[[0.0,0.0,1.0],[0.0,0.0,0.0],[0.0,0.0,1.0]]\nmaterial=\"m\"\n"
-    ));
-    assert_eq!(code, 2);
-    assert!(
-        msg.contains("triangles[0].normals[1]") && msg.contains("zero length"),
-        "{msg}"
-    );
-}
-
-#[test]
-fn unknown_material_is_named() {
-    let (code, msg) = err_of(&format!(
-        "{OK}[[spheres]]\ncenter=[0.0,0.0,0.0]\nradius=1.0\nmaterial=\"gold\"\n"
-    ));
-    assert_eq!(code, 2);
-    assert!(
-        msg.contains("'gold'") && msg.contains("not a defined material"),
-        "{msg}"
-    );
+fn bad_scene_text_is_refused_naming_the_fault() {
+    for (body, words) in BAD_SCENES {
+        let (code, msg) = err_of(&format!("{OK}{body}"));
+        assert_eq!(code, 2, "{body}: {msg}");
+        assert!(words.iter().all(|w| msg.contains(w)), "{body}: {msg}");
+    }
 }
 
 #[test]

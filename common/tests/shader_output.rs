@@ -9,7 +9,7 @@ use twinray_common::cli::RenderArgs;
 use twinray_common::plan::build_bvh;
 use twinray_common::plan::requests::Api;
 use twinray_common::scene::load::BUILTIN_SCENES;
-use twinray_common::scene::numerics::{Numerics, Offset, SphereTest, TriangleTest};
+use twinray_common::scene::numerics::Numerics;
 use twinray_common::scene::Scene;
 use twinray_common::shader::build;
 use twinray_common::shader::variant::Variant;
@@ -29,17 +29,7 @@ fn variants() -> Vec<Variant> {
         local.knobs.split_ray_stack = true;
         v.push(local);
     }
-    for offset in Offset::ALL {
-        for triangle in TriangleTest::ALL {
-            for sphere in SphereTest::ALL {
-                v.push(Variant::generic(Numerics {
-                    offset,
-                    triangle,
-                    sphere,
-                }));
-            }
-        }
-    }
+    v.extend(Numerics::all().map(Variant::generic));
     v
 }
 

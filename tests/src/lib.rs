@@ -2,6 +2,7 @@
 //! running them the way a user does, and reading back their PNG + JSON.
 
 pub mod markdown;
+pub mod repo;
 
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
@@ -92,6 +93,19 @@ pub fn run(program: &Path, args: &[&str], env: &[(&str, &str)]) -> Output {
         .unwrap_or_else(|e| panic!("starting {}: {e}", program.display()))
 }
 
+/// Runs a command as [`run`] does and expects it to succeed; its output.
+pub fn run_ok(program: &Path, args: &[&str], env: &[(&str, &str)]) -> Output {
+    let o = run(program, args, env);
+    assert!(
+        o.status.success(),
+        "{} {args:?} failed ({}): {}",
+        program.display(),
+        o.status,
+        String::from_utf8_lossy(&o.stderr)
+    );
+    o
+}
+
 /// Which app to run.
 #[derive(Clone, Copy, Debug)]
 pub enum App {
@@ -108,6 +122,26 @@ impl App {
             App::OpenGl => "twinray-gl",
         })
     }
+}
+
+/// `--set` overrides as (key, value) pairs.
+pub type Overrides = &'static [(&'static str, &'static str)];
+
+/// The standard scenes as the image-agreement tests render them: (scene,
+/// size, `--set` overrides). The sphere list with 100 more spheres, hidden in
+/// the visible one, so that a wrong sphere count shows.
+pub const STANDARD_SCENES: [(&str, &str, Overrides); 3] = [
+    ("box", "160x120", &[]),
+    ("teapot", "64x48", &[]),
+    ("spherelist", "160x120", &[("extra_spheres", "100")]),
+];
+
+/// `--set KEY=VALUE` for each of `overrides`.
+pub fn set_args(overrides: &[(&str, &str)]) -> Vec<String> {
+    overrides
+        .iter()
+        .flat_map(|(k, v)| ["--set".to_string(), format!("{k}={v}")])
+        .collect()
 }
 
 /// A successful validated headless render: its report and its 8-bit image.
@@ -145,6 +179,62 @@ pub fn render(
     (report, img)
 }
 
+/// `twinray render --api API --scene SCENE --size SIZE EXTRA --out OUT` as a
+/// user runs it, which must succeed; the image it wrote.
+pub fn orchestrator_render(
+    api: &str,
+    scene: &str,
+    size: &str,
+    extra: &[&str],
+    out: &Path,
+) -> image::RgbImage {
+    let mut args = vec!["render", "--api", api, "--scene", scene, "--size", size];
+    args.extend_from_slice(extra);
+    args.extend(["--out", out.to_str().unwrap()]);
+    let o = run(&bin("twinray"), &args, &[]);
+    assert!(
+        o.status.success(),
+        "twinray {args:?}: {}",
+        String::from_utf8_lossy(&o.stderr)
+    );
+    twinray_common::reference::image_io::load_png(out).unwrap()
+}
+
+/// A render that is clean: no validation message (or GL debug error) and no
+/// NaN/Inf pixel before quantisation.
+pub fn assert_clean(report: &RunReport, what: &str) {
+    assert_eq!(report.validation_messages, 0, "{what}: validation messages");
+    assert_eq!(
+        report.nonfinite_pixels, 0,
+        "{what}: NaN/Inf pixels before quantisation"
+    );
+}
+
+/// Two images agree: at least the share `min` of their pixels within 1/255
+/// of each other. The share is printed as well, so that a passing run still
+/// shows its margin.
+pub fn assert_within_1(a: &image::RgbImage, b: &image::RgbImage, min: f64, what: &str) {
+    let m = twinray_common::reference::metrics::compare(a, b).unwrap();
+    let within = 100.0 * m.within_1();
+    println!("{what}: {within:.4}% within 1/255, max {}", m.max_abs);
+    assert!(
+        m.within_1() >= min,
+        "{what}: only {within:.4}% within 1/255 (at least {}% expected)",
+        100.0 * min
+    );
+}
+
+/// Nothing went wrong; otherwise the test fails naming `problem`, how many
+/// there are, and each of them.
+pub fn assert_none(problem: &str, wrong: &[String]) {
+    assert!(
+        wrong.is_empty(),
+        "{problem} ({}):\n{}",
+        wrong.len(),
+        wrong.join("\n")
+    );
+}
+
 /// The exit code and stderr of a run that is expected to fail.
 pub fn fail(program: &Path, args: &[&str], env: &[(&str, &str)]) -> (i32, String) {
     let o = run(program, args, env);
@@ -166,6 +256,45 @@ pub fn refused(app: App, args: &[&str], sentence: &str) {
         stderr.contains(sentence),
         "{app:?} {args:?}: stderr must say '{sentence}', got: {stderr}"
     );
+}
+
+/// The arguments of a windowed run of the box scene at `size` for `frames`
+/// frames, then `extra`: the windowed tests' common start.
+pub fn box_window<'a>(size: &'a str, frames: &'a str, extra: &[&'a str]) -> Vec<&'a str> {
+    let mut args = vec!["--scene", "box", "--size", size, "--frames", frames];
+    args.extend_from_slice(extra);
+    args
+}
+
+/// The validation layer's synchronisation validation (hazards between
+/// commands, submits and presents), on top of `--validate`'s core checks; the
+/// GL app ignores it.
+pub const SYNC_VALIDATION: (&str, &str) = (
+    "VK_LAYER_ENABLES",
+    "VK_VALIDATION_FEATURE_ENABLE_SYNCHRONIZATION_VALIDATION_EXT",
+);
+
+/// Writes an executable shell script `name` into `dir`: a stand-in for an
+/// app, for tests of how the orchestrator takes an app's failure.
+pub fn stand_in(dir: &Path, name: &str, script: &str) -> PathBuf {
+    use std::os::unix::fs::PermissionsExt;
+    let path = dir.join(name);
+    std::fs::write(&path, script).unwrap();
+    std::fs::set_permissions(&path, std::fs::Permissions::from_mode(0o755)).unwrap();
+    path
+}
+
+/// All of a finished child's piped stderr.
+pub fn stderr_of(child: &mut std::process::Child) -> String {
+    use std::io::Read;
+    let mut stderr = Vec::new();
+    child
+        .stderr
+        .take()
+        .expect("stderr piped")
+        .read_to_end(&mut stderr)
+        .unwrap();
+    String::from_utf8_lossy(&stderr).into_owned()
 }
 
 /// A private X server for one windowed test (Debian's `xvfb`; tests/run.sh

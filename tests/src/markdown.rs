@@ -1,13 +1,10 @@
 //! Reading Markdown as the page tests do: prose outside code blocks, the
 //! anchors GitHub gives headings, the targets of links, and whether a
-//! relative link leads anywhere. One reader for readme.rs and findings.rs,
+//! relative link leads anywhere. One reader for the page tests,
 //! so that the two cannot disagree on what a link or a heading is.
 
+use crate::repo::{assert_scan, read, root};
 use std::path::Path;
-
-fn read(path: &Path) -> String {
-    std::fs::read_to_string(path).unwrap_or_else(|e| panic!("{}: {e}", path.display()))
-}
 
 /// A line without its inline code spans (`like this`).
 pub fn without_code_spans(line: &str) -> String {
@@ -26,6 +23,31 @@ pub fn prose(text: &str) -> Vec<&str> {
         }
     }
     lines
+}
+
+/// The inline code spans of a text's prose, e.g. `vk/src/device.rs::Device::new`.
+pub fn code_spans(text: &str) -> Vec<String> {
+    prose(text)
+        .iter()
+        .flat_map(|line| line.split('`').skip(1).step_by(2).map(str::to_string))
+        .collect()
+}
+
+/// Every `COMMIT:PATH` a line cites: an abbreviated or full commit (7 to 40
+/// hexadecimal digits), a colon, and a path.
+pub fn citations(line: &str) -> Vec<String> {
+    line.split(|c: char| c.is_whitespace() || "()\"'`,;<>[]*".contains(c))
+        .filter_map(|word| {
+            let word = word.trim_end_matches(['.', ':']);
+            let (commit, path) = word.split_once(':')?;
+            let hex = (7..=40).contains(&commit.len())
+                && commit
+                    .chars()
+                    .all(|c| c.is_ascii_hexdigit() && !c.is_ascii_uppercase());
+            (hex && !path.is_empty() && !path.contains(':') && !path.starts_with('/'))
+                .then(|| word.to_string())
+        })
+        .collect()
 }
 
 /// The anchor GitHub gives a heading: lower case, everything but letters,
@@ -112,4 +134,22 @@ pub fn broken(from: &Path, target: &str) -> Option<String> {
         ));
     }
     None
+}
+
+/// Every relative link of the `pages` (relative to the root) leads somewhere,
+/// and at least `min` links were read.
+pub fn assert_links_resolve<S: AsRef<str>>(pages: &[S], min: usize, what: &str) {
+    let mut broken_links = Vec::new();
+    let mut checked = 0;
+    for page in pages {
+        let page = page.as_ref();
+        let path = root().join(page);
+        for target in links(&read(&path)) {
+            checked += 1;
+            if let Some(why) = broken(&path, &target) {
+                broken_links.push(format!("{page}: {why}"));
+            }
+        }
+    }
+    assert_scan("links that lead nowhere", &broken_links, checked, min, what);
 }

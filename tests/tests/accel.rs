@@ -4,7 +4,7 @@
 //! within 1/255, in both APIs.
 
 use twinray_common::reference::metrics::compare;
-use twinray_tests::{render, scratch, App};
+use twinray_tests::{assert_within_1, orchestrator_render, render, scratch, App};
 
 const SCENES: [(&str, &str, &[&str]); 3] = [
     ("box", "96x72", &[]),
@@ -12,34 +12,33 @@ const SCENES: [(&str, &str, &[&str]); 3] = [
     ("spherelist", "96x72", &["--set", "extra_spheres=500"]),
 ];
 
-fn agree(app: App, scene: &str, size: &str, a: &[&str], b: &[&str], what: &str) {
-    let dir = scratch(&format!("accel-{scene}-{what}"));
-    let (ra, ia) = render(app, scene, size, a, &dir.join("a.png"));
-    let (rb, ib) = render(app, scene, size, b, &dir.join("b.png"));
-    assert_ne!(
-        ra.variant, rb.variant,
-        "{what}: the two runs must use different shaders"
-    );
-    let m = compare(&ia, &ib).unwrap();
-    assert!(
-        m.within_1() >= 0.9999,
-        "{app:?} {scene} {what} ({} vs {}): {:.4}% within 1/255",
-        ra.variant,
-        rb.variant,
-        100.0 * m.within_1()
-    );
-    std::fs::remove_dir_all(dir).ok();
+/// On every scene and both APIs, the runs with the scene's arguments and
+/// then `a`, and with them and then `b`, use different shaders and render the
+/// same image.
+fn agree(a: &[&str], b: &[&str], what: &str) {
+    for app in App::BOTH {
+        for (scene, size, set) in SCENES {
+            let dir = scratch(&format!("accel-{scene}-{what}"));
+            let (ra, ia) = render(app, scene, size, &[set, a].concat(), &dir.join("a.png"));
+            let (rb, ib) = render(app, scene, size, &[set, b].concat(), &dir.join("b.png"));
+            assert_ne!(
+                ra.variant, rb.variant,
+                "{what}: the two runs must use different shaders"
+            );
+            assert_within_1(
+                &ia,
+                &ib,
+                0.9999,
+                &format!("{app:?} {scene} {what} ({} vs {})", ra.variant, rb.variant),
+            );
+            std::fs::remove_dir_all(dir).ok();
+        }
+    }
 }
 
 #[test]
 fn bvh_and_brute_force_give_the_same_image() {
-    for app in App::BOTH {
-        for (scene, size, set) in SCENES {
-            let none: Vec<&str> = set.iter().copied().chain(["--accel", "none"]).collect();
-            let bvh: Vec<&str> = set.iter().copied().chain(["--accel", "bvh"]).collect();
-            agree(app, scene, size, &none, &bvh, "bvh");
-        }
-    }
+    agree(&["--accel", "none"], &["--accel", "bvh"], "bvh");
 }
 
 /// The 4- and 8-wide trees (`--accel bvh4`, `bvh8`) on both paths: the same
@@ -49,26 +48,17 @@ fn wide_bvhs_and_brute_force_give_the_same_image() {
     for app in App::BOTH {
         for (scene, size, set) in SCENES {
             let dir = scratch(&format!("accel-wide-{scene}"));
-            let none: Vec<&str> = set.iter().copied().chain(["--accel", "none"]).collect();
+            let none = [set, &["--accel", "none"]].concat();
             let (rn, brute) = render(app, scene, size, &none, &dir.join("none.png"));
             for (accel, width) in [("bvh4", 4), ("bvh8", 8)] {
                 for path in ["fragment", "compute"] {
-                    let args: Vec<&str> = set
-                        .iter()
-                        .copied()
-                        .chain(["--accel", accel, "--path", path])
-                        .collect();
+                    let args = [set, &["--accel", accel, "--path", path]].concat();
                     let (r, img) = render(app, scene, size, &args, &dir.join("w.png"));
                     let what = format!("{app:?} {scene} {accel} {path} ({})", r.variant);
                     assert!(r.variant.contains(&format!("/wide{width}/bvh")), "{what}");
                     assert_eq!(r.bvh_width, Some(width), "{what}: the JSON's width");
                     assert_ne!(r.variant, rn.variant);
-                    let m = compare(&brute, &img).unwrap();
-                    assert!(
-                        m.within_1() >= 0.9999,
-                        "{what}: {:.4}% within 1/255 of brute force",
-                        100.0 * m.within_1()
-                    );
+                    assert_within_1(&brute, &img, 0.9999, &format!("{what} vs brute force"));
                 }
             }
             std::fs::remove_dir_all(dir).ok();
@@ -78,17 +68,11 @@ fn wide_bvhs_and_brute_force_give_the_same_image() {
 
 #[test]
 fn every_scene_variant_agrees_with_the_generic_shader() {
-    for app in App::BOTH {
-        for (scene, size, set) in SCENES {
-            let variant: Vec<&str> = set.iter().copied().chain(["--accel", "none"]).collect();
-            let generic: Vec<&str> = set
-                .iter()
-                .copied()
-                .chain(["--accel", "none", "--generic"])
-                .collect();
-            agree(app, scene, size, &variant, &generic, "generic");
-        }
-    }
+    agree(
+        &["--accel", "none"],
+        &["--accel", "none", "--generic"],
+        "generic",
+    );
 }
 
 #[test]
@@ -96,13 +80,7 @@ fn specialization_constants_render_what_the_scene_variant_renders() {
     // --specialize: one source whose feature switches are constant_id overrides
     // set per scene (naga's process_overrides), in both APIs, with and without
     // the BVH.
-    for app in App::BOTH {
-        for (scene, size, set) in SCENES {
-            let variant: Vec<&str> = set.to_vec();
-            let spec: Vec<&str> = set.iter().copied().chain(["--specialize"]).collect();
-            agree(app, scene, size, &variant, &spec, "specialize");
-        }
-    }
+    agree(&[], &["--specialize"], "specialize");
 }
 
 #[test]
@@ -156,25 +134,13 @@ fn a_bvh_deeper_than_the_small_fixed_stacks_renders_every_primitive() {
     let scene = deep_bvh_scene(&dir);
     let scene = scene.to_str().unwrap();
     let reference = dir.join("ref.png");
-    let r = twinray_tests::run(
-        &twinray_tests::bin("twinray"),
-        &[
-            "render",
-            "--api",
-            "reference",
-            "--scene",
-            scene,
-            "--size",
-            "64x48",
-            "--accel",
-            "none",
-            "--out",
-            reference.to_str().unwrap(),
-        ],
-        &[],
+    let truth = orchestrator_render(
+        "reference",
+        scene,
+        "64x48",
+        &["--accel", "none"],
+        &reference,
     );
-    assert!(r.status.success(), "{}", String::from_utf8_lossy(&r.stderr));
-    let truth = twinray_common::reference::image_io::load_png(&reference).unwrap();
     for app in App::BOTH {
         for path in ["fragment", "compute"] {
             let (report, img) = render(

@@ -4,7 +4,7 @@
 //! the local origin's before/after rows are measured, and random scenes are
 //! compared three ways.
 
-use twinray_tests::{bin, run, scratch};
+use twinray_tests::{bin, run_ok, scratch};
 
 fn rows(csv: &str) -> (Vec<String>, Vec<Vec<String>>) {
     let mut lines = csv.lines();
@@ -26,7 +26,7 @@ fn rows(csv: &str) -> (Vec<String>, Vec<Vec<String>>) {
 #[test]
 fn quick_accuracy_report_covers_every_configuration_and_the_default_passes_the_hard_cases() {
     let out = scratch("accuracy-quick");
-    let o = run(
+    run_ok(
         &bin("twinray"),
         &[
             "accuracy",
@@ -37,11 +37,6 @@ fn quick_accuracy_report_covers_every_configuration_and_the_default_passes_the_h
             out.to_str().unwrap(),
         ],
         &[],
-    );
-    assert!(
-        o.status.success(),
-        "accuracy failed: {}",
-        String::from_utf8_lossy(&o.stderr)
     );
 
     let (h, body) = rows(&std::fs::read_to_string(out.join("accuracy.csv")).unwrap());

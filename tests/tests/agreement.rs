@@ -5,18 +5,16 @@
 use twinray_common::gpu::layout::GpuTriangle;
 use twinray_common::gpu::upload::UPLOAD_CHUNK_BYTES;
 use twinray_common::reference;
-use twinray_common::reference::metrics::compare;
 use twinray_common::scene::Scene;
-use twinray_tests::{render, scratch, App};
+use twinray_tests::{
+    assert_clean, assert_within_1, render, scratch, set_args, App, STANDARD_SCENES,
+};
 
 fn check(scene: &str, size: &str, set: &[(&str, &str)]) {
-    let kv: Vec<String> = set.iter().map(|(k, v)| format!("{k}={v}")).collect();
+    let args = set_args(set);
     // Named by the overrides too: tests of one scene run in parallel.
-    let dir = scratch(&format!("agree-{scene}{}", kv.concat()));
-    let mut extra = Vec::new();
-    for s in &kv {
-        extra.extend(["--set", s.as_str()]);
-    }
+    let dir = scratch(&format!("agree-{scene}{}", args.concat()));
+    let extra: Vec<&str> = args.iter().map(String::as_str).collect();
     let sz = twinray_common::cli::parse_size(size).unwrap();
     let overrides: Vec<(String, String)> = set
         .iter()
@@ -30,52 +28,32 @@ fn check(scene: &str, size: &str, set: &[(&str, &str)]) {
     let mut images = Vec::new();
     for app in App::BOTH {
         let (report, img) = render(app, scene, size, &extra, &dir.join(format!("{app:?}.png")));
-        assert_eq!(
-            report.validation_messages, 0,
-            "{scene} {app:?}: validation messages"
-        );
-        assert_eq!(
-            report.nonfinite_pixels, 0,
-            "{scene} {app:?}: NaN/Inf pixels before quantisation"
-        );
+        assert_clean(&report, &format!("{scene} {app:?}"));
         assert_eq!((report.width, report.height), (sz.width, sz.height));
         assert_eq!(report.scene.triangles, sc.triangles.len());
         assert_eq!(report.scene.spheres, sc.spheres.len());
-        let m = compare(&img, &reference).unwrap();
-        println!(
-            "{scene} {app:?} vs reference: {:.4}% within 1/255, max {}",
-            100.0 * m.within_1(),
-            m.max_abs
-        );
-        assert!(
-            m.within_1() >= 0.995,
-            "{scene} {app:?} vs reference: only {:.4}% within 1/255",
-            100.0 * m.within_1()
+        assert_within_1(
+            &img,
+            &reference,
+            0.995,
+            &format!("{scene} {app:?} vs reference"),
         );
         images.push(img);
     }
-    let m = compare(&images[0], &images[1]).unwrap();
-    println!(
-        "{scene} Vulkan vs OpenGL: {:.4}% within 1/255, max {}",
-        100.0 * m.within_1(),
-        m.max_abs
-    );
-    assert!(
-        m.within_1() >= 0.999,
-        "{scene} Vulkan vs OpenGL: only {:.4}% within 1/255",
-        100.0 * m.within_1()
+    assert_within_1(
+        &images[0],
+        &images[1],
+        0.999,
+        &format!("{scene} Vulkan vs OpenGL"),
     );
     std::fs::remove_dir_all(dir).ok();
 }
 
 #[test]
-fn box_agrees() {
-    check("box", "160x120", &[]);
-}
-
-#[test]
-fn teapot_agrees_at_a_small_size() {
-    check("teapot", "64x48", &[]);
+fn the_standard_scenes_agree() {
+    for (scene, size, set) in STANDARD_SCENES {
+        check(scene, size, set);
+    }
 }
 
 /// A teapot whose triangle buffer is larger than one upload chunk: each app
@@ -94,22 +72,17 @@ fn teapot_larger_than_one_upload_chunk_agrees() {
 }
 
 #[test]
-fn spherelist_with_100_extra_spheres_agrees() {
-    check("spherelist", "160x120", &[("extra_spheres", "100")]);
-}
-
-#[test]
 fn generic_shader_renders_the_same_as_the_variant() {
     let dir = scratch("generic");
     for app in App::BOTH {
         let (_, variant) = render(app, "box", "96x72", &[], &dir.join("v.png"));
         let (report, generic) = render(app, "box", "96x72", &["--generic"], &dir.join("g.png"));
         assert!(report.variant.contains("stack17"), "{}", report.variant);
-        let m = compare(&variant, &generic).unwrap();
-        assert!(
-            m.within_1() >= 0.9999,
-            "{app:?}: generic vs variant {:.4}%",
-            100.0 * m.within_1()
+        assert_within_1(
+            &variant,
+            &generic,
+            0.9999,
+            &format!("{app:?}: generic vs variant"),
         );
     }
 }
@@ -128,11 +101,6 @@ fn opengl_running_naga_spirv_matches_its_glsl() {
             &dir.join("spirv.png"),
         );
         assert!(report.variant.ends_with("(SPIR-V)"), "{}", report.variant);
-        let m = compare(&glsl, &spirv).unwrap();
-        assert!(
-            m.within_1() >= 0.9999,
-            "{scene}: SPIR-V vs GLSL {:.4}%",
-            100.0 * m.within_1()
-        );
+        assert_within_1(&glsl, &spirv, 0.9999, &format!("{scene}: SPIR-V vs GLSL"));
     }
 }

@@ -12,6 +12,8 @@ use std::collections::{BTreeMap, BTreeSet, HashMap};
 use std::path::{Path, PathBuf};
 use syn::spanned::Spanned;
 use syn::visit::Visit;
+use twinray_tests::assert_none;
+use twinray_tests::repo::{files_under, root};
 
 const CRATES: [&str; 5] = ["common", "vk", "gl", "comparison", "tests"];
 const MAX_FILE_LINES: usize = 600;
@@ -19,35 +21,12 @@ const MAX_FN_LINES: usize = 120;
 const FILE_MARKER: &str = "//! Long file:";
 const FN_MARKER: &str = "Long function:";
 
-fn root() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR"))
-        .parent()
-        .unwrap()
-        .to_path_buf()
-}
-
-fn rust_files(dir: &Path, out: &mut Vec<PathBuf>) {
-    let Ok(entries) = std::fs::read_dir(dir) else {
-        return;
-    };
-    let mut entries: Vec<PathBuf> = entries.map(|e| e.unwrap().path()).collect();
-    entries.sort();
-    for path in entries {
-        if path.is_dir() {
-            rust_files(&path, out);
-        } else if path.extension().is_some_and(|e| e == "rs") {
-            out.push(path);
-        }
-    }
-}
-
 /// Every .rs file of a crate: its library or binary sources and its tests.
 fn crate_files(krate: &str) -> Vec<PathBuf> {
-    let mut files = Vec::new();
-    for sub in ["src", "tests", "benches", "examples"] {
-        rust_files(&root().join(krate).join(sub), &mut files);
-    }
-    files
+    ["src", "tests", "benches", "examples"]
+        .iter()
+        .flat_map(|sub| files_under(&root().join(krate).join(sub), &["rs"]))
+        .collect()
 }
 
 fn every_file() -> Vec<PathBuf> {
@@ -306,8 +285,7 @@ fn cycles(graph: &BTreeMap<Vec<String>, BTreeSet<Vec<String>>>) -> Vec<Vec<Vec<S
 fn crate_cycles(krate: &str) -> Vec<String> {
     let src = root().join(krate).join("src");
     let has_lib = src.join("lib.rs").is_file();
-    let mut files = Vec::new();
-    rust_files(&src, &mut files);
+    let files = files_under(&src, &["rs"]);
     let mut modules = BTreeMap::new();
     for file in files {
         let Some(module) = module_path(&src, &file, has_lib) else {
@@ -370,12 +348,7 @@ fn crate_cycles(krate: &str) -> Vec<String> {
 #[test]
 fn no_import_cycle_between_the_files_of_a_crate() {
     let found: Vec<String> = CRATES.iter().flat_map(|c| crate_cycles(c)).collect();
-    assert!(
-        found.is_empty(),
-        "{} import cycle(s); give each pair one direction (move what both need into a module both import):\n{}",
-        found.len(),
-        found.join("\n")
-    );
+    assert_none("import cycle(s); give each pair one direction (move what both need into a module both import)", &found);
 }
 
 #[test]
@@ -438,12 +411,7 @@ fn no_file_over_600_lines_without_a_reason() {
             offenders.push(format!("{}: {lines} lines", relative(&file)));
         }
     }
-    assert!(
-        offenders.is_empty(),
-        "{} file(s) over {MAX_FILE_LINES} lines: split them, or open them with `{FILE_MARKER} <reason>`:\n{}",
-        offenders.len(),
-        offenders.join("\n")
-    );
+    assert_none(&format!("file(s) over {MAX_FILE_LINES} lines: split them, or open them with `{FILE_MARKER} <reason>`"), &offenders);
 }
 
 /// Every function with a body: free, in an impl, default in a trait, nested.
@@ -530,12 +498,7 @@ fn no_function_over_120_lines_without_a_reason() {
         }
     }
     assert!(checked > 300, "only {checked} functions found");
-    assert!(
-        offenders.is_empty(),
-        "{} function(s) over {MAX_FN_LINES} lines: split them, or put `// {FN_MARKER} <reason>` directly above:\n{}",
-        offenders.len(),
-        offenders.join("\n")
-    );
+    assert_none(&format!("function(s) over {MAX_FN_LINES} lines: split them, or put `// {FN_MARKER} <reason>` directly above"), &offenders);
 }
 
 #[test]
@@ -587,9 +550,5 @@ fn the_orchestrator_links_no_winit() {
             chains.push(chain.into_iter().rev().collect::<Vec<_>>().join("\n"));
         }
     }
-    assert!(
-        chains.is_empty(),
-        "`cargo tree -p twinray -e normal` lists a window system; keep the windowed code behind the apps' feature:\n{}",
-        chains.join("\n")
-    );
+    assert_none("`cargo tree -p twinray -e normal` lists a window system; keep the windowed code behind the apps' feature", &chains);
 }

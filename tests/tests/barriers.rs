@@ -6,24 +6,9 @@
 //! mean, and the runs are clean under synchronisation validation with images
 //! byte-identical between the two recordings.
 
-use std::path::{Path, PathBuf};
+use twinray_tests::repo::{assert_scan, root, WALKTHROUGH};
+use twinray_tests::{assert_none, box_window, SYNC_VALIDATION};
 use twinray_vk::barrier::{self, Access, Barrier, Guards, Recording};
-
-fn root() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR"))
-        .parent()
-        .unwrap()
-        .to_path_buf()
-}
-
-fn page_path() -> PathBuf {
-    root().join("docs/vulkan-walkthrough.md")
-}
-
-const SYNC_VALIDATION: (&str, &str) = (
-    "VK_LAYER_ENABLES",
-    "VK_VALIDATION_FEATURE_ENABLE_SYNCHRONIZATION_VALIDATION_EXT",
-);
 
 fn sync2_env(recording: Recording) -> (&'static str, &'static str) {
     let on = match recording {
@@ -57,14 +42,12 @@ fn no_stage_access_or_layout_outside_the_barrier_module() {
             }
         }
     }
-    assert!(
-        outside.is_empty(),
-        "stage masks, access masks or layouts outside vk/src/barrier.rs: name the accesses instead\n{}",
-        outside.join("\n")
-    );
-    assert!(
-        inside >= 10,
-        "only {inside} mask lines seen in barrier.rs: is the search still reading it?"
+    assert_scan(
+        "stage masks, access masks or layouts outside vk/src/barrier.rs: name the accesses instead",
+        &outside,
+        inside,
+        10,
+        "mask lines in barrier.rs",
     );
 }
 
@@ -135,7 +118,7 @@ fn page_holds(name: &str, expected: &str) {
     // The two table tests run at once; a rewrite must not undo the other's.
     static PAGE: std::sync::Mutex<()> = std::sync::Mutex::new(());
     let _only_one = PAGE.lock().unwrap_or_else(|e| e.into_inner());
-    let path = page_path();
+    let path = root().join(WALKTHROUGH);
     let doc = std::fs::read_to_string(&path).unwrap();
     let (begin, end) = (
         format!("<!-- {name}:begin -->\n"),
@@ -386,42 +369,44 @@ fn explain_prints_each_headless_barrier_as_recorded() {
             }
         }
     }
-    assert!(
-        wrong.is_empty(),
-        "--explain's barriers:\n{}",
-        wrong.join("\n")
+    assert_none("--explain's barriers", &wrong);
+}
+
+/// twinray-vk's box window at 64x48 for `frames` frames with `args`,
+/// validated and explained, in `recording`, under synchronisation validation
+/// and with `env`: its stderr, the run having succeeded.
+fn in_window(
+    xvfb: &twinray_tests::Xvfb,
+    recording: Recording,
+    (frames, args): (&str, &[&str]),
+    env: (&str, &str),
+    name: &str,
+) -> String {
+    let dir = twinray_tests::scratch(&format!("barriers-{name}-{recording:?}"));
+    let args = box_window(
+        "64x48",
+        frames,
+        &[args, &["--validate", "--explain"]].concat(),
     );
+    let env = [SYNC_VALIDATION, sync2_env(recording), env];
+    let app = twinray_tests::bin("twinray-vk");
+    let out = xvfb.run(&app, &args, &env, &dir);
+    let stderr = String::from_utf8_lossy(&out.stderr).into_owned();
+    assert!(
+        out.status.success(),
+        "the window {args:?} failed ({recording:?}):\n{stderr}"
+    );
+    stderr
 }
 
 #[test]
 fn explain_prints_each_window_barrier_as_recorded() {
     let xvfb = twinray_tests::Xvfb::start();
-    let app = twinray_tests::bin("twinray-vk");
     let mut wrong = Vec::new();
     for recording in RECORDINGS {
-        let dir = twinray_tests::scratch(&format!("barriers-window-{recording:?}"));
         // Two frames on the fragment path (`R` changes nothing), then `C`: the compute path.
-        let args = [
-            "--scene",
-            "box",
-            "--size",
-            "64x48",
-            "--frames",
-            "5",
-            "--validate",
-            "--explain",
-        ];
-        let env = [
-            SYNC_VALIDATION,
-            sync2_env(recording),
-            ("TWINRAY_TEST_KEYS", "r,r,c"),
-        ];
-        let out = xvfb.run(&app, &args, &env, &dir);
-        let stderr = String::from_utf8_lossy(&out.stderr);
-        assert!(
-            out.status.success(),
-            "the window failed ({recording:?}):\n{stderr}"
-        );
+        let keys = ("TWINRAY_TEST_KEYS", "r,r,c");
+        let stderr = in_window(&xvfb, recording, ("5", &[]), keys, "window");
         let mut printed = check_printed(&stderr, recording, &mut wrong);
         printed.sort();
         printed.dedup();
@@ -444,11 +429,7 @@ fn explain_prints_each_window_barrier_as_recorded() {
             ));
         }
     }
-    assert!(
-        wrong.is_empty(),
-        "--explain's barriers in the window:\n{}",
-        wrong.join("\n")
-    );
+    assert_none("--explain's barriers in the window", &wrong);
 }
 
 #[test]
@@ -494,30 +475,11 @@ fn both_recordings_make_the_same_image_under_sync_validation() {
 #[test]
 fn both_recordings_survive_resizes_under_sync_validation() {
     let xvfb = twinray_tests::Xvfb::start();
-    let app = twinray_tests::bin("twinray-vk");
     for recording in RECORDINGS {
         for path in ["fragment", "compute"] {
-            let dir = twinray_tests::scratch(&format!("barriers-resize-{path}-{recording:?}"));
-            let args = [
-                "--scene",
-                "box",
-                "--size",
-                "64x48",
-                "--frames",
-                "100",
-                "--path",
-                path,
-                "--validate",
-                "--explain",
-            ];
-            let env = [
-                SYNC_VALIDATION,
-                sync2_env(recording),
-                ("TWINRAY_TEST_RESIZE", "1"),
-            ];
-            let out = xvfb.run(&app, &args, &env, &dir);
-            let stderr = String::from_utf8_lossy(&out.stderr);
-            assert!(out.status.success(), "{path}, {recording:?}:\n{stderr}");
+            let resize = ("TWINRAY_TEST_RESIZE", "1");
+            let run = ("100", &["--path", path][..]);
+            let stderr = in_window(&xvfb, recording, run, resize, &format!("resize-{path}"));
             assert!(
                 !stderr.contains("twinray-vk: validation"),
                 "{path}, {recording:?}:\n{stderr}"

@@ -1,32 +1,7 @@
 //! Comments and pages that count what `common/src/gpu/layout.rs` declares
 //! count it right: the storage buffers, and each binding's own comment.
 
-use std::path::{Path, PathBuf};
-
-fn root() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR"))
-        .parent()
-        .unwrap()
-        .to_path_buf()
-}
-
-fn doc_path() -> PathBuf {
-    root().join("docs/vulkan-walkthrough.md")
-}
-
-fn rust_sources(dir: &Path, text: &mut String) {
-    let Ok(entries) = std::fs::read_dir(dir) else {
-        return;
-    };
-    for entry in entries {
-        let path = entry.unwrap().path();
-        if path.is_dir() {
-            rust_sources(&path, text);
-        } else if path.extension().is_some_and(|e| e == "rs") {
-            *text += &std::fs::read_to_string(&path).unwrap();
-        }
-    }
-}
+use twinray_tests::repo::{assert_scan, rust_sources, text, WALKTHROUGH};
 
 /// Counts that comments and pages give of the scene's storage buffers (`four
 /// storage buffers`) are the count in `common/src/gpu/layout.rs`'s
@@ -34,7 +9,7 @@ fn rust_sources(dir: &Path, text: &mut String) {
 /// binding, not a neighbour's (`5 is ...` over binding 6).
 #[test]
 fn comments_count_what_layout_rs_declares() {
-    let layout = std::fs::read_to_string(root().join("common/src/gpu/layout.rs")).unwrap();
+    let layout = text("common/src/gpu/layout.rs");
     let declared = layout
         .split("pub const STORAGE: [u32; ")
         .nth(1)
@@ -43,14 +18,9 @@ fn comments_count_what_layout_rs_declares() {
     let numbers = [
         "one", "two", "three", "four", "five", "six", "seven", "eight", "nine", "ten",
     ];
-    let mut texts = vec![(
-        "docs/vulkan-walkthrough.md".to_string(),
-        std::fs::read_to_string(doc_path()).unwrap(),
-    )];
+    let mut texts = vec![(WALKTHROUGH.to_string(), text(WALKTHROUGH))];
     for dir in ["vk/src", "gl/src", "common/src"] {
-        let mut text = String::new();
-        rust_sources(&root().join(dir), &mut text);
-        texts.push((dir.to_string(), text));
+        texts.push((dir.to_string(), rust_sources(&[dir])));
     }
     let mut wrong = Vec::new();
     let mut seen = 0;
@@ -104,9 +74,11 @@ fn comments_count_what_layout_rs_declares() {
         }
         doc.clear();
     }
-    assert!(
-        seen >= 2,
-        "only {seen} storage-buffer counts found: is the search still reading?"
+    assert_scan(
+        "counts that are not layout.rs's",
+        &wrong,
+        seen,
+        2,
+        "storage-buffer counts",
     );
-    assert!(wrong.is_empty(), "{}", wrong.join("\n"));
 }

@@ -3,9 +3,10 @@
 //! NaN, zero validation messages / GL debug errors; every measured workgroup
 //! size, and image sizes that are not a multiple of the workgroup, included.
 
-use twinray_common::reference::metrics::compare;
 use twinray_common::value_name::ValueName;
-use twinray_tests::{render, scratch, App};
+use twinray_tests::{
+    assert_clean, assert_within_1, render, scratch, set_args, App, STANDARD_SCENES,
+};
 
 fn check(scene: &str, size: &str, extra: &[&str]) {
     let dir = scratch(&format!("compute-{scene}"));
@@ -24,42 +25,27 @@ fn check(scene: &str, size: &str, extra: &[&str]) {
             report.workgroup.is_some(),
             "{app:?}: the report names the workgroup"
         );
-        assert_eq!(
-            report.validation_messages, 0,
-            "{scene} {app:?} compute: validation messages"
-        );
-        assert_eq!(
-            report.nonfinite_pixels, 0,
-            "{scene} {app:?} compute: NaN/Inf pixels"
-        );
-        let m = compare(&compute, &fragment).unwrap();
-        println!(
-            "{scene} {app:?} compute vs fragment: {:.4}% within 1/255, max {}",
-            100.0 * m.within_1(),
-            m.max_abs
-        );
-        assert!(
-            m.within_1() >= 0.9999,
-            "{scene} {app:?}: compute vs fragment only {:.4}% within 1/255",
-            100.0 * m.within_1()
+        assert_clean(&report, &format!("{scene} {app:?} compute"));
+        assert_within_1(
+            &compute,
+            &fragment,
+            0.9999,
+            &format!("{scene} {app:?}: compute vs fragment"),
         );
     }
     std::fs::remove_dir_all(dir).ok();
 }
 
 #[test]
-fn box_compute_matches_fragment() {
-    check("box", "160x120", &[]);
-}
-
-#[test]
-fn teapot_compute_matches_fragment_at_a_small_size() {
-    check("teapot", "64x48", &[]);
-}
-
-#[test]
-fn spherelist_with_100_extra_spheres_compute_matches_fragment() {
-    check("spherelist", "160x120", &["--set", "extra_spheres=100"]);
+fn the_standard_scenes_compute_matches_fragment() {
+    for (scene, size, set) in STANDARD_SCENES {
+        let args = set_args(set);
+        check(
+            scene,
+            size,
+            &args.iter().map(String::as_str).collect::<Vec<_>>(),
+        );
+    }
 }
 
 #[test]
@@ -78,12 +64,7 @@ fn every_measured_workgroup_covers_an_odd_sized_image() {
             );
             assert_eq!(report.workgroup.as_deref(), Some(wg));
             assert_eq!(report.validation_messages, 0);
-            let m = compare(&img, &fragment).unwrap();
-            assert!(
-                m.within_1() >= 0.9999,
-                "{app:?} {wg}: {:.4}% within 1/255",
-                100.0 * m.within_1()
-            );
+            assert_within_1(&img, &fragment, 0.9999, &format!("{app:?} {wg}"));
         }
     }
 }

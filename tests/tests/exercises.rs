@@ -5,14 +5,9 @@
 //! request: it rebuilds twinray-vk six times), and the fixed code survives what
 //! exercise 3 breaks.
 
-use std::path::{Path, PathBuf};
-
-fn root() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR"))
-        .parent()
-        .unwrap()
-        .to_path_buf()
-}
+use std::path::Path;
+use twinray_tests::box_window;
+use twinray_tests::repo::{root, text, WALKTHROUGH};
 
 /// The page's exercise `n`: its numbered item, up to the next one.
 fn exercise_on_the_page(doc: &str, n: u32) -> String {
@@ -32,8 +27,8 @@ fn exercise_on_the_page(doc: &str, n: u32) -> String {
 
 #[test]
 fn the_script_checks_the_outcome_each_exercise_promises() {
-    let doc = std::fs::read_to_string(root().join("docs/vulkan-walkthrough.md")).unwrap();
-    let script = std::fs::read_to_string(root().join("tests/exercises.sh")).unwrap();
+    let doc = text(WALKTHROUGH);
+    let script = text("tests/exercises.sh");
     let mut graded = 0;
     let mut wrong = Vec::new();
     for line in script.lines() {
@@ -99,18 +94,8 @@ fn the_window_survives_an_out_of_date_acquire() {
     let dir = twinray_tests::scratch("out-of-date");
     let app = twinray_tests::bin("twinray-vk");
     let app = app.to_str().unwrap();
-    let args = [
-        "60",
-        app,
-        "--scene",
-        "box",
-        "--size",
-        "64x48",
-        "--frames",
-        "10",
-        "--validate",
-        "--explain",
-    ];
+    let window = box_window("64x48", "10", &["--validate", "--explain"]);
+    let args = [&["60", app][..], &window].concat();
     let out = xvfb.run(
         Path::new("timeout"),
         &args,

@@ -14,25 +14,17 @@
 
 use std::collections::BTreeMap;
 use std::io::Write;
-use std::path::{Path, PathBuf};
 use std::process::{Command, Stdio};
-use twinray_tests::markdown::{anchors, broken, links, prose, without_code_spans};
+use twinray_tests::assert_none;
+use twinray_tests::markdown::{
+    anchors, assert_links_resolve, citations, links, prose, without_code_spans,
+};
+use twinray_tests::repo::{assert_scan, read, root};
 
 const FINDINGS: &str = "docs/findings";
 const INDEX: &str = "README.md";
 const MAX_PAGE_LINES: usize = 300;
 const MAX_VERDICT_LINES: usize = 10;
-
-fn root() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR"))
-        .parent()
-        .unwrap()
-        .to_path_buf()
-}
-
-fn read(path: &Path) -> String {
-    std::fs::read_to_string(path).unwrap_or_else(|e| panic!("{}: {e}", path.display()))
-}
 
 /// `git ARGS` in the repository's root; its stdout, or `None` where git is
 /// missing or this is no git checkout.
@@ -63,23 +55,6 @@ fn tracked_markdown() -> Vec<String> {
         .lines()
         .filter(|f| root().join(f).is_file())
         .map(str::to_string)
-        .collect()
-}
-
-/// Every `COMMIT:PATH` a line cites: an abbreviated or full commit (7 to 40
-/// hexadecimal digits), a colon, and a path.
-fn citations(line: &str) -> Vec<String> {
-    line.split(|c: char| c.is_whitespace() || "()\"'`,;<>[]*".contains(c))
-        .filter_map(|word| {
-            let word = word.trim_end_matches(['.', ':']);
-            let (commit, path) = word.split_once(':')?;
-            let hex = (7..=40).contains(&commit.len())
-                && commit
-                    .chars()
-                    .all(|c| c.is_ascii_hexdigit() && !c.is_ascii_uppercase());
-            (hex && !path.is_empty() && !path.contains(':') && !path.starts_with('/'))
-                .then(|| word.to_string())
-        })
         .collect()
 }
 
@@ -207,35 +182,12 @@ fn every_cited_commit_path_opens() {
         .filter(|(_, answer)| answer.ends_with(" missing") || answer.ends_with(" ambiguous"))
         .map(|((citation, places), _)| format!("{citation} (cited at {})", places.join(", ")))
         .collect();
-    assert!(
-        missing.is_empty(),
-        "cited COMMIT:PATHs that `git show` cannot open:\n{}",
-        missing.join("\n")
-    );
+    assert_none("cited COMMIT:PATHs that `git show` cannot open", &missing);
 }
 
 #[test]
 fn every_relative_link_of_the_markdown_resolves() {
-    let mut broken_links = Vec::new();
-    let mut checked = 0;
-    for file in tracked_markdown() {
-        let path = root().join(&file);
-        for target in links(&read(&path)) {
-            checked += 1;
-            if let Some(why) = broken(&path, &target) {
-                broken_links.push(format!("{file}: {why}"));
-            }
-        }
-    }
-    assert!(
-        broken_links.is_empty(),
-        "links that lead nowhere:\n{}",
-        broken_links.join("\n")
-    );
-    assert!(
-        checked >= 100,
-        "only {checked} links found in the tracked Markdown: is the parser still reading it?"
-    );
+    assert_links_resolve(&tracked_markdown(), 100, "links in the tracked Markdown");
 }
 
 #[test]
@@ -317,14 +269,12 @@ fn no_figure_is_stated_on_two_findings_pages() {
         .filter(|(_, on)| on.len() > 1)
         .map(|(figure, on)| format!("{figure}: {}", on.join(", ")))
         .collect();
-    assert!(
-        twice.is_empty(),
-        "figures stated on more than one findings page (keep each on one, link from the others):\n{}",
-        twice.join("\n")
-    );
-    assert!(
-        total >= 50,
-        "only {total} figures found on the findings pages: is the scan still reading them?"
+    assert_scan(
+        "figures stated on more than one findings page (keep each on one, link from the others)",
+        &twice,
+        total,
+        50,
+        "figures on the findings pages",
     );
 }
 

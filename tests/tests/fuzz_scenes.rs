@@ -11,7 +11,6 @@
 //! the seed (README, "Testing").
 
 use arbitrary::Unstructured;
-use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
 use twinray_common::error::exit_code_of;
 use twinray_common::gpu::layout::binding;
@@ -20,6 +19,7 @@ use twinray_common::plan::build_bvh;
 use twinray_common::scene::accel::Accel;
 use twinray_common::scene::load::BUILTIN_SCENES;
 use twinray_common::scene::Scene;
+use twinray_tests::repo::{files_under, read, root, text};
 
 /// Values that break parsers and f32 conversions: zero, signed zero, overflow
 /// in f32 and f64, underflow, NaN, the edges of u32, and plain ones.
@@ -124,26 +124,15 @@ const OVERRIDES: &[(&str, &str)] = &[
     ("triangle", "watertight"),
 ];
 
-fn repo() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("..")
-}
-
 /// (name, text, folder relative to the scratch root) of every bundled scene.
 fn seeds() -> Vec<(String, String, &'static str)> {
     let mut v: Vec<_> = BUILTIN_SCENES
         .iter()
         .map(|(n, t)| (n.to_string(), t.to_string(), "scenes"))
         .collect();
-    let hard = repo().join("scenes/hard");
-    let mut files: Vec<_> = std::fs::read_dir(&hard)
-        .unwrap()
-        .map(|e| e.unwrap().path())
-        .filter(|p| p.extension().is_some_and(|e| e == "toml"))
-        .collect();
-    files.sort();
-    for p in files {
+    for p in files_under(&root().join("scenes/hard"), &["toml"]) {
         let name = p.file_stem().unwrap().to_string_lossy().to_string();
-        v.push((name, std::fs::read_to_string(&p).unwrap(), "scenes/hard"));
+        v.push((name, read(&p), "scenes/hard"));
     }
     v
 }
@@ -156,7 +145,7 @@ fn meshes() -> Vec<(&'static str, String)> {
         "scenes/hard/icosphere.obj",
     ]
     .iter()
-    .map(|p| (*p, std::fs::read_to_string(repo().join(p)).unwrap()))
+    .map(|p| (*p, text(p)))
     .collect()
 }
 

@@ -15,7 +15,7 @@ use twinray_common::reference;
 use twinray_common::reference::image_io::FloatImage;
 use twinray_common::scene::hard::{self, HardCase};
 use twinray_common::scene::Scene;
-use twinray_tests::{render, scratch, App};
+use twinray_tests::{assert_clean, assert_within_1, render, scratch, App};
 
 const SIZE: &str = "64x64";
 
@@ -68,11 +68,7 @@ fn within_tolerance(
     truth: &image::RgbImage,
 ) {
     let name = format!("{} {app:?} {}", case.name, extra.join(" "));
-    assert_eq!(
-        report.nonfinite_pixels, 0,
-        "{name}: NaN/Inf pixels before quantisation"
-    );
-    assert_eq!(report.validation_messages, 0, "{name}: validation messages");
+    assert_clean(report, &name);
     let wrong = 100.0 * hard::wrong_share(img, truth);
     println!(
         "{name}: {wrong:.3}% wrong (tolerance {}%)",
@@ -214,11 +210,6 @@ fn numerics_set_keys_work_in_both_apps() {
             "{}",
             report.variant
         );
-        let m = twinray_common::reference::metrics::compare(&img, &reference).unwrap();
-        assert!(
-            m.within_1() >= 0.995,
-            "{app:?}: {:.3}% within 1/255",
-            100.0 * m.within_1()
-        );
+        assert_within_1(&img, &reference, 0.995, &format!("{app:?}"));
     }
 }

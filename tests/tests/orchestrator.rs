@@ -1,27 +1,12 @@
 //! `twinray render --api reference` and `twinray diff` as a user runs them.
 
-use twinray_tests::{bin, run, scratch};
+use twinray_tests::{bin, orchestrator_render, run, scratch};
 
 #[test]
 fn reference_render_and_diff_of_identical_images() {
     let dir = scratch("orch");
     let out = dir.join("ref.png");
-    let o = run(
-        &bin("twinray"),
-        &[
-            "render",
-            "--api",
-            "reference",
-            "--scene",
-            "box",
-            "--size",
-            "64x48",
-            "--out",
-            out.to_str().unwrap(),
-        ],
-        &[],
-    );
-    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    orchestrator_render("reference", "box", "64x48", &[], &out);
     let o = run(
         &bin("twinray"),
         &[
@@ -43,23 +28,7 @@ fn reference_render_and_diff_of_identical_images() {
 fn render_through_the_orchestrator_matches_the_app() {
     let dir = scratch("orch-app");
     let out = dir.join("vk.png");
-    let o = run(
-        &bin("twinray"),
-        &[
-            "render",
-            "--api",
-            "vulkan",
-            "--scene",
-            "spherelist",
-            "--size",
-            "48x32",
-            "--out",
-            out.to_str().unwrap(),
-        ],
-        &[],
-    );
-    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
-    let img = twinray_common::reference::image_io::load_png(&out).unwrap();
+    let img = orchestrator_render("vulkan", "spherelist", "48x32", &[], &out);
     assert_eq!(img.dimensions(), (48, 32));
 }
 
@@ -74,13 +43,7 @@ fn the_tolerance_script_gets_the_hard_cases_truth_and_runs() {
     let dir = scratch("truth");
     let scene = format!("{}/coplanar.toml", hard::SOURCE_DIR);
     let render = |extra: &[&str], name: &str| {
-        let out = dir.join(name);
-        let mut args = vec!["render", "--api", "reference", "--scene", &scene];
-        args.extend(["--size", "64x64", "--out", out.to_str().unwrap()]);
-        args.extend(extra);
-        let o = run(&bin("twinray"), &args, &[]);
-        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
-        twinray_common::reference::image_io::load_png(&out).unwrap()
+        orchestrator_render("reference", &scene, "64x64", extra, &dir.join(name))
     };
     let truth = render(&["--truth"], "truth.png");
     let own = render(&[], "own.png");

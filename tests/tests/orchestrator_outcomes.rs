@@ -7,7 +7,7 @@
 use std::path::Path;
 use std::process::{Child, Command, Stdio};
 use std::time::{Duration, Instant};
-use twinray_tests::{bin, scratch};
+use twinray_tests::{bin, scratch, stand_in, stderr_of};
 
 /// Two stand-in apps that fail every run the way a real one fails on bad
 /// input (clap's `error:` line, then its "For more information" line), and
@@ -25,10 +25,7 @@ fn failing_apps(dir: &Path, slow_s: u32) -> String {
              echo \"For more information, try '--help'.\" >&2\n\
              exit 2\n"
         );
-        let path = bin_dir.join(app);
-        std::fs::write(&path, script).unwrap();
-        use std::os::unix::fs::PermissionsExt;
-        std::fs::set_permissions(&path, std::fs::Permissions::from_mode(0o755)).unwrap();
+        stand_in(&bin_dir, app, &script);
     }
     bin_dir.to_str().unwrap().to_string()
 }
@@ -102,15 +99,7 @@ fn finish(mut child: Child, limit: Duration) -> (Option<i32>, String) {
     let started = Instant::now();
     loop {
         if let Some(status) = child.try_wait().unwrap() {
-            let mut stderr = String::new();
-            use std::io::Read;
-            child
-                .stderr
-                .take()
-                .unwrap()
-                .read_to_string(&mut stderr)
-                .unwrap();
-            return (status.code(), stderr);
+            return (status.code(), stderr_of(&mut child));
         }
         if started.elapsed() > limit {
             let _ = child.kill();
@@ -118,6 +107,16 @@ fn finish(mut child: Child, limit: Duration) -> (Option<i32>, String) {
         }
         std::thread::sleep(Duration::from_millis(50));
     }
+}
+
+/// The report an interrupted run wrote to `out`, whose title holds `title`
+/// and whose text holds `says`.
+fn interrupted_report(out: &Path, title: &str, says: &str) -> String {
+    let report = std::fs::read_to_string(out.join("report.md")).unwrap();
+    let first = report.lines().next().unwrap_or_default();
+    assert!(first.contains(title), "{first}");
+    assert!(report.contains(says), "{report}");
+    report
 }
 
 #[test]
@@ -158,15 +157,10 @@ fn sigterm_during_the_sweep_keeps_the_finished_points_and_exits_143() {
     signal(&child, "TERM");
     let (code, stderr) = finish(child, Duration::from_secs(30));
     assert_eq!(code, Some(143), "{stderr}");
-    let report = std::fs::read_to_string(out.join("report.md")).unwrap();
-    let title = report.lines().next().unwrap_or_default();
-    assert!(
-        title.contains("(interrupted by SIGTERM during the sweep)"),
-        "{title}"
-    );
-    assert!(
-        report.contains("> Interrupted by SIGTERM during the sweep"),
-        "{report}"
+    let report = interrupted_report(
+        &out,
+        "(interrupted by SIGTERM during the sweep)",
+        "> Interrupted by SIGTERM during the sweep",
     );
     assert!(report.contains("## Points not run"), "{report}");
     let csv = std::fs::read_to_string(out.join("results.csv")).unwrap();
@@ -189,14 +183,10 @@ fn sighup_and_sigint_after_the_sweep_are_stated_and_exit_129_and_130() {
         let (got, stderr) = finish(child, Duration::from_secs(30));
         // Interrupted, not failed: the signal's code, though every run failed.
         assert_eq!(got, Some(code), "SIG{name}: {stderr}");
-        let report = std::fs::read_to_string(out.join("report.md")).unwrap();
-        let stated = format!("interrupted by SIG{name} during the shader statistics");
-        assert!(report.lines().next().unwrap().contains(&stated), "{report}");
-        assert!(
-            report.contains(&format!(
-                "> Interrupted by SIG{name} during the shader statistics"
-            )),
-            "{report}"
+        interrupted_report(
+            &out,
+            &format!("interrupted by SIG{name} during the shader statistics"),
+            &format!("> Interrupted by SIG{name} during the shader statistics"),
         );
         assert!(out.join("results.csv").is_file());
     }
@@ -224,15 +214,10 @@ fn sigterm_during_the_accuracy_sweeps_keeps_the_finished_runs_and_exits_143() {
     signal(&child, "TERM");
     let (code, stderr) = finish(child, Duration::from_secs(60));
     assert_eq!(code, Some(143), "{stderr}");
-    let report = std::fs::read_to_string(out.join("report.md")).unwrap();
-    let title = report.lines().next().unwrap_or_default();
-    assert!(
-        title.contains("(interrupted by SIGTERM during the sweeps)"),
-        "{title}"
-    );
-    assert!(
-        report.contains("The run was interrupted by SIGTERM"),
-        "{report}"
+    interrupted_report(
+        &out,
+        "(interrupted by SIGTERM during the sweeps)",
+        "The run was interrupted by SIGTERM",
     );
     let csv = std::fs::read_to_string(out.join("accuracy.csv")).unwrap();
     assert!(
@@ -261,10 +246,7 @@ fn hanging_apps(dir: &Path, hang_on: &str) -> String {
              exit 2\n",
             marker.display()
         );
-        let path = bin_dir.join(app);
-        std::fs::write(&path, script).unwrap();
-        use std::os::unix::fs::PermissionsExt;
-        std::fs::set_permissions(&path, std::fs::Permissions::from_mode(0o755)).unwrap();
+        stand_in(&bin_dir, app, &script);
     }
     bin_dir.to_str().unwrap().to_string()
 }
@@ -292,77 +274,45 @@ struct Step {
     csv: &'static str,
 }
 
+const fn step(
+    command: &'static [&'static str],
+    hang_on: &'static str,
+    during: &'static str,
+    csv: &'static str,
+) -> Step {
+    Step {
+        command,
+        hang_on,
+        during,
+        csv,
+    }
+}
+
+const COMPARE_ACCEL: &[&str] = &[
+    "compare",
+    "--quick",
+    "--only",
+    "box,accel",
+    "--paths",
+    "fragment",
+];
+const COMPARE_BOX: &[&str] = &["compare", "--quick", "--only", "box", "--paths", "fragment"];
+const COMPARE_WHY: &[&str] = &["compare", "--quick", "--only", "why", "--paths", "fragment"];
+const ACCURACY: &[&str] = &["accuracy", "--quick", "--random", "1"];
+
+#[rustfmt::skip]
 const STEPS: [Step; 9] = [
-    Step {
-        command: &[
-            "compare",
-            "--quick",
-            "--only",
-            "box,accel",
-            "--paths",
-            "fragment",
-        ],
-        hang_on: "*--frames*--accel\\ none*",
-        during: "during the sweep",
-        csv: "results.csv",
-    },
-    Step {
-        command: &[
-            "compare",
-            "--quick",
-            "--only",
-            "box,accel",
-            "--paths",
-            "fragment",
-        ],
-        hang_on: "*--accel\\ bvh*",
-        during: "during the acceleration runs",
-        csv: "results.csv",
-    },
-    Step {
-        command: &["compare", "--quick", "--only", "box", "--paths", "fragment"],
-        hang_on: "*/images/*",
-        during: "during the image agreement",
-        csv: "results.csv",
-    },
-    Step {
-        command: &["compare", "--quick", "--only", "box", "--paths", "fragment"],
-        hang_on: "*--dump-shaders*",
-        during: "during the shader statistics",
-        csv: "results.csv",
-    },
-    Step {
-        command: &["compare", "--quick", "--only", "why", "--paths", "fragment"],
-        hang_on: "*--experiment*",
-        during: "during the why step",
-        csv: "why.csv",
-    },
-    Step {
-        command: &["accuracy", "--quick", "--random", "1"],
-        hang_on: "*",
-        during: "during the sweeps",
-        csv: "accuracy.csv",
-    },
-    Step {
-        command: &["accuracy", "--quick", "--random", "1"],
-        hang_on: "*/hard/*",
-        during: "during the hard cases",
-        csv: "hard_cases.csv",
-    },
-    Step {
-        command: &["accuracy", "--quick", "--no-hard", "--random", "1"],
-        hang_on: "*random:*",
-        during: "during the random scenes",
-        csv: "random.csv",
-    },
-    Step {
-        // Every operation at the default 2^20 inputs: the CPU's column of all
-        // of them, computed after the signal, once took 2.6 s more.
-        command: &["ulp"],
-        hang_on: "*",
-        during: "interrupted by",
-        csv: "ulp.csv",
-    },
+    step(COMPARE_ACCEL, "*--frames*--accel\\ none*", "during the sweep", "results.csv"),
+    step(COMPARE_ACCEL, "*--accel\\ bvh*", "during the acceleration runs", "results.csv"),
+    step(COMPARE_BOX, "*/images/*", "during the image agreement", "results.csv"),
+    step(COMPARE_BOX, "*--dump-shaders*", "during the shader statistics", "results.csv"),
+    step(COMPARE_WHY, "*--experiment*", "during the why step", "why.csv"),
+    step(ACCURACY, "*", "during the sweeps", "accuracy.csv"),
+    step(ACCURACY, "*/hard/*", "during the hard cases", "hard_cases.csv"),
+    step(&["accuracy", "--quick", "--no-hard", "--random", "1"], "*random:*", "during the random scenes", "random.csv"),
+    // Every operation at the default 2^20 inputs: the CPU's column of all
+    // of them, computed after the signal, once took 2.6 s more.
+    step(&["ulp"], "*", "interrupted by", "ulp.csv"),
 ];
 
 /// One step, one signal: the orchestrator ends within 2 s with the signal's

@@ -15,7 +15,7 @@ use twinray_common::reference;
 use twinray_common::reference::metrics;
 use twinray_common::scene::random;
 use twinray_common::scene::Scene;
-use twinray_tests::{render, scratch, App};
+use twinray_tests::{assert_none, render, scratch, App};
 
 const SEEDS: std::ops::Range<u64> = 0..20;
 const W: u32 = 48;
@@ -71,12 +71,7 @@ fn vulkan_opengl_and_the_reference_agree_on_random_scenes() {
         }
     }
     println!("worst: {} ({:.3}% off by >8/255)", worst.1, 100.0 * worst.0);
-    assert!(
-        failures.is_empty(),
-        "{} disagreements:\n{}",
-        failures.len(),
-        failures.join("\n")
-    );
+    assert_none("disagreements", &failures);
     std::fs::remove_dir_all(dir).ok();
 }
 

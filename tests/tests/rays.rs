@@ -13,7 +13,7 @@
 
 use twinray_common::rays::RayCounts;
 use twinray_common::scene::Scene;
-use twinray_tests::{render, run, scratch, App, Xvfb};
+use twinray_tests::{render, run_ok, scratch, App, Xvfb};
 
 /// How closely the GPU's counts must follow the reference's.
 #[derive(Clone, Copy, Debug)]
@@ -91,12 +91,7 @@ fn gpu_counts_match_the_reference_on_both_apis_and_paths() {
                     "--path",
                     path,
                 ];
-                let o = run(&app.exe(), &args, &[]);
-                assert!(
-                    o.status.success(),
-                    "{app:?} {args:?}: {}",
-                    String::from_utf8_lossy(&o.stderr)
-                );
+                let o = run_ok(&app.exe(), &args, &[]);
                 let report: twinray_common::report::RunReport =
                     serde_json::from_slice(&o.stdout).unwrap();
                 assert_eq!(report.validation_messages, 0, "{scene} {app:?} {path}");

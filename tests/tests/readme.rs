@@ -7,8 +7,9 @@
 //! names a heading that is there; and the Rust version the pages ask a
 //! newcomer to install is the one cargo enforces.
 
-use std::path::{Path, PathBuf};
-use twinray_tests::markdown::{anchors, broken, links, slug};
+use std::path::PathBuf;
+use twinray_tests::markdown::{anchors, assert_links_resolve, broken, links, slug};
+use twinray_tests::repo::{assert_scan, files_under, read, root};
 
 const MAX_README_LINES: usize = 150;
 
@@ -28,32 +29,6 @@ const CODE_DIRS: [&str; 5] = [
     "shaders",
 ];
 const CODE_EXTENSIONS: [&str; 5] = ["rs", "glsl", "frag", "comp", "vert"];
-
-fn root() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR"))
-        .parent()
-        .unwrap()
-        .to_path_buf()
-}
-
-fn read(path: &Path) -> String {
-    std::fs::read_to_string(path).unwrap_or_else(|e| panic!("{}: {e}", path.display()))
-}
-
-fn code_files(dir: &Path, out: &mut Vec<PathBuf>) {
-    let entries = std::fs::read_dir(dir).unwrap_or_else(|e| panic!("{}: {e}", dir.display()));
-    for entry in entries {
-        let path = entry.unwrap().path();
-        if path.is_dir() {
-            code_files(&path, out);
-        } else if path
-            .extension()
-            .is_some_and(|e| CODE_EXTENSIONS.iter().any(|x| e == *x))
-        {
-            out.push(path);
-        }
-    }
-}
 
 /// Every `path.md#anchor` written in a line, as the text cites it.
 fn cited_anchors(line: &str) -> Vec<String> {
@@ -75,34 +50,14 @@ fn the_readme_is_a_five_minute_read() {
 
 #[test]
 fn every_link_of_the_front_pages_resolves() {
-    let mut broken_links = Vec::new();
-    let mut checked = 0;
-    for page in FRONT_PAGES {
-        let path = root().join(page);
-        for target in links(&read(&path)) {
-            checked += 1;
-            if let Some(why) = broken(&path, &target) {
-                broken_links.push(format!("{page}: {why}"));
-            }
-        }
-    }
-    assert!(
-        broken_links.is_empty(),
-        "links that lead nowhere:\n{}",
-        broken_links.join("\n")
-    );
-    assert!(
-        checked >= 20,
-        "only {checked} links found on the front pages: is the parser still reading them?"
-    );
+    assert_links_resolve(&FRONT_PAGES, 20, "links on the front pages");
 }
 
 #[test]
 fn every_page_a_code_comment_cites_has_the_heading() {
-    let mut files = Vec::new();
-    for dir in CODE_DIRS {
-        code_files(&root().join(dir), &mut files);
-    }
+    let files = CODE_DIRS
+        .iter()
+        .flat_map(|dir| files_under(&root().join(dir), &CODE_EXTENSIONS));
     let mut missing = Vec::new();
     let mut checked = 0;
     for file in files {
@@ -117,14 +72,12 @@ fn every_page_a_code_comment_cites_has_the_heading() {
             }
         }
     }
-    assert!(
-        missing.is_empty(),
-        "code comments cite sections that are not there:\n{}",
-        missing.join("\n")
-    );
-    assert!(
-        checked >= 5,
-        "only {checked} cited sections found in the code: is the search still reading it?"
+    assert_scan(
+        "code comments cite sections that are not there",
+        &missing,
+        checked,
+        5,
+        "cited sections in the code",
     );
 }
 
@@ -221,12 +174,7 @@ fn the_readme_verdict_is_what_twinray_summary_prints() {
     let mut args = vec!["summary".to_string()];
     args.extend(dirs.iter().map(|d| d.display().to_string()));
     let args: Vec<&str> = args.iter().map(String::as_str).collect();
-    let out = twinray_tests::run(&twinray_tests::bin("twinray"), &args, &[]);
-    assert!(
-        out.status.success(),
-        "twinray summary failed: {}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+    let out = twinray_tests::run_ok(&twinray_tests::bin("twinray"), &args, &[]);
     let printed = String::from_utf8(out.stdout).unwrap();
     assert_eq!(
         &readme[b + begin.len()..e],

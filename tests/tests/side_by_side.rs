@@ -3,37 +3,8 @@
 //! code passes: a name alone let `draw_arrays(glow::TRIANGLES, 0, 3)` stand for
 //! the headless draw of `pass.vertices()` vertices.
 
-use std::path::{Path, PathBuf};
-
-fn root() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR"))
-        .parent()
-        .unwrap()
-        .to_path_buf()
-}
-
-fn doc_path() -> PathBuf {
-    root().join("docs/vulkan-walkthrough.md")
-}
-
-/// Backticked spans of a Markdown text, e.g. `vk/src/device.rs::Device::new`.
-fn code_spans(doc: &str) -> Vec<String> {
-    // Only inline spans outside ``` blocks.
-    let mut spans = Vec::new();
-    let mut in_block = false;
-    for line in doc.lines() {
-        if line.trim_start().starts_with("```") {
-            in_block = !in_block;
-            continue;
-        }
-        if in_block {
-            continue;
-        }
-        let parts: Vec<&str> = line.split('`').collect();
-        spans.extend(parts.iter().skip(1).step_by(2).map(|s| s.to_string()));
-    }
-    spans
-}
+use twinray_tests::markdown::code_spans;
+use twinray_tests::repo::{assert_scan, rust_sources, text, WALKTHROUGH};
 
 /// Identifiers directly followed by `(`: the functions a snippet calls.
 fn called(snippet: &str) -> Vec<String> {
@@ -51,29 +22,6 @@ fn called(snippet: &str) -> Vec<String> {
         current.clear();
     }
     names
-}
-
-fn rust_sources(dir: &Path, text: &mut String) {
-    let Ok(entries) = std::fs::read_dir(dir) else {
-        return;
-    };
-    for entry in entries {
-        let path = entry.unwrap().path();
-        if path.is_dir() {
-            rust_sources(&path, text);
-        } else if path.extension().is_some_and(|e| e == "rs") {
-            *text += &std::fs::read_to_string(&path).unwrap();
-        }
-    }
-}
-
-/// The Rust source under `dirs` (relative to the root), all files together.
-fn sources(dirs: &[&str]) -> String {
-    let mut text = String::new();
-    for dir in dirs {
-        rust_sources(&root().join(dir), &mut text);
-    }
-    text
 }
 
 /// Each call of a snippet with its arguments, as written: `name(args)`, the
@@ -119,10 +67,10 @@ fn call_in(squeezed_source: &str, call: &str) -> bool {
 /// really make, with the arguments they make them with.
 #[test]
 fn the_side_by_side_calls_are_in_the_code() {
-    let doc = std::fs::read_to_string(doc_path()).unwrap();
+    let doc = text(WALKTHROUGH);
     let (vk_sq, gl_sq) = (
-        squeezed(&sources(&["vk/src"])),
-        squeezed(&sources(&["gl/src"])),
+        squeezed(&rust_sources(&["vk/src"])),
+        squeezed(&rust_sources(&["gl/src"])),
     );
     let mut in_table = false;
     let mut missing = Vec::new();
@@ -161,13 +109,14 @@ fn the_side_by_side_calls_are_in_the_code() {
             }
         }
     }
-    assert!(
-        missing.is_empty(),
-        "the side-by-side tables quote calls the code does not make:\n{}",
-        missing.join("\n")
+    assert_scan(
+        "the side-by-side tables quote calls the code does not make",
+        &missing,
+        checked,
+        60,
+        "calls in the tables",
     );
     assert!(tables >= 15, "only {tables} side-by-side tables found");
-    assert!(checked >= 60, "only {checked} calls read from the tables");
 }
 
 #[test]

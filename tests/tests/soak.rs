@@ -12,7 +12,7 @@
 
 use std::process::{Command, Stdio};
 use std::time::{Duration, Instant};
-use twinray_tests::App;
+use twinray_tests::{stderr_of, App};
 
 const FRAMES: &str = "2000";
 const MAX_GROWTH_KB: u64 = 2 * 1024;
@@ -30,7 +30,7 @@ fn soak(app: App, path: &str, frames: &str, extra: &[&str]) -> (u64, u64, usize)
     // One frame first: with a cold Mesa shader cache the first run also holds
     // the compiled shader in memory while a background thread writes it out,
     // a one-time cost of a few MB that is not growth per frame.
-    let warm = twinray_tests::run(
+    twinray_tests::run_ok(
         &app.exe(),
         &[
             &[
@@ -46,11 +46,6 @@ fn soak(app: App, path: &str, frames: &str, extra: &[&str]) -> (u64, u64, usize)
         ]
         .concat(),
         &[],
-    );
-    assert!(
-        warm.status.success(),
-        "{app:?} {path}: {}",
-        String::from_utf8_lossy(&warm.stderr)
     );
     let cache = std::env::temp_dir().join("twinray-mesa-cache");
     let mut child = Command::new(app.exe())
@@ -87,14 +82,7 @@ fn soak(app: App, path: &str, frames: &str, extra: &[&str]) -> (u64, u64, usize)
         );
         std::thread::sleep(Duration::from_millis(50));
     };
-    let mut stderr = String::new();
-    use std::io::Read;
-    child
-        .stderr
-        .take()
-        .unwrap()
-        .read_to_string(&mut stderr)
-        .ok();
+    let stderr = stderr_of(&mut child);
     assert!(status.success(), "{app:?} {path}: {status}: {stderr}");
     let total = start.elapsed();
     let after: Vec<u64> = samples

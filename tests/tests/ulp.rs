@@ -8,7 +8,7 @@
 
 use std::collections::HashMap;
 use std::path::Path;
-use twinray_tests::{bin, fail, refused, run, scratch, App};
+use twinray_tests::{bin, fail, refused, run, scratch, stand_in, App};
 
 /// One CSV line's fields (the csv crate's quoting: "..." with "" inside).
 fn fields(line: &str) -> Vec<String> {
@@ -110,43 +110,37 @@ fn the_probe_is_lossless_and_exact_operations_are_exact() {
     let _ = std::fs::remove_dir_all(&dir);
 }
 
+/// A stand-in for `app` in `apps` that fails every run, in `words`.
+fn failing(apps: &Path, app: &str, words: &str) {
+    let script = format!("#!/bin/sh\necho \"error: {words}\" >&2\nexit 3\n");
+    stand_in(apps, app, &script);
+}
+
+/// `twinray ulp` on 64 inputs with the apps in `dir`/apps, writing to
+/// `dir`/out, expected to fail saying each of `words`: its exit code and
+/// stderr.
+fn ulp_failing(dir: &Path, extra: &[&str], words: &[&str]) -> (i32, String) {
+    let (apps, out) = (dir.join("apps"), dir.join("out"));
+    let mut args = vec!["--bin-dir", apps.to_str().unwrap(), "ulp", "--inputs", "64"];
+    args.extend_from_slice(extra);
+    args.extend(["--out", out.to_str().unwrap()]);
+    let (code, stderr) = fail(&bin("twinray"), &args, &[]);
+    assert!(words.iter().all(|w| stderr.contains(w)), "{stderr}");
+    (code, stderr)
+}
+
 #[test]
 fn a_run_in_which_every_app_fails_is_a_failure_and_says_why() {
     let dir = scratch("ulp-fail");
     let apps = dir.join("apps");
     std::fs::create_dir_all(&apps).unwrap();
     for app in ["twinray-vk", "twinray-gl"] {
-        let path = apps.join(app);
-        std::fs::write(
-            &path,
-            "#!/bin/sh\necho \"error: no device here\" >&2\nexit 3\n",
-        )
-        .unwrap();
-        use std::os::unix::fs::PermissionsExt;
-        std::fs::set_permissions(&path, std::fs::Permissions::from_mode(0o755)).unwrap();
+        failing(&apps, app, "no device here");
     }
-    let out = dir.join("out");
-    let (code, stderr) = fail(
-        &bin("twinray"),
-        &[
-            "--bin-dir",
-            apps.to_str().unwrap(),
-            "ulp",
-            "--inputs",
-            "64",
-            "--ops",
-            "div",
-            "--out",
-            out.to_str().unwrap(),
-        ],
-        &[],
-    );
+    let words = ["4 runs failed", "no device here"];
+    let (code, stderr) = ulp_failing(&dir, &["--ops", "div"], &words);
     assert_ne!(code, 0, "{stderr}");
-    assert!(
-        stderr.contains("4 runs failed") && stderr.contains("no device here"),
-        "{stderr}"
-    );
-    let md = std::fs::read_to_string(out.join("ulp.md")).unwrap();
+    let md = std::fs::read_to_string(dir.join("out/ulp.md")).unwrap();
     assert!(
         md.contains("## Failed runs") && md.contains("| `div` | failed | failed |"),
         "{md}"
@@ -203,38 +197,11 @@ fn a_run_in_which_some_apps_fail_exits_1_and_keeps_the_rest() {
     let apps = dir.join("apps");
     std::fs::create_dir_all(&apps).unwrap();
     std::os::unix::fs::symlink(bin("twinray-vk"), apps.join("twinray-vk")).unwrap();
-    let gl = apps.join("twinray-gl");
-    std::fs::write(
-        &gl,
-        "#!/bin/sh\necho \"error: no context here\" >&2\nexit 3\n",
-    )
-    .unwrap();
-    use std::os::unix::fs::PermissionsExt;
-    std::fs::set_permissions(&gl, std::fs::Permissions::from_mode(0o755)).unwrap();
-    let out = dir.join("out");
-    let (code, stderr) = fail(
-        &bin("twinray"),
-        &[
-            "--bin-dir",
-            apps.to_str().unwrap(),
-            "ulp",
-            "--inputs",
-            "64",
-            "--ops",
-            "add",
-            "--paths",
-            "fragment",
-            "--out",
-            out.to_str().unwrap(),
-        ],
-        &[],
-    );
+    failing(&apps, "twinray-gl", "no context here");
+    let add = ["--ops", "add", "--paths", "fragment"];
+    let (code, stderr) = ulp_failing(&dir, &add, &["1 run failed", "no context here"]);
     assert_eq!(code, 1, "{stderr}");
-    assert!(
-        stderr.contains("1 run failed") && stderr.contains("no context here"),
-        "{stderr}"
-    );
-    let csv = std::fs::read_to_string(out.join("ulp.csv")).unwrap();
+    let csv = std::fs::read_to_string(dir.join("out/ulp.csv")).unwrap();
     assert!(
         csv.lines().any(|l| l.starts_with("add,vulkan,fragment")),
         "{csv}"

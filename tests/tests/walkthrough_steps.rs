@@ -4,18 +4,8 @@
 //! objects of a headless run with the page's step numbers in the order the
 //! page states, and the main path, before the appendix, reads in one sitting.
 
-use std::path::{Path, PathBuf};
-
-fn root() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR"))
-        .parent()
-        .unwrap()
-        .to_path_buf()
-}
-
-fn page() -> String {
-    std::fs::read_to_string(root().join("docs/vulkan-walkthrough.md")).unwrap()
-}
+use twinray_tests::repo::{assert_scan, root, text, WALKTHROUGH};
+use twinray_tests::{assert_none, box_window};
 
 /// One `## N. Title` section of the page.
 struct Step {
@@ -84,7 +74,7 @@ fn squeezed(text: &str) -> String {
 
 #[test]
 fn every_snippet_line_is_in_a_file_its_step_names() {
-    let doc = page();
+    let doc = text(WALKTHROUGH);
     let steps = steps(&doc);
     assert!(
         steps.len() >= 22,
@@ -133,12 +123,13 @@ fn every_snippet_line_is_in_a_file_its_step_names() {
             }
         }
     }
-    assert!(
-        wrong.is_empty(),
-        "the walkthrough's snippets are out of step with the code:\n{}",
-        wrong.join("\n")
+    assert_scan(
+        "the walkthrough's snippets are out of step with the code",
+        &wrong,
+        checked,
+        50,
+        "snippet lines",
     );
-    assert!(checked >= 50, "only {checked} snippet lines read");
 }
 
 /// The page's table of `--explain` orders: each row a command and the step
@@ -176,7 +167,7 @@ fn explained(stderr: &str) -> Vec<(u32, String)> {
 
 #[test]
 fn explain_prints_the_pages_steps_in_the_pages_order() {
-    let doc = page();
+    let doc = text(WALKTHROUGH);
     let steps = steps(&doc);
     let orders = stated_orders(&doc);
     assert_eq!(
@@ -220,16 +211,12 @@ fn explain_prints_the_pages_steps_in_the_pages_order() {
             }
         }
     }
-    assert!(
-        wrong.is_empty(),
-        "--explain and the walkthrough disagree:\n{}",
-        wrong.join("\n")
-    );
+    assert_none("--explain and the walkthrough disagree", &wrong);
 }
 
 #[test]
 fn the_main_path_reads_in_one_sitting() {
-    let doc = page();
+    let doc = text(WALKTHROUGH);
     let end = doc
         .find("\n# Appendix")
         .expect("the walkthrough has an appendix");
@@ -245,7 +232,7 @@ fn the_main_path_reads_in_one_sitting() {
 /// names after the wait, in its order, are `--explain`'s teardown lines.
 #[test]
 fn the_pages_drop_order_is_the_windows() {
-    let doc = page();
+    let doc = text(WALKTHROUGH);
     let step = steps(&doc)
         .into_iter()
         .find(|s| s.number == 20)
@@ -266,15 +253,7 @@ fn the_pages_drop_order_is_the_windows() {
     let xvfb = twinray_tests::Xvfb::start();
     let dir = twinray_tests::scratch("drop-order");
     let app = twinray_tests::bin("twinray-vk");
-    let args = [
-        "--scene",
-        "box",
-        "--size",
-        "64x48",
-        "--frames",
-        "3",
-        "--explain",
-    ];
+    let args = box_window("64x48", "3", &["--explain"]);
     let out = xvfb.run(&app, &args, &[], &dir);
     let stderr = String::from_utf8_lossy(&out.stderr);
     assert!(out.status.success(), "the window failed:\n{stderr}");

@@ -94,7 +94,7 @@ impl Compute {
                 )
             },
         );
-        let commands = Commands::record_with(device, |d, cmd| {
+        let commands = Commands::record_with(device, |_, cmd| {
             if let Some(t) = timestamps {
                 t.record_reset(cmd);
             }
@@ -109,18 +109,7 @@ impl Compute {
                 t.record(cmd, 0);
             }
             // SAFETY: as above; the set matches the pipeline's layout.
-            unsafe {
-                d.cmd_bind_pipeline(cmd, vk::PipelineBindPoint::COMPUTE, pipeline.pipeline);
-                d.cmd_bind_descriptor_sets(
-                    cmd,
-                    vk::PipelineBindPoint::COMPUTE,
-                    pipeline.layout,
-                    0,
-                    &[descriptors.set],
-                    &[],
-                );
-                d.cmd_dispatch(cmd, groups.0, groups.1, 1);
-            }
+            unsafe { pipeline.dispatch(cmd, descriptors.set, groups) };
             if let Some(t) = timestamps {
                 t.record(cmd, 1);
             }
@@ -289,16 +278,8 @@ impl WindowCompute {
         // is the swapchain image acquired for this frame, alive with the swapchain.
         unsafe {
             pipeline_barrier::record(device, cmd, &[to_general]);
-            d.cmd_bind_pipeline(cmd, vk::PipelineBindPoint::COMPUTE, self.pipeline.pipeline);
-            d.cmd_bind_descriptor_sets(
-                cmd,
-                vk::PipelineBindPoint::COMPUTE,
-                self.pipeline.layout,
-                0,
-                &[self.descriptors.set],
-                &[],
-            );
-            d.cmd_dispatch(cmd, self.groups.0, self.groups.1, 1);
+            self.pipeline
+                .dispatch(cmd, self.descriptors.set, self.groups);
             pipeline_barrier::record(device, cmd, &to_blit);
             d.cmd_blit_image(
                 cmd,
@@ -358,12 +339,13 @@ impl ComputePipeline {
         spirv: &[u32],
     ) -> Result<ComputePipeline> {
         let d = &device.device;
+        // Owned from here on, so that an error below frees the layout (dropping
+        // a null pipeline does nothing).
         let mut this = ComputePipeline {
             device: d.clone(),
-            layout: vk::PipelineLayout::null(),
+            layout: crate::pipeline::layout(d, set_layout, "compute")?,
             pipeline: vk::Pipeline::null(),
         };
-        this.layout = crate::pipeline::layout(d, set_layout, "compute")?;
         // Dropped after the pipeline is made: it keeps its own copy of the code.
         let module = crate::pipeline::module(d, spirv, "compute")?;
         let stage = vk::PipelineShaderStageCreateInfo::default()
@@ -384,6 +366,28 @@ impl ComputePipeline {
             .context("creating the compute pipeline")?[0];
         crate::statistics::capture(device, this.pipeline, "compute");
         Ok(this)
+    }
+
+    /// Binds the pipeline and `set`, then dispatches `groups` workgroups.
+    ///
+    /// # Safety
+    /// `cmd` is recording; `set` matches the pipeline's layout, and both
+    /// outlive the commands' execution.
+    unsafe fn dispatch(&self, cmd: vk::CommandBuffer, set: vk::DescriptorSet, groups: (u32, u32)) {
+        let d = &self.device;
+        // SAFETY: forwarded from the caller.
+        unsafe {
+            d.cmd_bind_pipeline(cmd, vk::PipelineBindPoint::COMPUTE, self.pipeline);
+            d.cmd_bind_descriptor_sets(
+                cmd,
+                vk::PipelineBindPoint::COMPUTE,
+                self.layout,
+                0,
+                &[set],
+                &[],
+            );
+            d.cmd_dispatch(cmd, groups.0, groups.1, 1);
+        }
     }
 }
 

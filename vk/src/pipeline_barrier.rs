@@ -17,6 +17,40 @@ pub enum On<'a> {
     Nothing,
 }
 
+/// A buffer barrier (with its stages set, where it has them) completed with
+/// the `(src, dst)` access masks, over the whole `buffer`, with no queue
+/// transfer. Vulkan 1.0's and synchronization2's structures differ in type
+/// but not in these fields, hence a macro.
+macro_rules! whole_buffer {
+    ($base:expr, $access:expr, $buffer:expr) => {{
+        let (src, dst) = $access;
+        $base
+            .src_access_mask(src)
+            .dst_access_mask(dst)
+            .src_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
+            .dst_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
+            .buffer($buffer)
+            .size(vk::WHOLE_SIZE)
+    }};
+}
+
+/// As `whole_buffer!`, for the colour `image` moving between the `(old, new)`
+/// layouts.
+macro_rules! colour_image {
+    ($base:expr, $access:expr, $image:expr, $layouts:expr) => {{
+        let ((src, dst), (old, new)) = ($access, $layouts);
+        $base
+            .src_access_mask(src)
+            .dst_access_mask(dst)
+            .old_layout(old)
+            .new_layout(new)
+            .src_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
+            .dst_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
+            .image($image)
+            .subresource_range(COLOR_IMAGE)
+    }};
+}
+
 /// Records `barriers` (each with what it guards) as one barrier call, in the
 /// device's recording, and prints each with `--explain` the first time it is
 /// recorded, from the structures the call was given.
@@ -62,27 +96,17 @@ unsafe fn record_1_0(d: &ash::Device, cmd: vk::CommandBuffer, barriers: &[(Barri
         dst |= dst_stages;
         match on {
             On::Buffers(list) => buffers.extend(list.iter().map(|&buffer| {
-                vk::BufferMemoryBarrier::default()
-                    .src_access_mask(src_access)
-                    .dst_access_mask(dst_access)
-                    .src_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
-                    .dst_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
-                    .buffer(buffer)
-                    .size(vk::WHOLE_SIZE)
+                let base = vk::BufferMemoryBarrier::default();
+                whole_buffer!(base, (src_access, dst_access), buffer)
             })),
             On::Image(image) => {
-                let (old, new) = b.layouts();
-                images.push(
-                    vk::ImageMemoryBarrier::default()
-                        .src_access_mask(src_access)
-                        .dst_access_mask(dst_access)
-                        .old_layout(old)
-                        .new_layout(new)
-                        .src_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
-                        .dst_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
-                        .image(*image)
-                        .subresource_range(COLOR_IMAGE),
-                )
+                let base = vk::ImageMemoryBarrier::default();
+                images.push(colour_image!(
+                    base,
+                    (src_access, dst_access),
+                    *image,
+                    b.layouts()
+                ))
             }
             // An execution dependency: the stage masks alone.
             On::Nothing => {}
@@ -133,31 +157,21 @@ unsafe fn record_2(d: &ash::Device, cmd: vk::CommandBuffer, barriers: &[(Barrier
         let ((src_stages, src_access), (dst_stages, dst_access)) = (b.source(r), b.destination(r));
         match on {
             On::Buffers(list) => buffers.extend(list.iter().map(|&buffer| {
-                vk::BufferMemoryBarrier2::default()
+                let staged = vk::BufferMemoryBarrier2::default()
                     .src_stage_mask(src_stages)
-                    .src_access_mask(src_access)
-                    .dst_stage_mask(dst_stages)
-                    .dst_access_mask(dst_access)
-                    .src_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
-                    .dst_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
-                    .buffer(buffer)
-                    .size(vk::WHOLE_SIZE)
+                    .dst_stage_mask(dst_stages);
+                whole_buffer!(staged, (src_access, dst_access), buffer)
             })),
             On::Image(image) => {
-                let (old, new) = b.layouts();
-                images.push(
-                    vk::ImageMemoryBarrier2::default()
-                        .src_stage_mask(src_stages)
-                        .src_access_mask(src_access)
-                        .dst_stage_mask(dst_stages)
-                        .dst_access_mask(dst_access)
-                        .old_layout(old)
-                        .new_layout(new)
-                        .src_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
-                        .dst_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
-                        .image(*image)
-                        .subresource_range(COLOR_IMAGE),
-                )
+                let staged = vk::ImageMemoryBarrier2::default()
+                    .src_stage_mask(src_stages)
+                    .dst_stage_mask(dst_stages);
+                images.push(colour_image!(
+                    staged,
+                    (src_access, dst_access),
+                    *image,
+                    b.layouts()
+                ))
             }
             // Stages live in the barriers now: an execution dependency is a
             // memory barrier with stages and no access bits.

@@ -318,21 +318,15 @@ fn command_line(
 #[cfg(test)]
 mod tests {
     use super::check_output;
+    use crate::scene::load::tests::obj_scene;
     use std::path::Path;
 
     #[test]
     fn an_output_may_not_name_the_scene_or_its_mesh() {
         let dir = std::env::temp_dir().join(format!("twinray-clobber-{}", std::process::id()));
         std::fs::create_dir_all(dir.join("sub")).unwrap();
-        std::fs::write(dir.join("mesh.obj"), "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n").unwrap();
-        let scene = dir.join("scene.toml");
-        std::fs::write(
-            &scene,
-            "[camera]\neye = [0.0, 0.0, 5.0]\nlook_at = [0.0, 0.0, 0.0]\n\
-             [[materials]]\nname = \"m\"\n[[meshes]]\nobj = \"mesh.obj\"\nmaterial = \"m\"\n",
-        )
-        .unwrap();
-        let scene = scene.to_str().unwrap();
+        let scene = obj_scene(&dir, b"v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n");
+        let scene = scene.as_str();
         for (out, words) in [
             (
                 Path::new(scene).to_path_buf(),

@@ -60,29 +60,38 @@ pub fn render_counting(
     bvh_width: Option<u32>,
     rows_done: &AtomicUsize,
 ) -> FloatImage {
-    render_turned(
+    let picture = Picture {
         scene,
         width,
         height,
         numerics,
-        bvh_width,
-        rows_done,
-        DVec2::ZERO,
-    )
+    };
+    render_turned(&picture, bvh_width, rows_done, DVec2::ZERO)
+}
+
+/// What a reference render draws: a scene at a size, with numerical choices.
+struct Picture<'a> {
+    scene: &'a Scene,
+    width: u32,
+    height: u32,
+    numerics: &'a Numerics,
 }
 
 /// `render_counting` with every primary ray turned by `turn` radians
 /// towards the image's right (x) and down (y) (`unsettled`); zero leaves
 /// each direction as it is, bit for bit.
 fn render_turned(
-    scene: &Scene,
-    width: u32,
-    height: u32,
-    numerics: &Numerics,
+    picture: &Picture,
     bvh_width: Option<u32>,
     rows_done: &AtomicUsize,
     turn: DVec2,
 ) -> FloatImage {
+    let &Picture {
+        scene,
+        width,
+        height,
+        numerics,
+    } = picture;
     // The GPU's frame: positions relative to the local origin, then rounded to f32.
     let frame = RayFrame::local(scene, &scene.camera, width, height).rounded_to_f32();
     let (right, down) = (frame.step_x.normalize(), frame.step_y.normalize());

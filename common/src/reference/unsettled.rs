@@ -7,7 +7,7 @@
 //! the mask and `twinray diff --exclude MASK.png` leaves those pixels out, so
 //! an accuracy target can state how many it excludes and hold the rest.
 
-use super::render_turned;
+use super::{render_turned, Picture};
 use crate::scene::numerics::Numerics;
 use crate::scene::Scene;
 use glam::DVec2;
@@ -38,18 +38,13 @@ pub fn unsettled_with(
     numerics: &Numerics,
     turn: f64,
 ) -> Vec<bool> {
-    let draw = |by: DVec2| {
-        render_turned(
-            scene,
-            width,
-            height,
-            numerics,
-            Some(2),
-            &AtomicUsize::new(0),
-            by,
-        )
-        .to_rgb8()
+    let picture = Picture {
+        scene,
+        width,
+        height,
+        numerics,
     };
+    let draw = |by: DVec2| render_turned(&picture, Some(2), &AtomicUsize::new(0), by).to_rgb8();
     let base = draw(DVec2::ZERO);
     let mut mask = vec![false; base.pixels().len()];
     for by in [DVec2::X, -DVec2::X, DVec2::Y, -DVec2::Y] {

@@ -177,7 +177,7 @@ pub fn scene_inputs(name_or_path: &str) -> Vec<(String, std::path::PathBuf)> {
 }
 
 #[cfg(test)]
-mod tests {
+pub(crate) mod tests {
     use super::*;
     use std::time::Instant;
 
@@ -228,7 +228,17 @@ mod tests {
         assert!(Scene::load("spherelist", &set).is_ok());
     }
 
-    fn obj_scene(dir: &Path, obj: &[u8]) -> String {
+    /// A scene whose mesh is `obj` is refused in words that hold each of `words`.
+    fn obj_refused(dir: &Path, obj: &str, words: &[&str]) {
+        let e = message(Scene::load(&obj_scene(dir, obj.as_bytes()), &[]));
+        for word in words {
+            assert!(e.contains(word), "{obj:?}: lacks '{word}': {e}");
+        }
+    }
+
+    /// Writes `dir`/mesh.obj with `obj` and `dir`/scene.toml whose one mesh
+    /// it is; the scene file's path.
+    pub(crate) fn obj_scene(dir: &Path, obj: &[u8]) -> String {
         std::fs::write(dir.join("mesh.obj"), obj).unwrap();
         let scene = dir.join("scene.toml");
         std::fs::write(
@@ -287,11 +297,7 @@ mod tests {
             ("l 1 2 3\n", &["line 5", "line element"]),
             ("f\n", &["line 5", "names no vertex"]),
         ] {
-            let scene = obj_scene(&dir, format!("{head}{obj}f 1 2 3\n").as_bytes());
-            let e = message(Scene::load(&scene, &[]));
-            for word in words {
-                assert!(e.contains(word), "{obj:?}: lacks '{word}': {e}");
-            }
+            obj_refused(&dir, &format!("{head}{obj}f 1 2 3\n"), words);
         }
         let _ = std::fs::remove_dir_all(&dir);
     }
@@ -330,11 +336,7 @@ mod tests {
                 &["line 4", "'1/2/3/4'"],
             ),
         ] {
-            let scene = obj_scene(&dir, obj.as_bytes());
-            let e = message(Scene::load(&scene, &[]));
-            for word in words {
-                assert!(e.contains(word), "{obj:?}: lacks '{word}': {e}");
-            }
+            obj_refused(&dir, obj, words);
         }
         let _ = std::fs::remove_dir_all(&dir);
     }

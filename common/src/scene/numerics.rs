@@ -143,6 +143,19 @@ impl Numerics {
     /// The keys shared by `[render]` in scene files and `--set`.
     pub const KEYS: [&'static str; 3] = ["offset", "triangle", "sphere"];
 
+    /// Every configuration, the offset changing slowest and the sphere test fastest.
+    pub fn all() -> impl Iterator<Item = Numerics> {
+        Offset::ALL.into_iter().flat_map(|offset| {
+            TriangleTest::ALL.into_iter().flat_map(move |triangle| {
+                SphereTest::ALL.into_iter().map(move |sphere| Numerics {
+                    offset,
+                    triangle,
+                    sphere,
+                })
+            })
+        })
+    }
+
     /// Applies `key = value` if `key` is one of `KEYS`; returns whether it was.
     /// `what` names the source in the error (e.g. `--set offset`).
     pub fn set(&mut self, key: &str, value: &str, what: &str) -> anyhow::Result<bool> {

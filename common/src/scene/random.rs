@@ -104,56 +104,8 @@ fn v3(v: [f64; 3]) -> String {
     format!("[{:?}, {:?}, {:?}]", v[0], v[1], v[2])
 }
 
-const MATERIALS: &str = r#"
-[[materials]]
-name = "ground"
-ambient = [0.04, 0.04, 0.04]
-diffuse = [0.7, 0.7, 0.65]
-specular = [0.1, 0.1, 0.1]
-shininess = 16.0
-
-[[materials]]
-name = "red"
-ambient = [0.05, 0.01, 0.01]
-diffuse = [0.8, 0.15, 0.1]
-specular = [0.4, 0.4, 0.4]
-shininess = 40.0
-
-[[materials]]
-name = "green"
-ambient = [0.01, 0.05, 0.01]
-diffuse = [0.15, 0.7, 0.2]
-specular = [0.2, 0.2, 0.2]
-shininess = 12.0
-
-[[materials]]
-name = "blue"
-ambient = [0.01, 0.01, 0.05]
-diffuse = [0.1, 0.2, 0.8]
-
-[[materials]]
-name = "mirror"
-ambient = [0.0, 0.0, 0.0]
-diffuse = [0.05, 0.05, 0.05]
-specular = [0.6, 0.6, 0.6]
-shininess = 120.0
-reflectivity = 0.85
-
-[[materials]]
-name = "glass"
-specular = [0.7, 0.7, 0.7]
-shininess = 200.0
-transparency = 0.9
-ior = 1.5
-
-[[materials]]
-name = "water"
-specular = [0.5, 0.5, 0.5]
-shininess = 100.0
-reflectivity = 0.05
-transparency = 0.85
-ior = 1.33
-"#;
+/// The materials every random scene offers, kept as the TOML they are.
+const MATERIALS: &str = include_str!("random_materials.toml");
 
 const SOLID: [&str; 4] = ["red", "green", "blue", "mirror"];
 
@@ -167,6 +119,7 @@ pub fn toml(seed: u64) -> String {
         "description = \"random scene {seed} (common/src/scene/random.rs)\"\n"
     );
     camera_and_render(&mut r, &mut s);
+    s.push('\n');
     s.push_str(MATERIALS);
     lights(&mut r, &mut s);
     ground(&mut s);

@@ -8,6 +8,8 @@ use crate::compare::runs::{Interruption, Outcome, Results, EXPERIMENTS};
 use crate::compare::study::{self, StudyRow};
 use std::fmt::Write as _;
 use twinray_common::cli::RenderPath;
+use twinray_common::report::RunReport;
+use twinray_common::stats::Summary;
 
 /// report.md's title line, naming the device: Vulkan's where a Vulkan run
 /// succeeded, the driver's plain name ("NVIDIA H100 80GB HBM3"), else OpenGL's
@@ -208,26 +210,10 @@ fn ratios(exp: &str, path: RenderPath, outcomes: &[Outcome], study: &[StudyRow])
     for v in &values {
         let vk = report_of(&rows, v, Api::Vulkan, path);
         let gl = report_of(&rows, v, Api::Opengl, path);
-        if let Some(x) = ratio(
-            vk.and_then(|r| r.wall_ms).map(|s| s.median),
-            gl.and_then(|r| r.wall_ms).map(|s| s.median),
-        ) {
-            r.wall.push(x);
-            r.wall_iv.push(ratio_interval(
-                vk.and_then(|r| r.wall_ms),
-                gl.and_then(|r| r.wall_ms),
-            ));
-        }
-        if let Some(x) = ratio(
-            vk.and_then(|r| r.gpu_ms).map(|s| s.median),
-            gl.and_then(|r| r.gpu_ms).map(|s| s.median),
-        ) {
-            r.gpu.push(x);
-            r.gpu_iv.push(ratio_interval(
-                vk.and_then(|r| r.gpu_ms),
-                gl.and_then(|r| r.gpu_ms),
-            ));
-        }
+        let wall = |r: &RunReport| r.wall_ms;
+        push_ratio((vk, gl), wall, &mut r.wall, &mut r.wall_iv);
+        let gpu = |r: &RunReport| r.gpu_ms;
+        push_ratio((vk, gl), gpu, &mut r.gpu, &mut r.gpu_iv);
         let glspv = report_of(&rows, v, Api::OpenglSpirv, path);
         if let Some(x) = ratio(
             vk.and_then(|r| r.gpu_ms).map(|s| s.median),
@@ -240,6 +226,21 @@ fn ratios(exp: &str, path: RenderPath, outcomes: &[Outcome], study: &[StudyRow])
         }
     }
     r
+}
+
+/// Vulkan's median of `time` over OpenGL's, where both have one, pushed to
+/// the ratios with its interval (from the two medians' intervals) beside it.
+fn push_ratio(
+    (vk, gl): (Option<&RunReport>, Option<&RunReport>),
+    time: impl Fn(&RunReport) -> Option<Summary>,
+    ratios: &mut Vec<f64>,
+    intervals: &mut Vec<Option<(f64, f64)>>,
+) {
+    let (vk, gl) = (vk.and_then(&time), gl.and_then(&time));
+    if let Some(x) = ratio(vk.map(|s| s.median), gl.map(|s| s.median)) {
+        ratios.push(x);
+        intervals.push(ratio_interval(vk, gl));
+    }
 }
 
 /// Who is faster over a sweep: the verdict at its median point, a tie where

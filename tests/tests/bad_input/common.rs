@@ -4,16 +4,8 @@
 use std::path::Path;
 use twinray_tests::{fail, App};
 
-pub const SCENE_HEAD: &str = r#"
-[camera]
-eye = [0.0, 0.0, 5.0]
-look_at = [0.0, 0.0, 0.0]
-[[materials]]
-name = "m"
-diffuse = [0.5, 0.5, 0.5]
-[[lights]]
-position = [0.0, 5.0, 5.0]
-"#;
+/// A scene that loads, which each bad scene file completes.
+pub const SCENE_HEAD: &str = include_str!("../../data/scene_head.toml");
 
 /// Runs both apps with `args` and checks the exit code and that the one error
 /// line contains every word in `expect`.

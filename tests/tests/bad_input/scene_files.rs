@@ -20,60 +20,34 @@ fn missing_and_unknown_scenes() {
     );
 }
 
-#[test]
-fn malformed_scene_names_line_and_column() {
-    let dir = scratch("malformed");
-    let p = scene_file(
-        &dir,
-        "bad.toml",
-        "[[spheres]]\ncenter = [0.0, 0.0\nradius = 1.0\n",
-    );
-    expect_both(
-        &strs(&headless(&p)),
-        &[],
-        2,
-        &["bad.toml", "line 12, column"],
-    );
-}
+/// Scene files with one fault each, and what the refusal (exit 2) must name:
+/// the file, then the line and column, the key, or the field.
+const BAD_FILES: [(&str, &str, &[&str]); 6] = [
+    ("bad.toml", "[[spheres]]\ncenter = [0.0, 0.0\nradius = 1.0\n", &["line 12, column"]),
+    ("k.toml", "[[spheres]]\ncenter = [0.0, 0.0, 0.0]\nradius = 1.0\nmaterial = \"m\"\nglow = 2.0\n", &["glow", "line 14"]),
+    ("nan.toml", "[[spheres]]\ncenter = [nan, 0.0, 0.0]\nradius = 1.0\nmaterial = \"m\"\n", &["spheres[0].center"]),
+    ("neg.toml", "[[spheres]]\ncenter = [0.0, 0.0, 0.0]\nradius = -2.0\nmaterial = \"m\"\n", &["spheres[0].radius = -2"]),
+    (
+        "normal.toml",
+        "[[triangles]]\nvertices = [[0.0,0.0,0.0],[1.0,0.0,0.0],[0.0,1.0,0.0]]\nnormals = [[0.0,0.0,0.0],[0.0,0.0,1.0],[0.0,0.0,1.0]]\nmaterial = \"m\"\n",
+        &["triangles[0].normals[0]"],
+    ),
+    ("mat.toml", "[[spheres]]\ncenter = [0.0, 0.0, 0.0]\nradius = 1.0\nmaterial = \"unobtainium\"\n", &["'unobtainium'"]),
+];
 
 #[test]
-fn unknown_key_is_named() {
-    let dir = scratch("unknown-key");
-    let p = scene_file(
-        &dir,
-        "k.toml",
-        "[[spheres]]\ncenter = [0.0, 0.0, 0.0]\nradius = 1.0\nmaterial = \"m\"\nglow = 2.0\n",
-    );
-    expect_both(&strs(&headless(&p)), &[], 2, &["k.toml", "glow", "line 14"]);
-}
-
-#[test]
-fn bad_values_are_named() {
-    let dir = scratch("bad-values");
-    let cases = [
-        ("nan.toml", "[[spheres]]\ncenter = [nan, 0.0, 0.0]\nradius = 1.0\nmaterial = \"m\"\n", "spheres[0].center"),
-        ("neg.toml", "[[spheres]]\ncenter = [0.0, 0.0, 0.0]\nradius = -2.0\nmaterial = \"m\"\n", "spheres[0].radius = -2"),
-        (
-            "normal.toml",
-            "[[triangles]]\nvertices = [[0.0,0.0,0.0],[1.0,0.0,0.0],[0.0,1.0,0.0]]\nnormals = [[0.0,0.0,0.0],[0.0,0.0,1.0],[0.0,0.0,1.0]]\nmaterial = \"m\"\n",
-            "triangles[0].normals[0]",
-        ),
-        ("mat.toml", "[[spheres]]\ncenter = [0.0, 0.0, 0.0]\nradius = 1.0\nmaterial = \"unobtainium\"\n", "'unobtainium'"),
-    ];
-    for (file, body, what) in cases {
+fn bad_scene_files_are_named_by_file_and_line_or_field() {
+    let dir = scratch("bad-scene-files");
+    for (file, body, words) in BAD_FILES {
         let p = scene_file(&dir, file, body);
-        expect_both(&strs(&headless(&p)), &[], 2, &[file, what]);
+        expect_both(&strs(&headless(&p)), &[], 2, &[&[file], words].concat());
     }
 }
 
 #[test]
 fn missing_and_broken_obj() {
     let dir = scratch("obj");
-    let p = scene_file(
-        &dir,
-        "mesh.toml",
-        "[[meshes]]\nobj = \"pot.obj\"\nmaterial = \"m\"\n",
-    );
+    let p = obj_scene(&dir, "mesh.toml", "pot.obj");
     expect_both(&strs(&headless(&p)), &[], 2, &["pot.obj", "cannot be read"]);
     std::fs::write(dir.join("pot.obj"), "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 7\n").unwrap();
     expect_both(&strs(&headless(&p)), &[], 2, &["pot.obj"]);
@@ -104,14 +78,22 @@ fn unknown_numerics_value() {
     );
 }
 
-/// The three tools: both apps, and the reference through `twinray render`.
-fn three_tools() -> [(std::path::PathBuf, Vec<&'static str>); 3] {
+/// A scene file `toml` in `dir` whose one mesh is the OBJ file `obj`.
+fn obj_scene(dir: &std::path::Path, toml: &str, obj: &str) -> String {
+    let body = format!("[[meshes]]\nobj = \"{obj}\"\nmaterial = \"m\"\n");
+    scene_file(dir, toml, &body)
+}
+
+/// The three tools, each with its arguments for an 8x8 headless render of
+/// `scene`: both apps, and the reference through `twinray render`.
+fn three_tools(scene: &str) -> [(std::path::PathBuf, Vec<&str>); 3] {
+    let run = ["--headless", "--size", "8x8", "--scene", scene];
     [
-        (bin("twinray-vk"), vec![]),
-        (bin("twinray-gl"), vec![]),
+        (bin("twinray-vk"), run.to_vec()),
+        (bin("twinray-gl"), run.to_vec()),
         (
             bin("twinray"),
-            vec!["render", "--api", "reference", "--json"],
+            [&["render", "--api", "reference", "--json"], &run[..]].concat(),
         ),
     ]
 }
@@ -127,13 +109,8 @@ fn a_polygon_past_the_triangle_limit_is_refused_from_its_line_in_little_memory()
     obj.extend(b"1 2 3 ".repeat(n / 3 + 1));
     std::fs::write(dir.join("big.obj"), &obj).unwrap();
     drop(obj);
-    let p = scene_file(
-        &dir,
-        "big.toml",
-        "[[meshes]]\nobj = \"big.obj\"\nmaterial = \"m\"\n",
-    );
-    for (exe, mut args) in three_tools() {
-        args.extend(["--headless", "--size", "8x8", "--scene", &p]);
+    let p = obj_scene(&dir, "big.toml", "big.obj");
+    for (exe, args) in three_tools(&p) {
         // 1 GiB of address space: enough for the file, the tool and the
         // driver's reservations (the device is open before the scene is read,
         // so that its storage limit can refuse a scene before it is built),
@@ -189,14 +166,9 @@ fn fifty_million_points_or_lines_are_refused_from_their_first_line_in_little_mem
         obj.extend(line.as_bytes().repeat(50_000_000));
         std::fs::write(dir.join(format!("{name}.obj")), &obj).unwrap();
         drop(obj);
-        let p = scene_file(
-            &dir,
-            &format!("{name}.toml"),
-            &format!("[[meshes]]\nobj = \"{name}.obj\"\nmaterial = \"m\"\n"),
-        );
+        let p = obj_scene(&dir, &format!("{name}.toml"), &format!("{name}.obj"));
         let at = format!("{name}.obj', line {}", head.lines().count() + 1);
-        for (exe, mut args) in three_tools() {
-            args.extend(["--headless", "--size", "8x8", "--scene", &p]);
+        for (exe, args) in three_tools(&p) {
             let (code, stderr, secs, mb) = measured(&exe, &args);
             assert_eq!(code, 2, "{exe:?}: {stderr}");
             assert!(
@@ -219,19 +191,9 @@ fn an_obj_with_a_byte_order_mark_renders() {
         "\u{feff}v -1 -1 0\nv 1 -1 0\nv 0 1 0\nf 1 2 3\n",
     )
     .unwrap();
-    let p = scene_file(
-        &dir,
-        "bom.toml",
-        "[[meshes]]\nobj = \"bom.obj\"\nmaterial = \"m\"\n",
-    );
-    for (exe, mut args) in three_tools() {
-        args.extend(["--headless", "--size", "8x8", "--scene", &p]);
-        let o = twinray_tests::run(&exe, &args, &[]);
-        assert!(
-            o.status.success(),
-            "{exe:?}: {}",
-            String::from_utf8_lossy(&o.stderr)
-        );
+    let p = obj_scene(&dir, "bom.toml", "bom.obj");
+    for (exe, args) in three_tools(&p) {
+        twinray_tests::run_ok(&exe, &args, &[]);
     }
 }
 
@@ -251,11 +213,7 @@ fn a_loop_of_symbolic_links_is_named_as_one() {
         2,
         &["a.toml", "loop of symbolic links"],
     );
-    let p = scene_file(
-        &dir,
-        "mesh.toml",
-        "[[meshes]]\nobj = \"a.obj\"\nmaterial = \"m\"\n",
-    );
+    let p = obj_scene(&dir, "mesh.toml", "a.obj");
     expect_both(
         &strs(&headless(&p)),
         &[],

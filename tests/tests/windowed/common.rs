@@ -5,7 +5,7 @@
 use std::io::Read;
 use std::process::{Child, Output};
 use twinray_common::report::RunReport;
-use twinray_tests::{App, Xvfb};
+use twinray_tests::{box_window, App, Xvfb};
 
 pub fn stderr(o: &Output) -> String {
     String::from_utf8_lossy(&o.stderr).into_owned()
@@ -21,6 +21,21 @@ pub fn clean_report(app: App, o: &Output) -> RunReport {
         .unwrap_or_else(|e| panic!("{app:?}: not JSON ({e}): {out}"));
     assert_eq!(report.validation_messages, 0, "{app:?}: {err}");
     report
+}
+
+/// A validated `--json` run of the box window at `size` for `frames` frames,
+/// with `extra` arguments, which must end cleanly: its report and stderr.
+pub fn clean_box_run(
+    x: &Xvfb,
+    app: App,
+    (size, frames): (&str, &str),
+    extra: &[&str],
+    env: &[(&str, &str)],
+    dir: &std::path::Path,
+) -> (RunReport, String) {
+    let args = box_window(size, frames, &[extra, &["--validate", "--json"]].concat());
+    let o = x.run(&app.exe(), &args, env, dir);
+    (clean_report(app, &o), stderr(&o))
 }
 
 /// Asserts that the resize hook's line on stderr (`TWINRAY_TEST_RESIZE`)

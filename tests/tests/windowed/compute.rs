@@ -4,20 +4,13 @@
 //! its path, under the validation layer's synchronisation validation.
 
 use crate::common::{
-    assert_resized, clean_report, escape_delivered, stderr, xdotool_failed, xdotool_retrying, FOCUS,
+    assert_resized, clean_box_run, clean_report, escape_delivered, stderr, xdotool_failed,
+    xdotool_retrying, FOCUS,
 };
 use std::path::Path;
 use twinray_common::cli::RenderPath;
 use twinray_common::value_name::ValueName;
-use twinray_tests::{render, scratch, App, Xvfb};
-
-/// The validation layer's synchronisation validation (hazards between
-/// commands, submits and presents), on top of `--validate`'s core checks; the
-/// GL app ignores it.
-const SYNC_VALIDATION: (&str, &str) = (
-    "VK_LAYER_ENABLES",
-    "VK_VALIDATION_FEATURE_ENABLE_SYNCHRONIZATION_VALIDATION_EXT",
-);
+use twinray_tests::{box_window, render, scratch, App, Xvfb, SYNC_VALIDATION};
 
 fn tag(app: App) -> &'static str {
     match app {
@@ -44,21 +37,19 @@ fn compute_path_window_and_live_switch_screenshots_equal_headless() {
     for app in App::BOTH {
         // --path compute opens a window; --out at exit is the compute image.
         let win = dir.join(format!("{}-compute.png", tag(app)));
-        let args = [
-            "--path",
-            "compute",
-            "--scene",
-            "box",
-            "--size",
+        let args = box_window(
             "64x48",
-            "--frames",
             "4",
-            "--validate",
-            "--json",
-            "--explain",
-            "--out",
-            win.to_str().unwrap(),
-        ];
+            &[
+                "--path",
+                "compute",
+                "--validate",
+                "--json",
+                "--explain",
+                "--out",
+                win.to_str().unwrap(),
+            ],
+        );
         let o = x.run(&app.exe(), &args, &[SYNC_VALIDATION], &dir);
         let r = clean_report(app, &o);
         assert_eq!(r.path, RenderPath::Compute, "{app:?}");
@@ -83,26 +74,10 @@ fn compute_path_window_and_live_switch_screenshots_equal_headless() {
         // Live: C to compute, P, C back to fragment, P, C, 3 (spherelist on
         // the compute path), P, Esc: one action per frame.
         let keys = "c,p,c,p,c,3,p,esc";
-        let args = [
-            "--scene",
-            "box",
-            "--size",
-            "64x48",
-            "--frames",
-            "100",
-            "--validate",
-            "--json",
-        ];
-        let o = x.run(
-            &app.exe(),
-            &args,
-            &[("TWINRAY_TEST_KEYS", keys), SYNC_VALIDATION],
-            &dir,
-        );
-        let r = clean_report(app, &o);
+        let env = [("TWINRAY_TEST_KEYS", keys), SYNC_VALIDATION];
+        let (r, err) = clean_box_run(&x, app, ("64x48", "100"), &[], &env, &dir);
         assert_eq!(r.frames.len(), 8, "{app:?}: Esc after the 8th frame");
         assert_eq!(r.path, RenderPath::Compute, "{app:?}: the path at exit");
-        let err = stderr(&o);
         let switches: Vec<&str> = err.lines().filter(|l| l.contains(": path ")).collect();
         assert_eq!(switches.len(), 3, "{app:?}: {err}");
         assert!(switches[0].ends_with("path compute") && switches[1].ends_with("path fragment"));
@@ -132,27 +107,14 @@ fn compute_path_survives_a_resize_storm_with_scene_and_path_switches() {
     // Scene and path switches in the first frames, while the window resizes.
     let keys = "3,c,c,2,c,c";
     for app in App::BOTH {
-        let args = [
-            "--path",
-            "compute",
-            "--scene",
-            "box",
-            "--size",
-            "64x48",
-            "--frames",
-            "70",
-            "--validate",
-            "--json",
-        ];
         let env = [
             ("TWINRAY_TEST_RESIZE", "1"),
             ("TWINRAY_TEST_KEYS", keys),
             SYNC_VALIDATION,
         ];
-        let o = x.run(&app.exe(), &args, &env, &dir);
-        let r = clean_report(app, &o);
+        let compute = ["--path", "compute"];
+        let (r, err) = clean_box_run(&x, app, ("64x48", "70"), &compute, &env, &dir);
         assert_eq!(r.path, RenderPath::Compute, "{app:?}");
-        let err = stderr(&o);
         assert_eq!(err.matches(": path ").count(), 4, "{app:?}: {err}");
         assert_resized(app, &err, 25);
     }
@@ -177,17 +139,7 @@ fn c_key_switches_the_path_the_title_follows_and_the_screen_equals_headless() {
             App::Vulkan => "1000",
             App::OpenGl => "20000",
         };
-        let args = [
-            "--path",
-            "compute",
-            "--scene",
-            "box",
-            "--size",
-            "64x48",
-            "--frames",
-            cap,
-            "--validate",
-        ];
+        let args = box_window("64x48", cap, &["--path", "compute", "--validate"]);
         let mut child = x.spawn(&app.exe(), &args, &[SYNC_VALIDATION], &dir);
         // xdotool's --name is a regular expression, and --sync waits until a
         // title matches: FPS in the title means frames of that path were shown.

@@ -3,7 +3,7 @@
 
 use crate::common::{escape_delivered, stderr, xdotool_failed, xdotool_retrying, FOCUS};
 use twinray_common::reference::metrics::compare;
-use twinray_tests::{render, scratch, App, Xvfb};
+use twinray_tests::{box_window, render, scratch, App, Xvfb};
 
 /// Opens a 96x72 box window, waits for it, performs `gesture` (xdotool
 /// commands, the window as %1), presses `keys` and Escape, and returns the
@@ -17,19 +17,13 @@ fn after_gesture(
 ) -> image::RgbImage {
     let out = dir.join("gesture.png");
     let _ = std::fs::remove_file(&out);
-    let args = [
-        "--scene",
-        "box",
-        "--size",
+    // A cap, not the plan: Escape ends the run after about 150 frames.
+    // (lavapipe leaks about 3 MB per frame, see README, so no open end.)
+    let args = box_window(
         "96x72",
-        // A cap, not the plan: Escape ends the run after about 150 frames.
-        // (lavapipe leaks about 3 MB per frame, see README, so no open end.)
-        "--frames",
         "1000",
-        "--validate",
-        "--out",
-        out.to_str().unwrap(),
-    ];
+        &["--validate", "--out", out.to_str().unwrap()],
+    );
     let mut child = x.spawn(&app.exe(), &args, &[], dir);
     let mut cmd = FOCUS.to_vec();
     // Pauses let frames render between the steps: the saved view is the last

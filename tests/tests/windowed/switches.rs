@@ -47,23 +47,14 @@ fn scene_switches_keep_accel_and_the_overrides_that_apply() {
         assert_eq!(r.scene.max_depth, 2, "{app:?}");
         // 50 hidden spheres cannot apply to the box: the switch drops them
         // and says so; back on the sphere list they apply again.
-        let (r, err) = switched(
-            &x,
-            app,
-            &["--scene", "spherelist", "--set", "extra_spheres=50"],
-            "2",
-        );
+        let extra_50 = ["--scene", "spherelist", "--set", "extra_spheres=50"];
+        let (r, err) = switched(&x, app, &extra_50, "2");
         assert_eq!(r.scene.name, "box", "{app:?}: the switch happened: {err}");
         assert!(
             err.contains("'box' without it: --set extra_spheres"),
             "{app:?}: the dropped option is named: {err}"
         );
-        let (r, err) = switched(
-            &x,
-            app,
-            &["--scene", "spherelist", "--set", "extra_spheres=50"],
-            "2,3",
-        );
+        let (r, err) = switched(&x, app, &extra_50, "2,3");
         assert_eq!(r.scene.name, "spherelist", "{app:?}: {err}");
         assert_eq!(r.scene.spheres, 51, "{app:?}: the override is back: {err}");
     }
