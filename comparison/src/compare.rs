@@ -303,33 +303,36 @@ pub fn run(args: &CompareArgs) -> anyhow::Result<()> {
     };
     write_report(&args.out, &results, &shader_rows, why.as_ref(), only_why)?;
     let failed = failures(&results, &shader_rows, why.as_ref());
-    // A run with no sweep (--only why) says nothing of one.
-    let planned = plan.points.len() * runs.len();
-    let sweep = if planned == 0 {
-        String::new()
-    } else {
-        format!(
-            "; the sweep's {} of {planned} runs done",
-            outcomes.iter().filter(|o| o.result.is_ok()).count()
-        )
-    };
-    eprintln!(
-        "twinray compare: {} app runs in {:.0} s{sweep}{}; report: {}",
-        cost.0,
-        cost.1,
-        match interrupted {
-            Some(i) => format!(
-                " (interrupted by {} during {}: the finished points are kept)",
-                i.signal, i.step
-            ),
-            None => String::new(),
-        },
-        args.out.join("report.md").display()
-    );
+    eprintln!("{}", done_line(&results, &args.out));
     if let Some((_, code)) = stop.signal() {
         std::process::exit(code);
     }
     crate::failures::check(&failed)
+}
+
+/// The log's last line: the app runs and seconds of every step, the sweep's
+/// share done (where it ran any), an interruption, and where the report is.
+fn done_line(results: &runs::Results, out: &std::path::Path) -> String {
+    let (runs, seconds) = results.cost.as_ref().map_or((0, 0.0), |c| (c.0, c.1));
+    // A run with no sweep (--only why) says nothing of one.
+    let planned = results.plan.points.len() * results.runs.len();
+    let sweep = if planned == 0 {
+        String::new()
+    } else {
+        let done = results.outcomes.iter().filter(|o| o.result.is_ok()).count();
+        format!("; the sweep's {done} of {planned} runs done")
+    };
+    let interrupted = match results.interrupted {
+        Some(i) => format!(
+            " (interrupted by {} during {}: the finished points are kept)",
+            i.signal, i.step
+        ),
+        None => String::new(),
+    };
+    format!(
+        "twinray compare: {runs} app runs in {seconds:.0} s{sweep}{interrupted}; report: {}",
+        out.join("report.md").display()
+    )
 }
 
 /// report.md (or, for `--only why`, its title alone) with results.csv and

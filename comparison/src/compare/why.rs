@@ -533,7 +533,10 @@ mod tests {
             assert_eq!(vk.0, Api::Vulkan);
             assert_ne!(gl.0, Api::Vulkan);
             assert!(
-                !case.vulkan.is_empty() || !case.opengl.is_empty() || gl.0 == Api::OpenglSpirv,
+                !case.vulkan.is_empty()
+                    || !case.opengl.is_empty()
+                    || gl.0 == Api::OpenglSpirv
+                    || case.workgroup.is_some(),
                 "{} has a case that changes nothing",
                 case.gap.name
             );
