@@ -499,6 +499,7 @@ mod tests {
                 "shared-bvh-stack",
                 "local-bvh-stack",
                 "split-ray-stack",
+                "first-of-equals",
                 "uniform-counts",
                 "no-contraction",
                 "float-controls",
