@@ -211,6 +211,7 @@ fn why_table_has_a_verdict_per_gap_and_experiment(report: &str, out: &std::path:
         "float-controls",
         "first-of-equals",
         "workgroup 4x8",
+        "--set max_depth=1",
     ] {
         assert!(experiments.contains(e), "no why row for {e}");
     }

@@ -142,8 +142,27 @@ pub struct Case {
     pub vulkan: &'static [Experiment],
     pub opengl: &'static [Experiment],
     pub opengl_api: Api,
-    /// Both APIs at this one compute workgroup instead of each at its own.
-    pub workgroup: Option<(u32, u32)>,
+    /// What both APIs' runs hold fixed instead of their defaults, if anything.
+    pub hold: Option<Hold>,
+}
+
+/// A change a case makes to both APIs' runs that is no experiment.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Hold {
+    /// One compute workgroup for both, instead of each API's own.
+    Workgroup(u32, u32),
+    /// One more scene value (`--set KEY=VALUE`).
+    Set(&'static str),
+}
+
+impl Hold {
+    /// As it appears in run labels and file names: `4x8`, `max_depth=1`.
+    pub fn label(self) -> String {
+        match self {
+            Hold::Workgroup(x, y) => format!("{x}x{y}"),
+            Hold::Set(kv) => kv.to_string(),
+        }
+    }
 }
 
 /// A gap's figure (VK/GL ratio or % of pixels within 1/255) by default and

@@ -6,7 +6,7 @@
 
 use crate::apps::api_name;
 use crate::apps::{run_json, Api};
-use crate::compare::runs::{Case, Gap, GapMeasure, Why, WhyFigures, WhyRow};
+use crate::compare::runs::{Case, Gap, GapMeasure, Hold, Why, WhyFigures, WhyRow};
 use std::collections::BTreeMap;
 use std::ffi::OsStr;
 use std::path::Path;
@@ -89,7 +89,7 @@ const fn case(
         vulkan,
         opengl,
         opengl_api,
-        workgroup: None,
+        hold: None,
     }
 }
 
@@ -98,7 +98,17 @@ const fn case(
 /// memory and the tracer in fewer registers.
 const fn one_workgroup(gap: &'static Gap) -> Case {
     Case {
-        workgroup: Some((4, 8)),
+        hold: Some(Hold::Workgroup(4, 8)),
+        ..case(gap, &[], &[], Api::Opengl)
+    }
+}
+
+/// Both APIs at a maximum depth of 1: no mirror ray, and so no ray loop,
+/// which NVIDIA's OpenGL compiler holds in more registers than the walk
+/// alone needs (fewer warps a multiprocessor than Vulkan's).
+const fn no_ray_loop(gap: &'static Gap) -> Case {
+    Case {
+        hold: Some(Hold::Set("max_depth=1")),
         ..case(gap, &[], &[], Api::Opengl)
     }
 }
@@ -142,6 +152,7 @@ pub const CASES: &[Case] = &[
     both(&SPHERELIST_BVH_COMPUTE, &[Experiment::LocalBvhStack]),
     gl_spirv(&SPHERELIST_BVH_COMPUTE),
     one_workgroup(&SPHERELIST_BVH_COMPUTE),
+    no_ray_loop(&SPHERELIST_BVH_COMPUTE),
     both(&BOX_IMAGES, &[Experiment::NoContraction]),
     vulkan(&BOX_IMAGES, &[Experiment::NoContraction]),
     vulkan(&BOX_IMAGES, &[Experiment::FloatControls]),
@@ -164,15 +175,15 @@ pub struct WhyPlan {
     pub rounds: u32,
 }
 
-/// One process to run at a gap: an API with its experiments, and the
-/// workgroup it is held to (None: its own).
-type Run = (Api, &'static [Experiment], Option<(u32, u32)>);
+/// One process to run at a gap: an API with its experiments, and what else
+/// it is held to (`Hold`; None: its defaults).
+type Run = (Api, &'static [Experiment], Option<Hold>);
 
 /// What `case` runs: its Vulkan run and its OpenGL run.
 fn runs_of(case: &Case) -> [Run; 2] {
     [
-        (Api::Vulkan, case.vulkan, case.workgroup),
-        (case.opengl_api, case.opengl, case.workgroup),
+        (Api::Vulkan, case.vulkan, case.hold),
+        (case.opengl_api, case.opengl, case.hold),
     ]
 }
 
@@ -180,7 +191,7 @@ fn runs_of(case: &Case) -> [Run; 2] {
 pub fn run_label(run: Run) -> String {
     std::iter::once(api_name(run.0).to_string())
         .chain(run.1.iter().map(|e| e.name()))
-        .chain(run.2.map(|(x, y)| format!("{x}x{y}")))
+        .chain(run.2.map(Hold::label))
         .collect::<Vec<_>>()
         .join("-")
 }
@@ -368,7 +379,19 @@ fn measure(
                         settle: (!images).then_some(plan.settle),
                         out: images.then(|| dir.join(format!("{}-{label}.png", gap.scene))),
                         experiment: run.1.to_vec(),
-                        workgroup: run.2.map(|(x, y)| Workgroup { x, y }),
+                        workgroup: match run.2 {
+                            Some(Hold::Workgroup(x, y)) => Some(Workgroup { x, y }),
+                            _ => None,
+                        },
+                        set: base
+                            .set
+                            .iter()
+                            .cloned()
+                            .chain(match run.2 {
+                                Some(Hold::Set(kv)) => Some(kv.to_string()),
+                                _ => None,
+                            })
+                            .collect(),
                         ..base.clone()
                     };
                     run_json(run.0, &args).map_err(|e| refused_or_failed(run, &e))
@@ -536,7 +559,7 @@ mod tests {
                 !case.vulkan.is_empty()
                     || !case.opengl.is_empty()
                     || gl.0 == Api::OpenglSpirv
-                    || case.workgroup.is_some(),
+                    || case.hold.is_some(),
                 "{} has a case that changes nothing",
                 case.gap.name
             );

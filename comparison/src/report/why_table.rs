@@ -4,7 +4,7 @@
 //! the thresholds below.
 
 use crate::apps::api_name;
-use crate::compare::runs::{Case, GapMeasure, Why, WhyRow};
+use crate::compare::runs::{Case, GapMeasure, Hold, Why, WhyRow};
 use crate::csv::Num;
 use anyhow::Context;
 use std::fmt::Write as _;
@@ -117,8 +117,10 @@ fn change(case: &Case) -> String {
     };
     let (vk, gl) = (names(case.vulkan), names(case.opengl));
     let gl_api = api_name(case.opengl_api);
-    if let Some((x, y)) = case.workgroup {
-        return format!("both at workgroup {x}x{y}");
+    match case.hold {
+        Some(Hold::Workgroup(x, y)) => return format!("both at workgroup {x}x{y}"),
+        Some(Hold::Set(kv)) => return format!("both with --set {kv}"),
+        None => {}
     }
     match (vk.is_empty(), gl.is_empty()) {
         (true, true) => format!("{gl_api} (as shipped)"),
