@@ -161,11 +161,11 @@ impl Planner {
         });
         let (bvh, bvh_ms) = if self.args.accel.wants_bvh(&scene) {
             let t0 = Instant::now();
-            let width = self.args.accel.width();
+            let (binary, width) = (build_bvh(&scene), self.args.accel.width());
             let bvh = if self.changes.first_of_equals {
-                build_bvh(&scene).widen_first_of_equals(width)
+                binary.widen_first_of_equals(width)
             } else {
-                build_bvh(&scene).widen(width)
+                binary.widen(width)
             };
             let ms = t0.elapsed().as_secs_f64() * 1e3;
             explain::numbered(0, "BVH (twinray-common)", || {

@@ -374,26 +374,18 @@ fn measure(
                     Err(format!("not run: {tool} not on PATH"))
                 }
                 _ => {
-                    let args = RenderArgs {
+                    let mut args = RenderArgs {
                         frames: Some(frames),
                         settle: (!images).then_some(plan.settle),
                         out: images.then(|| dir.join(format!("{}-{label}.png", gap.scene))),
                         experiment: run.1.to_vec(),
-                        workgroup: match run.2 {
-                            Some(Hold::Workgroup(x, y)) => Some(Workgroup { x, y }),
-                            _ => None,
-                        },
-                        set: base
-                            .set
-                            .iter()
-                            .cloned()
-                            .chain(match run.2 {
-                                Some(Hold::Set(kv)) => Some(kv.to_string()),
-                                _ => None,
-                            })
-                            .collect(),
                         ..base.clone()
                     };
+                    match run.2 {
+                        Some(Hold::Workgroup(x, y)) => args.workgroup = Some(Workgroup { x, y }),
+                        Some(Hold::Set(kv)) => args.set.push(kv.to_string()),
+                        None => {}
+                    }
                     run_json(run.0, &args).map_err(|e| refused_or_failed(run, &e))
                 }
             };

@@ -8,8 +8,9 @@
 //! binary levels down, so that equal boxes (the sphere list's identical
 //! spheres) still give a node two binary levels: first-of-equals made that
 //! tree 16 levels deep instead of 10, and its stack too large for OpenGL to
-//! use every multiprocessor (docs/findings/opengl-compute.md). The leaves are the binary tree's, primitives and
-//! order alike, so the leaf primitive array is shared and only the nodes differ.
+//! use every multiprocessor (docs/findings/opengl-compute.md). The leaves
+//! are the binary tree's, primitives and order alike, so the leaf primitive
+//! array is shared and only the nodes differ.
 //!
 //! Like the builder it depends only on the binary tree, so the wide tree is
 //! as deterministic as the binary one. The top levels are made first, the
