@@ -500,6 +500,7 @@ mod tests {
                 "local-bvh-stack",
                 "split-ray-stack",
                 "first-of-equals",
+                "walk-then-shade",
                 "uniform-counts",
                 "no-contraction",
                 "float-controls",

@@ -148,29 +148,10 @@ vec3 trace(vec3 origin, vec3 dir) {
             }
             Material m = material_buf.materials[mat_index];
 
-            vec3 local = m.ambient;
-            for (uint li = 0u; li < LIGHT_COUNT; li++) {
-                Light light = light_buf.lights[li];
-                // The offset may depend on the direction (OFFSET_RAY): aim from p first.
-                vec3 p_out = spawn_point(p, ng, normalize(light.position - p), scale);
-                vec3 to_light = light.position - p_out;
-                float dist = length(to_light);
-                vec3 l = to_light / dist;
-                float ndl = dot(ns, l);
-                bool lit = ndl > 0.0 && dot(ng, l) > 0.0;
-                if (lit) {
-                    // Stop a hair before the light: a light lying on a surface would
-                    // otherwise be hidden by that surface at the whim of rounding.
-                    lit = !occluded(p_out, l, dist * SHADOW_REACH);
-                }
-                if (lit) {
-                    vec3 r = reflect(-l, ns);
-                    float spec = pow(max(dot(r, -d), 0.0), m.shininess);
-                    local += light.color * (m.diffuse * ndl + m.specular * spec);
-                }
-            }
-            color += w * local;
-
+            // The mirror and glass rays go on the stack before the lights are
+            // shaded: what they need (p, the normals, d, the material's
+            // reflectivity) is then dead before the shadow walks instead of
+            // live across them. See ONE_LIGHT below for what that is worth.
 #if defined(HAS_MIRROR) || defined(HAS_GLASS)
             SPEC(SPEC_MIRROR || SPEC_GLASS)
             if (depth + 1u < max_depth) {
@@ -222,6 +203,70 @@ vec3 trace(vec3 origin, vec3 dir) {
                 }
             }
 #endif
+
+            vec3 local = m.ambient;
+#ifdef ONE_LIGHT
+            // A scene of one light (the sphere list) shades it before its
+            // shadow walk and rebuilds the walk's ray from the light's
+            // position after: across the walk only the spawn point's inputs
+            // and the light's share stay live, not the normals, the view
+            // direction and the material. On the H200 that let NVIDIA's
+            // OpenGL hold 28 warps a multiprocessor instead of 24 and took
+            // 5.5 % off its 1080p sphere-list frames, Vulkan's within 2 %
+            // (docs/findings/opengl-compute.md#the-one-lights-share-before-its-walk-h200;
+            // --experiment walk-then-shade puts the loop back). With several
+            // lights the shares held across the walks cost Vulkan 3 %, so
+            // they keep the loop. Same operations, same order: the same image.
+            vec3 share = vec3(0.0);
+            bool lit = false;
+            {
+                Light light = light_buf.lights[0];
+                vec3 p_out = spawn_point(p, ng, normalize(light.position - p), scale);
+                vec3 to_light = light.position - p_out;
+                float dist = length(to_light);
+                vec3 l = to_light / dist;
+                float ndl = dot(ns, l);
+                if (ndl > 0.0 && dot(ng, l) > 0.0) {
+                    vec3 r = reflect(-l, ns);
+                    float spec = pow(max(dot(r, -d), 0.0), m.shininess);
+                    share = light.color * (m.diffuse * ndl + m.specular * spec);
+                    lit = true;
+                }
+            }
+            if (lit) {
+                vec3 position = light_buf.lights[0].position;
+                vec3 p_out = spawn_point(p, ng, normalize(position - p), scale);
+                vec3 to_light = position - p_out;
+                float dist = length(to_light);
+                vec3 l = to_light / dist;
+                // Stop a hair before the light (the loop below has why).
+                if (!occluded(p_out, l, dist * SHADOW_REACH)) {
+                    local += share;
+                }
+            }
+#else
+            for (uint li = 0u; li < LIGHT_COUNT; li++) {
+                Light light = light_buf.lights[li];
+                // The offset may depend on the direction (OFFSET_RAY): aim from p first.
+                vec3 p_out = spawn_point(p, ng, normalize(light.position - p), scale);
+                vec3 to_light = light.position - p_out;
+                float dist = length(to_light);
+                vec3 l = to_light / dist;
+                float ndl = dot(ns, l);
+                bool lit = ndl > 0.0 && dot(ng, l) > 0.0;
+                if (lit) {
+                    // Stop a hair before the light: a light lying on a surface would
+                    // otherwise be hidden by that surface at the whim of rounding.
+                    lit = !occluded(p_out, l, dist * SHADOW_REACH);
+                }
+                if (lit) {
+                    vec3 r = reflect(-l, ns);
+                    float spec = pow(max(dot(r, -d), 0.0), m.shininess);
+                    local += light.color * (m.diffuse * ndl + m.specular * spec);
+                }
+            }
+#endif
+            color += w * local;
         }
     }
     return color;

@@ -210,6 +210,7 @@ fn why_table_has_a_verdict_per_gap_and_experiment(report: &str, out: &std::path:
         "no-contraction",
         "float-controls",
         "first-of-equals",
+        "walk-then-shade",
         "workgroup 4x8",
         "--set max_depth=1",
     ] {

@@ -16,6 +16,7 @@ pub enum Experiment {
     LocalBvhStack,
     SplitRayStack,
     FirstOfEquals,
+    WalkThenShade,
     UniformCounts,
     NoContraction,
     FloatControls,

@@ -82,6 +82,9 @@ pub const REGISTRY: &[Entry] = &[
     entry(Experiment::FirstOfEquals, "The wide tree's collapse opens the first of equal-area boxes, as it did until the shallowest was preferred: the sphere list's identical spheres then give a 4-wide tree of 16 levels at 100k spheres instead of 10, and a BVH stack of 368 B instead of 224 B, past what lets NVIDIA's OpenGL use every multiprocessor.", |c| {
         c.first_of_equals = true
     }),
+    entry(Experiment::WalkThenShade, "A scene of one light shades it after its shadow walk, through the lights' loop, as every scene did until its share was taken first: the hit's normals, view direction and material then stay live across the walk, and NVIDIA's OpenGL holds 24 warps a multiprocessor on the sphere list instead of 28.", |c| {
+        c.knobs.walk_then_shade = true
+    }),
     entry(Experiment::UniformCounts, "Read the primitive and light counts from the Frame uniform instead of baking them into the shader (what made lavapipe grow per frame).", |c| {
         c.counts = Some(Counts::Uniform)
     }),

@@ -102,6 +102,8 @@ pub struct ShaderKnobs {
     pub shared_bvh_stack: bool,
     /// The ray stack as four arrays instead of two of vec4 pairs.
     pub split_ray_stack: bool,
+    /// A scene of one light shaded through the lights' loop, after its walk.
+    pub walk_then_shade: bool,
     /// Compute: KiB of workgroup memory the tracer does not need.
     pub shared_pad_kib: Option<u32>,
     /// The arithmetic probe (shaders/lab/ulp.glsl) in place of the tracer's
@@ -337,6 +339,9 @@ impl Variant {
             d.insert("SPHERE_COUNT".into(), format!("{spheres}u"));
             d.insert("TRIANGLE_COUNT".into(), format!("{triangles}u"));
             d.insert("LIGHT_COUNT".into(), format!("{lights}u"));
+            if lights == 1 && !k.walk_then_shade {
+                d.insert("ONE_LIGHT".into(), "1".into());
+            }
         }
         if let Some(kib) = k.shared_pad_kib {
             d.insert("SHARED_PAD_KIB".into(), kib.to_string());

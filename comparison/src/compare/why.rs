@@ -149,6 +149,7 @@ pub const CASES: &[Case] = &[
     gl_spirv(&TEAPOT_BVH_COMPUTE),
     one_workgroup(&TEAPOT_BVH_COMPUTE),
     both(&SPHERELIST_BVH_COMPUTE, &[Experiment::FirstOfEquals]),
+    both(&SPHERELIST_BVH_COMPUTE, &[Experiment::WalkThenShade]),
     both(&SPHERELIST_BVH_COMPUTE, &[Experiment::LocalBvhStack]),
     gl_spirv(&SPHERELIST_BVH_COMPUTE),
     one_workgroup(&SPHERELIST_BVH_COMPUTE),
