@@ -16,6 +16,7 @@ pub enum Experiment {
     LocalBvhStack,
     SplitRayStack,
     FirstOfEquals,
+    OptimalCollapse,
     UniformCounts,
     NoContraction,
     FloatControls,
