@@ -500,6 +500,7 @@ mod tests {
                 "local-bvh-stack",
                 "split-ray-stack",
                 "first-of-equals",
+                "optimal-collapse",
                 "walk-then-shade",
                 "uniform-counts",
                 "no-contraction",

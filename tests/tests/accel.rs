@@ -1,7 +1,8 @@
-//! Model only what a scene needs: the BVH and the per-scene shader variants
-//! change the speed, never the picture. BVH (of each width) vs brute force, variant vs
+//! Model only what a scene needs: the BVH, its collapse and the per-scene
+//! shader variants change the speed, never the picture. BVH (of each width) vs brute force, variant vs
 //! `--generic` and variant vs `--specialize` agree on ≥ 99.99 % of pixels
-//! within 1/255, in both APIs.
+//! within 1/255, in both APIs; the optimal collapse renders the greedy one's
+//! image byte for byte.
 
 use twinray_common::reference::metrics::compare;
 use twinray_tests::{assert_within_1, orchestrator_render, render, scratch, App};
@@ -59,6 +60,44 @@ fn wide_bvhs_and_brute_force_give_the_same_image() {
                     assert_eq!(r.bvh_width, Some(width), "{what}: the JSON's width");
                     assert_ne!(r.variant, rn.variant);
                     assert_within_1(&brute, &img, 0.9999, &format!("{what} vs brute force"));
+                }
+            }
+            std::fs::remove_dir_all(dir).ok();
+        }
+    }
+}
+
+/// `--experiment optimal-collapse` (the wide tree of least SAH cost over the
+/// same leaves, in the same order) on both paths of both apps at both
+/// widths: a tree no costlier by the JSON's SAH cost, and the default tree's
+/// image byte for byte. Only the order the walk meets the leaves in changes,
+/// which could change a pixel only where two primitives are hit at exactly
+/// the same distance.
+#[test]
+fn the_optimal_collapse_renders_the_default_trees_image() {
+    for app in App::BOTH {
+        for (scene, size, set) in SCENES {
+            let dir = scratch(&format!("accel-optimal-{scene}"));
+            for accel in ["bvh4", "bvh8"] {
+                for path in ["fragment", "compute"] {
+                    let args = [set, &["--accel", accel, "--path", path]].concat();
+                    let (rd, default) = render(app, scene, size, &args, &dir.join("default.png"));
+                    let args = [&args[..], &["--experiment", "optimal-collapse"]].concat();
+                    let (ro, optimal) = render(app, scene, size, &args, &dir.join("optimal.png"));
+                    let what = format!("{app:?} {scene} {accel} {path} ({})", ro.variant);
+                    assert!(ro.variant.ends_with("/optimal-collapse"), "{what}");
+                    assert_eq!(ro.validation_messages, 0, "{what}: validation messages");
+                    let (d, o) = (rd.bvh_sah_cost.unwrap(), ro.bvh_sah_cost.unwrap());
+                    assert!(o <= d * (1.0 + 1e-9), "{what}: SAH cost {o}, default {d}");
+                    let differing = optimal
+                        .pixels()
+                        .zip(default.pixels())
+                        .filter(|(a, b)| a != b)
+                        .count();
+                    assert_eq!(
+                        differing, 0,
+                        "{what}: {differing} pixels differ from the default tree's"
+                    );
                 }
             }
             std::fs::remove_dir_all(dir).ok();

@@ -16,6 +16,7 @@ pub enum Experiment {
     LocalBvhStack,
     SplitRayStack,
     FirstOfEquals,
+    OptimalCollapse,
     WalkThenShade,
     UniformCounts,
     NoContraction,

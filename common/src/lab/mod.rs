@@ -24,6 +24,8 @@ pub struct Changes {
     pub counts: Option<Counts>,
     /// The wide collapse opens the first of equal-area boxes.
     pub first_of_equals: bool,
+    /// The wide collapse is the one of least SAH cost.
+    pub optimal_collapse: bool,
     /// The experiments' names in registry order, for the variant's label.
     pub tags: Vec<String>,
 }
@@ -82,6 +84,9 @@ pub const REGISTRY: &[Entry] = &[
     entry(Experiment::FirstOfEquals, "The wide tree's collapse opens the first of equal-area boxes, as it did until the shallowest was preferred: the sphere list's identical spheres then give a 4-wide tree of 16 levels at 100k spheres instead of 10, and a BVH stack of 368 B instead of 224 B, past what lets NVIDIA's OpenGL use every multiprocessor.", |c| {
         c.first_of_equals = true
     }),
+    entry(Experiment::OptimalCollapse, "The wide tree's collapse chooses each node's children by dynamic programming over the binary tree, for the least SAH cost over the same leaves, instead of opening the largest box until the node is full.", |c| {
+        c.optimal_collapse = true
+    }),
     entry(Experiment::WalkThenShade, "A scene of one light shades it after its shadow walk, through the lights' loop, as every scene did until its share was taken first: the hit's normals, view direction and material then stay live across the walk, and NVIDIA's OpenGL holds 24 warps a multiprocessor on the sphere list instead of 28.", |c| {
         c.knobs.walk_then_shade = true
     }),
@@ -120,13 +125,21 @@ pub const REGISTRY: &[Entry] = &[
 
 /// Experiments that cannot be combined, each pair with why: the shader has
 /// no variant for both (naga would refuse it, naming a macro the user never
-/// wrote). A pair where one wins (`naga-loop-bounding` over
-/// `no-loop-bounding`) is not here: its entry says which.
-pub const EXCLUSIVE: &[(Experiment, Experiment, &str)] = &[(
-    Experiment::SharedBvhStack,
-    Experiment::LocalBvhStack,
-    "the BVH stack lives either in shared memory or in each walk",
-)];
+/// wrote), or the tree has no collapse for both. A pair where one wins
+/// (`naga-loop-bounding` over `no-loop-bounding`) is not here: its entry
+/// says which.
+pub const EXCLUSIVE: &[(Experiment, Experiment, &str)] = &[
+    (
+        Experiment::SharedBvhStack,
+        Experiment::LocalBvhStack,
+        "the BVH stack lives either in shared memory or in each walk",
+    ),
+    (
+        Experiment::FirstOfEquals,
+        Experiment::OptimalCollapse,
+        "first-of-equals is a rule of the greedy collapse, which the optimal one replaces",
+    ),
+];
 
 /// The registry's entry for `e`.
 pub fn entry_of(e: Experiment) -> &'static Entry {

@@ -5,7 +5,7 @@ use crate::gpu::layout::{child_ref, Bounds, Bvh, EMPTY_SLOT_MAX, EMPTY_SLOT_MIN,
 use crate::scene::accel::MAX_LEAF;
 use crate::scene::Scene;
 
-fn check(scene: &Scene) -> Bvh {
+pub(super) fn check(scene: &Scene) -> Bvh {
     let bvh = Bvh::build(scene);
     let total = scene.spheres.len() + scene.triangles.len();
     let mut seen = bvh.prims.clone();
@@ -132,7 +132,14 @@ fn the_teapot_tree_costs_no_more_than_before() {
 /// children but one).
 fn check_wide(scene: &Scene, width: u32) -> Bvh {
     let binary = check(scene);
-    let b = Bvh::build(scene).widen(width);
+    let b = binary.clone().widen(width);
+    check_wide_tree(&binary, &b, width);
+    b
+}
+
+/// `check_wide` of `b`, collapsed from `binary` (whose leaves' boxes and
+/// primitives are already checked).
+pub(super) fn check_wide_tree(binary: &Bvh, b: &Bvh, width: u32) {
     assert_eq!((b.width, b.nodes.len()), (width, 0));
     assert_eq!(
         b.prims, binary.prims,
@@ -217,7 +224,6 @@ fn check_wide(scene: &Scene, width: u32) -> Bvh {
         b.stack_entries()
     );
     assert!(b.stack_entries() <= (width - 1) * (b.depth - 1).max(1));
-    b
 }
 
 #[test]
@@ -251,9 +257,11 @@ fn wide_trees_hold_every_primitive_once_inside_their_boxes() {
 /// The wide tree is collapsed in pieces on several threads and laid out as
 /// one depth-first collapse would write it: the same bytes, depth and stack
 /// bound whether no level, the default levels or every level (one piece a
-/// node) is made apart, and on any number of threads.
+/// node) is made apart, and on any number of threads; the optimal collapse's
+/// table, filled in parallel too, alike.
 #[test]
 fn the_wide_tree_is_the_same_however_it_is_split() {
+    use super::wide::Rule;
     let teapot = Scene::load("teapot", &[("tessellation".into(), "40x30".into())]).unwrap();
     let spheres = Scene::load("spherelist", &[("extra_spheres".into(), "1000".into())]).unwrap();
     let mut one = Scene::load("spherelist", &[]).unwrap();
@@ -262,16 +270,19 @@ fn the_wide_tree_is_the_same_however_it_is_split() {
     let bytes = |b: &Bvh| bytemuck::cast_slice::<_, u8>(&b.wide).to_vec();
     for scene in [&teapot, &spheres, &one] {
         let binary = Bvh::build(scene);
-        for width in [4, 8] {
-            let serial = binary.clone().widen_on(width, 0);
+        for (width, rule) in [4, 8]
+            .into_iter()
+            .flat_map(|w| [(w, Rule::Largest), (w, Rule::Optimal)])
+        {
+            let serial = binary.clone().widen_on(width, 0, rule);
             for (levels, threads) in [(super::wide::PARALLEL_LEVELS, 1), (4, 3), (2, 8), (64, 8)] {
                 let pool = rayon::ThreadPoolBuilder::new()
                     .num_threads(threads)
                     .build()
                     .unwrap();
-                let b = pool.install(|| binary.clone().widen_on(width, levels));
+                let b = pool.install(|| binary.clone().widen_on(width, levels, rule));
                 let what = format!(
-                    "{} at width {width}, {levels} levels, {threads} threads",
+                    "{} at width {width} ({rule:?}), {levels} levels, {threads} threads",
                     scene.name
                 );
                 assert!(bytes(&b) == bytes(&serial), "{what}: nodes");

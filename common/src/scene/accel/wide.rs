@@ -10,7 +10,8 @@
 //! tree 16 levels deep instead of 10, and its stack too large for OpenGL to
 //! use every multiprocessor (docs/findings/opengl-compute.md). The leaves
 //! are the binary tree's, primitives and order alike, so the leaf primitive
-//! array is shared and only the nodes differ.
+//! array is shared and only the nodes differ. `--experiment optimal-collapse`
+//! chooses each node's children for the least SAH cost instead (`Optimal`).
 //!
 //! Like the builder it depends only on the binary tree, so the wide tree is
 //! as deterministic as the binary one. The top levels are made first, the
@@ -29,16 +30,40 @@ pub fn quads(width: u32) -> usize {
     (width as usize).div_ceil(4)
 }
 
-fn area((min, max): Bounds) -> f64 {
+fn boxed((min, max): Bounds) -> Box3 {
     Box3 {
         min: min.into(),
         max: max.into(),
     }
-    .area()
+}
+
+fn area(b: Bounds) -> f64 {
+    boxed(b).area()
+}
+
+/// A binary node's two children: box and child reference, left first.
+fn children(n: &GpuBvhNode) -> [(Bounds, u32); 2] {
+    [
+        ((n.left_min, n.left_max), n.left),
+        ((n.right_min, n.right_max), n.right),
+    ]
 }
 
 /// A wide node's children before they are written: box and child reference.
 type Kids = ([(Bounds, u32); 8], usize);
+
+const NO_KIDS: Kids = ([(([0.0; 3], [0.0; 3]), 0); 8], 0);
+
+/// How a binary subtree becomes a wide node's children.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(super) enum Rule {
+    /// Open the largest box, the shallowest of equals (`widen`).
+    Largest,
+    /// Open the largest box, the first of equals (`--experiment first-of-equals`).
+    FirstOfEquals,
+    /// The children of least SAH cost (`--experiment optimal-collapse`).
+    Optimal,
+}
 
 /// Levels of the wide tree whose nodes are made first, on one thread; the
 /// subtrees below them are then collapsed side by side (rayon). Four levels
@@ -48,9 +73,9 @@ pub(super) const PARALLEL_LEVELS: u32 = 4;
 struct Collapse<'a> {
     binary: &'a [GpuBvhNode],
     width: usize,
-    /// Of equal areas open the first, not the shallowest: the collapse as it
-    /// was, for `--experiment first-of-equals` (lab/mod.rs).
-    first_of_equals: bool,
+    rule: Rule,
+    /// The optimal collapse's table, for `Rule::Optimal`.
+    optimal: Option<Optimal<'a>>,
 }
 
 /// A run of the wide tree's nodes, in the order the tree lays them out.
@@ -73,12 +98,16 @@ impl Collapse<'_> {
     /// The children of the wide node that replaces binary node `index`.
     fn kids(&self, index: usize) -> Kids {
         let n = &self.binary[index];
-        let mut kids: Kids = ([(([0.0; 3], [0.0; 3]), 0); 8], 2);
-        kids.0[0] = ((n.left_min, n.left_max), n.left);
-        kids.0[1] = ((n.right_min, n.right_max), n.right);
+        let mut kids: Kids = NO_KIDS;
+        kids.0[..2].copy_from_slice(&children(n));
+        kids.1 = 2;
         // A tree of one leaf has a root whose two children are that leaf.
         if n.left == n.right && child_ref::as_leaf(n.left).is_some() {
             kids.1 = 1;
+            return kids;
+        }
+        if let Some(o) = &self.optimal {
+            return o.kids(index);
         }
         // How many binary levels below this node each child is.
         let mut level = [1u32; 8];
@@ -88,7 +117,9 @@ impl Collapse<'_> {
             let mut open: Option<(usize, f64, u32)> = None;
             for (i, &(b, c)) in kids.0[..kids.1].iter().enumerate() {
                 let a = area(b);
-                let shallower = |l| !self.first_of_equals && level[i] < l;
+                // Of equal areas, first-of-equals opens the first: the
+                // collapse as it was (lab/mod.rs).
+                let shallower = |l| self.rule != Rule::FirstOfEquals && level[i] < l;
                 let better =
                     |(_, best, l): (usize, f64, u32)| a > best || (a == best && shallower(l));
                 if child_ref::as_leaf(c).is_none() && open.is_none_or(better) {
@@ -101,8 +132,7 @@ impl Collapse<'_> {
             // children stay in the binary tree's left-to-right order.
             kids.0.copy_within(i + 1..kids.1, i + 2);
             level.copy_within(i + 1..kids.1, i + 2);
-            kids.0[i] = ((n.left_min, n.left_max), n.left);
-            kids.0[i + 1] = ((n.right_min, n.right_max), n.right);
+            kids.0[i..i + 2].copy_from_slice(&children(n));
             level[i] = l + 1;
             level[i + 1] = l + 1;
             kids.1 += 1;
@@ -214,25 +244,27 @@ impl Bvh {
     /// This tree collapsed to `width` children a node (4 or 8; 2 keeps it
     /// binary). The binary nodes are dropped: the wide tree replaces them.
     pub fn widen(self, width: u32) -> Bvh {
-        self.widen_on(width, PARALLEL_LEVELS)
+        self.widen_on(width, PARALLEL_LEVELS, Rule::Largest)
     }
 
     /// `widen` opening the first of equal-area boxes instead of the
     /// shallowest (`--experiment first-of-equals`): the sphere list's tree
     /// as it was before, 16 levels deep at 100k spheres.
     pub fn widen_first_of_equals(self, width: u32) -> Bvh {
-        self.collapse(width, PARALLEL_LEVELS, true)
+        self.widen_on(width, PARALLEL_LEVELS, Rule::FirstOfEquals)
     }
 
-    /// `widen` with the top `levels` levels made first and the subtrees
+    /// `widen` with each node's children those of the wide tree of least SAH
+    /// cost over the same leaves (`--experiment optimal-collapse`, `Optimal`).
+    pub fn widen_optimal(self, width: u32) -> Bvh {
+        self.widen_on(width, PARALLEL_LEVELS, Rule::Optimal)
+    }
+
+    /// `widen` by `rule`, with the top `levels` levels made first and the subtrees
     /// below them collapsed in parallel, then laid out in the order a
     /// depth-first collapse writes them: the same tree for every `levels`
     /// (0: the whole tree one subtree, on this thread), which a test holds.
-    pub(super) fn widen_on(self, width: u32, levels: u32) -> Bvh {
-        self.collapse(width, levels, false)
-    }
-
-    fn collapse(mut self, width: u32, levels: u32, first_of_equals: bool) -> Bvh {
+    pub(super) fn widen_on(mut self, width: u32, levels: u32, rule: Rule) -> Bvh {
         debug_assert!(WIDTHS.contains(&width), "width {width}");
         if width <= 2 || self.nodes.is_empty() {
             return self;
@@ -241,7 +273,8 @@ impl Bvh {
         let c = Collapse {
             binary: &self.nodes,
             width: width as usize,
-            first_of_equals,
+            rule,
+            optimal: (rule == Rule::Optimal).then(|| Optimal::new(&self.nodes, width as usize)),
         };
         let mut pieces = Vec::new();
         c.top(0, 0, levels, &mut pieces);
@@ -276,6 +309,7 @@ impl Bvh {
         // The binary tree is done with: gone before the wide array is made,
         // so that the pieces and the array are the only trees in memory at
         // once (as the binary tree and the array were, before the pieces).
+        drop(c);
         self.nodes = Vec::new();
         let (depth, stack) = shape(&pieces, 0);
         // Where each piece starts, in nodes.
@@ -337,13 +371,9 @@ impl Bvh {
     /// whatever its width, so it favours the wide tree by the extra box tests
     /// a visit makes; what it compares fairly is trees of one width.
     pub(super) fn wide_sah_cost(&self) -> f64 {
-        let root: Vec<_> = self.wide_children(0).collect();
         let mut root_box = Box3::EMPTY;
-        for &((min, max), _) in &root {
-            root_box.grow(&Box3 {
-                min: min.into(),
-                max: max.into(),
-            });
+        for (b, _) in self.wide_children(0) {
+            root_box.grow(&boxed(b));
         }
         let root_area = root_box.area().max(f64::MIN_POSITIVE);
         let mut cost = TRAVERSAL_COST;
@@ -359,3 +389,187 @@ impl Bvh {
         cost
     }
 }
+
+/// The low bits of a key: the depth of what fills the slots (a leaf 1, a
+/// kept interior node its wide subtree's depth). The cost is above them, so
+/// that keys order by cost, then depth, and two keys add as costs do.
+const DEPTH_BITS: u32 = 8;
+const DEPTH: u64 = (1 << DEPTH_BITS) - 1;
+/// A leaf in a slot: no cost, one level.
+const LEAF: u64 = 1;
+/// The largest cost a whole tree can reach, so that a cost and its depth bits
+/// fit a u64: every interior node's area is at most the root's.
+const MOST_COST: f64 = (1u64 << (63 - DEPTH_BITS)) as f64;
+/// A subtree with fewer binary nodes fills its table on one thread.
+const PARALLEL_NODES: usize = 1 << 12;
+
+/// Two covers side by side: their costs add, the deeper one counts.
+fn join(a: u64, b: u64) -> u64 {
+    ((a & !DEPTH) + (b & !DEPTH)) | (a & DEPTH).max(b & DEPTH)
+}
+
+/// For one child of a binary node, the best cover of its subtree by at most
+/// `i` slots (index `i`, from 1): its key and whether the child is opened
+/// (its own children take the slots) rather than kept as one wide child.
+type Slots = [(u64, bool); 8];
+
+/// A choice of the table: the left child's share of the slots, and whether
+/// each child is opened.
+const SHARE: u8 = 0xf;
+const OPEN_LEFT: u8 = 0x10;
+const OPEN_RIGHT: u8 = 0x20;
+
+/// The optimal collapse (`--experiment optimal-collapse`): of the wide trees
+/// whose leaves are the binary tree's and whose nodes' children are each a
+/// cut of a binary subtree, kept in order, the one of least SAH cost, by
+/// dynamic programming over the binary tree (Ylitie, Karras, Laine and Aila
+/// 2017, "Efficient incoherent ray traversal on GPUs through compressed wide
+/// BVHs", without its leaf merging). The leaves being fixed, so is their
+/// share of the cost: what it minimises is the summed area of the interior
+/// nodes. Of equal costs it keeps the shallowest tree (the sphere list's
+/// identical spheres make many), then, node by node, a child kept whole over
+/// one opened, then the fewest slots to the left child. Costs are whole
+/// units of a share of the root's area, whose sums are exact in any order:
+/// a tie is a tie however the table was filled, and the tree as
+/// deterministic as the binary one. What is kept, for each node and each j
+/// from 2 to the width, is how the best cover of its two children by at
+/// most j slots shares them out: all that writing the tree needs.
+struct Optimal<'a> {
+    binary: &'a [GpuBvhNode],
+    width: usize,
+    /// The cost of the root's box: the most any node's can be.
+    most: f64,
+    /// Cost units per unit of area.
+    unit: f64,
+    /// `width - 1` choices a node, for j = 2..=width, in node order.
+    choice: Vec<u8>,
+}
+
+impl<'a> Optimal<'a> {
+    fn new(binary: &'a [GpuBvhNode], width: usize) -> Optimal<'a> {
+        let root = &binary[0];
+        let mut root_box = boxed((root.left_min, root.left_max));
+        root_box.grow(&boxed((root.right_min, root.right_max)));
+        let root_area = root_box.area().max(f64::MIN_POSITIVE);
+        let most = (MOST_COST / (binary.len() + 1) as f64).floor();
+        let mut o = Optimal {
+            binary,
+            width,
+            most,
+            unit: most / root_area,
+            choice: Vec::new(),
+        };
+        // The keys only while the table fills: writing the tree needs only
+        // the choices.
+        let mut best = vec![0; binary.len() * (width - 1)];
+        let mut choice = vec![0; best.len()];
+        o.fill(0, binary.len(), &mut best, &mut choice);
+        o.choice = choice;
+        o
+    }
+
+    /// The children of the wide node that replaces binary node `index`.
+    fn kids(&self, index: usize) -> Kids {
+        let mut kids = NO_KIDS;
+        self.cut(index, self.width, &mut kids);
+        kids
+    }
+
+    /// Appends the best cover of node `n`'s children by `j` slots, left to right.
+    fn cut(&self, n: usize, j: usize, kids: &mut Kids) {
+        let choice = self.choice[n * (self.width - 1) + j - 2];
+        let i = (choice & SHARE) as usize;
+        let [left, right] = children(&self.binary[n]);
+        for (open, (b, c), share) in [(OPEN_LEFT, left, i), (OPEN_RIGHT, right, j - i)] {
+            if choice & open != 0 {
+                self.cut(c as usize, share, kids);
+            } else {
+                kids.0[kids.1] = (b, c);
+                kids.1 += 1;
+            }
+        }
+    }
+
+    /// A box's area in cost units.
+    fn cost(&self, b: Bounds) -> u64 {
+        (area(b) * self.unit).round().min(self.most) as u64
+    }
+
+    /// The slots of both children of node `n`, from `best`, the keys of the
+    /// nodes from `base` on (`width - 1` a node, for j = 2..=width).
+    fn slots(&self, n: usize, best: &[u64], base: usize) -> [Slots; 2] {
+        let stride = self.width - 1;
+        children(&self.binary[n]).map(|(b, c)| {
+            let mut s = [(LEAF, false); 8];
+            if child_ref::as_leaf(c).is_none() {
+                let at = (c as usize - base) * stride;
+                let own = &best[at..at + stride];
+                // One slot: a wide node of its own, one level deeper.
+                let keep = own[stride - 1] + (self.cost(b) << DEPTH_BITS) + 1;
+                debug_assert!(keep & DEPTH != 0, "a tree deeper than the depth bits hold");
+                s[1] = (keep, false);
+                for i in 2..self.width {
+                    s[i] = if own[i - 2] < keep {
+                        (own[i - 2], true)
+                    } else {
+                        (keep, false)
+                    };
+                }
+            }
+            s
+        })
+    }
+
+    /// Fills the keys and choices of the subtree of node `n`, which ends
+    /// before node `end`, children before parents: a subtree's nodes are one
+    /// run of the depth-first array, its left child's subtree then its right
+    /// one's, so the two are filled apart.
+    fn fill(&self, n: usize, end: usize, best: &mut [u64], choice: &mut [u8]) {
+        if end - n < PARALLEL_NODES {
+            for m in (n..end).rev() {
+                self.solve(m, n, best, choice);
+            }
+            return;
+        }
+        let node = &self.binary[n];
+        let interior = |c: u32| child_ref::as_leaf(c).is_none().then_some(c as usize);
+        let (left, right) = (interior(node.left), interior(node.right));
+        let mid = right.unwrap_or(end);
+        debug_assert!(left.is_none_or(|l| l == n + 1) && (left.is_some() || mid == n + 1));
+        let (stride, at) = (self.width - 1, (mid - n - 1) * (self.width - 1));
+        let (lbest, rbest) = best[stride..].split_at_mut(at);
+        let (lchoice, rchoice) = choice[stride..].split_at_mut(at);
+        rayon::join(
+            || left.map(|l| self.fill(l, mid, lbest, lchoice)),
+            || right.map(|r| self.fill(r, end, rbest, rchoice)),
+        );
+        self.solve(n, n, best, choice);
+    }
+
+    /// Node `n`'s keys and choices, from its children's keys, in the tables
+    /// of the nodes from `base` on.
+    fn solve(&self, n: usize, base: usize, best: &mut [u64], choice: &mut [u8]) {
+        let slots = self.slots(n, best, base);
+        let at = (n - base) * (self.width - 1);
+        for j in 2..=self.width {
+            let (key, i) = share(&slots, j);
+            best[at + j - 2] = key;
+            choice[at + j - 2] = i as u8
+                | if slots[0][i].1 { OPEN_LEFT } else { 0 }
+                | if slots[1][j - i].1 { OPEN_RIGHT } else { 0 };
+        }
+    }
+}
+
+/// The least key of `j` slots shared by the two children, and the left
+/// child's share: of equal keys, the fewest slots to the left. Slots are
+/// never fewer for more of them, so all `j` are shared out.
+fn share([left, right]: &[Slots; 2], j: usize) -> (u64, usize) {
+    (1..j)
+        .map(|i| (join(left[i].0, right[j - i].0), i))
+        .min()
+        .expect("two slots or more")
+}
+
+#[cfg(test)]
+mod tests;

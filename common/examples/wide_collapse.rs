@@ -1,0 +1,55 @@
+//! The greedy collapse (`--accel bvh4`, `bvh8`) against the optimal one
+//! (`--experiment optimal-collapse`) on one scene, at both widths: SAH cost,
+//! depth, stack entries and collapse time (best of the rounds), one Markdown
+//! row each: `cargo run --release -p twinray-common --example wide_collapse -- teapot tessellation=160x120 [rounds]`.
+use twinray_common::gpu::layout::Bvh;
+use twinray_common::scene::Scene;
+
+/// A collapse of the binary tree to a width.
+type Widen = fn(Bvh, u32) -> Bvh;
+
+fn main() {
+    let a: Vec<String> = std::env::args().collect();
+    let sets: Vec<(String, String)> = a
+        .get(2)
+        .filter(|s| !s.is_empty())
+        .map(|s| {
+            let (k, v) = s.split_once('=').expect("KEY=VALUE");
+            vec![(k.to_string(), v.to_string())]
+        })
+        .unwrap_or_default();
+    let rounds: usize = a.get(3).map_or(3, |r| r.parse().expect("rounds"));
+    let scene = Scene::load(&a[1], &sets).unwrap_or_else(|e| panic!("{e:#}"));
+    let binary = Bvh::build(&scene);
+    println!(
+        "{} {}: {} primitives, {} binary nodes, depth {}, built in {:.0} ms ({} threads)",
+        a[1],
+        a.get(2).map_or("", |s| s.as_str()),
+        scene.primitive_count(),
+        binary.node_count(),
+        binary.depth,
+        binary.build_ms,
+        rayon::current_num_threads()
+    );
+    println!("| width | collapse | SAH cost | nodes | depth | stack entries | ms |\n|---|---|---|---|---|---|---|");
+    for width in [4, 8] {
+        let collapses: [(&str, Widen); 2] =
+            [("greedy", Bvh::widen), ("optimal", Bvh::widen_optimal)];
+        for (name, widen) in collapses {
+            let (mut best, mut tree) = (f64::INFINITY, None);
+            for _ in 0..rounds {
+                let t = widen(binary.clone(), width);
+                best = best.min(t.build_ms - binary.build_ms);
+                tree = Some(t);
+            }
+            let t = tree.expect("a round or more");
+            println!(
+                "| {width} | {name} | {:.4} | {} | {} | {} | {best:.1} |",
+                t.sah_cost(),
+                t.node_count(),
+                t.depth,
+                t.stack_entries()
+            );
+        }
+    }
+}
