@@ -62,6 +62,84 @@
 #define RAY_LOOP
 #endif
 
+// The hit's Phong shading with its shadow rays (SHADE, a macro: the ray loop
+// calls it before or after it pushes the hit's secondary rays, and a macro
+// cannot hold the preprocessor lines of the push).
+//
+// LIGHT_BEFORE_WALK: OpenGL's BVH walks in a scene of one light (the sphere
+// list; common's plan decides, Api::light_before_walk). The mirror and glass
+// rays go on the stack first, and the light is shaded before its shadow walk,
+// whose ray is then rebuilt from the light's position: across the walk only
+// the spawn point's inputs and the light's share stay live, not the normals,
+// the view direction and the material. NVIDIA's OpenGL then holds 28 warps a
+// multiprocessor on the sphere list instead of 24, and its 1080p frames are
+// 6-7 % shorter; its Vulkan compiler gains nothing and loses 1-4 %, and a box
+// of glass on OpenGL's fragment path lost 6 %, so only that path and API take
+// it (docs/findings/opengl-compute.md#the-one-lights-share-before-its-walk-h200;
+// --experiment walk-then-shade turns it off). The operations and their order
+// are the loop's: the same image.
+//
+// The loop's shadow ray stops a hair before the light: a light lying on a
+// surface would otherwise be hidden by that surface at the whim of rounding.
+// The offset may depend on the direction (OFFSET_RAY), so each shadow ray
+// aims from p first.
+#ifdef LIGHT_BEFORE_WALK
+#define SHADE()                                                                          \
+    {                                                                                    \
+        vec3 local = m.ambient;                                                          \
+        vec3 share = vec3(0.0);                                                          \
+        bool lit = false;                                                                \
+        {                                                                                \
+            Light light = light_buf.lights[0];                                           \
+            vec3 p_out = spawn_point(p, ng, normalize(light.position - p), scale);       \
+            vec3 to_light = light.position - p_out;                                      \
+            float dist = length(to_light);                                               \
+            vec3 l = to_light / dist;                                                    \
+            float ndl = dot(ns, l);                                                      \
+            if (ndl > 0.0 && dot(ng, l) > 0.0) {                                         \
+                vec3 r = reflect(-l, ns);                                                \
+                float spec = pow(max(dot(r, -d), 0.0), m.shininess);                     \
+                share = light.color * (m.diffuse * ndl + m.specular * spec);             \
+                lit = true;                                                              \
+            }                                                                            \
+        }                                                                                \
+        if (lit) {                                                                       \
+            vec3 position = light_buf.lights[0].position;                                \
+            vec3 p_out = spawn_point(p, ng, normalize(position - p), scale);             \
+            vec3 to_light = position - p_out;                                            \
+            float dist = length(to_light);                                               \
+            vec3 l = to_light / dist;                                                    \
+            if (!occluded(p_out, l, dist * SHADOW_REACH)) {                              \
+                local += share;                                                          \
+            }                                                                            \
+        }                                                                                \
+        color += w * local;                                                              \
+    }
+#else
+#define SHADE()                                                                          \
+    {                                                                                    \
+        vec3 local = m.ambient;                                                          \
+        for (uint li = 0u; li < LIGHT_COUNT; li++) {                                     \
+            Light light = light_buf.lights[li];                                          \
+            vec3 p_out = spawn_point(p, ng, normalize(light.position - p), scale);       \
+            vec3 to_light = light.position - p_out;                                      \
+            float dist = length(to_light);                                               \
+            vec3 l = to_light / dist;                                                    \
+            float ndl = dot(ns, l);                                                      \
+            bool lit = ndl > 0.0 && dot(ng, l) > 0.0;                                    \
+            if (lit) {                                                                   \
+                lit = !occluded(p_out, l, dist * SHADOW_REACH);                          \
+            }                                                                            \
+            if (lit) {                                                                   \
+                vec3 r = reflect(-l, ns);                                                \
+                float spec = pow(max(dot(r, -d), 0.0), m.shininess);                     \
+                local += light.color * (m.diffuse * ndl + m.specular * spec);            \
+            }                                                                            \
+        }                                                                                \
+        color += w * local;                                                              \
+    }
+#endif
+
 vec3 trace(vec3 origin, vec3 dir) {
     RAY_STACK_DECLARE;
 #ifdef HAS_GLASS
@@ -148,10 +226,9 @@ vec3 trace(vec3 origin, vec3 dir) {
             }
             Material m = material_buf.materials[mat_index];
 
-            // The mirror and glass rays go on the stack before the lights are
-            // shaded: what they need (p, the normals, d, the material's
-            // reflectivity) is then dead before the shadow walks instead of
-            // live across them. See ONE_LIGHT below for what that is worth.
+#ifndef LIGHT_BEFORE_WALK
+            SHADE();
+#endif
 #if defined(HAS_MIRROR) || defined(HAS_GLASS)
             SPEC(SPEC_MIRROR || SPEC_GLASS)
             if (depth + 1u < max_depth) {
@@ -203,70 +280,9 @@ vec3 trace(vec3 origin, vec3 dir) {
                 }
             }
 #endif
-
-            vec3 local = m.ambient;
-#ifdef ONE_LIGHT
-            // A scene of one light (the sphere list) shades it before its
-            // shadow walk and rebuilds the walk's ray from the light's
-            // position after: across the walk only the spawn point's inputs
-            // and the light's share stay live, not the normals, the view
-            // direction and the material. On the H200 that let NVIDIA's
-            // OpenGL hold 28 warps a multiprocessor instead of 24 and took
-            // 5.5 % off its 1080p sphere-list frames, Vulkan's within 2 %
-            // (docs/findings/opengl-compute.md#the-one-lights-share-before-its-walk-h200;
-            // --experiment walk-then-shade puts the loop back). With several
-            // lights the shares held across the walks cost Vulkan 3 %, so
-            // they keep the loop. Same operations, same order: the same image.
-            vec3 share = vec3(0.0);
-            bool lit = false;
-            {
-                Light light = light_buf.lights[0];
-                vec3 p_out = spawn_point(p, ng, normalize(light.position - p), scale);
-                vec3 to_light = light.position - p_out;
-                float dist = length(to_light);
-                vec3 l = to_light / dist;
-                float ndl = dot(ns, l);
-                if (ndl > 0.0 && dot(ng, l) > 0.0) {
-                    vec3 r = reflect(-l, ns);
-                    float spec = pow(max(dot(r, -d), 0.0), m.shininess);
-                    share = light.color * (m.diffuse * ndl + m.specular * spec);
-                    lit = true;
-                }
-            }
-            if (lit) {
-                vec3 position = light_buf.lights[0].position;
-                vec3 p_out = spawn_point(p, ng, normalize(position - p), scale);
-                vec3 to_light = position - p_out;
-                float dist = length(to_light);
-                vec3 l = to_light / dist;
-                // Stop a hair before the light (the loop below has why).
-                if (!occluded(p_out, l, dist * SHADOW_REACH)) {
-                    local += share;
-                }
-            }
-#else
-            for (uint li = 0u; li < LIGHT_COUNT; li++) {
-                Light light = light_buf.lights[li];
-                // The offset may depend on the direction (OFFSET_RAY): aim from p first.
-                vec3 p_out = spawn_point(p, ng, normalize(light.position - p), scale);
-                vec3 to_light = light.position - p_out;
-                float dist = length(to_light);
-                vec3 l = to_light / dist;
-                float ndl = dot(ns, l);
-                bool lit = ndl > 0.0 && dot(ng, l) > 0.0;
-                if (lit) {
-                    // Stop a hair before the light: a light lying on a surface would
-                    // otherwise be hidden by that surface at the whim of rounding.
-                    lit = !occluded(p_out, l, dist * SHADOW_REACH);
-                }
-                if (lit) {
-                    vec3 r = reflect(-l, ns);
-                    float spec = pow(max(dot(r, -d), 0.0), m.shininess);
-                    local += light.color * (m.diffuse * ndl + m.specular * spec);
-                }
-            }
+#ifdef LIGHT_BEFORE_WALK
+            SHADE();
 #endif
-            color += w * local;
         }
     }
     return color;

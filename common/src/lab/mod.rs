@@ -87,7 +87,7 @@ pub const REGISTRY: &[Entry] = &[
     entry(Experiment::OptimalCollapse, "The wide tree's collapse chooses each node's children by dynamic programming over the binary tree, for the least SAH cost over the same leaves, instead of opening the largest box until the node is full.", |c| {
         c.optimal_collapse = true
     }),
-    entry(Experiment::WalkThenShade, "A scene of one light shades it after its shadow walk, through the lights' loop, as every scene did until its share was taken first: the hit's normals, view direction and material then stay live across the walk, and NVIDIA's OpenGL holds 24 warps a multiprocessor on the sphere list instead of 28.", |c| {
+    entry(Experiment::WalkThenShade, "OpenGL's BVH walks on the compute path shade a scene's one light after its shadow walk, through the lights' loop, as every scene did, instead of before it with the hit's secondary rays pushed first: the hit's normals, view direction and material then stay live across the walk, and NVIDIA's OpenGL holds 24 warps a multiprocessor on the sphere list instead of 28. Vulkan and brute force shade that way already.", |c| {
         c.knobs.walk_then_shade = true
     }),
     entry(Experiment::UniformCounts, "Read the primitive and light counts from the Frame uniform instead of baking them into the shader (what made lavapipe grow per frame).", |c| {

@@ -255,6 +255,10 @@ impl Planner {
         }
         v.tags = c.tags.clone();
         v.entry = Entry::new(path, self.workgroup(bvh));
+        v.light_before_walk = !c.knobs.walk_then_shade
+            && self
+                .api
+                .light_before_walk(bvh.is_some(), path, scene.lights.len());
         v
     }
 }

@@ -48,6 +48,25 @@ impl Api {
         }
     }
 
+    /// Whether the tracer shades a scene's one light before its shadow walk,
+    /// with the hit's secondary rays pushed first (LIGHT_BEFORE_WALK in
+    /// shaders/trace/loop.glsl): on OpenGL's BVH walks on the compute path.
+    /// There NVIDIA's OpenGL holds 28 warps a multiprocessor on the sphere
+    /// list instead of 24, and its 1080p frames are 6-7 % shorter. Vulkan's
+    /// driver gains nothing from it (1-4 % slower), nor does brute force,
+    /// where OpenGL's glass box lost 6 % on the fragment path
+    /// (docs/findings/opengl-compute.md#the-one-lights-share-before-its-walk-h200).
+    /// Like the workgroup, each API runs the form it runs best; the image is
+    /// the same.
+    pub fn light_before_walk(
+        &self,
+        bvh: bool,
+        path: crate::cli::RenderPath,
+        lights: usize,
+    ) -> bool {
+        *self == Api::OpenGl && bvh && path == crate::cli::RenderPath::Compute && lights == 1
+    }
+
     /// The app's program name, as its messages begin.
     pub fn program(&self) -> &'static str {
         match self {

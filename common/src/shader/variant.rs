@@ -38,6 +38,9 @@ pub struct Variant {
     pub knobs: ShaderKnobs,
     /// How naga's output is finished (the product's passes unless the laboratory says otherwise).
     pub passes: Passes,
+    /// The one light shaded before its shadow walk, the hit's secondary rays
+    /// pushed before it (LIGHT_BEFORE_WALK; `Api::light_before_walk` decides).
+    pub light_before_walk: bool,
     /// The experiments' names, in registry order, for the label.
     pub tags: Vec<String>,
 }
@@ -102,7 +105,7 @@ pub struct ShaderKnobs {
     pub shared_bvh_stack: bool,
     /// The ray stack as four arrays instead of two of vec4 pairs.
     pub split_ray_stack: bool,
-    /// A scene of one light shaded through the lights' loop, after its walk.
+    /// No LIGHT_BEFORE_WALK where the plan would choose it.
     pub walk_then_shade: bool,
     /// Compute: KiB of workgroup memory the tracer does not need.
     pub shared_pad_kib: Option<u32>,
@@ -202,6 +205,7 @@ impl Variant {
             count_rays: false,
             knobs: ShaderKnobs::default(),
             passes: Passes::default(),
+            light_before_walk: false,
             tags: Vec::new(),
         }
     }
@@ -317,6 +321,7 @@ impl Variant {
         flag(bvh && self.bvh_width > 2, "USE_BVH_WIDE");
         flag(bvh && k.local_bvh_stack, "BVH_STACK_LOCAL");
         flag(k.split_ray_stack, "RAY_STACK_SPLIT");
+        flag(self.light_before_walk, "LIGHT_BEFORE_WALK");
         flag(self.count_rays, "COUNT_RAYS");
         flag(self.bvh_stack_in_shared_memory(), "BVH_STACK_SHARED");
         for n in self.numerics.defines() {
@@ -339,9 +344,6 @@ impl Variant {
             d.insert("SPHERE_COUNT".into(), format!("{spheres}u"));
             d.insert("TRIANGLE_COUNT".into(), format!("{triangles}u"));
             d.insert("LIGHT_COUNT".into(), format!("{lights}u"));
-            if lights == 1 && !k.walk_then_shade {
-                d.insert("ONE_LIGHT".into(), "1".into());
-            }
         }
         if let Some(kib) = k.shared_pad_kib {
             d.insert("SHARED_PAD_KIB".into(), kib.to_string());
@@ -389,7 +391,8 @@ impl Variant {
     /// A short label such as `spheres+triangles+mirror+glass/stack6/normal-scaled/watertight/stable`
     /// (with `/bvhN` when the variant traces through a BVH with an N-entry
     /// stack, preceded by `/wide4` or `/wide8` for a wide one, `/spec` when
-    /// specialised, then any experiment's name).
+    /// specialised, `/light-first` with LIGHT_BEFORE_WALK, then any
+    /// experiment's name).
     pub fn label(&self) -> String {
         let f = match self.form {
             Form::Generic => ALL_FEATURES,
@@ -418,9 +421,14 @@ impl Variant {
         } else {
             ""
         };
+        let light = if self.light_before_walk {
+            "/light-first"
+        } else {
+            ""
+        };
         let tags: String = self.tags.iter().map(|t| format!("/{t}")).collect();
         format!(
-            "{}/stack{}/{}{bvh}{spec}{tags}",
+            "{}/stack{}/{}{bvh}{spec}{light}{tags}",
             parts.join("+"),
             self.ray_stack,
             self.numerics.label()
