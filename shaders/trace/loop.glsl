@@ -7,6 +7,7 @@
 // Features a scene lacks are compiled out through defines chosen in
 // common's shader module: HAS_SPHERES, HAS_TRIANGLES, HAS_MIRROR, HAS_GLASS,
 // and STACK_SIZE (the ray stack: max_depth + 1 with glass, else 1).
+// LIGHT_BEFORE_WALK reorders one light's shading for OpenGL's BVH walks (SHADE).
 //
 // The primitive and light counts are defines too (SPHERE_COUNT, TRIANGLE_COUNT,
 // LIGHT_COUNT): they bound the loops, and a loop bound read from
