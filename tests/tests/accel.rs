@@ -2,7 +2,7 @@
 //! shader variants change the speed, never the picture. BVH (of each width) vs brute force, variant vs
 //! `--generic` and variant vs `--specialize` agree on ≥ 99.99 % of pixels
 //! within 1/255, in both APIs; the optimal collapse renders the greedy one's
-//! image byte for byte.
+//! image, and OpenGL's light-first shading the lights' loop's, byte for byte.
 
 use twinray_common::reference::metrics::compare;
 use twinray_tests::{assert_within_1, orchestrator_render, render, scratch, App};
@@ -99,6 +99,49 @@ fn the_optimal_collapse_renders_the_default_trees_image() {
                         "{what}: {differing} pixels differ from the default tree's"
                     );
                 }
+            }
+            std::fs::remove_dir_all(dir).ok();
+        }
+    }
+}
+
+/// OpenGL's BVH walks on the compute path shade a scene's one light before
+/// its shadow walk (`/light-first`, Api::light_before_walk); Vulkan, brute
+/// force, the fragment path and scenes of several lights keep the loop. The
+/// same operations in the same order: `--experiment walk-then-shade`, which
+/// puts the loop back, renders the same image byte for byte.
+#[test]
+fn the_light_first_shading_renders_the_loops_image() {
+    let cases: [(&str, &str, &[&str], bool); 4] = [
+        ("spherelist", "96x72", &["--set", "extra_spheres=500"], true),
+        ("box", "96x72", &["--accel", "bvh4"], true),
+        ("box", "96x72", &["--accel", "none"], false),
+        ("teapot", "64x48", &[], false),
+    ];
+    for app in App::BOTH {
+        for (scene, size, set, one_light_bvh) in cases {
+            let dir = scratch(&format!("accel-light-first-{scene}"));
+            for path in ["fragment", "compute"] {
+                let args = [set, &["--path", path]].concat();
+                let (rd, default) = render(app, scene, size, &args, &dir.join("default.png"));
+                let loop_args = [&args[..], &["--experiment", "walk-then-shade"]].concat();
+                let (rl, looped) = render(app, scene, size, &loop_args, &dir.join("loop.png"));
+                let what = format!("{app:?} {scene} {args:?} ({})", rd.variant);
+                let expected = matches!(app, App::OpenGl) && path == "compute" && one_light_bvh;
+                assert_eq!(rd.variant.contains("/light-first"), expected, "{what}");
+                assert!(
+                    !rl.variant.contains("/light-first"),
+                    "{what}: with the loop"
+                );
+                let differing = looped
+                    .pixels()
+                    .zip(default.pixels())
+                    .filter(|(a, b)| a != b)
+                    .count();
+                assert_eq!(
+                    differing, 0,
+                    "{what}: {differing} pixels differ from the loop's"
+                );
             }
             std::fs::remove_dir_all(dir).ok();
         }
