@@ -5,6 +5,9 @@
 //! resident memory each step of a run's preparation peaks at and keeps
 //! (loading the scene, building the BVH, collapsing it to the 4-wide tree the
 //! apps trace, making the GPU's bytes a chunk at a time as an upload does).
+mod support {
+    pub mod args;
+}
 use std::io::Write as _;
 use twinray_common::gpu::layout::{binding, Bvh};
 use twinray_common::gpu::upload::{GpuScene, UPLOAD_CHUNK_BYTES};
@@ -12,19 +15,15 @@ use twinray_common::plan::build_bvh;
 use twinray_common::scene::Scene;
 
 fn main() {
-    let a: Vec<String> = std::env::args().collect();
-    let sets: Vec<(String, String)> = a
-        .get(2)
-        .filter(|s| !s.is_empty())
-        .map(|s| {
-            let (k, v) = s.split_once('=').expect("KEY=VALUE");
-            vec![(k.to_string(), v.to_string())]
-        })
-        .unwrap_or_default();
-    let rounds: usize = a.get(3).map_or(3, |r| r.parse().expect("rounds"));
+    let support::args::Args {
+        scene: name,
+        set,
+        sets,
+        rounds,
+    } = support::args::parse();
     let mut memory = Memory::new();
     let t = std::time::Instant::now();
-    let scene = Scene::load(&a[1], &sets).unwrap_or_else(|e| panic!("{e:#}"));
+    let scene = Scene::load(&name, &sets).unwrap_or_else(|e| panic!("{e:#}"));
     let load_ms = t.elapsed().as_secs_f64() * 1e3;
     memory.step("Scene::load");
     let n = scene.primitive_count();
@@ -48,8 +47,8 @@ fn main() {
     let _ = writeln!(
         out,
         "{} {}: {n} primitives, load {load_ms:.0} ms, build {best:.1} ms ({:.2} M prims/s, {} threads; {cpu_ms:.0} ms of CPU a build), {} nodes, depth {}, SAH {:.3}, {:.1} MB, same tree every round: {same}",
-        a[1],
-        a.get(2).map_or("", |s| s.as_str()),
+        name,
+        set,
         n as f64 / best / 1e3,
         rayon::current_num_threads(),
         b.node_count(),

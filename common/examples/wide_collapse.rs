@@ -2,6 +2,9 @@
 //! (`--experiment optimal-collapse`) on one scene, at both widths: SAH cost,
 //! depth, stack entries and collapse time (best of the rounds), one Markdown
 //! row each: `cargo run --release -p twinray-common --example wide_collapse -- teapot tessellation=160x120 [rounds]`.
+mod support {
+    pub mod args;
+}
 use twinray_common::gpu::layout::Bvh;
 use twinray_common::scene::Scene;
 
@@ -9,22 +12,18 @@ use twinray_common::scene::Scene;
 type Widen = fn(Bvh, u32) -> Bvh;
 
 fn main() {
-    let a: Vec<String> = std::env::args().collect();
-    let sets: Vec<(String, String)> = a
-        .get(2)
-        .filter(|s| !s.is_empty())
-        .map(|s| {
-            let (k, v) = s.split_once('=').expect("KEY=VALUE");
-            vec![(k.to_string(), v.to_string())]
-        })
-        .unwrap_or_default();
-    let rounds: usize = a.get(3).map_or(3, |r| r.parse().expect("rounds"));
-    let scene = Scene::load(&a[1], &sets).unwrap_or_else(|e| panic!("{e:#}"));
+    let support::args::Args {
+        scene: name,
+        set,
+        sets,
+        rounds,
+    } = support::args::parse();
+    let scene = Scene::load(&name, &sets).unwrap_or_else(|e| panic!("{e:#}"));
     let binary = Bvh::build(&scene);
     println!(
         "{} {}: {} primitives, {} binary nodes, depth {}, built in {:.0} ms ({} threads)",
-        a[1],
-        a.get(2).map_or("", |s| s.as_str()),
+        name,
+        set,
         scene.primitive_count(),
         binary.node_count(),
         binary.depth,

@@ -80,10 +80,17 @@
 // --experiment walk-then-shade turns it off). The operations and their order
 // are the loop's: the same image.
 //
-// The loop's shadow ray stops a hair before the light: a light lying on a
-// surface would otherwise be hidden by that surface at the whim of rounding.
-// The offset may depend on the direction (OFFSET_RAY), so each shadow ray
-// aims from p first.
+// A shadow ray stops a hair before the light (SHADOW_REACH): a light lying on
+// a surface would otherwise be hidden by that surface at the whim of rounding.
+
+// The shadow ray from p to a light at `position`: its start p_out, its
+// direction l and its length dist. The offset may depend on the direction
+// (OFFSET_RAY), so the ray aims from p first.
+#define LIGHT_RAY(position)                                                              \
+    vec3 p_out = spawn_point(p, ng, normalize((position) - p), scale);                   \
+    vec3 to_light = (position) - p_out;                                                  \
+    float dist = length(to_light);                                                       \
+    vec3 l = to_light / dist;
 #ifdef LIGHT_BEFORE_WALK
 #define SHADE()                                                                          \
     {                                                                                    \
@@ -92,10 +99,7 @@
         bool lit = false;                                                                \
         {                                                                                \
             Light light = light_buf.lights[0];                                           \
-            vec3 p_out = spawn_point(p, ng, normalize(light.position - p), scale);       \
-            vec3 to_light = light.position - p_out;                                      \
-            float dist = length(to_light);                                               \
-            vec3 l = to_light / dist;                                                    \
+            LIGHT_RAY(light.position)                                                    \
             float ndl = dot(ns, l);                                                      \
             if (ndl > 0.0 && dot(ng, l) > 0.0) {                                         \
                 vec3 r = reflect(-l, ns);                                                \
@@ -106,10 +110,7 @@
         }                                                                                \
         if (lit) {                                                                       \
             vec3 position = light_buf.lights[0].position;                                \
-            vec3 p_out = spawn_point(p, ng, normalize(position - p), scale);             \
-            vec3 to_light = position - p_out;                                            \
-            float dist = length(to_light);                                               \
-            vec3 l = to_light / dist;                                                    \
+            LIGHT_RAY(position)                                                          \
             if (!occluded(p_out, l, dist * SHADOW_REACH)) {                              \
                 local += share;                                                          \
             }                                                                            \
@@ -122,10 +123,7 @@
         vec3 local = m.ambient;                                                          \
         for (uint li = 0u; li < LIGHT_COUNT; li++) {                                     \
             Light light = light_buf.lights[li];                                          \
-            vec3 p_out = spawn_point(p, ng, normalize(light.position - p), scale);       \
-            vec3 to_light = light.position - p_out;                                      \
-            float dist = length(to_light);                                               \
-            vec3 l = to_light / dist;                                                    \
+            LIGHT_RAY(light.position)                                                    \
             float ndl = dot(ns, l);                                                      \
             bool lit = ndl > 0.0 && dot(ng, l) > 0.0;                                    \
             if (lit) {                                                                   \

@@ -224,6 +224,13 @@ pub fn assert_within_1(a: &image::RgbImage, b: &image::RgbImage, min: f64, what:
     );
 }
 
+/// Two images are the same byte for byte; otherwise the test fails saying
+/// how many pixels differ.
+pub fn assert_identical(a: &image::RgbImage, b: &image::RgbImage, what: &str) {
+    let differing = a.pixels().zip(b.pixels()).filter(|(a, b)| a != b).count();
+    assert_eq!(differing, 0, "{what}: {differing} pixels differ");
+}
+
 /// Nothing went wrong; otherwise the test fails naming `problem`, how many
 /// there are, and each of them.
 pub fn assert_none(problem: &str, wrong: &[String]) {

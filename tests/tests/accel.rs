@@ -5,7 +5,7 @@
 //! image, and OpenGL's light-first shading the lights' loop's, byte for byte.
 
 use twinray_common::reference::metrics::compare;
-use twinray_tests::{assert_within_1, orchestrator_render, render, scratch, App};
+use twinray_tests::{assert_identical, assert_within_1, orchestrator_render, render, scratch, App};
 
 const SCENES: [(&str, &str, &[&str]); 3] = [
     ("box", "96x72", &[]),
@@ -89,14 +89,10 @@ fn the_optimal_collapse_renders_the_default_trees_image() {
                     assert_eq!(ro.validation_messages, 0, "{what}: validation messages");
                     let (d, o) = (rd.bvh_sah_cost.unwrap(), ro.bvh_sah_cost.unwrap());
                     assert!(o <= d * (1.0 + 1e-9), "{what}: SAH cost {o}, default {d}");
-                    let differing = optimal
-                        .pixels()
-                        .zip(default.pixels())
-                        .filter(|(a, b)| a != b)
-                        .count();
-                    assert_eq!(
-                        differing, 0,
-                        "{what}: {differing} pixels differ from the default tree's"
+                    assert_identical(
+                        &optimal,
+                        &default,
+                        &format!("{what}, against the default tree"),
                     );
                 }
             }
@@ -133,15 +129,7 @@ fn the_light_first_shading_renders_the_loops_image() {
                     !rl.variant.contains("/light-first"),
                     "{what}: with the loop"
                 );
-                let differing = looped
-                    .pixels()
-                    .zip(default.pixels())
-                    .filter(|(a, b)| a != b)
-                    .count();
-                assert_eq!(
-                    differing, 0,
-                    "{what}: {differing} pixels differ from the loop's"
-                );
+                assert_identical(&looped, &default, &format!("{what}, against the loop"));
             }
             std::fs::remove_dir_all(dir).ok();
         }

@@ -11,7 +11,7 @@
 //! Every run that cannot honour one exits 2 with one sentence saying why, and
 //! `--dump-shaders` with `--gl-spirv` no longer crashes Mesa.
 
-use twinray_tests::{refused, render, run, scratch, App};
+use twinray_tests::{assert_identical, refused, render, run, scratch, App};
 
 /// One measurement: what it adds to the command line, what the run it is
 /// compared with adds (nothing: the default), and whether it exists on the
@@ -46,16 +46,8 @@ fn same_image(scene: &str, size: &str, extra: &[&str], variants: &[Variant]) {
                     "{scene} {app:?} {path} {:?}: validation messages",
                     v.args
                 );
-                let differing = img
-                    .pixels()
-                    .zip(base.pixels())
-                    .filter(|(a, b)| a != b)
-                    .count();
-                assert_eq!(
-                    differing, 0,
-                    "{scene} {app:?} {path} {:?} against {:?}: {differing} pixels differ",
-                    v.args, v.base
-                );
+                let what = format!("{scene} {app:?} {path} {:?} against {:?}", v.args, v.base);
+                assert_identical(&img, &base, &what);
             }
         }
     }

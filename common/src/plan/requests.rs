@@ -2,6 +2,8 @@
 //! atomics the counting frame needs), and which app is asking. Both apps
 //! read these, so Vulkan and OpenGL ask alike.
 
+use crate::cli::RenderPath;
+
 /// What the device must offer beyond what every run needs.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub struct DeviceRequest {
@@ -64,7 +66,7 @@ impl Api {
         path: crate::cli::RenderPath,
         lights: usize,
     ) -> bool {
-        *self == Api::OpenGl && bvh && path == crate::cli::RenderPath::Compute && lights == 1
+        *self == Api::OpenGl && bvh && path == RenderPath::Compute && lights == 1
     }
 
     /// The app's program name, as its messages begin.

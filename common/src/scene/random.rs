@@ -76,11 +76,12 @@ pub fn seed_of(name: &str) -> Option<anyhow::Result<u64>> {
 }
 
 /// SplitMix64 (Steele, Lea & Flood 2014): tiny, seedable, and the same on
-/// every platform, so a seed names one scene forever.
-struct Rng(u64);
+/// every platform, so a seed names one scene forever. The wide collapse's
+/// tests draw their random trees from it too.
+pub(crate) struct Rng(pub(crate) u64);
 
 impl Rng {
-    fn next(&mut self) -> u64 {
+    pub(crate) fn next(&mut self) -> u64 {
         self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
         let mut z = self.0;
         z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);

@@ -6,27 +6,17 @@
 use super::area;
 use crate::gpu::layout::{child_ref, Bounds, Bvh, GpuBvhNode};
 use crate::scene::accel::tests::{check, check_wide_tree};
+use crate::scene::random::Rng;
 use crate::scene::Scene;
 
-/// splitmix64: the trees are the same every run, from the seed alone.
-struct Rng(u64);
+/// The random scenes' SplitMix64: the trees are the same every run, from
+/// the seed alone.
+fn below(rng: &mut Rng, n: usize) -> usize {
+    (rng.next() % n as u64) as usize
+}
 
-impl Rng {
-    fn next(&mut self) -> u64 {
-        self.0 = self.0.wrapping_add(0x9e37_79b9_7f4a_7c15);
-        let mut z = self.0;
-        z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
-        z ^ (z >> 31)
-    }
-
-    fn below(&mut self, n: usize) -> usize {
-        (self.next() % n as u64) as usize
-    }
-
-    fn unit(&mut self) -> f32 {
-        (self.next() >> 40) as f32 / (1u64 << 24) as f32
-    }
+fn unit(rng: &mut Rng) -> f32 {
+    (rng.next() >> 40) as f32 / (1u64 << 24) as f32
 }
 
 fn union((amin, amax): Bounds, (bmin, bmax): Bounds) -> Bounds {
@@ -55,19 +45,19 @@ fn random_tree(rng: &mut Rng, leaves: usize, same: bool) -> Bvh {
             let b = if same {
                 ([0.0; 3], [1.0; 3])
             } else {
-                let min = [0; 3].map(|_| 10.0 * rng.unit());
+                let min = [0; 3].map(|_| 10.0 * unit(rng));
                 let mut max = min;
                 for m in &mut max {
-                    *m += 0.01 + 3.0 * rng.unit();
+                    *m += 0.01 + 3.0 * unit(rng);
                 }
                 (min, max)
             };
             return (b, child_ref::leaf(first as u32, 1), 1);
         }
-        let left = match rng.below(4) {
+        let left = match below(rng, 4) {
             0 => 1,
             1 => count - 1,
-            _ => 1 + rng.below(count - 1),
+            _ => 1 + below(rng, count - 1),
         };
         let at = nodes.len();
         nodes.push(GpuBvhNode::default());
@@ -236,7 +226,7 @@ fn every_collapse(binary: &Bvh, width: usize) -> Vec<(f64, u32, u32)> {
 fn the_optimal_collapse_is_the_cheapest_of_every_collapse() {
     let mut rng = Rng(2017);
     for t in 0..400 {
-        let (leaves, same) = (2 + rng.below(11), t % 3 == 0);
+        let (leaves, same) = (2 + below(&mut rng, 11), t % 3 == 0);
         let tree = random_tree(&mut rng, leaves, same);
         for width in [4u32, 8] {
             let all = every_collapse(&tree, width as usize);
