@@ -15,15 +15,11 @@ use twinray_common::plan::build_bvh;
 use twinray_common::scene::Scene;
 
 fn main() {
-    let support::args::Args {
-        scene: name,
-        set,
-        sets,
-        rounds,
-    } = support::args::parse();
+    let args = support::args::parse();
+    let (name, set, rounds) = (&args.scene, &args.set, args.rounds);
     let mut memory = Memory::new();
     let t = std::time::Instant::now();
-    let scene = Scene::load(&name, &sets).unwrap_or_else(|e| panic!("{e:#}"));
+    let scene = Scene::load(name, &args.sets).unwrap_or_else(|e| panic!("{e:#}"));
     let load_ms = t.elapsed().as_secs_f64() * 1e3;
     memory.step("Scene::load");
     let n = scene.primitive_count();

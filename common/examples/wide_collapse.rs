@@ -5,6 +5,7 @@
 mod support {
     pub mod args;
 }
+use std::io::Write as _;
 use twinray_common::gpu::layout::Bvh;
 use twinray_common::scene::Scene;
 
@@ -12,15 +13,14 @@ use twinray_common::scene::Scene;
 type Widen = fn(Bvh, u32) -> Bvh;
 
 fn main() {
-    let support::args::Args {
-        scene: name,
-        set,
-        sets,
-        rounds,
-    } = support::args::parse();
-    let scene = Scene::load(&name, &sets).unwrap_or_else(|e| panic!("{e:#}"));
+    let args = support::args::parse();
+    let (name, set, rounds) = (&args.scene, &args.set, args.rounds);
+    let scene = Scene::load(name, &args.sets).unwrap_or_else(|e| panic!("{e:#}"));
     let binary = Bvh::build(&scene);
-    println!(
+    // Written, not println!: a closed pipe (`| head`) ends the output, not the process with a panic.
+    let mut out = std::io::stdout().lock();
+    let _ = writeln!(
+        out,
         "{} {}: {} primitives, {} binary nodes, depth {}, built in {:.0} ms ({} threads)",
         name,
         set,
@@ -30,7 +30,7 @@ fn main() {
         binary.build_ms,
         rayon::current_num_threads()
     );
-    println!("| width | collapse | SAH cost | nodes | depth | stack entries | ms |\n|---|---|---|---|---|---|---|");
+    let _ = writeln!(out, "| width | collapse | SAH cost | nodes | depth | stack entries | ms |\n|---|---|---|---|---|---|---|");
     for width in [4, 8] {
         let collapses: [(&str, Widen); 2] =
             [("greedy", Bvh::widen), ("optimal", Bvh::widen_optimal)];
@@ -42,7 +42,8 @@ fn main() {
                 tree = Some(t);
             }
             let t = tree.expect("a round or more");
-            println!(
+            let _ = writeln!(
+                out,
                 "| {width} | {name} | {:.4} | {} | {} | {} | {best:.1} |",
                 t.sah_cost(),
                 t.node_count(),
