@@ -508,6 +508,7 @@ mod tests {
                 "glslang",
                 "naga-aliasing",
                 "warp-probe",
+                "timed-barrier",
                 "ulp"
             ]
         );

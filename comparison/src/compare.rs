@@ -5,13 +5,13 @@
 
 mod accel;
 mod agreement;
+pub(crate) mod gaps;
 pub(crate) mod runs;
 pub(crate) mod shaders;
 pub(crate) mod study;
 pub(crate) mod why;
 
-use crate::apps::api_name;
-use crate::apps::{is_software, run_json, Api};
+use crate::apps::{api_name, is_software, run_json, Api};
 use anyhow::Context;
 use runs::{Outcome, Plan, Point};
 use std::collections::HashMap;
@@ -104,6 +104,7 @@ impl Preset {
                     teapot_side: 16,
                     teapot_brute_side: 16,
                     large_frame: (64, 36),
+                    small_side: 100,
                     frames: 8,
                     settle: 2.0,
                     seconds_per_point: 2.0,
@@ -129,6 +130,7 @@ impl Preset {
                     teapot_side: 1000,
                     teapot_brute_side: 400,
                     large_frame: (1920, 1080),
+                    small_side: 300,
                     frames: 60,
                     settle: 1.0,
                     seconds_per_point: 30.0,

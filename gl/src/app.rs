@@ -137,12 +137,7 @@ impl HeadlessRun<'_> {
     /// (what Vulkan records ahead of its first timestamp), the GPU-timed
     /// `draw` (the draw call or the dispatch), then glFinish, not a fence: the
     /// wait is part of what the study timed.
-    fn frames(
-        &self,
-        timer: &Timer,
-        before: &dyn Fn(),
-        draw: &dyn Fn(),
-    ) -> Result<(Vec<FrameTime>, f64)> {
+    fn frames(&self, timer: &Timer, draw: &dyn Fn()) -> Result<(Vec<FrameTime>, f64)> {
         let gl = &self.ctx.gl;
         self.log.check(gl, "after setup");
         timed_frames(
@@ -150,7 +145,6 @@ impl HeadlessRun<'_> {
             self.started,
             "Frame 1: the draw or dispatch between timer queries, then glFinish",
             || {
-                before();
                 timer.begin();
                 draw();
                 timer.end();
@@ -204,7 +198,7 @@ fn render_fragment(run: &HeadlessRun, shaders: &Shaders) -> Result<(Rendered, Ve
     program.bind(&vao);
     // SAFETY: program, VAO, buffers and FBO are bound and alive.
     let draw = || unsafe { gl.draw_arrays(glow::TRIANGLES, 0, 3) };
-    let (frames, setup_ms) = run.frames(&timer, &|| {}, &draw)?;
+    let (frames, setup_ms) = run.frames(&timer, &draw)?;
     let pixels = target.read();
     explain::numbered(11, "Readback", || {
         format!("{width}x{height} RGBA32F, top row first")
@@ -234,9 +228,19 @@ fn render_compute(
     let stats = run.dump_binary(compute.program())?;
     let _buffers = SceneBuffers::new(gl, &run.plan.gpu())?;
     let timer = Timer::new(gl, &run.info.device)?;
-    // The barrier before the timer starts, as Vulkan records its barrier
-    // before the first timestamp: both time the dispatch alone.
-    let (frames, setup_ms) = run.frames(&timer, &|| compute.barrier_between_frames(), &|| {
+    // No barrier between headless frames: the glFinish that ends each one has
+    // completed its image stores before the next dispatch. Issued before the
+    // timer starts, NVIDIA's driver does a glMemoryBarrier's work with the next
+    // dispatch, inside the timed span (0.4-0.6 us of a 300x300 frame:
+    // docs/findings/opengl-compute.md#the-small-frames-a-fixed-cost-h200). Vulkan's
+    // fence wait orders nothing on the GPU, so Vulkan records its barrier, before
+    // its first timestamp: both time the dispatch alone. The laboratory's
+    // `timed_barrier` times the barrier in both.
+    let timed_barrier = run.plan.timed_barrier;
+    let (frames, setup_ms) = run.frames(&timer, &|| {
+        if timed_barrier {
+            compute.barrier_between_frames();
+        }
         compute.dispatch()
     })?;
     if let Some(probe) = &probe {

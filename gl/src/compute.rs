@@ -5,7 +5,9 @@
 //! What the fragment path gets from the framebuffer, GL asks for explicitly
 //! here: `imageStore` writes are *incoherent*, so a `glMemoryBarrier` must order
 //! them before anything else touches the texture, the next dispatch's stores
-//! (SHADER_IMAGE_ACCESS) and the readback (TEXTURE_UPDATE, for glGetTexImage).
+//! (SHADER_IMAGE_ACCESS; in the window: a headless frame ends in glFinish,
+//! which has completed them) and the readback (TEXTURE_UPDATE, for
+//! glGetTexImage).
 //!
 //! In the window the texture is also the colour attachment of a read
 //! framebuffer, and each frame blits it into the window's default framebuffer
@@ -232,7 +234,8 @@ impl<'gl> Compute<'gl> {
     }
 
     /// Orders this frame's image stores before the next frame's (the same
-    /// texels): the counterpart of Vulkan's barrier between dispatches.
+    /// texels): the counterpart of Vulkan's barrier between dispatches. The
+    /// window's frames need it; headless ones end in glFinish (app.rs).
     pub fn barrier_between_frames(&self) {
         // SAFETY: plain state call on the current context.
         unsafe {

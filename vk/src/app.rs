@@ -18,7 +18,7 @@ use crate::pipeline::{Pipeline, RenderPass};
 use crate::rays::count_rays;
 use crate::scene::scene_buffers;
 use crate::target::Target;
-use crate::timestamps::Timestamps;
+use crate::timestamps::{Span, Timestamps};
 use crate::window;
 use anyhow::{bail, Result};
 use std::sync::atomic::Ordering;
@@ -204,7 +204,9 @@ fn render_compute(run: &HeadlessRun, shader: &ComputeShader) -> Result<Rendered>
         shader,
         size.width,
         size.height,
-        timestamps.as_ref(),
+        timestamps
+            .as_ref()
+            .map(|t| (t, Span::of(run.plan.timed_barrier))),
     )?;
     let (frames, setup_ms) = run.frames(&compute.commands, timestamps.as_ref())?;
     let image = compute.read_back(run.device)?;

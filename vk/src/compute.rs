@@ -34,7 +34,7 @@ use crate::memory::Buffer;
 use crate::pipeline_barrier::{self, On};
 use crate::scene::scene_buffers;
 use crate::target::{create_image_with_view, read_image, readback_buffer, record_copy_to_host};
-use crate::timestamps::Timestamps;
+use crate::timestamps::{Span, Timestamps};
 use anyhow::{Context, Result};
 use ash::vk;
 use twinray_common::explain;
@@ -69,7 +69,7 @@ impl Compute {
         shader: &ComputeShader,
         width: u32,
         height: u32,
-        timestamps: Option<&Timestamps>,
+        timestamps: Option<(&Timestamps, Span)>,
     ) -> Result<Compute> {
         let groups = device
             .compute_limits()
@@ -95,22 +95,27 @@ impl Compute {
             },
         );
         let commands = Commands::record_with(device, |_, cmd| {
-            if let Some(t) = timestamps {
+            if let Some((t, _)) = timestamps {
                 t.record_reset(cmd);
             }
             // Write-after-write: this frame's imageStores must come after the
             // previous frame's (same image). A render pass's external subpass
             // dependency says this for the fragment path; here it is a barrier.
+            // The first timestamp goes after it, so that the span is the
+            // dispatch alone, as OpenGL's timer is (`Span`).
             let after_last_frame = (barrier::FRAME_AFTER_FRAME, On::Image(image.image));
+            if let Some((t, Span::BarrierAndDispatch)) = timestamps {
+                t.record(cmd, 0);
+            }
             // SAFETY: `cmd` is recording (inside record_with); the storage image
             // is owned by the `Compute` that will own these commands too.
             unsafe { pipeline_barrier::record(device, cmd, &[after_last_frame]) };
-            if let Some(t) = timestamps {
+            if let Some((t, Span::Dispatch)) = timestamps {
                 t.record(cmd, 0);
             }
             // SAFETY: as above; the set matches the pipeline's layout.
             unsafe { pipeline.dispatch(cmd, descriptors.set, groups) };
-            if let Some(t) = timestamps {
+            if let Some((t, _)) = timestamps {
                 t.record(cmd, 1);
             }
         })?;

@@ -105,3 +105,24 @@ impl Drop for Timestamps {
         unsafe { self.device.destroy_query_pool(self.pool, None) };
     }
 }
+
+/// What a headless compute frame's two timestamps bracket.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Span {
+    /// The dispatch alone: the first timestamp after the barrier that orders
+    /// the frame after the last one, as OpenGL times its dispatch.
+    Dispatch,
+    /// The barrier too (the run plan's `timed_barrier`, from the laboratory).
+    BarrierAndDispatch,
+}
+
+impl Span {
+    /// The span the plan asks for: `timed_barrier` from the laboratory.
+    pub fn of(timed_barrier: bool) -> Span {
+        if timed_barrier {
+            Span::BarrierAndDispatch
+        } else {
+            Span::Dispatch
+        }
+    }
+}

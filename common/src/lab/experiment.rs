@@ -24,6 +24,7 @@ pub enum Experiment {
     Glslang,
     NagaAliasing,
     WarpProbe,
+    TimedBarrier,
     Ulp,
 }
 

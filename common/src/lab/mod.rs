@@ -26,6 +26,8 @@ pub struct Changes {
     pub first_of_equals: bool,
     /// The wide collapse is the one of least SAH cost.
     pub optimal_collapse: bool,
+    /// The frame's barrier inside the timed span.
+    pub timed_barrier: bool,
     /// The experiments' names in registry order, for the variant's label.
     pub tags: Vec<String>,
 }
@@ -114,6 +116,13 @@ pub const REGISTRY: &[Entry] = &[
         headless: true,
         ..entry(Experiment::WarpProbe, "NVIDIA only: record the highest warp slot in use on each multiprocessor (GL_NV_shader_thread_group's gl_WarpIDNV), the occupancy that OpenGL's driver does not report.", |c| {
             c.passes.warp_probe = true
+        })
+    },
+    Entry {
+        path: Some(RenderPath::Compute),
+        headless: true,
+        ..entry(Experiment::TimedBarrier, "The barrier that orders a headless frame's image stores after the last frame's, inside the timed span in both APIs: Vulkan records its first timestamp before the barrier instead of after it, and OpenGL issues a glMemoryBarrier after its timer starts, where it otherwise issues none between headless frames (the glFinish that ends each frame has completed the last one).", |c| {
+            c.timed_barrier = true
         })
     },
     Entry {

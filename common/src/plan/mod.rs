@@ -48,6 +48,9 @@ pub struct RunPlan {
     pub size: (u32, u32),
     /// The shaders of the variant's path, compiled.
     pub shaders: PathShaders,
+    /// A headless compute frame times its barrier with its dispatch
+    /// (`--experiment timed-barrier`); by default each API times the dispatch alone.
+    pub timed_barrier: bool,
 }
 
 /// What the untimed ray-counting frame renders (`--count-rays`), in either
@@ -204,6 +207,7 @@ impl Planner {
             variant,
             size: (width, height),
             shaders,
+            timed_barrier: self.changes.timed_barrier,
         })
     }
 

@@ -126,12 +126,22 @@ pub struct Gap {
     pub scene: &'static str,
     /// Scene values (`--set KEY=VALUE`) the gap's point takes.
     pub set: &'static [&'static str],
-    /// At the preset's large frame (`WhyPlan::large_frame`, 1080p in the
-    /// full preset) instead of its square side for the scene.
-    pub large_frame: bool,
+    pub frame: GapFrame,
     pub accel: Accel,
     pub path: RenderPath,
     pub measure: GapMeasure,
+}
+
+/// The frame a gap is measured at (`WhyPlan` gives the sizes).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum GapFrame {
+    /// A square of the preset's side for the scene.
+    Square,
+    /// The preset's large frame (1080p in the full preset).
+    Large,
+    /// The preset's small square (300² in the full preset): a frame of one
+    /// wave of workgroups, which a fixed cost of each dispatch weighs on.
+    Small,
 }
 
 /// One candidate cause of a gap: what each API runs instead of its default.
@@ -153,6 +163,11 @@ pub enum Hold {
     Workgroup(u32, u32),
     /// One more scene value (`--set KEY=VALUE`).
     Set(&'static str),
+    /// Both also trace an empty frame of the same size, shader variant and
+    /// workgroup (the sphere list behind its camera: every ray misses), and
+    /// each API's time of it comes off its time at the gap: what is left is
+    /// the tracing, without each API's fixed cost of a dispatch.
+    Floor,
 }
 
 impl Hold {
@@ -161,6 +176,7 @@ impl Hold {
         match self {
             Hold::Workgroup(x, y) => format!("{x}x{y}"),
             Hold::Set(kv) => kv.to_string(),
+            Hold::Floor => "floor".to_string(),
         }
     }
 }
@@ -173,7 +189,9 @@ pub struct WhyFigures {
     pub after: f64,
     /// "GPU" or "wall" for a ratio (GPU where all four runs have a timer), "image" for agreement.
     pub clock: &'static str,
-    /// Median ms: Vulkan and OpenGL by default, then with the experiment (ratios only).
+    /// Median ms: Vulkan and OpenGL by default, then with the experiment
+    /// (ratios only; with `Hold::Floor`, of the empty frame, whose time the
+    /// ratio with the experiment takes off each API's).
     pub ms: Option<[f64; 4]>,
 }
 

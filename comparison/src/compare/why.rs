@@ -6,7 +6,11 @@
 
 use crate::apps::api_name;
 use crate::apps::{run_json, Api};
-use crate::compare::runs::{Case, Gap, GapMeasure, Hold, Why, WhyFigures, WhyRow};
+use crate::compare::gaps::{
+    BOX_COMPUTE, BOX_FRAGMENT, BOX_IMAGES, SPHERELIST_BVH_COMPUTE, SPHERELIST_BVH_SMALL,
+    TEAPOT_BVH_COMPUTE, TEAPOT_FRAGMENT,
+};
+use crate::compare::runs::{Case, Gap, GapFrame, GapMeasure, Hold, Why, WhyFigures, WhyRow};
 use std::collections::BTreeMap;
 use std::ffi::OsStr;
 use std::path::Path;
@@ -19,63 +23,6 @@ use twinray_common::reference::metrics;
 use twinray_common::report::RunReport;
 use twinray_common::scene::accel::Accel;
 use twinray_common::value_name::ValueName;
-
-const BOX_FRAGMENT: Gap = Gap {
-    name: "box brute fragment",
-    scene: "box",
-    set: &[],
-    large_frame: false,
-    accel: Accel::None,
-    path: RenderPath::Fragment,
-    measure: GapMeasure::Ratio,
-};
-const BOX_COMPUTE: Gap = Gap {
-    name: "box brute compute",
-    scene: "box",
-    set: &[],
-    large_frame: false,
-    accel: Accel::None,
-    path: RenderPath::Compute,
-    measure: GapMeasure::Ratio,
-};
-const TEAPOT_FRAGMENT: Gap = Gap {
-    name: "teapot brute fragment",
-    scene: "teapot",
-    set: &[],
-    large_frame: false,
-    accel: Accel::None,
-    path: RenderPath::Fragment,
-    measure: GapMeasure::Ratio,
-};
-/// Through the tree every user gets (`--accel auto`: the 4-wide one).
-const TEAPOT_BVH_COMPUTE: Gap = Gap {
-    name: "teapot BVH compute",
-    scene: "teapot",
-    set: &[],
-    large_frame: false,
-    accel: Accel::Auto,
-    path: RenderPath::Compute,
-    measure: GapMeasure::Ratio,
-};
-/// The sphere list at its largest: the deepest tree of the study's scenes.
-const SPHERELIST_BVH_COMPUTE: Gap = Gap {
-    name: "sphere list BVH compute",
-    scene: "spherelist",
-    set: &["extra_spheres=100000"],
-    large_frame: true,
-    accel: Accel::Auto,
-    path: RenderPath::Compute,
-    measure: GapMeasure::Ratio,
-};
-const BOX_IMAGES: Gap = Gap {
-    name: "box image agreement",
-    scene: "box",
-    set: &[],
-    large_frame: false,
-    accel: Accel::None,
-    path: RenderPath::Fragment,
-    measure: GapMeasure::Agreement,
-};
 
 /// What each API runs at `gap` instead of its default.
 const fn case(
@@ -109,6 +56,14 @@ const fn one_workgroup(gap: &'static Gap) -> Case {
 const fn no_ray_loop(gap: &'static Gap) -> Case {
     Case {
         hold: Some(Hold::Set("max_depth=1")),
+        ..case(gap, &[], &[], Api::Opengl)
+    }
+}
+
+/// Each API's empty frame of the gap's size taken off its time (`Hold::Floor`).
+const fn floor(gap: &'static Gap) -> Case {
+    Case {
+        hold: Some(Hold::Floor),
         ..case(gap, &[], &[], Api::Opengl)
     }
 }
@@ -154,6 +109,8 @@ pub const CASES: &[Case] = &[
     gl_spirv(&SPHERELIST_BVH_COMPUTE),
     one_workgroup(&SPHERELIST_BVH_COMPUTE),
     no_ray_loop(&SPHERELIST_BVH_COMPUTE),
+    both(&SPHERELIST_BVH_SMALL, &[Experiment::TimedBarrier]),
+    floor(&SPHERELIST_BVH_SMALL),
     both(&BOX_IMAGES, &[Experiment::NoContraction]),
     vulkan(&BOX_IMAGES, &[Experiment::NoContraction]),
     vulkan(&BOX_IMAGES, &[Experiment::FloatControls]),
@@ -169,6 +126,8 @@ pub struct WhyPlan {
     pub teapot_brute_side: u32,
     /// The frame of the gaps measured where users trace large frames.
     pub large_frame: (u32, u32),
+    /// The side of the gaps measured in a frame of one wave.
+    pub small_side: u32,
     /// Frames per run at most; each stops once settled (`settle`, per cent).
     pub frames: u32,
     pub settle: f64,
@@ -197,6 +156,10 @@ pub fn run_label(run: Run) -> String {
         .join("-")
 }
 
+/// `Hold::Floor`'s scene, written beside the why step's images.
+const FLOOR_SCENE: &str = include_str!("../../plans/scenes/spherelist-missed.toml");
+const FLOOR_FILE: &str = "spherelist-missed.toml";
+
 /// The tool an experiment needs on PATH, if any.
 fn tool_needed(run: Run) -> Option<&'static str> {
     run.1
@@ -220,11 +183,11 @@ pub fn on_path(tool: &str, path: Option<&OsStr>) -> bool {
 pub fn run(out: &Path, plan: &WhyPlan, paths: &[RenderPath], stop: &AtomicBool) -> Why {
     let mut why = Why::default();
     let dir = out.join("why");
-    if let Err(e) = std::fs::create_dir_all(&dir) {
-        eprintln!(
-            "twinray compare: why step skipped: cannot create '{}': {e}",
-            dir.display()
-        );
+    let made = std::fs::create_dir_all(&dir)
+        .and_then(|()| std::fs::write(dir.join(FLOOR_FILE), FLOOR_SCENE))
+        .map_err(|e| format!("cannot write '{}': {e}", dir.join(FLOOR_FILE).display()));
+    if let Err(e) = made {
+        eprintln!("twinray compare: why step skipped: {e}");
         return why;
     }
     let mut gaps: Vec<&'static Gap> = Vec::new();
@@ -250,10 +213,10 @@ pub fn run(out: &Path, plan: &WhyPlan, paths: &[RenderPath], stop: &AtomicBool) 
             ("teapot", _) => plan.teapot_side,
             _ => plan.box_side,
         };
-        let (width, height) = if gap.large_frame {
-            plan.large_frame
-        } else {
-            (side, side)
+        let (width, height) = match gap.frame {
+            GapFrame::Square => (side, side),
+            GapFrame::Large => plan.large_frame,
+            GapFrame::Small => (plan.small_side, plan.small_side),
         };
         let size = Size { width, height };
         let cases: Vec<Case> = CASES
@@ -385,6 +348,9 @@ fn measure(
                     match run.2 {
                         Some(Hold::Workgroup(x, y)) => args.workgroup = Some(Workgroup { x, y }),
                         Some(Hold::Set(kv)) => args.set.push(kv.to_string()),
+                        Some(Hold::Floor) => {
+                            args.scene = dir.join(FLOOR_FILE).display().to_string()
+                        }
                         None => {}
                     }
                     run_json(run.0, &args).map_err(|e| refused_or_failed(run, &e))
@@ -469,9 +435,21 @@ fn figures(gap: &Gap, case: &Case, measured: &Measured, dir: &Path) -> Result<Wh
                 .iter()
                 .map(|rs| median_ms(rs, gpu))
                 .collect::<Result<_, _>>()?;
+            let after = if case.hold == Some(Hold::Floor) {
+                let (vk, gl) = (ms[0] - ms[2], ms[1] - ms[3]);
+                if vk <= 0.0 || gl <= 0.0 {
+                    return Err(format!(
+                        "failed: the empty frame ({:.4} / {:.4} ms) took as long as the gap's ({:.4} / {:.4} ms)",
+                        ms[2], ms[3], ms[0], ms[1]
+                    ));
+                }
+                vk / gl
+            } else {
+                ms[2] / ms[3]
+            };
             Ok(WhyFigures {
                 before: ms[0] / ms[1],
-                after: ms[2] / ms[3],
+                after,
                 clock: if gpu { "GPU" } else { "wall" },
                 ms: Some([ms[0], ms[1], ms[2], ms[3]]),
             })

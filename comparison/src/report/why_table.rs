@@ -120,6 +120,7 @@ fn change(case: &Case) -> String {
     match case.hold {
         Some(Hold::Workgroup(x, y)) => return format!("both at workgroup {x}x{y}"),
         Some(Hold::Set(kv)) => return format!("both with --set {kv}"),
+        Some(Hold::Floor) => return "both less their empty frame's time".to_string(),
         None => {}
     }
     match (vk.is_empty(), gl.is_empty()) {
@@ -203,7 +204,9 @@ pub fn markdown(why: &Why) -> String {
          in fresh processes with the order alternating (`why.csv` has the times). Verdicts follow from the figures: \
          a VK/GL ratio within {:.0} % of 1 is no gap (by default) or a closed gap (with the experiment); an experiment \
          that moves the ratio, or the disagreeing pixels, by less than {:.0} % of itself has no effect; otherwise it \
-         explains the share of the gap it closes. Images agree when at least {AGREEMENT_CLOSED} % of pixels are within 1/255.\n",
+         explains the share of the gap it closes. Images agree when at least {AGREEMENT_CLOSED} % of pixels are within 1/255. \
+         Where both run less their empty frame's time, the times shown with it are each API's empty frame (the same size, \
+         shader variant and workgroup, every ray missing) and its ratio is of the times less them.\n",
         RATIO_CLOSED * 100.0,
         NO_EFFECT * 100.0
     );
