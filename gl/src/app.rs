@@ -133,10 +133,10 @@ struct HeadlessRun<'a> {
 }
 
 impl HeadlessRun<'_> {
-    /// The timed loop, the same for both paths: one iteration = `before`
-    /// (what Vulkan records ahead of its first timestamp), the GPU-timed
+    /// The timed loop, the same for both paths: one iteration = the GPU-timed
     /// `draw` (the draw call or the dispatch), then glFinish, not a fence: the
-    /// wait is part of what the study timed.
+    /// wait is part of what the study timed, and it completes the frame before
+    /// the next begins.
     fn frames(&self, timer: &Timer, draw: &dyn Fn()) -> Result<(Vec<FrameTime>, f64)> {
         let gl = &self.ctx.gl;
         self.log.check(gl, "after setup");
