@@ -111,6 +111,7 @@ pub const CASES: &[Case] = &[
     no_ray_loop(&SPHERELIST_BVH_COMPUTE),
     both(&SPHERELIST_BVH_SMALL, &[Experiment::TimedBarrier]),
     floor(&SPHERELIST_BVH_SMALL),
+    one_workgroup(&SPHERELIST_BVH_SMALL),
     both(&BOX_IMAGES, &[Experiment::NoContraction]),
     vulkan(&BOX_IMAGES, &[Experiment::NoContraction]),
     vulkan(&BOX_IMAGES, &[Experiment::FloatControls]),
