@@ -1,7 +1,8 @@
 //! The compute path draws the fragment path's image: for every standard scene
 //! and both APIs, ≥ 99.99 % of pixels within 1/255 of the fragment image, no
 //! NaN, zero validation messages / GL debug errors; every measured workgroup
-//! size, and image sizes that are not a multiple of the workgroup, included.
+//! size, and image sizes that are not a multiple of the workgroup, included;
+//! and where the frame's barrier sits changes no pixel.
 
 use twinray_common::value_name::ValueName;
 use twinray_tests::{
@@ -65,6 +66,34 @@ fn every_measured_workgroup_covers_an_odd_sized_image() {
             assert_eq!(report.workgroup.as_deref(), Some(wg));
             assert_eq!(report.validation_messages, 0);
             assert_within_1(&img, &fragment, 0.9999, &format!("{app:?} {wg}"));
+        }
+    }
+}
+
+/// Where the frame's barrier sits is a matter of timing only: with
+/// `--experiment timed-barrier` (the barrier inside the timed span, in both
+/// APIs; by default Vulkan records it before its first timestamp and OpenGL's
+/// headless frames, each ended by glFinish, have none) every frame of a
+/// several-frame run draws the default's image byte for byte, with no
+/// validation message, and the label says which span was timed.
+#[test]
+fn the_timed_barrier_moves_the_span_not_the_image() {
+    for app in App::BOTH {
+        for (scene, set) in [
+            ("box", &[][..]),
+            ("spherelist", &["--set", "extra_spheres=200"][..]),
+        ] {
+            let dir = scratch(&format!("compute-timed-barrier-{scene}"));
+            let args = [set, &["--path", "compute", "--frames", "4"]].concat();
+            let (rd, default) = render(app, scene, "72x40", &args, &dir.join("default.png"));
+            let timed_args = [&args[..], &["--experiment", "timed-barrier"]].concat();
+            let (rt, timed) = render(app, scene, "72x40", &timed_args, &dir.join("timed.png"));
+            let what = format!("{app:?} {scene} ({})", rt.variant);
+            assert!(rt.variant.ends_with("/timed-barrier"), "{what}");
+            assert!(!rd.variant.contains("timed-barrier"), "{what}");
+            assert_eq!(rt.frames.len(), rd.frames.len(), "{what}: frames");
+            assert_clean(&rt, &what);
+            twinray_tests::assert_identical(&default, &timed, &what);
         }
     }
 }
