@@ -185,6 +185,15 @@ fn why_table_has_a_verdict_per_gap_and_experiment(report: &str, out: &std::path:
             assert!(experiment.contains("glslang"), "{row:?}");
             continue;
         }
+        // A software driver's runs have wall time, which the empty frame's
+        // row does not take apart: the row says so.
+        if status.starts_with("not measured: ") {
+            assert!(
+                experiment.contains("empty frame") && status.contains("wall time"),
+                "{row:?}"
+            );
+            continue;
+        }
         assert_eq!(status, "ok", "{row:?}");
         let verdict = row[col("verdict")];
         assert!(verdicts.iter().any(|v| verdict.starts_with(v)), "{verdict}");

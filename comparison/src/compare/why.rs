@@ -157,6 +157,10 @@ pub fn run_label(run: Run) -> String {
         .join("-")
 }
 
+/// A row whose runs all ran but whose figure this device cannot give: the
+/// table's answer, not a failure.
+pub const NOT_MEASURED: &str = "not measured: ";
+
 /// `Hold::Floor`'s scene, written beside the why step's images.
 const FLOOR_SCENE: &str = include_str!("../../plans/scenes/spherelist-missed.toml");
 const FLOOR_FILE: &str = "spherelist-missed.toml";
@@ -437,6 +441,11 @@ fn figures(gap: &Gap, case: &Case, measured: &Measured, dir: &Path) -> Result<Wh
                 .map(|rs| median_ms(rs, gpu))
                 .collect::<Result<_, _>>()?;
             let after = if case.hold == Some(Hold::Floor) {
+                // A wall-clock frame holds the host's share of the loop too,
+                // which an empty frame does not measure apart from the GPU's.
+                if !gpu {
+                    return Err(format!("{NOT_MEASURED}each API's empty frame comes off GPU time only, and this driver's runs have wall time"));
+                }
                 let (vk, gl) = (ms[0] - ms[2], ms[1] - ms[3]);
                 if vk <= 0.0 || gl <= 0.0 {
                     return Err(format!(
@@ -519,6 +528,49 @@ mod tests {
         assert_eq!(title(&why), format!("# twinray compare — {VK}"));
         assert!(!why.software);
         assert_eq!(title(&Why::default()), "# twinray compare — no device");
+    }
+
+    /// The empty frame's row: each API's time less its empty frame's, on GPU
+    /// time only; an empty frame as long as the gap's frame is a failure.
+    #[test]
+    fn a_floor_row_takes_each_empty_frame_off_gpu_time_only() {
+        let case = floor(&SPHERELIST_BVH_SMALL);
+        let measured = |times: [f64; 4], gpu: bool| -> Measured {
+            let labels = ["vulkan", "opengl", "vulkan-floor", "opengl-floor"];
+            labels
+                .iter()
+                .zip(times)
+                .map(|(label, ms)| {
+                    let mut r =
+                        crate::compare::runs::test_outcome(Api::Vulkan, RenderPath::Compute, ms)
+                            .result
+                            .expect("a test outcome succeeds");
+                    if !gpu {
+                        r.gpu_ms = None;
+                    }
+                    (label.to_string(), vec![Ok(r)])
+                })
+                .collect()
+        };
+        let dir = Path::new("/nonexistent");
+        let f = figures(
+            case.gap,
+            &case,
+            &measured([18.0, 20.0, 6.0, 8.0], true),
+            dir,
+        )
+        .unwrap();
+        assert_eq!((f.before, f.after, f.clock), (0.9, 1.0, "GPU"));
+        assert_eq!(f.ms, Some([18.0, 20.0, 6.0, 8.0]));
+        let wall = figures(
+            case.gap,
+            &case,
+            &measured([18.0, 20.0, 6.0, 8.0], false),
+            dir,
+        );
+        assert!(wall.unwrap_err().starts_with(NOT_MEASURED));
+        let longer = figures(case.gap, &case, &measured([18.0, 7.0, 6.0, 8.0], true), dir);
+        assert!(longer.unwrap_err().starts_with("failed: the empty frame"));
     }
 
     #[test]
