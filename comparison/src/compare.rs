@@ -374,10 +374,9 @@ fn write_report(
 }
 
 /// Every run that failed, in every step, with the app's own error line: a
-/// comparison in which any failed is not a success. The why step's rows that
-/// were not run (an experiment this device refuses, a missing tool) or not
-/// measured (a figure this device's clock cannot give) are not failures;
-/// they are the table's answer.
+/// comparison in which any failed is not a success. The why step's rows not
+/// run (a refused experiment, a missing tool) or not measured (a figure this
+/// device's clock cannot give) are not failures; they are the table's answer.
 fn failures(
     results: &runs::Results,
     shader_rows: &[shaders::ShaderRow],

@@ -1,6 +1,7 @@
 //! The points where the why step measures a Vulkan/OpenGL gap (why.rs's
 //! `CASES` names the experiments run at each): scene, values, frame, tree,
-//! path, and what the gap is a gap in.
+//! path, and what the gap is a gap in; and the empty frame `Hold::Floor`
+//! traces beside them.
 
 use crate::compare::runs::{Gap, GapFrame, GapMeasure};
 use twinray_common::cli::RenderPath;
@@ -74,3 +75,7 @@ pub(crate) const BOX_IMAGES: Gap = Gap {
     path: RenderPath::Fragment,
     measure: GapMeasure::Agreement,
 };
+
+/// `Hold::Floor`'s scene, written beside the why step's images.
+pub(crate) const FLOOR_SCENE: &str = include_str!("../../plans/scenes/spherelist-missed.toml");
+pub(crate) const FLOOR_FILE: &str = "spherelist-missed.toml";

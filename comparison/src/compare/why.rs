@@ -7,8 +7,8 @@
 use crate::apps::api_name;
 use crate::apps::{run_json, Api};
 use crate::compare::gaps::{
-    BOX_COMPUTE, BOX_FRAGMENT, BOX_IMAGES, SPHERELIST_BVH_COMPUTE, SPHERELIST_BVH_SMALL,
-    TEAPOT_BVH_COMPUTE, TEAPOT_FRAGMENT,
+    BOX_COMPUTE, BOX_FRAGMENT, BOX_IMAGES, FLOOR_FILE, FLOOR_SCENE, SPHERELIST_BVH_COMPUTE,
+    SPHERELIST_BVH_SMALL, TEAPOT_BVH_COMPUTE, TEAPOT_FRAGMENT,
 };
 use crate::compare::runs::{Case, Gap, GapFrame, GapMeasure, Hold, Why, WhyFigures, WhyRow};
 use std::collections::BTreeMap;
@@ -160,10 +160,6 @@ pub fn run_label(run: Run) -> String {
 /// A row whose runs all ran but whose figure this device cannot give: the
 /// table's answer, not a failure.
 pub const NOT_MEASURED: &str = "not measured: ";
-
-/// `Hold::Floor`'s scene, written beside the why step's images.
-const FLOOR_SCENE: &str = include_str!("../../plans/scenes/spherelist-missed.toml");
-const FLOOR_FILE: &str = "spherelist-missed.toml";
 
 /// The tool an experiment needs on PATH, if any.
 fn tool_needed(run: Run) -> Option<&'static str> {
