@@ -6,11 +6,18 @@
 const uint SPHERE_BIT = 0x80000000u;
 
 // The traversal stack holds the far children still to visit, each entry
-// uvec2(child reference, floatBitsToUint(entry t)), two entries to a uvec4: NVIDIA's
-// OpenGL compiler gives every element of a local array a whole 16-byte slot,
-// so two scalar arrays cost it four times the memory of these pairs (what
-// that was worth: docs/findings/bvh.md#what-made-the-walk-fast; data:
-// f8d14ba:comparison/results/nvidia-h100/investigation/paired.jsonl).
+// uvec2(child reference, floatBitsToUint(entry t)). Each API's stack takes
+// the form its driver runs best (Api::bvh_stack_pairs in
+// common/src/plan/requests.rs decides, as it decides the workgroup):
+// - OpenGL (BVH_STACK_PAIRS): two entries to a uvec4. NVIDIA's OpenGL
+//   compiler gives every element of a local array a whole 16-byte slot, so
+//   two scalar arrays cost it four times the memory of these pairs (what
+//   that was worth: docs/findings/bvh.md#what-made-the-walk-fast; data:
+//   f8d14ba:comparison/results/nvidia-h100/investigation/paired.jsonl), and
+//   one uvec2 a slot twice that of the pairs.
+// - Vulkan: one entry a uvec2, with no test of which half of a pair an entry
+//   is in: its teapot frames 2-3 % shorter
+//   (docs/findings/bvh.md#the-leaves-edges-and-vulkans-stack-h200).
 // BVH_STACK is the built tree's depth - 1
 // (common/src/shader/variant.rs): the traversal pushes at most one child per level of
 // the current path, so no push is ever dropped and no slot is wasted.
@@ -31,7 +38,7 @@ const uint SPHERE_BIT = 0x80000000u;
 shared uvec2 bvh_stack[BVH_STACK * WG_X * WG_Y];
 #define BVH_PUSH(i, e) bvh_stack[(i) * uint(WG_X * WG_Y) + gl_LocalInvocationIndex] = (e)
 #define BVH_POP(i) bvh_stack[(i) * uint(WG_X * WG_Y) + gl_LocalInvocationIndex]
-#else
+#elif defined(BVH_STACK_PAIRS)
 #if BVH_STACK <= 2
 // Never a one-element array: Mesa 22.3's GLSL front end (llvmpipe, OpenGL)
 // stores the last component written into every component of `uvec4 s[1]`, so
@@ -43,6 +50,15 @@ shared uvec2 bvh_stack[BVH_STACK * WG_X * WG_Y];
 #endif
 #define BVH_PUSH(i, e) if (((i) & 1u) == 0u) { stack[(i) >> 1u].xy = (e); } else { stack[(i) >> 1u].zw = (e); }
 #define BVH_POP(i) (((i) & 1u) == 0u ? stack[(i) >> 1u].xy : stack[(i) >> 1u].zw)
+#else
+// Never a one-element array either (see above).
+#if BVH_STACK < 2
+#define BVH_STACK_DECLARE uvec2 stack[2]
+#else
+#define BVH_STACK_DECLARE uvec2 stack[BVH_STACK]
+#endif
+#define BVH_PUSH(i, e) stack[(i)] = (e)
+#define BVH_POP(i) stack[(i)]
 #endif
 #if !defined(BVH_STACK_SHARED) && !defined(BVH_STACK_LOCAL)
 // One stack for both walks (closest hit and any hit), at module scope: per
@@ -109,8 +125,13 @@ bool hit_leaf(inout Hit h, vec3 origin, vec3 dir, TriRay ray, uint first, uint c
                 h.index = i;
             }
         } else {
+#ifdef TRIANGLE_WATERTIGHT
             Triangle tri = Triangle(p.a, 0u, p.b, 0u, p.c, 0u, vec3(0.0), 0u, vec3(0.0), 0u, vec3(0.0), 0u);
             vec3 r = hit_triangle(ray, tri, 0.0, h.t);
+#else
+            // p0 and the two edges (gpu::layout::GpuBvhPrim).
+            vec3 r = moller_trumbore(ray, p.a, p.b, p.c, 0.0, h.t);
+#endif
             if (r.x > 0.0) {
                 h.t = r.x;
                 h.kind = 2u;

@@ -110,10 +110,12 @@ pub struct GpuBvhPrim {
     /// A triangle's p0, a sphere's centre.
     pub a: [f32; 3],
     pub code: u32,
-    /// A triangle's p1; a sphere's radius in x.
+    /// A triangle's p1, or under Möller–Trumbore (TRIANGLE_WATERTIGHT not
+    /// defined) its edge p1 - p0, subtracted in f32 as the test would; a
+    /// sphere's radius in x.
     pub b: [f32; 3],
     pub pad0: u32,
-    /// A triangle's p2; zero for a sphere.
+    /// A triangle's p2, or its edge p2 - p0 as `b`; zero for a sphere.
     pub c: [f32; 3],
     pub pad1: u32,
 }

@@ -9,6 +9,7 @@ use crate::gpu::layout::{
 };
 use crate::limits::StorageLimit;
 use crate::scene::camera::{local_origin, RayFrame};
+use crate::scene::numerics::TriangleTest;
 use crate::scene::{Camera, Scene, Triangle};
 use bytemuck::Pod;
 use glam::DVec3;
@@ -35,6 +36,9 @@ pub struct GpuScene<'a> {
     bvh_wide_nodes: &'a [GpuBvhWideNode],
     /// The leaves' primitive codes, expanded into `GpuBvhPrim`s.
     bvh_codes: &'a [u32],
+    /// Whether a leaf triangle holds p0 and its two edges (the Möller–Trumbore
+    /// test's inputs) rather than its three vertices (the watertight test's).
+    leaf_edges: bool,
 }
 
 /// How many bytes of a storage buffer an upload converts at once, at most
@@ -119,6 +123,7 @@ impl<'a> GpuScene<'a> {
             bvh_nodes: bvh.map_or(&[], |b| &b.nodes),
             bvh_wide_nodes: bvh.map_or(&[], |b| &b.wide),
             bvh_codes: bvh.map_or(&[], |b| &b.prims),
+            leaf_edges: world.numerics.triangle == TriangleTest::MollerTrumbore,
         }
     }
 
@@ -145,7 +150,8 @@ impl<'a> GpuScene<'a> {
 
     /// The leaf primitive of `code`, from the same f32 values as the sphere
     /// and triangle buffers, so a leaf tests exactly the positions that the
-    /// brute-force loops and the shading read.
+    /// brute-force loops and the shading read (for Möller–Trumbore, as p0
+    /// and the edges that its test subtracts from them).
     pub fn bvh_prim(&self, code: u32) -> GpuBvhPrim {
         if code & PRIM_SPHERE_BIT != 0 {
             let s = &self.spheres[(code & !PRIM_SPHERE_BIT) as usize];
@@ -156,7 +162,13 @@ impl<'a> GpuScene<'a> {
                 ..Default::default()
             }
         } else {
-            let [a, b, c] = self.positions(code as usize);
+            let [a, mut b, mut c] = self.positions(code as usize);
+            if self.leaf_edges {
+                // The f32 subtractions the shader's hit_triangle makes: the
+                // same values, so a leaf's hit is the brute-force loop's.
+                b = std::array::from_fn(|k| b[k] - a[k]);
+                c = std::array::from_fn(|k| c[k] - a[k]);
+            }
             GpuBvhPrim {
                 a,
                 code,

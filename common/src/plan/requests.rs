@@ -69,6 +69,18 @@ impl Api {
         *self == Api::OpenGl && bvh && path == RenderPath::Compute && lights == 1
     }
 
+    /// Whether the BVH stack holds two entries to a `uvec4` (BVH_STACK_PAIRS
+    /// in shaders/trace/bvh.glsl): on OpenGL, whose NVIDIA compiler gives
+    /// each element of a local array 16 bytes, so that one entry an element
+    /// would double its stack (the teapot's tracer 240 to 496 B, past the
+    /// 256 B OpenGL keeps every multiprocessor busy within). Vulkan's driver
+    /// gives an 8-byte entry 8 bytes, and without the test of which half an
+    /// entry is in its teapot frames are 2-3 % shorter
+    /// (docs/findings/bvh.md#the-leaves-edges-and-vulkans-stack-h200).
+    pub fn bvh_stack_pairs(&self) -> bool {
+        *self == Api::OpenGl
+    }
+
     /// The app's program name, as its messages begin.
     pub fn program(&self) -> &'static str {
         match self {

@@ -41,6 +41,9 @@ pub struct Variant {
     /// The one light shaded before its shadow walk, the hit's secondary rays
     /// pushed before it (LIGHT_BEFORE_WALK; `Api::light_before_walk` decides).
     pub light_before_walk: bool,
+    /// The BVH stack as two entries to a `uvec4` (BVH_STACK_PAIRS;
+    /// `Api::bvh_stack_pairs` decides), not one to a `uvec2`.
+    pub bvh_stack_pairs: bool,
     /// The experiments' names, in registry order, for the label.
     pub tags: Vec<String>,
 }
@@ -206,6 +209,7 @@ impl Variant {
             knobs: ShaderKnobs::default(),
             passes: Passes::default(),
             light_before_walk: false,
+            bvh_stack_pairs: false,
             tags: Vec::new(),
         }
     }
@@ -322,6 +326,7 @@ impl Variant {
         flag(bvh && k.local_bvh_stack, "BVH_STACK_LOCAL");
         flag(k.split_ray_stack, "RAY_STACK_SPLIT");
         flag(self.light_before_walk, "LIGHT_BEFORE_WALK");
+        flag(bvh && self.bvh_stack_pairs, "BVH_STACK_PAIRS");
         flag(self.count_rays, "COUNT_RAYS");
         flag(self.bvh_stack_in_shared_memory(), "BVH_STACK_SHARED");
         for n in self.numerics.defines() {
