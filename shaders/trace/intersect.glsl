@@ -81,59 +81,63 @@ TriRay tri_ray(vec3 o, vec3 d) {
 // A triangle whose edges are parallel in f32 has no normal (normalize(0) is
 // undefined), yet rounding can still let a ray through a collinear triangle's
 // line pass either test. Checked only for candidate hits, so it costs little.
+bool is_degenerate(Triangle tri) {
+    vec3 c = cross(tri.p1 - tri.p0, tri.p2 - tri.p0);
+    return c.x == 0.0 && c.y == 0.0 && c.z == 0.0;
+}
+
+#ifndef TRIANGLE_WATERTIGHT
+// Moller-Trumbore 1997, from p0 and the edges E1 = p1 - p0, E2 = p2 - p0,
+// returning (t, u, v) or `miss` from the function it is written into: a
+// macro, so that hit_triangle (the brute-force loops) compiles to exactly
+// what it did before the BVH's leaves took their own copy (NVIDIA's OpenGL
+// fragment path ran the box 2 % slower through a shared function).
+#define MOLLER_TRUMBORE(P0, E1, E2, DEGENERATE)                                 \
+    vec3 pv = cross(r.d, E2);                                                   \
+    float det = dot(E1, pv);                                                    \
+    if (det == 0.0) {                                                           \
+        return miss;                                                            \
+    }                                                                           \
+    float inv = 1.0 / det;                                                      \
+    vec3 tv = r.o - P0;                                                         \
+    float u = dot(tv, pv) * inv;                                                \
+    if (!(u >= 0.0 && u <= 1.0)) {                                              \
+        return miss;                                                            \
+    }                                                                           \
+    vec3 qv = cross(tv, E1);                                                    \
+    float v = dot(r.d, qv) * inv;                                               \
+    if (!(v >= 0.0 && u + v <= 1.0)) {                                          \
+        return miss;                                                            \
+    }                                                                           \
+    float t = dot(E2, qv) * inv;                                                \
+    bool degenerate = DEGENERATE;                                               \
+    if (!(t > t_min && t < t_max) || degenerate) {                              \
+        return miss;                                                            \
+    }                                                                           \
+    return vec3(t, u, v);
+
+#ifdef USE_BVH
+// The BVH's leaves hold p0 and the edges already subtracted (the same f32
+// subtraction, made once on the CPU: common/src/gpu/upload.rs), which saves
+// every leaf test six subtractions (docs/findings/bvh.md#the-leaves-edges-and-vulkans-stack-h200).
+// The degenerate test is is_degenerate's, on the edges.
 bool edges_degenerate(vec3 e1, vec3 e2) {
     vec3 c = cross(e1, e2);
     return c.x == 0.0 && c.y == 0.0 && c.z == 0.0;
 }
 
-bool is_degenerate(Triangle tri) {
-    return edges_degenerate(tri.p1 - tri.p0, tri.p2 - tri.p0);
-}
-
-#ifndef TRIANGLE_WATERTIGHT
-// Moller-Trumbore 1997, from p0 and the edges e1 = p1 - p0, e2 = p2 - p0:
-// the BVH's leaves hold the edges already subtracted (the same f32
-// subtraction, made once on the CPU: common/src/gpu/upload.rs), which saves
-// every leaf test six subtractions (1-2 % of the teapot's frames in both
-// APIs: docs/findings/bvh.md#the-leaves-edges-and-vulkans-stack-h200).
-// Returns (t, u, v) as hit_triangle does.
 vec3 moller_trumbore(TriRay r, vec3 p0, vec3 e1, vec3 e2, float t_min, float t_max) {
     vec3 miss = vec3(-1.0, 0.0, 0.0);
-    vec3 pv = cross(r.d, e2);
-    float det = dot(e1, pv);
-    if (det == 0.0) {
-        return miss;
-    }
-    float inv = 1.0 / det;
-    vec3 tv = r.o - p0;
-    float u = dot(tv, pv) * inv;
-    if (!(u >= 0.0 && u <= 1.0)) {
-        return miss;
-    }
-    vec3 qv = cross(tv, e1);
-    float v = dot(r.d, qv) * inv;
-    if (!(v >= 0.0 && u + v <= 1.0)) {
-        return miss;
-    }
-    float t = dot(e2, qv) * inv;
-    // Computed on every call, as naga always did for the call right of `||`
-    // this once was (the product's timings include it; testing it only
-    // inside the branch, along with early exits in the shadow test, was
-    // slower on the brute-force points:
-    // docs/findings/shader-compilers.md#what-naga-adds-and-what-the-source-now-says).
-    bool degenerate = edges_degenerate(e1, e2);
-    if (!(t > t_min && t < t_max) || degenerate) {
-        return miss;
-    }
-    return vec3(t, u, v);
+    MOLLER_TRUMBORE(p0, e1, e2, edges_degenerate(e1, e2))
 }
+#endif
 #endif
 
 // Returns (t, u, v) with u, v the weights of p1 and p2, or t = -1 for a miss.
 // Conditions are written so that NaN fails them: a degenerate triangle is never hit.
 vec3 hit_triangle(TriRay r, Triangle tri, float t_min, float t_max) {
-#ifdef TRIANGLE_WATERTIGHT
     vec3 miss = vec3(-1.0, 0.0, 0.0);
+#ifdef TRIANGLE_WATERTIGHT
     // Vertices relative to the origin, in the sheared frame where the ray is +z.
     // Each vertex is transformed alone, so two triangles sharing an edge compute
     // the same 2D edge function with opposite sign: no ray slips between them.
@@ -172,7 +176,14 @@ vec3 hit_triangle(TriRay r, Triangle tri, float t_min, float t_max) {
     }
     return vec3(t, ev * inv, ew * inv);
 #else
-    return moller_trumbore(r, tri.p0, tri.p1 - tri.p0, tri.p2 - tri.p0, t_min, t_max);
+    vec3 e1 = tri.p1 - tri.p0;
+    vec3 e2 = tri.p2 - tri.p0;
+    // Computed on every call, as naga always did for the call right of `||`
+    // this once was (the product's timings include it; testing it only
+    // inside the branch, along with early exits in the shadow test, was
+    // slower on the brute-force points:
+    // docs/findings/shader-compilers.md#what-naga-adds-and-what-the-source-now-says).
+    MOLLER_TRUMBORE(tri.p0, e1, e2, is_degenerate(tri))
 #endif
 }
 
