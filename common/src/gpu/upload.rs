@@ -451,14 +451,40 @@ mod tests {
             g.write_storage(b, start, &mut bytes);
             assert!(bytes == whole[start..end], "binding {b}, bytes 7..107");
         }
-        // The leaves hold the very vertices of the triangle buffer.
-        let prims: Vec<GpuBvhPrim> =
-            bytemuck::pod_collect_to_vec(&g.storage_vec(binding::BVH_PRIMS));
-        let tris: Vec<GpuTriangle> =
-            bytemuck::pod_collect_to_vec(&g.storage_vec(binding::TRIANGLES));
-        for p in prims.iter().filter(|p| p.code & PRIM_SPHERE_BIT == 0) {
-            let t = &tris[p.code as usize];
-            assert_eq!([p.a, p.b, p.c], [t.p0, t.p1, t.p2]);
+    }
+
+    /// A leaf's triangle is the triangle buffer's to the bit: its vertices
+    /// for the watertight test, and for Möller–Trumbore p0 and the edges that
+    /// hit_triangle subtracts in f32 from them.
+    #[test]
+    fn the_leaves_hold_what_each_triangle_test_reads() {
+        for (set, edges) in [("moller-trumbore", true), ("watertight", false)] {
+            let s = Scene::load("teapot", &[("triangle".into(), set.into())]).unwrap();
+            let bvh = Bvh::build(&s);
+            let g = GpuScene::new(&s, Some(&bvh), 8, 8);
+            let prims: Vec<GpuBvhPrim> =
+                bytemuck::pod_collect_to_vec(&g.storage_vec(binding::BVH_PRIMS));
+            let tris: Vec<GpuTriangle> =
+                bytemuck::pod_collect_to_vec(&g.storage_vec(binding::TRIANGLES));
+            let sub = |a: [f32; 3], b: [f32; 3]| [a[0] - b[0], a[1] - b[1], a[2] - b[2]];
+            let mut checked = 0;
+            for p in prims.iter().filter(|p| p.code & PRIM_SPHERE_BIT == 0) {
+                let t = &tris[p.code as usize];
+                let want = if edges {
+                    [t.p0, sub(t.p1, t.p0), sub(t.p2, t.p0)]
+                } else {
+                    [t.p0, t.p1, t.p2]
+                };
+                let bits = |v: [[f32; 3]; 3]| v.map(|p| p.map(f32::to_bits));
+                assert_eq!(
+                    bits([p.a, p.b, p.c]),
+                    bits(want),
+                    "{set}, triangle {}",
+                    p.code
+                );
+                checked += 1;
+            }
+            assert_eq!(checked, tris.len(), "{set}: every triangle in a leaf");
         }
     }
 }
