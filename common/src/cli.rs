@@ -499,6 +499,7 @@ mod tests {
                 "shared-bvh-stack",
                 "local-bvh-stack",
                 "split-ray-stack",
+                "unpaired-bvh-stack",
                 "first-of-equals",
                 "optimal-collapse",
                 "walk-then-shade",

@@ -4,7 +4,8 @@
 //! what it stores, or what the driver is told: on lavapipe and llvmpipe each
 //! renders the default image bit for bit, with the validation layer / GL debug
 //! context silent. `local-bvh-stack` and `split-ray-stack` put back the old
-//! stacks, `naga-aliasing` naga's declarations without `restrict`,
+//! stacks, `unpaired-bvh-stack` gives OpenGL Vulkan's form of the BVH stack,
+//! `naga-aliasing` naga's declarations without `restrict`,
 //! `naga-loop-bounding` naga's loop counters on the BVH variants too,
 //! `--shared-pad` unused workgroup memory, and `--gl-spirv` loads the SPIR-V
 //! that `Restrict` now decorates.
@@ -70,6 +71,7 @@ const VARIANTS: &[Variant] = &[
         "split-ray-stack",
     ]),
     everywhere(&["--experiment", "naga-aliasing"]),
+    everywhere(&["--experiment", "unpaired-bvh-stack"]),
     everywhere(&["--experiment", "naga-loop-bounding"]),
     // Mesa's GLSL and SPIR-V compilers may round a pixel differently (they
     // did on the box before `Restrict` existed), so the SPIR-V with `Restrict`

@@ -15,6 +15,7 @@ pub enum Experiment {
     SharedBvhStack,
     LocalBvhStack,
     SplitRayStack,
+    UnpairedBvhStack,
     FirstOfEquals,
     OptimalCollapse,
     WalkThenShade,

@@ -110,6 +110,8 @@ pub struct ShaderKnobs {
     pub split_ray_stack: bool,
     /// No LIGHT_BEFORE_WALK where the plan would choose it.
     pub walk_then_shade: bool,
+    /// No BVH_STACK_PAIRS where the plan would choose it.
+    pub unpaired_bvh_stack: bool,
     /// Compute: KiB of workgroup memory the tracer does not need.
     pub shared_pad_kib: Option<u32>,
     /// The arithmetic probe (shaders/lab/ulp.glsl) in place of the tracer's
