@@ -13,8 +13,8 @@ const uint SPHERE_BIT = 0x80000000u;
 //   compiler gives every element of a local array a whole 16-byte slot, so
 //   two scalar arrays cost it four times the memory of these pairs (what
 //   that was worth: docs/findings/bvh.md#what-made-the-walk-fast; data:
-//   f8d14ba:comparison/results/nvidia-h100/investigation/paired.jsonl), and
-//   one uvec2 a slot twice that of the pairs.
+//   f8d14ba:comparison/results/nvidia-h100/investigation/paired.jsonl); one
+//   uvec2 an element would double the stack's local memory.
 // - Vulkan: one entry a uvec2, with no test of which half of a pair an entry
 //   is in: its teapot frames 2-3 % shorter
 //   (docs/findings/bvh.md#the-leaves-edges-and-vulkans-stack-h200).

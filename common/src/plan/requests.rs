@@ -73,7 +73,9 @@ impl Api {
     /// in shaders/trace/bvh.glsl): on OpenGL, whose NVIDIA compiler gives
     /// each element of a local array 16 bytes, so that one entry an element
     /// would double its stack (the teapot's tracer 240 to 496 B, past the
-    /// 256 B OpenGL keeps every multiprocessor busy within). Vulkan's driver
+    /// 256 B its tracers are held to: above about 254 B its driver was seen
+    /// to idle multiprocessors; `--experiment unpaired-bvh-stack` measures
+    /// it again). Vulkan's driver
     /// gives an 8-byte entry 8 bytes, and without the test of which half an
     /// entry is in its teapot frames are 2-3 % shorter
     /// (docs/findings/bvh.md#the-leaves-edges-and-vulkans-stack-h200).
