@@ -9,15 +9,17 @@ const uint SPHERE_BIT = 0x80000000u;
 // uvec2(child reference, floatBitsToUint(entry t)). Each API's stack takes
 // the form its driver runs best (Api::bvh_stack_pairs in
 // common/src/plan/requests.rs decides, as it decides the workgroup):
-// - OpenGL (BVH_STACK_PAIRS): two entries to a uvec4. NVIDIA's OpenGL
-//   compiler gives every element of a local array a whole 16-byte slot, so
-//   two scalar arrays cost it four times the memory of these pairs (what
-//   that was worth: docs/findings/bvh.md#what-made-the-walk-fast; data:
-//   f8d14ba:comparison/results/nvidia-h100/investigation/paired.jsonl); one
-//   uvec2 an element would double the stack's local memory.
-// - Vulkan: one entry a uvec2, with no test of which half of a pair an entry
-//   is in: its teapot frames 2-3 % shorter
-//   (docs/findings/bvh.md#the-leaves-edges-and-vulkans-stack-h200).
+// - OpenGL on trees of up to 30 entries (BVH_STACK_PAIRS): two entries to a
+//   uvec4. NVIDIA's OpenGL compiler reports a whole 16-byte slot for every
+//   element of a local array, so two scalar arrays cost it four times the
+//   memory of these pairs (what that was worth:
+//   docs/findings/bvh.md#what-made-the-walk-fast; data:
+//   f8d14ba:comparison/results/nvidia-h100/investigation/paired.jsonl).
+// - Vulkan, and OpenGL on deeper trees: one entry a uvec2, with no test of
+//   which half of a pair an entry is in. OpenGL's report then doubles, but
+//   its multiprocessors do not drop; it holds 4 warps fewer, and gains from
+//   the 307k-triangle teapot up
+//   (docs/findings/bvh.md#the-stacks-form-in-opengl-h200).
 // BVH_STACK is the built tree's depth - 1
 // (common/src/shader/variant.rs): the traversal pushes at most one child per level of
 // the current path, so no push is ever dropped and no slot is wasted.

@@ -83,7 +83,7 @@ pub const REGISTRY: &[Entry] = &[
     entry(Experiment::SplitRayStack, "The ray stack as four arrays (origin, direction, weight, depth) instead of two of vec4 pairs.", |c| {
         c.knobs.split_ray_stack = true
     }),
-    entry(Experiment::UnpairedBvhStack, "OpenGL's BVH stack one entry to a uvec2, as Vulkan's is, instead of two entries to a uvec4: NVIDIA's OpenGL compiler reports 16 bytes for each element, twice the local memory (the teapot's tracer 496 B instead of 240 B), yet in a probe it ran the teapot 5-7 % faster from 307k triangles up and 2-3 % slower at 4K; this measures that, and with warp-probe its multiprocessors. Vulkan's stack is that way already.", |c| {
+    entry(Experiment::UnpairedBvhStack, "OpenGL's BVH stack one entry to a uvec2 on every tree, as Vulkan's is, instead of two entries to a uvec4 on trees of up to 30 entries (the default scenes'; deeper trees take the uvec2 form already): NVIDIA's OpenGL compiler reports 16 bytes for each element, twice the local memory (the teapot's tracer 480 B instead of 240 B), yet runs it on as many multiprocessors, with 24 warps each instead of 28. Vulkan's stack is that way already.", |c| {
         c.knobs.unpaired_bvh_stack = true
     }),
     entry(Experiment::FirstOfEquals, "The wide tree's collapse opens the first of equal-area boxes, as it did until the shallowest was preferred: the sphere list's identical spheres then give a 4-wide tree of 16 levels at 100k spheres instead of 10, and a BVH stack of 368 B instead of 224 B, past what lets NVIDIA's OpenGL use every multiprocessor.", |c| {

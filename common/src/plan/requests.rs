@@ -18,6 +18,10 @@ pub enum Api {
     OpenGl,
 }
 
+/// The deepest BVH stack OpenGL keeps in pairs (`Api::bvh_stack_pairs`):
+/// the default teapot's tree (30 entries), 240 B of local memory.
+pub const PAIRED_STACK_MOST: u32 = 30;
+
 impl Api {
     pub fn name(&self) -> &'static str {
         match self {
@@ -69,18 +73,22 @@ impl Api {
         *self == Api::OpenGl && bvh && path == RenderPath::Compute && lights == 1
     }
 
-    /// Whether the BVH stack holds two entries to a `uvec4` (BVH_STACK_PAIRS
-    /// in shaders/trace/bvh.glsl): on OpenGL, whose NVIDIA compiler gives
-    /// each element of a local array 16 bytes, so that one entry an element
-    /// would double its stack (the teapot's tracer 240 to 496 B, past the
-    /// 256 B its tracers are held to: above about 254 B its driver was seen
-    /// to idle multiprocessors; `--experiment unpaired-bvh-stack` measures
-    /// it again). Vulkan's driver
-    /// gives an 8-byte entry 8 bytes, and without the test of which half an
-    /// entry is in its teapot frames are 2-3 % shorter
-    /// (docs/findings/bvh.md#the-leaves-edges-and-vulkans-stack-h200).
-    pub fn bvh_stack_pairs(&self) -> bool {
-        *self == Api::OpenGl
+    /// Whether a BVH stack of `entries` holds two entries to a `uvec4`
+    /// (BVH_STACK_PAIRS in shaders/trace/bvh.glsl), not one to a `uvec2`:
+    /// on OpenGL, for trees of at most `PAIRED_STACK_MOST` entries. Vulkan's
+    /// driver gives an 8-byte entry 8 bytes, and without the test of which
+    /// half an entry is in its teapot frames are 2-3 % shorter. NVIDIA's
+    /// OpenGL compiler reports 16 bytes for each element of a local array, so
+    /// one entry an element reads as twice the local memory (the teapot's
+    /// tracer 240 to 480 B); yet it ran on as many multiprocessors as the
+    /// pairs at every tree size, so its real footprint is the same, and it
+    /// held 24 warps a multiprocessor to the pairs' 28. Up to the default
+    /// teapot's 30 entries the pairs were as fast or faster at some points
+    /// (4K, the 1080p sphere list); from the 307k-triangle teapot's 38 up the
+    /// one-entry form was 5-7 % faster
+    /// (docs/findings/bvh.md#the-stacks-form-in-opengl-h200).
+    pub fn bvh_stack_pairs(&self, entries: u32) -> bool {
+        *self == Api::OpenGl && entries <= PAIRED_STACK_MOST
     }
 
     /// The app's program name, as its messages begin.

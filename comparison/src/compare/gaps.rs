@@ -76,6 +76,50 @@ pub(crate) const BOX_IMAGES: Gap = Gap {
     measure: GapMeasure::Agreement,
 };
 
-/// `Hold::Floor`'s scene, written beside the why step's images.
-pub(crate) const FLOOR_SCENE: &str = include_str!("../../plans/scenes/spherelist-missed.toml");
-pub(crate) const FLOOR_FILE: &str = "spherelist-missed.toml";
+/// `Hold::Floor`'s sphere list: its camera, light and kinds of primitive, all
+/// behind the camera.
+const SPHERELIST_MISSED: &str = include_str!("../../plans/scenes/spherelist-missed.toml");
+const TEAPOT: &str = include_str!("../../../scenes/teapot.toml");
+const TEAPOT_PATCHES: &str = include_str!("../../../scenes/teapot.bpt");
+/// The teapot's camera target, and where its empty frame looks instead:
+/// straight up, above everything the scene holds.
+const TEAPOT_LOOK_AT: &str = "look_at = [0.2, 1.4, 0.0]";
+const TEAPOT_LOOK_UP: &str = "look_at = [0.0, 30.0, 8.6]";
+
+/// The files `Hold::Floor` writes beside the why step's images: each gap
+/// scene's empty frame (the same shader variant, tree and size, every primary
+/// ray missing), and what it names. The teapot's is the built-in scene with
+/// its camera turned up, so it stays the teapot as it ships.
+pub(crate) fn floor_files() -> [(&'static str, String); 3] {
+    [
+        (floor_file("spherelist"), SPHERELIST_MISSED.to_string()),
+        (
+            floor_file("teapot"),
+            TEAPOT.replacen(TEAPOT_LOOK_AT, TEAPOT_LOOK_UP, 1),
+        ),
+        ("teapot.bpt", TEAPOT_PATCHES.to_string()),
+    ]
+}
+
+/// The empty frame `Hold::Floor` traces for a gap on `scene`.
+pub(crate) fn floor_file(scene: &str) -> &'static str {
+    match scene {
+        "teapot" => "teapot-missed.toml",
+        _ => "spherelist-missed.toml",
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The teapot's empty frame is the teapot with only its camera's target
+    /// moved: if the scene's camera line changed, the replacement would
+    /// silently leave the teapot in view.
+    #[test]
+    fn the_teapots_empty_frame_turns_only_its_camera() {
+        let [_, (_, missed), _] = floor_files();
+        assert_eq!(TEAPOT.matches(TEAPOT_LOOK_AT).count(), 1);
+        assert_eq!(missed.replacen(TEAPOT_LOOK_UP, TEAPOT_LOOK_AT, 1), TEAPOT);
+    }
+}

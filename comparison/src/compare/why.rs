@@ -7,7 +7,7 @@
 use crate::apps::api_name;
 use crate::apps::{run_json, Api};
 use crate::compare::gaps::{
-    BOX_COMPUTE, BOX_FRAGMENT, BOX_IMAGES, FLOOR_FILE, FLOOR_SCENE, SPHERELIST_BVH_COMPUTE,
+    floor_file, floor_files, BOX_COMPUTE, BOX_FRAGMENT, BOX_IMAGES, SPHERELIST_BVH_COMPUTE,
     SPHERELIST_BVH_SMALL, TEAPOT_BVH_COMPUTE, TEAPOT_FRAGMENT,
 };
 use crate::compare::runs::{Case, Gap, GapFrame, GapMeasure, Hold, Why, WhyFigures, WhyRow};
@@ -103,6 +103,7 @@ pub const CASES: &[Case] = &[
     opengl(&TEAPOT_BVH_COMPUTE, &[Experiment::NagaAliasing]),
     gl_spirv(&TEAPOT_BVH_COMPUTE),
     one_workgroup(&TEAPOT_BVH_COMPUTE),
+    floor(&TEAPOT_BVH_COMPUTE),
     both(&SPHERELIST_BVH_COMPUTE, &[Experiment::FirstOfEquals]),
     both(&SPHERELIST_BVH_COMPUTE, &[Experiment::WalkThenShade]),
     both(&SPHERELIST_BVH_COMPUTE, &[Experiment::LocalBvhStack]),
@@ -185,8 +186,13 @@ pub fn run(out: &Path, plan: &WhyPlan, paths: &[RenderPath], stop: &AtomicBool) 
     let mut why = Why::default();
     let dir = out.join("why");
     let made = std::fs::create_dir_all(&dir)
-        .and_then(|()| std::fs::write(dir.join(FLOOR_FILE), FLOOR_SCENE))
-        .map_err(|e| format!("cannot write '{}': {e}", dir.join(FLOOR_FILE).display()));
+        .map_err(|e| format!("cannot create '{}': {e}", dir.display()))
+        .and_then(|()| {
+            floor_files().iter().try_for_each(|(name, text)| {
+                std::fs::write(dir.join(name), text)
+                    .map_err(|e| format!("cannot write '{}': {e}", dir.join(name).display()))
+            })
+        });
     if let Err(e) = made {
         eprintln!("twinray compare: why step skipped: {e}");
         return why;
@@ -350,7 +356,7 @@ fn measure(
                         Some(Hold::Workgroup(x, y)) => args.workgroup = Some(Workgroup { x, y }),
                         Some(Hold::Set(kv)) => args.set.push(kv.to_string()),
                         Some(Hold::Floor) => {
-                            args.scene = dir.join(FLOOR_FILE).display().to_string()
+                            args.scene = dir.join(floor_file(gap.scene)).display().to_string()
                         }
                         None => {}
                     }
