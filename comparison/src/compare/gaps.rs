@@ -101,6 +101,15 @@ pub(crate) fn floor_files() -> [(&'static str, String); 3] {
     ]
 }
 
+/// `dir` made, with `floor_files` in it.
+pub(crate) fn write_floor_files(dir: &std::path::Path) -> Result<(), String> {
+    std::fs::create_dir_all(dir).map_err(|e| format!("cannot create '{}': {e}", dir.display()))?;
+    floor_files().iter().try_for_each(|(name, text)| {
+        std::fs::write(dir.join(name), text)
+            .map_err(|e| format!("cannot write '{}': {e}", dir.join(name).display()))
+    })
+}
+
 /// The empty frame `Hold::Floor` traces for a gap on `scene`.
 pub(crate) fn floor_file(scene: &str) -> &'static str {
     match scene {

@@ -7,7 +7,7 @@
 use crate::apps::api_name;
 use crate::apps::{run_json, Api};
 use crate::compare::gaps::{
-    floor_file, floor_files, BOX_COMPUTE, BOX_FRAGMENT, BOX_IMAGES, SPHERELIST_BVH_COMPUTE,
+    floor_file, write_floor_files, BOX_COMPUTE, BOX_FRAGMENT, BOX_IMAGES, SPHERELIST_BVH_COMPUTE,
     SPHERELIST_BVH_SMALL, TEAPOT_BVH_COMPUTE, TEAPOT_FRAGMENT,
 };
 use crate::compare::runs::{Case, Gap, GapFrame, GapMeasure, Hold, Why, WhyFigures, WhyRow};
@@ -185,15 +185,7 @@ pub fn on_path(tool: &str, path: Option<&OsStr>) -> bool {
 pub fn run(out: &Path, plan: &WhyPlan, paths: &[RenderPath], stop: &AtomicBool) -> Why {
     let mut why = Why::default();
     let dir = out.join("why");
-    let made = std::fs::create_dir_all(&dir)
-        .map_err(|e| format!("cannot create '{}': {e}", dir.display()))
-        .and_then(|()| {
-            floor_files().iter().try_for_each(|(name, text)| {
-                std::fs::write(dir.join(name), text)
-                    .map_err(|e| format!("cannot write '{}': {e}", dir.join(name).display()))
-            })
-        });
-    if let Err(e) = made {
+    if let Err(e) = write_floor_files(&dir) {
         eprintln!("twinray compare: why step skipped: {e}");
         return why;
     }

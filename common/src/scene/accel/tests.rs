@@ -309,7 +309,9 @@ fn auto_picks_the_width_the_crossover_measured() {
 
 /// NVIDIA's OpenGL runs a compute program on fewer multiprocessors once its
 /// local memory passes about 254 B an invocation (docs/findings/opengl-compute.md),
-/// and the BVH stack is all of that memory: two entries to a 16-byte slot.
+/// and the BVH stack is all of that memory: two entries to a 16-byte slot,
+/// the form OpenGL keeps for these trees (`Api::bvh_stack_pairs`; the
+/// one-entry form would report twice the bytes, docs/findings/bvh.md).
 /// The collapse must keep it within 256 B for the study's scenes, the sphere
 /// list included, whose identical hidden spheres give boxes of equal area at
 /// every level: opened first-of-equals they made a 4-wide tree of 16 levels
@@ -335,6 +337,11 @@ fn the_study_scenes_stacks_fit_opengls_local_memory_budget() {
         let binary = Bvh::build(&Scene::load(name, &set).unwrap());
         let depth = binary.depth;
         let wide = binary.widen(4);
+        assert!(
+            crate::plan::requests::Api::OpenGl.bvh_stack_pairs(wide.stack_entries()),
+            "{name} {set:?}: {} stack entries, not in OpenGL's pairs",
+            wide.stack_entries()
+        );
         assert!(
             stack_bytes(&wide) <= 256,
             "{name} {set:?}: {} stack entries, {} B",
