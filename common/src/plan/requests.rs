@@ -84,9 +84,9 @@ impl Api {
     /// pairs at every tree size, so its real footprint is the same, and it
     /// held 24 warps a multiprocessor to the pairs' 28. Up to the default
     /// teapot's 30 entries the pairs were as fast or faster at some points
-    /// (4K, the 1080p sphere list); from the 307k-triangle teapot's 38 up the
-    /// one-entry form was 5-7 % faster
-    /// (docs/findings/bvh.md#the-stacks-form-in-opengl-h200).
+    /// (4K, the 1080p sphere list); from the 307k-triangle teapot's 37 up the
+    /// one-entry form was 4-6 % faster on the compute path and 3-6 % on the
+    /// fragment path (docs/findings/bvh.md#the-stacks-form-in-opengl-h200).
     pub fn bvh_stack_pairs(&self, entries: u32) -> bool {
         *self == Api::OpenGl && entries <= PAIRED_STACK_MOST
     }
