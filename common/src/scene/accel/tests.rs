@@ -316,9 +316,12 @@ fn auto_picks_the_width_the_crossover_measured() {
 /// list included, whose identical hidden spheres give boxes of equal area at
 /// every level: opened first-of-equals they made a 4-wide tree of 16 levels
 /// (45 entries, 368 B: 90 of 132 multiprocessors on an H200) where 10 do.
+/// The variant that comes closest is the teapot's: 30 entries, 240 B, what
+/// `--dump-shaders` reports for its OpenGL tracer.
 #[test]
 fn the_study_scenes_stacks_fit_opengls_local_memory_budget() {
     let stack_bytes = |b: &Bvh| b.stack_entries().div_ceil(2) * 16;
+    let mut closest = ("", 0);
     for (name, set) in [
         ("teapot", vec![]),
         (
@@ -354,5 +357,9 @@ fn the_study_scenes_stacks_fit_opengls_local_memory_budget() {
             "{name} {set:?}: depth {depth} → {}",
             wide.depth
         );
+        if stack_bytes(&wide) > closest.1 {
+            closest = (name, stack_bytes(&wide));
+        }
     }
+    assert_eq!(closest, ("teapot", 240), "the variant closest to 256 B");
 }
