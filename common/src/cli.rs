@@ -510,6 +510,7 @@ mod tests {
                 "naga-aliasing",
                 "warp-probe",
                 "timed-barrier",
+                "back-to-back",
                 "ulp"
             ]
         );

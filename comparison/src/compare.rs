@@ -10,6 +10,7 @@ pub(crate) mod runs;
 pub(crate) mod shaders;
 pub(crate) mod study;
 pub(crate) mod why;
+pub(crate) mod why_figures;
 
 use crate::apps::{api_name, is_software, run_json, Api};
 use anyhow::Context;

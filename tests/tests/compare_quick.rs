@@ -232,6 +232,8 @@ fn why_table_has_a_verdict_per_gap_and_experiment(report: &str, out: &std::path:
         "--set max_depth=1",
         "timed-barrier",
         "less their empty frame's time",
+        "the second of two frames back to back",
+        "at workgroup 4x8: the second of two frames back to back",
     ] {
         assert!(experiments.contains(e), "no why row for {e}");
     }

@@ -70,30 +70,34 @@ fn every_measured_workgroup_covers_an_odd_sized_image() {
     }
 }
 
-/// Where the frame's barrier sits is a matter of timing only: with
+/// What a frame's timed span holds is a matter of timing only: with
 /// `--experiment timed-barrier` (the barrier inside the timed span, in both
 /// APIs; by default Vulkan records it before its first timestamp and OpenGL's
-/// headless frames, each ended by glFinish, have none) every frame of a
+/// headless frames, each ended by glFinish, have none) or `back-to-back` (two
+/// dispatches a frame, with no barrier between them) every frame of a
 /// several-frame run draws the default's image byte for byte, with no
 /// validation message, and the label says which span was timed.
 #[test]
-fn the_timed_barrier_moves_the_span_not_the_image() {
+fn the_frames_span_moves_the_timing_not_the_image() {
     for app in App::BOTH {
         for (scene, set) in [
             ("box", &[][..]),
             ("spherelist", &["--set", "extra_spheres=200"][..]),
         ] {
-            let dir = scratch(&format!("compute-timed-barrier-{scene}"));
+            let dir = scratch(&format!("compute-span-{scene}"));
             let args = [set, &["--path", "compute", "--frames", "4"]].concat();
             let (rd, default) = render(app, scene, "72x40", &args, &dir.join("default.png"));
-            let timed_args = [&args[..], &["--experiment", "timed-barrier"]].concat();
-            let (rt, timed) = render(app, scene, "72x40", &timed_args, &dir.join("timed.png"));
-            let what = format!("{app:?} {scene} ({})", rt.variant);
-            assert!(rt.variant.ends_with("/timed-barrier"), "{what}");
-            assert!(!rd.variant.contains("timed-barrier"), "{what}");
-            assert_eq!(rt.frames.len(), rd.frames.len(), "{what}: frames");
-            assert_clean(&rt, &what);
-            twinray_tests::assert_identical(&default, &timed, &what);
+            for experiment in ["timed-barrier", "back-to-back"] {
+                let timed_args = [&args[..], &["--experiment", experiment]].concat();
+                let png = dir.join(format!("{experiment}.png"));
+                let (rt, timed) = render(app, scene, "72x40", &timed_args, &png);
+                let what = format!("{app:?} {scene} ({})", rt.variant);
+                assert!(rt.variant.ends_with(&format!("/{experiment}")), "{what}");
+                assert!(!rd.variant.contains(experiment), "{what}");
+                assert_eq!(rt.frames.len(), rd.frames.len(), "{what}: frames");
+                assert_clean(&rt, &what);
+                twinray_tests::assert_identical(&default, &timed, &what);
+            }
         }
     }
 }

@@ -204,9 +204,7 @@ fn render_compute(run: &HeadlessRun, shader: &ComputeShader) -> Result<Rendered>
         shader,
         size.width,
         size.height,
-        timestamps
-            .as_ref()
-            .map(|t| (t, Span::of(run.plan.timed_barrier))),
+        (timestamps.as_ref(), Span::of(run.plan)),
     )?;
     let (frames, setup_ms) = run.frames(&compute.commands, timestamps.as_ref())?;
     let image = compute.read_back(run.device)?;

@@ -69,7 +69,7 @@ impl Compute {
         shader: &ComputeShader,
         width: u32,
         height: u32,
-        timestamps: Option<(&Timestamps, Span)>,
+        (timestamps, span): (Option<&Timestamps>, Span),
     ) -> Result<Compute> {
         let groups = device
             .compute_limits()
@@ -95,7 +95,7 @@ impl Compute {
             },
         );
         let commands = Commands::record_with(device, |_, cmd| {
-            if let Some((t, _)) = timestamps {
+            if let Some(t) = timestamps {
                 t.record_reset(cmd);
             }
             // Write-after-write: this frame's imageStores must come after the
@@ -104,18 +104,25 @@ impl Compute {
             // The first timestamp goes after it, so that the span is the
             // dispatch alone, as OpenGL's timer is (`Span`).
             let after_last_frame = (barrier::FRAME_AFTER_FRAME, On::Image(image.image));
-            if let Some((t, Span::BarrierAndDispatch)) = timestamps {
-                t.record(cmd, 0);
-            }
+            let first = |on: bool| {
+                if let (Some(t), true) = (timestamps, on) {
+                    t.record(cmd, 0);
+                }
+            };
+            first(span.barrier);
             // SAFETY: `cmd` is recording (inside record_with); the storage image
             // is owned by the `Compute` that will own these commands too.
             unsafe { pipeline_barrier::record(device, cmd, &[after_last_frame]) };
-            if let Some((t, Span::Dispatch)) = timestamps {
-                t.record(cmd, 0);
+            first(!span.barrier);
+            // A second dispatch (`Span::dispatches`) needs no barrier after the
+            // first: both store the same value in each texel, so their order
+            // cannot change the image, and without one the second's workgroups
+            // start as the first's finish.
+            for _ in 0..span.dispatches {
+                // SAFETY: as above; the set matches the pipeline's layout.
+                unsafe { pipeline.dispatch(cmd, descriptors.set, groups) };
             }
-            // SAFETY: as above; the set matches the pipeline's layout.
-            unsafe { pipeline.dispatch(cmd, descriptors.set, groups) };
-            if let Some((t, _)) = timestamps {
+            if let Some(t) = timestamps {
                 t.record(cmd, 1);
             }
         })?;

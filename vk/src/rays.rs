@@ -14,6 +14,7 @@ use crate::pipeline::{Pipeline, RenderPass};
 use crate::pipeline_barrier::{self, On};
 use crate::scene::scene_buffers;
 use crate::target::Target;
+use crate::timestamps::Span;
 use anyhow::Result;
 use ash::vk;
 use twinray_common::error::no_device;
@@ -57,7 +58,15 @@ pub fn count_rays(device: &Device, run: &CountingRun) -> Result<RayKinds> {
             commands.wait(false)?;
         }
         PathShaders::Compute(shader) => {
-            let compute = Compute::new(device, &frame, &storage, &shader, width, height, None)?;
+            let compute = Compute::new(
+                device,
+                &frame,
+                &storage,
+                &shader,
+                width,
+                height,
+                (None, Span::DISPATCH),
+            )?;
             compute.commands.submit()?;
             compute.commands.wait(false)?;
         }

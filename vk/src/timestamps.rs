@@ -106,23 +106,30 @@ impl Drop for Timestamps {
     }
 }
 
-/// What a headless compute frame's two timestamps bracket.
+/// What a headless compute frame records, and what its two timestamps bracket.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum Span {
-    /// The dispatch alone: the first timestamp after the barrier that orders
-    /// the frame after the last one, as OpenGL times its dispatch.
-    Dispatch,
-    /// The barrier too (the run plan's `timed_barrier`, from the laboratory).
-    BarrierAndDispatch,
+pub struct Span {
+    /// The barrier that orders the frame after the last one is inside the
+    /// span (`--experiment timed-barrier`). By default the first timestamp
+    /// follows it: the span is the dispatch alone, as OpenGL times its dispatch.
+    pub barrier: bool,
+    /// Dispatches of the tracer in the span: 1, or 2 with no barrier between
+    /// them (`--experiment back-to-back`), both writing the same values.
+    pub dispatches: u32,
 }
 
 impl Span {
-    /// The span the plan asks for: `timed_barrier` from the laboratory.
-    pub fn of(timed_barrier: bool) -> Span {
-        if timed_barrier {
-            Span::BarrierAndDispatch
-        } else {
-            Span::Dispatch
+    /// One dispatch, timed alone: every frame that is not a laboratory's.
+    pub const DISPATCH: Span = Span {
+        barrier: false,
+        dispatches: 1,
+    };
+
+    /// The span the plan asks for (its laboratory's `timed_barrier` and `back_to_back`).
+    pub fn of(plan: &twinray_common::plan::RunPlan) -> Span {
+        Span {
+            barrier: plan.timed_barrier,
+            dispatches: if plan.back_to_back { 2 } else { 1 },
         }
     }
 }

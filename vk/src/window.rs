@@ -27,6 +27,7 @@ use crate::scene::SceneResources;
 use crate::surface::{self, Surface};
 use crate::swapchain::{self, Swapchain};
 use crate::target::Target;
+use crate::timestamps::Span;
 use anyhow::{Context, Result};
 use ash::{khr, vk};
 use std::time::Instant;
@@ -354,8 +355,15 @@ impl Renderer for VkWindow {
         let (scene, shaders) = match &self.drawing {
             PathResources::Fragment(scene, shaders) => (scene, shaders),
             PathResources::Compute(c) => {
-                let compute =
-                    Compute::new(device, &c.frame, &c.storage, &c.shader, width, height, None)?;
+                let compute = Compute::new(
+                    device,
+                    &c.frame,
+                    &c.storage,
+                    &c.shader,
+                    width,
+                    height,
+                    (None, Span::DISPATCH),
+                )?;
                 compute.commands.submit()?;
                 compute.commands.wait(false)?;
                 return compute.read_back(device);

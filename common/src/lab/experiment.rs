@@ -26,6 +26,7 @@ pub enum Experiment {
     NagaAliasing,
     WarpProbe,
     TimedBarrier,
+    BackToBack,
     Ulp,
 }
 

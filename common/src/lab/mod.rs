@@ -28,6 +28,8 @@ pub struct Changes {
     pub optimal_collapse: bool,
     /// The frame's barrier inside the timed span.
     pub timed_barrier: bool,
+    /// Each timed frame dispatches the tracer twice.
+    pub back_to_back: bool,
     /// The experiments' names in registry order, for the variant's label.
     pub tags: Vec<String>,
 }
@@ -126,6 +128,13 @@ pub const REGISTRY: &[Entry] = &[
         headless: true,
         ..entry(Experiment::TimedBarrier, "The barrier that orders a headless frame's image stores after the last frame's, inside the timed span in both APIs: Vulkan records its first timestamp before the barrier instead of after it, and OpenGL issues a glMemoryBarrier after its timer starts, where it otherwise issues none between headless frames (the glFinish that ends each frame has completed the last one).", |c| {
             c.timed_barrier = true
+        })
+    },
+    Entry {
+        path: Some(RenderPath::Compute),
+        headless: true,
+        ..entry(Experiment::BackToBack, "Each headless frame dispatches the tracer twice inside its timed span, with no barrier between the two (both write the same values). The second dispatch's workgroups start as the first one's finish, so the frame's time less the default frame's is one frame's tracing without what a lone dispatch adds: its start, and its end, where the GPU waits on the last workgroups' latency. The why step takes that difference (`twinray compare --only why`).", |c| {
+            c.back_to_back = true
         })
     },
     Entry {

@@ -51,6 +51,8 @@ pub struct RunPlan {
     /// A headless compute frame times its barrier with its dispatch
     /// (`--experiment timed-barrier`); by default each API times the dispatch alone.
     pub timed_barrier: bool,
+    /// A headless compute frame dispatches twice (`--experiment back-to-back`).
+    pub back_to_back: bool,
 }
 
 /// What the untimed ray-counting frame renders (`--count-rays`), in either
@@ -208,6 +210,7 @@ impl Planner {
             size: (width, height),
             shaders,
             timed_barrier: self.changes.timed_barrier,
+            back_to_back: self.changes.back_to_back,
         })
     }
 

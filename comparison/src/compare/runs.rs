@@ -168,6 +168,12 @@ pub enum Hold {
     /// each API's time of it comes off its time at the gap: what is left is
     /// the tracing, without each API's fixed cost of a dispatch.
     Floor,
+    /// Both run two frames back to back (`--experiment back-to-back`), at
+    /// their own workgroups or at the one given, and one frame at the same
+    /// workgroup comes off each: the second frame's cost, the frame's
+    /// tracing without a lone dispatch's start and end (its last workgroups'
+    /// latency, when the GPU has nothing else to run).
+    SecondFrame(Option<(u32, u32)>),
 }
 
 impl Hold {
@@ -177,6 +183,8 @@ impl Hold {
             Hold::Workgroup(x, y) => format!("{x}x{y}"),
             Hold::Set(kv) => kv.to_string(),
             Hold::Floor => "floor".to_string(),
+            Hold::SecondFrame(None) => "back-to-back".to_string(),
+            Hold::SecondFrame(Some((x, y))) => format!("back-to-back-{x}x{y}"),
         }
     }
 }
@@ -191,7 +199,8 @@ pub struct WhyFigures {
     pub clock: &'static str,
     /// Median ms: Vulkan and OpenGL by default, then with the experiment
     /// (ratios only; with `Hold::Floor`, of the empty frame, whose time the
-    /// ratio with the experiment takes off each API's).
+    /// ratio with the experiment takes off each API's; with
+    /// `Hold::SecondFrame`, of the second frame, whose ratio it is).
     pub ms: Option<[f64; 4]>,
 }
 

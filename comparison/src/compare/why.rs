@@ -10,7 +10,7 @@ use crate::compare::gaps::{
     floor_file, write_floor_files, BOX_COMPUTE, BOX_FRAGMENT, BOX_IMAGES, SPHERELIST_BVH_COMPUTE,
     SPHERELIST_BVH_SMALL, TEAPOT_BVH_COMPUTE, TEAPOT_FRAGMENT,
 };
-use crate::compare::runs::{Case, Gap, GapFrame, GapMeasure, Hold, Why, WhyFigures, WhyRow};
+use crate::compare::runs::{Case, Gap, GapFrame, GapMeasure, Hold, Why, WhyRow};
 use std::collections::BTreeMap;
 use std::ffi::OsStr;
 use std::path::Path;
@@ -18,8 +18,6 @@ use std::sync::atomic::{AtomicBool, Ordering};
 use twinray_common::cli::{RenderArgs, RenderPath, Size, Workgroup};
 use twinray_common::error::{Failure, FailureKind};
 use twinray_common::lab::experiment::Experiment;
-use twinray_common::reference::image_io::load_png;
-use twinray_common::reference::metrics;
 use twinray_common::report::RunReport;
 use twinray_common::scene::accel::Accel;
 use twinray_common::value_name::ValueName;
@@ -61,9 +59,20 @@ const fn no_ray_loop(gap: &'static Gap) -> Case {
 }
 
 /// Each API's empty frame of the gap's size taken off its time (`Hold::Floor`).
-const fn floor(gap: &'static Gap) -> Case {
+pub(crate) const fn floor(gap: &'static Gap) -> Case {
     Case {
         hold: Some(Hold::Floor),
+        ..case(gap, &[], &[], Api::Opengl)
+    }
+}
+
+/// The second of two frames back to back (`--experiment back-to-back`), less
+/// the first, in both APIs, at each one's own workgroup or at `workgroup`:
+/// one frame's tracing without a lone dispatch's start and end
+/// (`Hold::SecondFrame`).
+pub(crate) const fn second_frame(gap: &'static Gap, workgroup: Option<(u32, u32)>) -> Case {
+    Case {
+        hold: Some(Hold::SecondFrame(workgroup)),
         ..case(gap, &[], &[], Api::Opengl)
     }
 }
@@ -104,6 +113,8 @@ pub const CASES: &[Case] = &[
     gl_spirv(&TEAPOT_BVH_COMPUTE),
     one_workgroup(&TEAPOT_BVH_COMPUTE),
     floor(&TEAPOT_BVH_COMPUTE),
+    second_frame(&TEAPOT_BVH_COMPUTE, None),
+    second_frame(&TEAPOT_BVH_COMPUTE, Some((4, 8))),
     both(&SPHERELIST_BVH_COMPUTE, &[Experiment::FirstOfEquals]),
     both(&SPHERELIST_BVH_COMPUTE, &[Experiment::WalkThenShade]),
     both(&SPHERELIST_BVH_COMPUTE, &[Experiment::LocalBvhStack]),
@@ -113,6 +124,8 @@ pub const CASES: &[Case] = &[
     both(&SPHERELIST_BVH_SMALL, &[Experiment::TimedBarrier]),
     floor(&SPHERELIST_BVH_SMALL),
     one_workgroup(&SPHERELIST_BVH_SMALL),
+    second_frame(&SPHERELIST_BVH_SMALL, None),
+    second_frame(&SPHERELIST_BVH_SMALL, Some((4, 8))),
     both(&BOX_IMAGES, &[Experiment::NoContraction]),
     vulkan(&BOX_IMAGES, &[Experiment::NoContraction]),
     vulkan(&BOX_IMAGES, &[Experiment::FloatControls]),
@@ -139,18 +152,28 @@ pub struct WhyPlan {
 
 /// One process to run at a gap: an API with its experiments, and what else
 /// it is held to (`Hold`; None: its defaults).
-type Run = (Api, &'static [Experiment], Option<Hold>);
+pub(crate) type Run = (Api, &'static [Experiment], Option<Hold>);
 
 /// What `case` runs: its Vulkan run and its OpenGL run.
-fn runs_of(case: &Case) -> [Run; 2] {
+pub(crate) fn runs_of(case: &Case) -> [Run; 2] {
     [
         (Api::Vulkan, case.vulkan, case.hold),
         (case.opengl_api, case.opengl, case.hold),
     ]
 }
 
+/// The runs `case`'s own are read against besides the defaults: a second
+/// frame held at one workgroup takes off one frame at that workgroup.
+pub(crate) fn baselines(case: &Case) -> [Run; 2] {
+    let hold = match case.hold {
+        Some(Hold::SecondFrame(Some((x, y)))) => Some(Hold::Workgroup(x, y)),
+        _ => None,
+    };
+    [(Api::Vulkan, &[], hold), (Api::Opengl, &[], hold)]
+}
+
 /// A run's label in file names and messages: `vulkan`, `opengl-glslang`...
-pub fn run_label(run: Run) -> String {
+pub(crate) fn run_label(run: Run) -> String {
     std::iter::once(api_name(run.0).to_string())
         .chain(run.1.iter().map(|e| e.name()))
         .chain(run.2.map(Hold::label))
@@ -225,7 +248,10 @@ pub fn run(out: &Path, plan: &WhyPlan, paths: &[RenderPath], stop: &AtomicBool) 
             .collect();
         // Every case is read against the defaults, whether a case runs them or not.
         let mut order: Vec<Run> = vec![(Api::Vulkan, &[], None), (Api::Opengl, &[], None)];
-        for run in cases.iter().flat_map(runs_of) {
+        for run in cases
+            .iter()
+            .flat_map(|c| baselines(c).into_iter().chain(runs_of(c)))
+        {
             if !order.contains(&run) {
                 order.push(run);
             }
@@ -233,7 +259,7 @@ pub fn run(out: &Path, plan: &WhyPlan, paths: &[RenderPath], stop: &AtomicBool) 
         let measured = measure(&dir, gap, size, plan, &order, i, stop);
         note_devices(&mut why, &order, &measured);
         for case in cases {
-            let result = figures(gap, &case, &measured, &dir);
+            let result = crate::compare::why_figures::figures(gap, &case, &measured, &dir);
             if let Err(e) = &result {
                 let [vk, gl] = runs_of(&case);
                 eprintln!(
@@ -277,7 +303,7 @@ fn note_devices(why: &mut Why, order: &[Run], measured: &Measured) {
 }
 
 /// Each run's reports at one gap, rounds in alternating order.
-type Measured = BTreeMap<String, Vec<Result<RunReport, String>>>;
+pub(crate) type Measured = BTreeMap<String, Vec<Result<RunReport, String>>>;
 
 /// Runs every one of `order` at the gap: once for images, `plan.rounds`
 /// times for timings (reversed every other round and gap), after a short
@@ -350,6 +376,10 @@ fn measure(
                         Some(Hold::Floor) => {
                             args.scene = dir.join(floor_file(gap.scene)).display().to_string()
                         }
+                        Some(Hold::SecondFrame(workgroup)) => {
+                            args.experiment.push(Experiment::BackToBack);
+                            args.workgroup = workgroup.map(|(x, y)| Workgroup { x, y });
+                        }
                         None => {}
                     }
                     run_json(run.0, &args).map_err(|e| refused_or_failed(run, &e))
@@ -373,91 +403,6 @@ fn refused_or_failed(run: Run, e: &anyhow::Error) -> String {
             format!("not run: {}", f.message)
         }
         _ => format!("failed: {e:#}"),
-    }
-}
-
-/// The median over rounds of each round's median: GPU ms with `gpu`, else wall ms.
-fn median_ms(reports: &[Result<RunReport, String>], gpu: bool) -> Result<f64, String> {
-    let mut v = Vec::new();
-    for r in reports {
-        let r = r.as_ref().map_err(Clone::clone)?;
-        let s = if gpu { r.gpu_ms } else { r.wall_ms };
-        v.push(s.map(|s| s.median).ok_or("failed: no frame times")?);
-    }
-    v.sort_by(f64::total_cmp);
-    v.get(v.len() / 2)
-        .copied()
-        .ok_or_else(|| "failed: not run (stopped)".to_string())
-}
-
-/// The case's figures from the runs at its gap.
-fn figures(gap: &Gap, case: &Case, measured: &Measured, dir: &Path) -> Result<WhyFigures, String> {
-    let [vk, gl] = runs_of(case);
-    let default = [(Api::Vulkan, &[][..], None), (Api::Opengl, &[][..], None)];
-    let four = [default[0], default[1], vk, gl];
-    let reports = |run: Run| -> Result<&Vec<Result<RunReport, String>>, String> {
-        measured
-            .get(&run_label(run))
-            .ok_or_else(|| "failed: not run (stopped)".to_string())
-    };
-    match gap.measure {
-        GapMeasure::Agreement => {
-            let within = |a: Run, b: Run| -> Result<f64, String> {
-                for run in [a, b] {
-                    reports(run)?
-                        .iter()
-                        .try_for_each(|r| r.as_ref().map(|_| ()).map_err(Clone::clone))?;
-                }
-                let png = |run| dir.join(format!("{}-{}.png", gap.scene, run_label(run)));
-                let (a, b) = (load_png(&png(a)), load_png(&png(b)));
-                let m = metrics::compare(
-                    &a.map_err(|e| format!("failed: {e:#}"))?,
-                    &b.map_err(|e| format!("failed: {e:#}"))?,
-                )
-                .map_err(|e| format!("failed: {e:#}"))?;
-                Ok(100.0 * m.within_1())
-            };
-            Ok(WhyFigures {
-                before: within(default[0], default[1])?,
-                after: within(vk, gl)?,
-                clock: "image",
-                ms: None,
-            })
-        }
-        GapMeasure::Ratio => {
-            let all: Vec<_> = four.iter().map(|&r| reports(r)).collect::<Result<_, _>>()?;
-            let gpu = all.iter().all(|rs| {
-                rs.iter()
-                    .all(|r| r.as_ref().is_ok_and(|r| r.gpu_ms.is_some()))
-            });
-            let ms: Vec<f64> = all
-                .iter()
-                .map(|rs| median_ms(rs, gpu))
-                .collect::<Result<_, _>>()?;
-            let after = if case.hold == Some(Hold::Floor) {
-                // A wall-clock frame holds the host's share of the loop too,
-                // which an empty frame does not measure apart from the GPU's.
-                if !gpu {
-                    return Err(format!("{NOT_MEASURED}each API's empty frame comes off GPU time only, and this driver's runs have wall time"));
-                }
-                let (vk, gl) = (ms[0] - ms[2], ms[1] - ms[3]);
-                if vk <= 0.0 || gl <= 0.0 {
-                    return Err(format!(
-                        "failed: the empty frame ({:.4} / {:.4} ms) took as long as the gap's ({:.4} / {:.4} ms)",
-                        ms[2], ms[3], ms[0], ms[1]
-                    ));
-                }
-                vk / gl
-            } else {
-                ms[2] / ms[3]
-            };
-            Ok(WhyFigures {
-                before: ms[0] / ms[1],
-                after,
-                clock: if gpu { "GPU" } else { "wall" },
-                ms: Some([ms[0], ms[1], ms[2], ms[3]]),
-            })
-        }
     }
 }
 
@@ -522,49 +467,6 @@ mod tests {
         assert_eq!(title(&why), format!("# twinray compare — {VK}"));
         assert!(!why.software);
         assert_eq!(title(&Why::default()), "# twinray compare — no device");
-    }
-
-    /// The empty frame's row: each API's time less its empty frame's, on GPU
-    /// time only; an empty frame as long as the gap's frame is a failure.
-    #[test]
-    fn a_floor_row_takes_each_empty_frame_off_gpu_time_only() {
-        let case = floor(&SPHERELIST_BVH_SMALL);
-        let measured = |times: [f64; 4], gpu: bool| -> Measured {
-            let labels = ["vulkan", "opengl", "vulkan-floor", "opengl-floor"];
-            labels
-                .iter()
-                .zip(times)
-                .map(|(label, ms)| {
-                    let mut r =
-                        crate::compare::runs::test_outcome(Api::Vulkan, RenderPath::Compute, ms)
-                            .result
-                            .expect("a test outcome succeeds");
-                    if !gpu {
-                        r.gpu_ms = None;
-                    }
-                    (label.to_string(), vec![Ok(r)])
-                })
-                .collect()
-        };
-        let dir = Path::new("/nonexistent");
-        let f = figures(
-            case.gap,
-            &case,
-            &measured([18.0, 20.0, 6.0, 8.0], true),
-            dir,
-        )
-        .unwrap();
-        assert_eq!((f.before, f.after, f.clock), (0.9, 1.0, "GPU"));
-        assert_eq!(f.ms, Some([18.0, 20.0, 6.0, 8.0]));
-        let wall = figures(
-            case.gap,
-            &case,
-            &measured([18.0, 20.0, 6.0, 8.0], false),
-            dir,
-        );
-        assert!(wall.unwrap_err().starts_with(NOT_MEASURED));
-        let longer = figures(case.gap, &case, &measured([18.0, 7.0, 6.0, 8.0], true), dir);
-        assert!(longer.unwrap_err().starts_with("failed: the empty frame"));
     }
 
     #[test]

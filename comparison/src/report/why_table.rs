@@ -121,6 +121,12 @@ fn change(case: &Case) -> String {
         Some(Hold::Workgroup(x, y)) => return format!("both at workgroup {x}x{y}"),
         Some(Hold::Set(kv)) => return format!("both with --set {kv}"),
         Some(Hold::Floor) => return "both less their empty frame's time".to_string(),
+        Some(Hold::SecondFrame(None)) => {
+            return "both: the second of two frames back to back".to_string()
+        }
+        Some(Hold::SecondFrame(Some((x, y)))) => {
+            return format!("both at workgroup {x}x{y}: the second of two frames back to back")
+        }
         None => {}
     }
     match (vk.is_empty(), gl.is_empty()) {
@@ -206,7 +212,9 @@ pub fn markdown(why: &Why) -> String {
          that moves the ratio, or the disagreeing pixels, by less than {:.0} % of itself has no effect; otherwise it \
          explains the share of the gap it closes. Images agree when at least {AGREEMENT_CLOSED} % of pixels are within 1/255. \
          Where both run less their empty frame's time, the times shown with it are each API's empty frame (the same size, \
-         shader variant and workgroup, every ray missing) and its ratio is of the times less them.\n",
+         shader variant and workgroup, every ray missing) and its ratio is of the times less them. \
+         Where both run a second frame straight after the first (`--experiment back-to-back`), the times shown with it \
+         are that second frame's (two frames' time less one frame's, at the same workgroup), and its ratio is of them.\n",
         RATIO_CLOSED * 100.0,
         NO_EFFECT * 100.0
     );
