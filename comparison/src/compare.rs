@@ -49,8 +49,7 @@ pub struct CompareArgs {
     /// Only these experiments (teapot, box, spherelist, accel, why), comma-separated.
     #[arg(long, value_delimiter = ',')]
     pub only: Vec<String>,
-    /// The tracer's entry points to measure, comma-separated: every point runs
-    /// both APIs on each of them.
+    /// The tracer's entry points to measure, comma-separated: each point runs both APIs on each.
     #[arg(long, value_enum, value_delimiter = ',', default_values_t = [RenderPath::Fragment, RenderPath::Compute])]
     pub paths: Vec<RenderPath>,
     /// The compute path's workgroup WxH (default: the apps' default).
@@ -421,7 +420,7 @@ fn failures(
     }
     for r in why.map(|w| w.rows.as_slice()).unwrap_or_default() {
         if let Err(e) = &r.result {
-            if !e.starts_with("not run") && !e.starts_with(why::NOT_MEASURED) {
+            if !e.starts_with("not run") && !e.starts_with(runs::NOT_MEASURED) {
                 let reason = e.strip_prefix("failed: ").unwrap_or(e).to_string();
                 failed.push((format!("why: {}", r.case.gap.name), reason));
             }

@@ -4,12 +4,14 @@
 //! them. The steps (compare.rs and its accel.rs, agreement.rs, why.rs) fill
 //! these in and the report reads them, so neither imports the other.
 
-use crate::apps::Api;
+use crate::apps::{api_name, Api};
+use std::collections::BTreeMap;
 use twinray_common::cli::{RenderPath, Size};
 use twinray_common::lab::experiment::Experiment;
 use twinray_common::reference::metrics::Metrics;
 use twinray_common::report::RunReport;
 use twinray_common::scene::accel::Accel;
+use twinray_common::value_name::ValueName;
 
 /// The study's three experiments, in the order every output lists them.
 pub const EXPERIMENTS: [&str; 3] = ["teapot", "box", "spherelist"];
@@ -287,3 +289,41 @@ pub fn test_outcome(api: Api, path: RenderPath, ms: f64) -> Outcome {
         result: Ok(r),
     }
 }
+
+/// One process to run at a gap: an API with its experiments, and what else
+/// it is held to (`Hold`; None: its defaults).
+pub(crate) type Run = (Api, &'static [Experiment], Option<Hold>);
+
+/// What `case` runs: its Vulkan run and its OpenGL run.
+pub(crate) fn runs_of(case: &Case) -> [Run; 2] {
+    [
+        (Api::Vulkan, case.vulkan, case.hold),
+        (case.opengl_api, case.opengl, case.hold),
+    ]
+}
+
+/// The runs `case`'s own are read against besides the defaults: a second
+/// frame held at one workgroup takes off one frame at that workgroup.
+pub(crate) fn baselines(case: &Case) -> [Run; 2] {
+    let hold = match case.hold {
+        Some(Hold::SecondFrame(Some((x, y)))) => Some(Hold::Workgroup(x, y)),
+        _ => None,
+    };
+    [(Api::Vulkan, &[], hold), (Api::Opengl, &[], hold)]
+}
+
+/// A run's label in file names and messages: `vulkan`, `opengl-glslang`...
+pub(crate) fn run_label(run: Run) -> String {
+    std::iter::once(api_name(run.0).to_string())
+        .chain(run.1.iter().map(|e| e.name()))
+        .chain(run.2.map(Hold::label))
+        .collect::<Vec<_>>()
+        .join("-")
+}
+
+/// A row whose runs all ran but whose figure this device cannot give: the
+/// table's answer, not a failure.
+pub const NOT_MEASURED: &str = "not measured: ";
+
+/// Each run's reports at one gap, rounds in alternating order.
+pub(crate) type Measured = BTreeMap<String, Vec<Result<RunReport, String>>>;

@@ -4,23 +4,22 @@
 //! order alternating, like the sweeps. The report's "Why the gaps" section and
 //! why.csv are written from what this returns (report/why_table.rs).
 
-use crate::apps::api_name;
 use crate::apps::{run_json, Api};
 use crate::compare::gaps::{
     floor_file, write_floor_files, BOX_COMPUTE, BOX_FRAGMENT, BOX_IMAGES, SPHERELIST_BVH_COMPUTE,
     SPHERELIST_BVH_SMALL, TEAPOT_BVH_COMPUTE, TEAPOT_FRAGMENT,
 };
-use crate::compare::runs::{Case, Gap, GapFrame, GapMeasure, Hold, Why, WhyRow};
-use std::collections::BTreeMap;
+use crate::compare::runs::{
+    baselines, run_label, runs_of, Case, Gap, GapFrame, GapMeasure, Hold, Measured, Run, Why,
+    WhyRow,
+};
 use std::ffi::OsStr;
 use std::path::Path;
 use std::sync::atomic::{AtomicBool, Ordering};
 use twinray_common::cli::{RenderArgs, RenderPath, Size, Workgroup};
 use twinray_common::error::{Failure, FailureKind};
 use twinray_common::lab::experiment::Experiment;
-use twinray_common::report::RunReport;
 use twinray_common::scene::accel::Accel;
-use twinray_common::value_name::ValueName;
 
 /// What each API runs at `gap` instead of its default.
 const fn case(
@@ -59,7 +58,7 @@ const fn no_ray_loop(gap: &'static Gap) -> Case {
 }
 
 /// Each API's empty frame of the gap's size taken off its time (`Hold::Floor`).
-pub(crate) const fn floor(gap: &'static Gap) -> Case {
+const fn floor(gap: &'static Gap) -> Case {
     Case {
         hold: Some(Hold::Floor),
         ..case(gap, &[], &[], Api::Opengl)
@@ -70,7 +69,7 @@ pub(crate) const fn floor(gap: &'static Gap) -> Case {
 /// the first, in both APIs, at each one's own workgroup or at `workgroup`:
 /// one frame's tracing without a lone dispatch's start and end
 /// (`Hold::SecondFrame`).
-pub(crate) const fn second_frame(gap: &'static Gap, workgroup: Option<(u32, u32)>) -> Case {
+const fn second_frame(gap: &'static Gap, workgroup: Option<(u32, u32)>) -> Case {
     Case {
         hold: Some(Hold::SecondFrame(workgroup)),
         ..case(gap, &[], &[], Api::Opengl)
@@ -149,41 +148,6 @@ pub struct WhyPlan {
     pub seconds_per_point: f64,
     pub rounds: u32,
 }
-
-/// One process to run at a gap: an API with its experiments, and what else
-/// it is held to (`Hold`; None: its defaults).
-pub(crate) type Run = (Api, &'static [Experiment], Option<Hold>);
-
-/// What `case` runs: its Vulkan run and its OpenGL run.
-pub(crate) fn runs_of(case: &Case) -> [Run; 2] {
-    [
-        (Api::Vulkan, case.vulkan, case.hold),
-        (case.opengl_api, case.opengl, case.hold),
-    ]
-}
-
-/// The runs `case`'s own are read against besides the defaults: a second
-/// frame held at one workgroup takes off one frame at that workgroup.
-pub(crate) fn baselines(case: &Case) -> [Run; 2] {
-    let hold = match case.hold {
-        Some(Hold::SecondFrame(Some((x, y)))) => Some(Hold::Workgroup(x, y)),
-        _ => None,
-    };
-    [(Api::Vulkan, &[], hold), (Api::Opengl, &[], hold)]
-}
-
-/// A run's label in file names and messages: `vulkan`, `opengl-glslang`...
-pub(crate) fn run_label(run: Run) -> String {
-    std::iter::once(api_name(run.0).to_string())
-        .chain(run.1.iter().map(|e| e.name()))
-        .chain(run.2.map(Hold::label))
-        .collect::<Vec<_>>()
-        .join("-")
-}
-
-/// A row whose runs all ran but whose figure this device cannot give: the
-/// table's answer, not a failure.
-pub const NOT_MEASURED: &str = "not measured: ";
 
 /// The tool an experiment needs on PATH, if any.
 fn tool_needed(run: Run) -> Option<&'static str> {
@@ -302,9 +266,6 @@ fn note_devices(why: &mut Why, order: &[Run], measured: &Measured) {
     }
 }
 
-/// Each run's reports at one gap, rounds in alternating order.
-pub(crate) type Measured = BTreeMap<String, Vec<Result<RunReport, String>>>;
-
 /// Runs every one of `order` at the gap: once for images, `plan.rounds`
 /// times for timings (reversed every other round and gap), after a short
 /// probe that sizes the frame count to `plan.seconds_per_point`.
@@ -409,6 +370,7 @@ fn refused_or_failed(run: Run, e: &anyhow::Error) -> String {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use twinray_common::report::RunReport;
 
     #[test]
     fn a_tool_is_found_only_as_an_executable_on_path() {

@@ -4,8 +4,10 @@
 //! another's (`Hold::Floor`, `Hold::SecondFrame`).
 
 use crate::apps::Api;
-use crate::compare::runs::{Case, Gap, GapMeasure, Hold, WhyFigures};
-use crate::compare::why::{baselines, run_label, runs_of, Measured, Run, NOT_MEASURED};
+use crate::compare::runs::{
+    baselines, run_label, runs_of, Case, Gap, GapMeasure, Hold, Measured, Run, WhyFigures,
+    NOT_MEASURED,
+};
 use std::path::Path;
 use twinray_common::reference::image_io::load_png;
 use twinray_common::reference::metrics;
@@ -125,8 +127,19 @@ pub(crate) fn figures(
 mod tests {
     use super::*;
     use crate::compare::gaps::{SPHERELIST_BVH_SMALL, TEAPOT_BVH_COMPUTE};
-    use crate::compare::why::{floor, second_frame};
     use twinray_common::cli::RenderPath;
+
+    /// Both APIs as shipped, held to `hold` at `gap` (what why.rs's `floor`
+    /// and `second_frame` make).
+    fn held(gap: &'static Gap, hold: Hold) -> Case {
+        Case {
+            gap,
+            vulkan: &[],
+            opengl: &[],
+            opengl_api: Api::Opengl,
+            hold: Some(hold),
+        }
+    }
 
     /// Reports of one frame each, `labels[i]` taking `times[i]` ms (GPU time
     /// with `gpu`, else wall time only).
@@ -151,7 +164,7 @@ mod tests {
     /// time only; an empty frame as long as the gap's frame is a failure.
     #[test]
     fn a_floor_row_takes_each_empty_frame_off_gpu_time_only() {
-        let case = floor(&SPHERELIST_BVH_SMALL);
+        let case = held(&SPHERELIST_BVH_SMALL, Hold::Floor);
         let labels = ["vulkan", "opengl", "vulkan-floor", "opengl-floor"];
         let dir = Path::new("/nonexistent");
         let at = |times: &[f64], gpu| figures(case.gap, &case, &measured(&labels, times, gpu), dir);
@@ -170,7 +183,7 @@ mod tests {
     #[test]
     fn a_second_frame_row_takes_one_frame_off_two_at_its_own_workgroup() {
         let dir = Path::new("/nonexistent");
-        let own = second_frame(&TEAPOT_BVH_COMPUTE, None);
+        let own = held(&TEAPOT_BVH_COMPUTE, Hold::SecondFrame(None));
         let labels = [
             "vulkan",
             "opengl",
@@ -190,7 +203,7 @@ mod tests {
             .unwrap_err()
             .starts_with("failed: two frames back to back"));
 
-        let held = second_frame(&TEAPOT_BVH_COMPUTE, Some((4, 8)));
+        let at = held(&TEAPOT_BVH_COMPUTE, Hold::SecondFrame(Some((4, 8))));
         let labels = [
             "vulkan",
             "opengl",
@@ -200,7 +213,7 @@ mod tests {
             "opengl-4x8",
         ];
         let m = measured(&labels, &[0.16, 0.19, 0.30, 0.32, 0.17, 0.19], true);
-        let f = figures(held.gap, &held, &m, dir).unwrap();
+        let f = figures(at.gap, &at, &m, dir).unwrap();
         assert_eq!(f.before, 0.16 / 0.19);
         let (vk, gl) = (0.30 - 0.17, 0.32 - 0.19);
         assert!((f.after - vk / gl).abs() < 1e-12, "{}", f.after);
