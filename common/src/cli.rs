@@ -500,6 +500,7 @@ mod tests {
                 "local-bvh-stack",
                 "split-ray-stack",
                 "unpaired-bvh-stack",
+                "capped-bvh-stack",
                 "first-of-equals",
                 "optimal-collapse",
                 "walk-then-shade",

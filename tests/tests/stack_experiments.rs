@@ -23,9 +23,10 @@ struct Variant {
     compute_only: bool,
 }
 
-/// Each of `variants` against its base, for one scene, both APIs, both paths.
-fn same_image(scene: &str, size: &str, extra: &[&str], variants: &[Variant]) {
-    let dir = scratch(&format!("stack-experiments-{scene}"));
+/// Each of `variants` against its base, for one scene, both APIs, both paths,
+/// in a scratch folder of the test's own (`name`: tests run in parallel).
+fn same_image(name: &str, scene: &str, size: &str, extra: &[&str], variants: &[Variant]) {
+    let dir = scratch(&format!("stack-experiments-{name}"));
     for app in App::BOTH {
         for path in ["fragment", "compute"] {
             for v in variants {
@@ -72,6 +73,7 @@ const VARIANTS: &[Variant] = &[
     ]),
     everywhere(&["--experiment", "naga-aliasing"]),
     everywhere(&["--experiment", "unpaired-bvh-stack"]),
+    everywhere(&["--experiment", "capped-bvh-stack"]),
     everywhere(&["--experiment", "naga-loop-bounding"]),
     // Mesa's GLSL and SPIR-V compilers may round a pixel differently (they
     // did on the box before `Restrict` existed), so the SPIR-V with `Restrict`
@@ -97,12 +99,38 @@ const VARIANTS: &[Variant] = &[
 /// compute path's edge workgroups are partial.
 #[test]
 fn box_bvh_renders_the_default_image_with_each_stack_and_declaration() {
-    same_image("box", "97x61", &["--accel", "bvh"], VARIANTS);
+    same_image("box", "box", "97x61", &["--accel", "bvh"], VARIANTS);
 }
 
 #[test]
 fn teapot_bvh_renders_the_default_image_with_each_stack_and_declaration() {
-    same_image("teapot", "65x49", &["--accel", "bvh"], VARIANTS);
+    same_image("teapot", "teapot", "65x49", &["--accel", "bvh"], VARIANTS);
+}
+
+/// `capped-bvh-stack` on a tree deeper than its cap (the 307k-triangle
+/// teapot's stack needs 37 entries; the cap is the default teapot's 30): the
+/// label says the shader declares 30, and no frame here needs more, so the
+/// image is the default's.
+#[test]
+fn a_capped_stack_renders_the_deep_teapots_image() {
+    let deep = ["--set", "tessellation=80x60"];
+    let capped = everywhere(&["--experiment", "capped-bvh-stack"]);
+    same_image("deep-teapot", "teapot", "40x30", &deep, &[capped]);
+    let dir = scratch("stack-experiments-capped-label");
+    let args = [
+        &deep[..],
+        &["--path", "compute", "--experiment", "capped-bvh-stack"],
+    ]
+    .concat();
+    for app in App::BOTH {
+        let (report, _) = render(app, "teapot", "8x8", &args, &dir.join("capped.png"));
+        assert!(
+            report.variant.contains("/bvh30") && report.variant.ends_with("/capped-bvh-stack"),
+            "{app:?}: {}",
+            report.variant
+        );
+    }
+    std::fs::remove_dir_all(dir).ok();
 }
 
 #[test]

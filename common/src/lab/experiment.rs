@@ -16,6 +16,7 @@ pub enum Experiment {
     LocalBvhStack,
     SplitRayStack,
     UnpairedBvhStack,
+    CappedBvhStack,
     FirstOfEquals,
     OptimalCollapse,
     WalkThenShade,

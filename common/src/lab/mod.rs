@@ -88,6 +88,9 @@ pub const REGISTRY: &[Entry] = &[
     entry(Experiment::UnpairedBvhStack, "OpenGL's BVH stack one entry to a uvec2 on every tree, as Vulkan's is, instead of two entries to a uvec4 on trees of up to 30 entries (the default scenes'; deeper trees take the uvec2 form already): NVIDIA's OpenGL compiler reports 16 bytes for each element, twice the local memory (the teapot's tracer 480 B instead of 240 B), yet runs it on as many multiprocessors, with 24 warps each instead of 28. Vulkan's stack is that way already.", |c| {
         c.knobs.unpaired_bvh_stack = true
     }),
+    entry(Experiment::CappedBvhStack, "The BVH stack at most 30 entries, the default teapot's, on deeper trees (the 307k-, 1.2M- and 4.9M-triangle teapots' need 37, 42 and 47), in each API's form for 30; a push that finds it full is dropped. A bet, not a bound: a walk that needs more loses a subtree, though the study's frames of those teapots came out the same. What the deep trees' stacks cost NVIDIA's OpenGL, whose driver runs a tracer on fewer multiprocessors as its local memory grows.", |c| {
+        c.knobs.capped_bvh_stack = true
+    }),
     entry(Experiment::FirstOfEquals, "The wide tree's collapse opens the first of equal-area boxes, as it did until the shallowest was preferred: the sphere list's identical spheres then give a 4-wide tree of 16 levels at 100k spheres instead of 10, and a BVH stack of 368 B instead of 224 B, past what lets NVIDIA's OpenGL use every multiprocessor.", |c| {
         c.first_of_equals = true
     }),

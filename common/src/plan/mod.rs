@@ -262,8 +262,9 @@ impl Planner {
         }
         v.tags = c.tags.clone();
         v.entry = Entry::new(path, self.workgroup(bvh));
-        v.bvh_stack_pairs =
-            !c.knobs.unpaired_bvh_stack && v.bvh_stack.is_some_and(|n| self.api.bvh_stack_pairs(n));
+        v.bvh_stack_pairs = !c.knobs.unpaired_bvh_stack
+            && v.bvh_stack_declared()
+                .is_some_and(|n| self.api.bvh_stack_pairs(n));
         v.light_before_walk = !c.knobs.walk_then_shade
             && self
                 .api

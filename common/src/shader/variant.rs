@@ -48,6 +48,11 @@ pub struct Variant {
     pub tags: Vec<String>,
 }
 
+/// The most entries `--experiment capped-bvh-stack` leaves a BVH stack: the
+/// default teapot's (a test holds the two together), whose stack NVIDIA's
+/// OpenGL runs on every multiprocessor.
+pub const CAPPED_BVH_STACK: u32 = 30;
+
 /// Which source the variant compiles.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Form {
@@ -112,6 +117,8 @@ pub struct ShaderKnobs {
     pub walk_then_shade: bool,
     /// No BVH_STACK_PAIRS where the plan would choose it.
     pub unpaired_bvh_stack: bool,
+    /// The BVH stack at most `CAPPED_BVH_STACK` entries, pushes past it dropped.
+    pub capped_bvh_stack: bool,
     /// Compute: KiB of workgroup memory the tracer does not need.
     pub shared_pad_kib: Option<u32>,
     /// The arithmetic probe (shaders/lab/ulp.glsl) in place of the tracer's
@@ -254,6 +261,17 @@ impl Variant {
         self
     }
 
+    /// The BVH stack's entries as the shader declares them: the tree's, or
+    /// with `--experiment capped-bvh-stack` at most `CAPPED_BVH_STACK`.
+    pub fn bvh_stack_declared(&self) -> Option<u32> {
+        let cap = if self.knobs.capped_bvh_stack {
+            CAPPED_BVH_STACK
+        } else {
+            u32::MAX
+        };
+        self.bvh_stack.map(|n| n.min(cap))
+    }
+
     /// This variant with the ray counters compiled in: the shader of the one
     /// untimed frame that counts rays. Everything else is the timed variant's,
     /// so both trace the same rays.
@@ -275,7 +293,7 @@ impl Variant {
     /// Whether the compute tracer keeps its BVH stack in shared memory: only
     /// with the laboratory's shared stack, and only where it fits the budget.
     pub fn bvh_stack_in_shared_memory(&self) -> bool {
-        let (Some(entries), Entry::Compute(wg)) = (self.bvh_stack, self.entry) else {
+        let (Some(entries), Entry::Compute(wg)) = (self.bvh_stack_declared(), self.entry) else {
             return false;
         };
         let bytes = entries as usize * (wg.x * wg.y) as usize * 8;
@@ -335,8 +353,12 @@ impl Variant {
             flag(true, n);
         }
         d.insert("STACK_SIZE".into(), self.ray_stack.to_string());
-        if let Some(n) = self.bvh_stack {
-            d.insert("BVH_STACK".into(), n.to_string());
+        if let (Some(n), Some(declared)) = (self.bvh_stack, self.bvh_stack_declared()) {
+            d.insert("BVH_STACK".into(), declared.to_string());
+            if declared < n {
+                // trace/bvh.glsl then drops a push that finds the stack full.
+                d.insert("BVH_STACK_FIXED".into(), "1".into());
+            }
             if self.bvh_width > 2 {
                 let quads = crate::scene::accel::wide::quads(self.bvh_width);
                 d.insert("BVH_WIDE_QUADS".into(), quads.to_string());
@@ -418,7 +440,7 @@ impl Variant {
         if parts.is_empty() {
             parts.push("background");
         }
-        let bvh = match (self.bvh_stack, self.bvh_width) {
+        let bvh = match (self.bvh_stack_declared(), self.bvh_width) {
             (None, _) => String::new(),
             (Some(n), 2) => format!("/bvh{n}"),
             (Some(n), w) => format!("/wide{w}/bvh{n}"),

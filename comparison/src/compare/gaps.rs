@@ -44,6 +44,18 @@ pub(crate) const TEAPOT_BVH_COMPUTE: Gap = Gap {
     path: RenderPath::Compute,
     measure: GapMeasure::Ratio,
 };
+/// The teapot at 307k triangles, whose 4-wide tree needs a stack of 37
+/// entries, deeper than any of the study's scenes: NVIDIA's OpenGL runs its
+/// tracer on fewer multiprocessors (110 of an H200's 132).
+pub(crate) const TEAPOT_DEEP_BVH_COMPUTE: Gap = Gap {
+    name: "teapot 307k BVH compute",
+    scene: "teapot",
+    set: &["tessellation=80x60"],
+    frame: GapFrame::Square,
+    accel: Accel::Auto,
+    path: RenderPath::Compute,
+    measure: GapMeasure::Ratio,
+};
 /// The sphere list at its largest: the deepest tree of the study's scenes.
 pub(crate) const SPHERELIST_BVH_COMPUTE: Gap = Gap {
     name: "sphere list BVH compute",

@@ -7,7 +7,7 @@
 use crate::apps::{run_json, Api};
 use crate::compare::gaps::{
     floor_file, write_floor_files, BOX_COMPUTE, BOX_FRAGMENT, BOX_IMAGES, SPHERELIST_BVH_COMPUTE,
-    SPHERELIST_BVH_SMALL, TEAPOT_BVH_COMPUTE, TEAPOT_FRAGMENT,
+    SPHERELIST_BVH_SMALL, TEAPOT_BVH_COMPUTE, TEAPOT_DEEP_BVH_COMPUTE, TEAPOT_FRAGMENT,
 };
 use crate::compare::runs::{
     baselines, run_label, runs_of, Case, Gap, GapFrame, GapMeasure, Hold, Measured, Run, Why,
@@ -114,6 +114,8 @@ pub const CASES: &[Case] = &[
     floor(&TEAPOT_BVH_COMPUTE),
     second_frame(&TEAPOT_BVH_COMPUTE, None),
     second_frame(&TEAPOT_BVH_COMPUTE, Some((4, 8))),
+    both(&TEAPOT_DEEP_BVH_COMPUTE, &[Experiment::CappedBvhStack]),
+    one_workgroup(&TEAPOT_DEEP_BVH_COMPUTE),
     both(&SPHERELIST_BVH_COMPUTE, &[Experiment::FirstOfEquals]),
     both(&SPHERELIST_BVH_COMPUTE, &[Experiment::WalkThenShade]),
     both(&SPHERELIST_BVH_COMPUTE, &[Experiment::LocalBvhStack]),

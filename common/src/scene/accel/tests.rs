@@ -362,4 +362,10 @@ fn the_study_scenes_stacks_fit_opengls_local_memory_budget() {
         }
     }
     assert_eq!(closest, ("teapot", 240), "the variant closest to 256 B");
+    // --experiment capped-bvh-stack caps deeper trees at the teapot's stack.
+    let teapot = Bvh::build(&Scene::load("teapot", &[]).unwrap()).widen(4);
+    assert_eq!(
+        teapot.stack_entries(),
+        crate::shader::variant::CAPPED_BVH_STACK
+    );
 }
