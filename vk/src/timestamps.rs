@@ -110,11 +110,11 @@ impl Drop for Timestamps {
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct Span {
     /// The barrier that orders the frame after the last one is inside the
-    /// span (`--experiment timed-barrier`). By default the first timestamp
+    /// span (the plan's `timed_barrier`). By default the first timestamp
     /// follows it: the span is the dispatch alone, as OpenGL times its dispatch.
     pub barrier: bool,
     /// Dispatches of the tracer in the span: 1, or 2 with no barrier between
-    /// them (`--experiment back-to-back`), both writing the same values.
+    /// them (the plan's `back_to_back`), both writing the same values.
     pub dispatches: u32,
 }
 
