@@ -235,15 +235,15 @@ fn render_compute(
     // docs/findings/opengl-compute.md#the-small-frames-a-fixed-cost-h200). Vulkan's
     // fence wait orders nothing on the GPU, so Vulkan records its barrier, before
     // its first timestamp: both time the dispatch alone. The laboratory's
-    // `timed_barrier` times the barrier in both; `back_to_back` dispatches
-    // twice, with no barrier between (both store the same values), as Vulkan does.
-    let (timed_barrier, back_to_back) = (run.plan.timed_barrier, run.plan.back_to_back);
+    // `timed_barrier` times the barrier in both; `frame_dispatches` above 1
+    // dispatches again with no barrier between (each stores the same values),
+    // as Vulkan does.
+    let (timed_barrier, dispatches) = (run.plan.timed_barrier, run.plan.frame_dispatches);
     let (frames, setup_ms) = run.frames(&timer, &|| {
         if timed_barrier {
             compute.barrier_between_frames();
         }
-        compute.dispatch();
-        if back_to_back {
+        for _ in 0..dispatches {
             compute.dispatch();
         }
     })?;

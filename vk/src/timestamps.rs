@@ -114,7 +114,7 @@ pub struct Span {
     /// follows it: the span is the dispatch alone, as OpenGL times its dispatch.
     pub barrier: bool,
     /// Dispatches of the tracer in the span: 1, or 2 with no barrier between
-    /// them (the plan's `back_to_back`), both writing the same values.
+    /// them (the plan's `frame_dispatches`), both writing the same values.
     pub dispatches: u32,
 }
 
@@ -125,11 +125,11 @@ impl Span {
         dispatches: 1,
     };
 
-    /// The span the plan asks for (its laboratory's `timed_barrier` and `back_to_back`).
+    /// The span the plan asks for (its `timed_barrier` and `frame_dispatches`).
     pub fn of(plan: &twinray_common::plan::RunPlan) -> Span {
         Span {
             barrier: plan.timed_barrier,
-            dispatches: if plan.back_to_back { 2 } else { 1 },
+            dispatches: plan.frame_dispatches,
         }
     }
 }

@@ -51,8 +51,9 @@ pub struct RunPlan {
     /// A headless compute frame times its barrier with its dispatch
     /// (`--experiment timed-barrier`); by default each API times the dispatch alone.
     pub timed_barrier: bool,
-    /// A headless compute frame dispatches twice (`--experiment back-to-back`).
-    pub back_to_back: bool,
+    /// Dispatches of the tracer in a headless compute frame's timed span, with
+    /// no barrier between them: 1, or 2 with `--experiment back-to-back`.
+    pub frame_dispatches: u32,
 }
 
 /// What the untimed ray-counting frame renders (`--count-rays`), in either
@@ -210,7 +211,7 @@ impl Planner {
             size: (width, height),
             shaders,
             timed_barrier: self.changes.timed_barrier,
-            back_to_back: self.changes.back_to_back,
+            frame_dispatches: if self.changes.back_to_back { 2 } else { 1 },
         })
     }
 
