@@ -7,8 +7,16 @@
 // APIs, and a plain copy/readback of the image gives the upright picture.
 //
 // WG_X x WG_Y is the workgroup size, set per run through naga defines
-// (common/src/shader/build.rs); the dispatch is ceil(width / WG_X) x ceil(height / WG_Y),
-// so invocations past the right and bottom edges return at once.
+// (common/src/shader/build.rs); the dispatch is ceil(width / WG_X) x ceil(height / WG_Y)
+// tiles, so invocations past the right and bottom edges return at once.
+//
+// Which tile a workgroup traces comes from the launch order (binding 8,
+// common/src/plan/launch.rs): a GPU starts workgroups in about the order of
+// their index, and a frame lasts until its slowest last ones finish, so the
+// costliest tiles are listed first. The frame says which grid of tiles the
+// order was made for: without one (a window, whose camera moves and whose size
+// changes) or for another grid, the tiles go in rows, and no workgroup waits
+// on a load before its first ray.
 
 #ifndef WG_X
 #define WG_X 8
@@ -21,13 +29,18 @@ layout(local_size_x = WG_X, local_size_y = WG_Y, local_size_z = 1) in;
 
 layout(rgba32f, set = 0, binding = 5) uniform writeonly image2D out_image;
 
+// Each workgroup's tile, y * tiles across + x, in launch order.
+layout(std430, set = 0, binding = 8) readonly buffer LaunchOrder {
+    uint tiles[];
+} launch_buf;
+
 #ifdef SHARED_PAD_KIB
 // --shared-pad (a measurement): workgroup memory the tracer does not need. A
 // driver splits each multiprocessor's memory between shared memory and L1
 // cache by what its shaders declare, and fits fewer workgroups once shared
 // memory runs out; this shows what either does to the time. Each invocation
 // writes one word, spread across the whole array, and reads it back through an
-// index the compiler cannot prove equal (frame.pad is always 0), so no
+// index the compiler cannot prove equal (the dispatch's depth is always 1), so no
 // compiler can drop the array, and no invocation reads another's word.
 shared uint shared_pad[SHARED_PAD_KIB * 256];
 #endif
@@ -37,11 +50,17 @@ void main() {
     uint group = uint(WG_X * WG_Y);
     uint stride = uint(SHARED_PAD_KIB * 256) / group;
     shared_pad[gl_LocalInvocationIndex * stride] = gl_LocalInvocationIndex;
-    if (shared_pad[((gl_LocalInvocationIndex + frame.pad) % group) * stride] == 0xffffffffu) {
+    if (shared_pad[((gl_LocalInvocationIndex + gl_NumWorkGroups.z - 1u) % group) * stride] == 0xffffffffu) {
         return;
     }
 #endif
-    uvec2 p = gl_GlobalInvocationID.xy;
+    uvec2 groups = gl_NumWorkGroups.xy;
+    uvec2 tile = gl_WorkGroupID.xy;
+    if (frame.launch_grid == ((groups.x << 16u) | groups.y)) {
+        uint t = launch_buf.tiles[tile.y * groups.x + tile.x];
+        tile = uvec2(t % groups.x, t / groups.x);
+    }
+    uvec2 p = tile * uvec2(WG_X, WG_Y) + gl_LocalInvocationID.xy;
     if (p.x >= frame.width || p.y >= frame.height) {
         return;
     }

@@ -512,6 +512,7 @@ mod tests {
                 "warp-probe",
                 "timed-barrier",
                 "back-to-back",
+                "row-order",
                 "ulp"
             ]
         );

@@ -141,7 +141,7 @@ fn naga_layout_matches_rust_for_every_shader_struct() {
             light_count,
             width,
             height,
-            pad
+            launch_grid
         }),
     );
 

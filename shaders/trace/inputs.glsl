@@ -86,7 +86,7 @@ layout(std140, set = 0, binding = 0) uniform Frame {
     uint light_count;
     uint width;   // image size in pixels: the compute entry point's bounds check
     uint height;
-    uint pad;
+    uint launch_grid;  // tiles across << 16 | down, of the launch order; 0: none (trace.comp)
 } frame;
 
 // Every variant an app runs bakes the counts in (Variant::with_scene_data);

@@ -24,7 +24,10 @@ pub struct GpuFrame {
     /// path's viewport does that job there).
     pub width: u32,
     pub height: u32,
-    pub pad: u32,
+    /// The grid of tiles the launch order (binding 8) was made for, as
+    /// `tiles across << 16 | tiles down`; 0 for none (the fragment path, a
+    /// window): the compute shader then takes its tiles in rows.
+    pub launch_grid: u32,
 }
 
 /// `Sphere` (std430 array element, binding 1).
@@ -308,8 +311,10 @@ pub mod binding {
     /// The BVH's nodes (`GpuBvhNode`), which the shader walks.
     pub const BVH_NODES: u32 = 6;
     pub const BVH_PRIMS: u32 = 7;
-    // 8 held the parent links of a stackless traversal, measured and rejected
-    // (docs/findings/bvh.md#tried-and-not-kept).
+    /// The compute path's launch order (`plan::launch`): the grid of tiles it
+    /// was made for, then which tile each workgroup traces. (8 once held the
+    /// parent links of a stackless traversal, measured and rejected.)
+    pub const LAUNCH_ORDER: u32 = 8;
     // 9 held the counts of `--experiment storage-counts`, retired
     // (docs/findings/software-drivers.md#a-shader-per-draw).
     /// The counting variant's per-pixel ray counts (`GpuRayCount`), written
@@ -320,7 +325,15 @@ pub mod binding {
     /// which only that experiment's GLSL declares (`shader::post::warp_probe_glsl`).
     pub const WARP_PROBE: u32 = 11;
     /// The storage buffers in binding order.
-    pub const STORAGE: [u32; 6] = [SPHERES, TRIANGLES, MATERIALS, LIGHTS, BVH_NODES, BVH_PRIMS];
+    pub const STORAGE: [u32; 7] = [
+        SPHERES,
+        TRIANGLES,
+        MATERIALS,
+        LIGHTS,
+        BVH_NODES,
+        BVH_PRIMS,
+        LAUNCH_ORDER,
+    ];
 }
 
 /// A flattened BVH: the nodes the shader walks (binding 6) and the primitive

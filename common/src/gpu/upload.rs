@@ -39,6 +39,9 @@ pub struct GpuScene<'a> {
     /// Whether a leaf triangle holds p0 and its two edges (the Möller–Trumbore
     /// test's inputs) rather than its three vertices (the watertight test's).
     leaf_edges: bool,
+    /// The compute path's launch order (`plan::launch`), empty until
+    /// `with_launch_order`: the shader then takes the tiles in rows.
+    launch_order: Vec<u32>,
 }
 
 /// How many bytes of a storage buffer an upload converts at once, at most
@@ -70,7 +73,7 @@ impl GpuFrame {
             light_count: scene.lights.len() as u32,
             width,
             height,
-            pad: 0,
+            launch_grid: 0,
         }
     }
 }
@@ -124,7 +127,20 @@ impl<'a> GpuScene<'a> {
             bvh_wide_nodes: bvh.map_or(&[], |b| &b.wide),
             bvh_codes: bvh.map_or(&[], |b| &b.prims),
             leaf_edges: world.numerics.triangle == TriangleTest::MollerTrumbore,
+            launch_order: Vec::new(),
         }
+    }
+
+    /// The same buffers with the compute path's launch order (binding 8):
+    /// `tiles` of a grid of `across` × `down`, which the frame's
+    /// `launch_grid` names so that the shader uses it. A grid too wide to
+    /// pack (never, at the image sizes the limits allow) keeps the rows.
+    pub fn with_launch_order(mut self, (across, down): (u32, u32), tiles: Vec<u32>) -> GpuScene<'a> {
+        if across < 1 << 16 && down < 1 << 16 {
+            self.frame.launch_grid = across << 16 | down;
+            self.launch_order = tiles;
+        }
+        self
     }
 
     /// Triangle `i`'s vertices as the GPU holds them.
@@ -209,6 +225,7 @@ impl<'a> GpuScene<'a> {
             }
             binding::BVH_NODES => (0, size_of::<GpuBvhNode>()),
             binding::BVH_PRIMS => (self.bvh_codes.len(), size_of::<GpuBvhPrim>()),
+            binding::LAUNCH_ORDER => (self.launch_order.len(), size_of::<u32>()),
             _ => panic!("binding {binding} is not a storage buffer"),
         };
         count.max(1) * size
@@ -230,6 +247,7 @@ impl<'a> GpuScene<'a> {
             binding::SPHERES => copy_elements(&self.spheres, offset, out),
             binding::MATERIALS => copy_elements(&self.materials, offset, out),
             binding::LIGHTS => copy_elements(&self.lights, offset, out),
+            binding::LAUNCH_ORDER => copy_elements(&self.launch_order, offset, out),
             binding::BVH_NODES if !self.bvh_wide_nodes.is_empty() => convert(offset, out, |i| {
                 gpu_node(self.bvh_wide_nodes, i, |n| n.on_gpu())
             }),
@@ -327,6 +345,7 @@ pub fn storage_name(binding: u32) -> &'static str {
         binding::LIGHTS => "lights",
         binding::BVH_NODES => "BVH node",
         binding::BVH_PRIMS => "BVH primitive",
+        binding::LAUNCH_ORDER => "launch order",
         _ => "frame",
     }
 }

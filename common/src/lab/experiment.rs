@@ -28,6 +28,7 @@ pub enum Experiment {
     WarpProbe,
     TimedBarrier,
     BackToBack,
+    RowOrder,
     Ulp,
 }
 

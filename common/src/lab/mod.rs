@@ -30,6 +30,8 @@ pub struct Changes {
     pub timed_barrier: bool,
     /// Each timed frame dispatches the tracer twice.
     pub back_to_back: bool,
+    /// The compute path hands out its tiles in rows, not costliest first.
+    pub row_order: bool,
     /// The experiments' names in registry order, for the variant's label.
     pub tags: Vec<String>,
 }
@@ -138,6 +140,12 @@ pub const REGISTRY: &[Entry] = &[
         headless: true,
         ..entry(Experiment::BackToBack, "Each headless frame dispatches the tracer twice inside its timed span, with no barrier between the two (both write the same values). The second dispatch's workgroups start as the first one's finish, so the frame's time less the default frame's is one frame's tracing without what a lone dispatch adds: its start, and its end, where the GPU waits on the last workgroups' latency. The why step takes that difference (`twinray compare --only why`).", |c| {
             c.back_to_back = true
+        })
+    },
+    Entry {
+        path: Some(RenderPath::Compute),
+        ..entry(Experiment::RowOrder, "The compute path's workgroups take the image's tiles in rows, top-down, as the dispatch numbers them, instead of the costliest first (ranked by the rays of one pixel in 16, traced by the reference through the run's tree before the first frame). A lone frame ends when its last workgroups do; launched in rows, the teapot's lower half and the box's mirror and glass spheres run last, on an otherwise idle GPU. Every image is the same in either order.", |c| {
+            c.row_order = true
         })
     },
     Entry {

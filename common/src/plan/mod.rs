@@ -8,6 +8,7 @@
 //! scene switches and the counting frame all come from here, so they cannot
 //! disagree about what a run is.
 
+pub mod launch;
 pub mod requests;
 
 use crate::cli::{RenderArgs, RenderPath, Workgroup};
@@ -54,6 +55,9 @@ pub struct RunPlan {
     /// Dispatches of the tracer in a headless compute frame's timed span, with
     /// no barrier between them: 1, or 2 with `--experiment back-to-back`.
     pub frame_dispatches: u32,
+    /// The compute path hands out the costliest tiles first (`launch`);
+    /// in rows with `--experiment row-order`.
+    pub launch_by_cost: bool,
 }
 
 /// What the untimed ray-counting frame renders (`--count-rays`), in either
@@ -212,6 +216,7 @@ impl Planner {
             shaders,
             timed_barrier: self.changes.timed_barrier,
             frame_dispatches: if self.changes.back_to_back { 2 } else { 1 },
+            launch_by_cost: !self.changes.row_order,
         })
     }
 
@@ -288,8 +293,30 @@ impl RunPlan {
     }
 
     /// The same at `width`×`height` (a window that has changed size).
+    /// On the compute path, with the launch order for that size (`launch`),
+    /// unless the frame is too small to need one or `--experiment row-order`
+    /// keeps the dispatch's rows.
     pub fn gpu_at(&self, width: u32, height: u32) -> GpuScene<'_> {
-        GpuScene::new(&self.scene, self.bvh.as_ref(), width, height)
+        let gpu = GpuScene::new(&self.scene, self.bvh.as_ref(), width, height);
+        let Entry::Compute(workgroup) = self.variant.entry else {
+            return gpu;
+        };
+        if !(self.launch_by_cost && launch::worth_ordering((width, height), workgroup)) {
+            return gpu;
+        }
+        let t0 = Instant::now();
+        let order = launch::launch_order(&self.scene, self.bvh.as_ref(), (width, height), workgroup);
+        explain::numbered(0, "Launch order (twinray-common)", || {
+            format!(
+                "{} tiles of {}x{}, costliest first by the rays of one pixel in {}; ranked in {:.1} ms",
+                order.tiles.len(),
+                workgroup.x,
+                workgroup.y,
+                launch::sample_step((width, height)).pow(2),
+                t0.elapsed().as_secs_f64() * 1e3
+            )
+        });
+        gpu.with_launch_order(order.grid, order.tiles)
     }
 
     /// The counting frame of this plan on its own path, at `width`×`height`

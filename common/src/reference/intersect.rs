@@ -8,13 +8,14 @@ use crate::scene::accel::MAX_LEAF;
 use crate::scene::numerics::{SphereTest, TriangleTest};
 use crate::scene::{Scene, Sphere, Triangle};
 use glam::DVec3;
+use std::borrow::Cow;
 
 pub(super) const T_MAX: f64 = 1.0e30;
 
-/// A scene and, above a few primitives, its BVH.
+/// A scene and, above a few primitives, its BVH: its own, or a run's.
 pub struct Tracer<'a> {
     pub(super) scene: &'a Scene,
-    pub(super) bvh: Option<Bvh>,
+    pub(super) bvh: Option<Cow<'a, Bvh>>,
 }
 
 /// Brute force below this many primitives: one leaf's worth.
@@ -30,7 +31,19 @@ impl<'a> Tracer<'a> {
     /// GPU's `--accel bvh4` or `bvh8` traces it.
     pub fn with_width(scene: &'a Scene, width: u32) -> Tracer<'a> {
         let bvh = (scene.primitive_count() >= BVH_FROM).then(|| Bvh::build(scene).widen(width));
-        Tracer { scene, bvh }
+        Tracer {
+            scene,
+            bvh: bvh.map(Cow::Owned),
+        }
+    }
+
+    /// Through a tree already built over `scene` (a run's, `plan::build_bvh`,
+    /// which a test holds to the reference's own), so that nothing is built twice.
+    pub fn through(scene: &'a Scene, bvh: &'a Bvh) -> Tracer<'a> {
+        Tracer {
+            scene,
+            bvh: Some(Cow::Borrowed(bvh)),
+        }
     }
 
     /// Brute force only, for the tests that check the BVH changes nothing.
@@ -317,7 +330,7 @@ pub(super) fn closest_hit(tracer: &Tracer, o: DVec3, d: DVec3) -> Option<(f64, H
     let scene = tracer.scene;
     let n = &scene.numerics;
     let r = tri_ray(n.triangle, o, d);
-    let Some(bvh) = &tracer.bvh else {
+    let Some(bvh) = tracer.bvh.as_deref() else {
         let mut best_t = T_MAX;
         let mut best = None;
         for (i, s) in scene.spheres.iter().enumerate() {
@@ -381,7 +394,7 @@ pub(super) fn occluded(tracer: &Tracer, o: DVec3, d: DVec3, dist: f64) -> bool {
             hit_triangle(n.triangle, &r, &scene.triangles[code as usize], 0.0, dist).is_some()
         }
     };
-    let Some(bvh) = &tracer.bvh else {
+    let Some(bvh) = tracer.bvh.as_deref() else {
         return scene
             .spheres
             .iter()

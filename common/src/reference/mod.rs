@@ -18,6 +18,7 @@ pub mod image_io;
 mod intersect;
 pub mod metrics;
 pub mod perturb;
+pub mod sampled;
 pub mod unsettled;
 
 use crate::rays::RayKinds;
@@ -460,7 +461,7 @@ mod tests {
         // A BVH even where `Tracer::new` would not build one (under BVH_FROM primitives).
         let bvh = Tracer {
             scene: &scene,
-            bvh: Some(Bvh::build(&scene).widen(bvh_width)),
+            bvh: Some(std::borrow::Cow::Owned(Bvh::build(&scene).widen(bvh_width))),
         };
         let brute = Tracer::brute_force(&scene);
         let mismatches = (0..width * height)
@@ -548,7 +549,7 @@ mod tests {
             let reference = Tracer::new(&local);
             let tree = reference
                 .bvh
-                .as_ref()
+                .as_deref()
                 .expect("a BVH above a few primitives");
             assert!(tree.nodes == gpu.bvh_nodes(), "{name}: the nodes differ");
             let prims: Vec<crate::gpu::layout::GpuBvhPrim> = bytemuck::pod_collect_to_vec(
@@ -560,7 +561,7 @@ mod tests {
                 let wide = bvh.clone().widen(width);
                 let gpu = crate::gpu::upload::GpuScene::new(&scene, Some(&wide), 8, 8);
                 let reference = Tracer::with_width(&local, width);
-                let tree = reference.bvh.as_ref().expect("a BVH");
+                let tree = reference.bvh.as_deref().expect("a BVH");
                 assert!(
                     tree.wide == gpu.bvh_wide_nodes(),
                     "{name}: the {width}-wide nodes differ"
