@@ -101,3 +101,26 @@ fn the_frames_span_moves_the_timing_not_the_image() {
         }
     }
 }
+
+/// The compute path hands a frame's tiles out costliest first once it has
+/// 4096 of them (`plan::launch`); `--experiment row-order` hands them out in
+/// rows. A tile taken twice or never would show: each app draws the same
+/// image either way, byte for byte, with no validation message.
+#[test]
+fn the_launch_order_moves_the_timing_not_the_image() {
+    for app in App::BOTH {
+        for scene in ["teapot", "box"] {
+            let dir = scratch(&format!("compute-launch-{scene}"));
+            // 64 × 64 tiles of 4×4: just enough for an order.
+            let args = ["--path", "compute", "--workgroup", "4x4"];
+            let (rd, ordered) = render(app, scene, "256x256", &args, &dir.join("ordered.png"));
+            let rows_args = [&args[..], &["--experiment", "row-order"]].concat();
+            let (rr, rows) = render(app, scene, "256x256", &rows_args, &dir.join("rows.png"));
+            let what = format!("{app:?} {scene} ({})", rr.variant);
+            assert!(rr.variant.ends_with("/row-order"), "{what}");
+            assert_clean(&rd, &what);
+            assert_clean(&rr, &what);
+            twinray_tests::assert_identical(&ordered, &rows, &what);
+        }
+    }
+}

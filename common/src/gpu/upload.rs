@@ -135,7 +135,11 @@ impl<'a> GpuScene<'a> {
     /// `tiles` of a grid of `across` × `down`, which the frame's
     /// `launch_grid` names so that the shader uses it. A grid too wide to
     /// pack (never, at the image sizes the limits allow) keeps the rows.
-    pub fn with_launch_order(mut self, (across, down): (u32, u32), tiles: Vec<u32>) -> GpuScene<'a> {
+    pub fn with_launch_order(
+        mut self,
+        (across, down): (u32, u32),
+        tiles: Vec<u32>,
+    ) -> GpuScene<'a> {
         if across < 1 << 16 && down < 1 << 16 {
             self.frame.launch_grid = across << 16 | down;
             self.launch_order = tiles;
@@ -379,6 +383,25 @@ mod tests {
     use crate::scene::OriginMode;
     use glam::DVec3;
     use std::borrow::Cow;
+
+    /// The frame names the order's grid as trace.comp compares it with the
+    /// dispatch's (`x << 16 | y`), and the buffer holds one word a tile.
+    #[test]
+    fn a_launch_order_names_its_grid_in_the_frame() {
+        let s = Scene::load("box", &[]).unwrap();
+        let g = GpuScene::new(&s, None, 8, 8);
+        assert_eq!(g.frame.launch_grid, 0, "no order: rows");
+        let g = g.with_launch_order((3, 5), (0..15).rev().collect());
+        assert_eq!(g.frame.launch_grid, 3 << 16 | 5);
+        let words: Vec<u32> = bytemuck::pod_collect_to_vec(&g.storage_vec(binding::LAUNCH_ORDER));
+        assert_eq!(words, (0..15).rev().collect::<Vec<u32>>());
+        let too_wide =
+            GpuScene::new(&s, None, 8, 8).with_launch_order((1 << 16, 1), vec![0; 1 << 16]);
+        assert_eq!(
+            too_wide.frame.launch_grid, 0,
+            "a grid that does not pack keeps the rows"
+        );
+    }
 
     #[test]
     fn near_scenes_keep_a_zero_origin_and_far_ones_trace_near_zero() {

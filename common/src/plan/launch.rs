@@ -61,10 +61,7 @@ pub fn launch_order(
     size: (u32, u32),
     workgroup: Workgroup,
 ) -> LaunchOrder {
-    let grid = (
-        size.0.div_ceil(workgroup.x),
-        size.1.div_ceil(workgroup.y),
-    );
+    let grid = (size.0.div_ceil(workgroup.x), size.1.div_ceil(workgroup.y));
     let mut tiles: Vec<u32> = (0..grid.0 * grid.1).collect();
     let samples = sampled_rays(scene, bvh, size, sample_step(size));
     let cost: Vec<(u32, u32)> = tiles
@@ -156,7 +153,24 @@ mod tests {
             .map(|&t| tile_cost(&samples, (t % grid_x, t / grid_x), wg))
             .collect();
         assert_eq!(costs[0].0, most);
-        assert!(costs.windows(2).all(|w| w[0] >= w[1]), "not costliest first");
+        assert!(
+            costs.windows(2).all(|w| w[0] >= w[1]),
+            "not costliest first"
+        );
         assert_eq!(costs.last().unwrap().0, 1, "the background's tiles last");
+    }
+
+    /// The sphere lists' 300² frames fit on an H200 at once (722 workgroups of
+    /// 8×16, 2,850 of 4×8) and keep their rows; 1000² and larger are ordered.
+    #[test]
+    fn only_frames_of_many_tiles_take_an_order() {
+        let wg = |x, y| Workgroup { x, y };
+        assert!(!worth_ordering((300, 300), wg(8, 16)));
+        assert!(!worth_ordering((300, 300), wg(4, 8)));
+        assert!(worth_ordering((1000, 1000), wg(8, 16)));
+        assert!(worth_ordering((1920, 1080), wg(4, 8)));
+        assert_eq!(sample_step((300, 300)), 1);
+        assert_eq!(sample_step((1920, 1080)), 4);
+        assert_eq!(sample_step((3840, 2160)), 8);
     }
 }

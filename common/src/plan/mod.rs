@@ -305,7 +305,8 @@ impl RunPlan {
             return gpu;
         }
         let t0 = Instant::now();
-        let order = launch::launch_order(&self.scene, self.bvh.as_ref(), (width, height), workgroup);
+        let order =
+            launch::launch_order(&self.scene, self.bvh.as_ref(), (width, height), workgroup);
         explain::numbered(0, "Launch order (twinray-common)", || {
             format!(
                 "{} tiles of {}x{}, costliest first by the rays of one pixel in {}; ranked in {:.1} ms",
