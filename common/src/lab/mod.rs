@@ -144,7 +144,7 @@ pub const REGISTRY: &[Entry] = &[
     },
     Entry {
         path: Some(RenderPath::Compute),
-        ..entry(Experiment::RowOrder, "The compute path's workgroups take the image's tiles in rows, top-down, as the dispatch numbers them, instead of the costliest first (ranked by the rays of one pixel in 16, traced by the reference through the run's tree before the first frame). A lone frame ends when its last workgroups do; launched in rows, the teapot's lower half and the box's mirror and glass spheres run last, on an otherwise idle GPU. Every image is the same in either order.", |c| {
+        ..entry(Experiment::RowOrder, "The compute path's workgroups take the image's tiles in rows, top-down, as the dispatch numbers them, and read no launch order, instead of the costliest tiles first (a frame of 4096 tiles or more: each tile ranked by the rays that the reference traces for a sparse grid of its pixels, through the run's tree, before the first frame). A lone frame ends when its last workgroups do; in rows the box's mirror and glass spheres and the teapot's lower half launch last and run on an otherwise idle GPU. Every image is the same in either order.", |c| {
             c.row_order = true
         })
     },
