@@ -1,7 +1,8 @@
 // trace.comp — compute entry point: the same tracer, one invocation per pixel,
 // written to an RGBA32F storage image instead of a colour attachment.
 //
-// Pixel (x, y) is gl_GlobalInvocationID.xy with y counted from the top, and the
+// Pixel (x, y) is the invocation's place in its workgroup's tile, with y counted
+// from the top (the tile comes from the launch order, below), and the
 // primary ray goes through its centre, (x, y) + 0.5: exactly the gl_FragCoord
 // the fragment path sees in Vulkan. Image row 0 is therefore the top row in both
 // APIs, and a plain copy/readback of the image gives the upright picture.

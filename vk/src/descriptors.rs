@@ -1,7 +1,7 @@
 //! Descriptors: how the shader's `layout(set = 0, binding = N)` blocks find our buffers.
 //!
 //! Vulkan splits this in three. The *set layout* is the shape (binding 0 is a
-//! uniform buffer; the storage buffers sit at bindings 1–4, 6 and 7, as
+//! uniform buffer; the storage buffers sit at bindings 1–4 and 6–8, as
 //! `common/src/gpu/layout.rs`'s `binding::STORAGE` lists them; all are read by
 //! the fragment stage; the compute path adds binding 5, a storage image, and
 //! names the compute stage); it
