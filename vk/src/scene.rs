@@ -1,4 +1,4 @@
-//! The scene on the GPU: the `Frame` uniform buffer, the six storage buffers,
+//! The scene on the GPU: the `Frame` uniform buffer, the seven storage buffers,
 //! the descriptor set pointing at them and the pipeline compiled for the
 //! scene's shader variant. Everything here depends on the scene (and nothing
 //! else does), so a scene switch or a new variant in the window rebuilds
