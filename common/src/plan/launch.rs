@@ -2,8 +2,8 @@
 //! traces. A GPU starts workgroups in about the order of their index, and a
 //! frame ends when its slowest last ones do, on an otherwise idle GPU; so the
 //! costliest tiles are handed out first, the cheapest last. A tile's cost is
-//! the most rays, then the sum, of the reference's samples inside it
-//! (`reference::sampled`), through the run's own tree. Which tile a
+//! the most rays of the reference's samples in or beside it, then the sum of
+//! those in it (`reference::sampled`), traced through the run's own tree. Which tile a
 //! workgroup takes never changes what a pixel computes, so every image is the
 //! same in any order; `--experiment row-order` hands the tiles out in rows,
 //! top-down, as the dispatch numbers them, with no order at all.
@@ -21,8 +21,9 @@ use std::cmp::Reverse;
 
 /// The most pixels that trace their rays for the estimate: every pixel of a
 /// frame up to 362², then one in 4, 16 (1000², 1080p), 64 (4K) and so on.
-/// On an H200 host's 16 cores that adds 30-110 ms to a 1080p or 4K start;
-/// a sample in four pixels ranked no better (`docs/findings/frame-end.md`).
+/// On an H200 host's 16 cores that added 10-160 ms to a 1000², 1080p or 4K
+/// start; one in four pixels, or every pixel, ranked no better
+/// (`docs/findings/frame-end.md`).
 pub const MOST_SAMPLES: u32 = 1 << 17;
 
 /// A frame of fewer tiles keeps its rows: a large GPU holds all their
