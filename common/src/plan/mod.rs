@@ -292,8 +292,15 @@ impl RunPlan {
         self.gpu_at(self.size.0, self.size.1)
     }
 
-    /// The same at `width`×`height` (a window that has changed size).
-    /// On the compute path, with the launch order for that size (`launch`),
+    /// A window's buffers at `width`×`height`: without a launch order, which
+    /// its moving camera and changing size would leave stale, so that its
+    /// compute frames take their tiles in rows (`launch`).
+    pub fn window_gpu_at(&self, width: u32, height: u32) -> GpuScene<'_> {
+        GpuScene::new(&self.scene, self.bvh.as_ref(), width, height)
+    }
+
+    /// The same at `width`×`height`. On the compute path, with the launch
+    /// order for that size (`launch`),
     /// unless the frame is too small to need one or `--experiment row-order`
     /// keeps the dispatch's rows.
     pub fn gpu_at(&self, width: u32, height: u32) -> GpuScene<'_> {
