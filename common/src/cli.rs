@@ -161,6 +161,12 @@ impl Workgroup {
         Workgroup { x: 16, y: 8 },
         Workgroup { x: 16, y: 16 },
     ];
+
+    /// The tiles across and down of a `width`×`height` image in workgroups
+    /// of this size: the dispatch, whose edge tiles overhang the image.
+    pub fn tiles(self, (width, height): (u32, u32)) -> (u32, u32) {
+        (width.div_ceil(self.x), height.div_ceil(self.y))
+    }
 }
 
 impl std::fmt::Display for Workgroup {

@@ -169,7 +169,7 @@ pub fn run(planner: &Planner, started: Instant) -> Result<(WindowedRun, DeviceIn
     // Declaration order is creation order, so the struct's fields (newest
     // first) and these locals go in reverse on every path.
     let drawing = path_program(gl, &plan.shaders, (size.width, size.height))?;
-    let buffers = SceneBuffers::new(gl, &plan.window_gpu_at(plan.size.0, plan.size.1))?;
+    let buffers = SceneBuffers::new(gl, &plan.gpu_in_rows(plan.size.0, plan.size.1))?;
     let vao = EmptyVertexArray::new(gl)?;
     let timers = (0..TIMERS)
         .map(|_| Timer::new(gl, &info.device))

@@ -111,7 +111,7 @@ fn render(
     let api = ("vulkan", device.info(), label);
     let mut report = planner.report(&plan, api, (frames, setup_ms), &image, stats)?;
     if args.count_rays {
-        let gpu = plan.gpu();
+        let gpu = plan.gpu_in_rows(width, height);
         let counting = plan.counting(&gpu, width, height);
         report.add_rays(count_rays(&device, &counting)?);
     }

@@ -147,7 +147,7 @@ pub fn run(
     );
     let drawing = path_resources(
         &device,
-        &plan.window_gpu_at(plan.size.0, plan.size.1),
+        &plan.gpu_in_rows(plan.size.0, plan.size.1),
         &plan.shaders,
         render_pass.render_pass,
         format.format,

@@ -43,8 +43,9 @@ pub fn sample_step((width, height): (u32, u32)) -> u32 {
 }
 
 /// Whether a frame of `size` in workgroups of `workgroup` takes an order.
-pub fn worth_ordering((width, height): (u32, u32), workgroup: Workgroup) -> bool {
-    width.div_ceil(workgroup.x) as u64 * height.div_ceil(workgroup.y) as u64 >= FEWEST_TILES as u64
+pub fn worth_ordering(size: (u32, u32), workgroup: Workgroup) -> bool {
+    let (across, down) = workgroup.tiles(size);
+    across as u64 * down as u64 >= FEWEST_TILES as u64
 }
 
 /// A frame's tiles in the order its workgroups take them.
@@ -62,7 +63,7 @@ pub fn launch_order(
     size: (u32, u32),
     workgroup: Workgroup,
 ) -> LaunchOrder {
-    let grid = (size.0.div_ceil(workgroup.x), size.1.div_ceil(workgroup.y));
+    let grid = workgroup.tiles(size);
     let mut tiles: Vec<u32> = (0..grid.0 * grid.1).collect();
     let samples = sampled_rays(scene, bvh, size, sample_step(size));
     let cost: Vec<(u32, u32)> = tiles

@@ -292,10 +292,11 @@ impl RunPlan {
         self.gpu_at(self.size.0, self.size.1)
     }
 
-    /// A window's buffers at `width`×`height`: without a launch order, which
-    /// its moving camera and changing size would leave stale, so that its
-    /// compute frames take their tiles in rows (`launch`).
-    pub fn window_gpu_at(&self, width: u32, height: u32) -> GpuScene<'_> {
+    /// The buffers at `width`×`height` without a launch order, so that
+    /// compute frames take their tiles in rows (`launch`): a window's, whose
+    /// moving camera and changing size would leave an order stale, and the
+    /// untimed counting frame's, whose time no one reads.
+    pub fn gpu_in_rows(&self, width: u32, height: u32) -> GpuScene<'_> {
         GpuScene::new(&self.scene, self.bvh.as_ref(), width, height)
     }
 

@@ -128,7 +128,7 @@ impl ComputeLimits {
                 l.group_size[0], l.group_size[1], l.invocations
             )));
         }
-        let groups = (width.div_ceil(wg.x), height.div_ceil(wg.y));
+        let groups = wg.tiles((width, height));
         if groups.0 > l.group_count[0] || groups.1 > l.group_count[1] {
             return Err(crate::error::bad_input(format!(
                 "--size {width}x{height} with --workgroup {wg} needs {}x{} workgroups, more than this device's {count} {}x{}",

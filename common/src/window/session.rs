@@ -248,7 +248,7 @@ impl<R: Renderer> Session<R> {
                 self.orbit = Orbit::new(&plan.scene.camera);
                 self.plan = plan;
                 if let Some(r) = self.renderer.as_mut() {
-                    r.load_scene(&self.plan.window_gpu_at(w, h), &self.plan.shaders)?;
+                    r.load_scene(&self.plan.gpu_in_rows(w, h), &self.plan.shaders)?;
                 }
                 self.restart_title();
             }
@@ -306,7 +306,7 @@ impl<R: Renderer> Session<R> {
         plan.shaders = PathShaders::build(&plan.variant)?;
         let (w, h) = (self.size.width.max(1), self.size.height.max(1));
         if let Some(r) = self.renderer.as_mut() {
-            r.load_scene(&plan.window_gpu_at(w, h), &plan.shaders)?;
+            r.load_scene(&plan.gpu_in_rows(w, h), &plan.shaders)?;
         }
         Ok(())
     }
@@ -322,7 +322,7 @@ impl<R: Renderer> Session<R> {
         self.rays_stale = false;
         let (width, height) = (self.size.width, self.size.height);
         let plan = &self.plan;
-        let mut gpu = plan.window_gpu_at(width, height);
+        let mut gpu = plan.gpu_in_rows(width, height);
         gpu.frame = self.frame_uniform();
         let run = plan.counting(&gpu, width, height);
         if let Some(r) = self.renderer.as_mut() {
