@@ -510,6 +510,7 @@ mod tests {
                 "first-of-equals",
                 "optimal-collapse",
                 "walk-then-shade",
+                "storage-nodes",
                 "uniform-counts",
                 "no-contraction",
                 "float-controls",

@@ -143,6 +143,9 @@ pub struct StorageLimit {
     pub bytes: u64,
     /// Whose limit, as a message names it: "this device's maxStorageBufferRange".
     pub name: &'static str,
+    /// The texels a buffer texture may hold (OpenGL's
+    /// GL_MAX_TEXTURE_BUFFER_SIZE): 0 where the app reads none.
+    pub texel_buffer: u64,
 }
 
 impl StorageLimit {
@@ -150,6 +153,7 @@ impl StorageLimit {
     pub const ANY: StorageLimit = StorageLimit {
         bytes: MAX_STORAGE_BUFFER_BYTES,
         name: "twinray's 4 GiB storage-buffer limit",
+        texel_buffer: 0,
     };
 
     /// Refuses `count` elements of `element_bytes` in the scene's `buffer`
@@ -224,6 +228,7 @@ mod tests {
         let small = StorageLimit {
             bytes: 1000,
             name: "a test device's limit",
+            texel_buffer: 0,
         };
         let e = small
             .check("--set tessellation", "triangles", 11, 96)

@@ -191,7 +191,8 @@ fn render_fragment(run: &HeadlessRun, shaders: &Shaders) -> Result<(Rendered, Ve
         Program::new(gl, &shaders.vertex.glsl, &shaders.fragment.glsl)?
     };
     let stats = run.dump_binary(program.raw())?;
-    let _buffers = SceneBuffers::new(gl, &run.plan.gpu())?;
+    // The fragment path reads the nodes from their storage block (`Api::node_texels`).
+    let _buffers = SceneBuffers::new(gl, &run.plan.gpu(), false)?;
     let target = Target::new(gl, width, height)?;
     let vao = EmptyVertexArray::new(gl)?;
     let timer = Timer::new(gl, &run.info.device)?;
@@ -226,7 +227,7 @@ fn render_compute(
         .then_some(&proc_address as &dyn Fn(&std::ffi::CStr) -> *const std::ffi::c_void);
     let compute = Compute::new(gl, shader, spirv, size.width, size.height)?;
     let stats = run.dump_binary(compute.program())?;
-    let _buffers = SceneBuffers::new(gl, &run.plan.gpu())?;
+    let _buffers = SceneBuffers::new(gl, &run.plan.gpu(), shader.variant.node_texels)?;
     let timer = Timer::new(gl, &run.info.device)?;
     // No barrier between headless frames: the glFinish that ends each one has
     // completed its image stores before the next dispatch. Issued before the

@@ -1,7 +1,8 @@
 //! The scene on the GPU: the `Frame` uniform buffer and the storage buffers,
-//! uploaded once from the bytes `common` builds for both APIs; and the storage
-//! buffers a shader writes for the app to read back once (the ray counts, the
-//! warp probe).
+//! uploaded once from the bytes `common` builds for both APIs, with the buffer
+//! texture over the wide tree's nodes where the variant reads them so
+//! (`Variant::node_texels`); and the storage buffers a shader writes for the
+//! app to read back once (the ray counts, the warp probe).
 //!
 //! The scene buffers are immutable (`glBufferStorage`) and filled by the GPU,
 //! the way the Vulkan twin fills its device-local buffers (vk/src/memory.rs):
@@ -27,6 +28,8 @@ pub struct SceneBuffers<'gl> {
     gl: &'gl glow::Context,
     /// UBO first, then the SSBOs in binding order.
     buffers: Vec<glow::Buffer>,
+    /// The buffer texture over the node buffer, where the variant reads it.
+    node_texels: Option<glow::Texture>,
 }
 
 impl<'gl> SceneBuffers<'gl> {
@@ -35,7 +38,12 @@ impl<'gl> SceneBuffers<'gl> {
     /// the numbers are the Vulkan descriptor bindings unchanged. The bytes are
     /// made in the staging buffer (`write_storage` converts the scene a chunk
     /// at a time), so the host never holds a second full copy of a large scene.
-    pub fn new(gl: &'gl glow::Context, scene: &GpuScene) -> anyhow::Result<SceneBuffers<'gl>> {
+    /// With `node_texels` the node buffer is also bound as a buffer texture.
+    pub fn new(
+        gl: &'gl glow::Context,
+        scene: &GpuScene,
+        node_texels: bool,
+    ) -> anyhow::Result<SceneBuffers<'gl>> {
         let frame = scene.frame_bytes();
         // One staging buffer, as large as the largest chunk any buffer needs.
         let chunk = UPLOAD_CHUNK_BYTES.min(scene.largest_storage().1.max(frame.len()));
@@ -63,10 +71,44 @@ impl<'gl> SceneBuffers<'gl> {
                 |offset, bytes| scene.write_storage(b, offset, bytes),
             )?;
         }
-        Ok(SceneBuffers {
+        let mut buffers = SceneBuffers {
             gl,
             buffers: uploads.finish(),
-        })
+            node_texels: None,
+        };
+        if node_texels {
+            buffers.bind_node_texels()?;
+        }
+        Ok(buffers)
+    }
+
+    /// The node buffer as an RGBA32F buffer texture at texture unit
+    /// `binding::BVH_NODES`, where the compute GLSL's `node_texels` sampler
+    /// reads it (twinray_common::shader::node_texels): the same memory, no copy.
+    fn bind_node_texels(&mut self) -> anyhow::Result<()> {
+        let gl = self.gl;
+        let slot = binding::STORAGE.iter().position(|&b| b == binding::BVH_NODES);
+        let buffer = self.buffers[1 + slot.expect("the nodes are a storage buffer")];
+        // SAFETY: a fresh texture on the current context, made a view of a
+        // live buffer of whole RGBA32F texels (GpuBvhWideNode is 7 of them);
+        // the plan checked their count against GL_MAX_TEXTURE_BUFFER_SIZE.
+        // `Drop` deletes it before the buffer.
+        unsafe {
+            let texture = gl
+                .create_texture()
+                .map_err(|e| anyhow!("creating the node buffer texture: {e}"))?;
+            self.node_texels = Some(texture);
+            gl.active_texture(glow::TEXTURE0 + binding::BVH_NODES);
+            gl.bind_texture(glow::TEXTURE_BUFFER, Some(texture));
+            gl.tex_buffer(glow::TEXTURE_BUFFER, glow::RGBA32F, Some(buffer));
+            gl.active_texture(glow::TEXTURE0);
+        }
+        explain::numbered(
+            5,
+            &format!("glCreateTextures + glTexBuffer (texture unit {})", binding::BVH_NODES),
+            || "the node buffer again, as an RGBA32F buffer texture: the compute tracer reads the wide tree's nodes with texelFetch, which NVIDIA's OpenGL guards with no bounds check".to_string(),
+        );
+        Ok(())
     }
 
     /// Rewrites the `Frame` uniform block (windowed: the camera moves). The
@@ -85,6 +127,10 @@ impl<'gl> SceneBuffers<'gl> {
 
 impl Drop for SceneBuffers<'_> {
     fn drop(&mut self) {
+        if let Some(texture) = self.node_texels {
+            // SAFETY: made on this context, which outlives it.
+            unsafe { self.gl.delete_texture(texture) }
+        }
         delete_buffers(self.gl, &self.buffers);
     }
 }

@@ -166,12 +166,20 @@ pub fn device_info(gl: &glow::Context) -> DeviceInfo {
     }
 }
 
-/// The largest storage block the context binds: what every run plan is checked against.
+/// The largest storage block the context binds: what every run plan is checked
+/// against; and the largest buffer texture, which the plan checks the tree's
+/// nodes against before OpenGL reads them through one (`Api::node_texels`).
 pub fn storage_limit(gl: &glow::Context) -> StorageLimit {
-    // SAFETY: plain query; 64-bit because the limit may exceed 2 GiB.
-    let bytes = unsafe { gl.get_parameter_i64(glow::MAX_SHADER_STORAGE_BLOCK_SIZE) };
+    // SAFETY: plain queries; 64-bit because the limits may exceed 2 GiB.
+    let (bytes, texels) = unsafe {
+        (
+            gl.get_parameter_i64(glow::MAX_SHADER_STORAGE_BLOCK_SIZE),
+            gl.get_parameter_i64(glow::MAX_TEXTURE_BUFFER_SIZE),
+        )
+    };
     StorageLimit {
         bytes: bytes.max(0) as u64,
         name: "this device's GL_MAX_SHADER_STORAGE_BLOCK_SIZE limit",
+        texel_buffer: texels.max(0) as u64,
     }
 }

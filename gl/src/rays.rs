@@ -22,7 +22,7 @@ use twinray_common::shader::build::PathShaders;
 pub fn count_rays(gl: &glow::Context, run: &CountingRun) -> anyhow::Result<RayKinds> {
     let (width, height) = (run.width, run.height);
     // Declared first, so deleted last: after the programs that use them.
-    let _scene = SceneBuffers::new(gl, run.gpu)?;
+    let _scene = SceneBuffers::new(gl, run.gpu, run.variant.node_texels)?;
     let counts = ReadbackBuffer::new(
         gl,
         binding::RAY_COUNTS,

@@ -169,7 +169,11 @@ pub fn run(planner: &Planner, started: Instant) -> Result<(WindowedRun, DeviceIn
     // Declaration order is creation order, so the struct's fields (newest
     // first) and these locals go in reverse on every path.
     let drawing = path_program(gl, &plan.shaders, (size.width, size.height))?;
-    let buffers = SceneBuffers::new(gl, &plan.gpu_in_rows(plan.size.0, plan.size.1))?;
+    let buffers = SceneBuffers::new(
+        gl,
+        &plan.gpu_in_rows(plan.size.0, plan.size.1),
+        plan.shaders.reads_node_texels(),
+    )?;
     let vao = EmptyVertexArray::new(gl)?;
     let timers = (0..TIMERS)
         .map(|_| Timer::new(gl, &info.device))
@@ -366,7 +370,7 @@ impl Renderer for GlWindow<'_> {
     fn load_scene(&mut self, scene: &GpuScene, shaders: &PathShaders) -> Result<()> {
         let gl = self.gl;
         self.drawing = path_program(gl, shaders, self.size)?;
-        self.buffers = SceneBuffers::new(gl, scene)?;
+        self.buffers = SceneBuffers::new(gl, scene, shaders.reads_node_texels())?;
         self.log.check(gl, "after a scene or path switch");
         Ok(())
     }

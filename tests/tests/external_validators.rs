@@ -75,7 +75,7 @@ fn variants() -> Vec<(String, Variant)> {
         };
         // OpenGL's planner: it takes every experiment listed below.
         let planner = Planner::new(&args, Api::OpenGl).unwrap();
-        planner.variant(&scene, bvh.as_ref(), RenderPath::Fragment)
+        planner.variant(&scene, bvh.as_ref(), RenderPath::Fragment, 0)
     };
     for n in Numerics::all() {
         v.push((format!("generic {}", n.label()), Variant::generic(n)));

@@ -246,6 +246,7 @@ queue family {queue_family}: {flags:?}, timestampValidBits {timestamp_valid_bits
         StorageLimit {
             bytes: self.properties.limits.max_storage_buffer_range as u64,
             name: "this device's maxStorageBufferRange limit",
+            texel_buffer: 0,
         }
     }
 

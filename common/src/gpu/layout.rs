@@ -146,6 +146,11 @@ pub struct GpuBvhWideNode {
     pub child: [u32; 4],
 }
 
+/// The RGBA32F texels of one `GpuBvhWideNode` where OpenGL reads the nodes
+/// through a buffer texture (`shader::post::node_texels_glsl`): the six
+/// bounds, then the children's references as the seventh's bits.
+pub const WIDE_NODE_TEXELS: u32 = (size_of::<GpuBvhWideNode>() / 16) as u32;
+
 /// An empty slot's box, its min corner at +`f32::MAX` and its max corner at
 /// -`f32::MAX`: inside out on every axis. The walk reads the near plane by
 /// the ray's sign, and for an inside-out box that plane lies beyond the far

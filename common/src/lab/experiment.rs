@@ -20,6 +20,7 @@ pub enum Experiment {
     FirstOfEquals,
     OptimalCollapse,
     WalkThenShade,
+    StorageNodes,
     UniformCounts,
     NoContraction,
     FloatControls,

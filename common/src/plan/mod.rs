@@ -13,7 +13,7 @@ pub mod requests;
 
 use crate::cli::{RenderArgs, RenderPath, Workgroup};
 use crate::explain;
-use crate::gpu::layout::Bvh;
+use crate::gpu::layout::{Bvh, WIDE_NODE_TEXELS};
 use crate::gpu::upload::{check_storage_limit, GpuScene};
 use crate::lab::{self, Changes};
 use crate::limits::StorageLimit;
@@ -195,7 +195,7 @@ impl Planner {
         } else {
             (None, None)
         };
-        let variant = self.variant(&scene, bvh.as_ref(), path);
+        let variant = self.variant(&scene, bvh.as_ref(), path, limit.texel_buffer);
         check_storage_limit(&GpuScene::new(&scene, bvh.as_ref(), width, height), limit)?;
         let shaders = PathShaders::build(&variant)?;
         let target = match self.api {
@@ -251,8 +251,15 @@ impl Planner {
 
     /// The variant the apps render for `scene` on `path`: `--generic`,
     /// `--specialize` or the scene's own, tracing through `bvh` where there is
-    /// one, with the laboratory's changes.
-    pub fn variant(&self, scene: &Scene, bvh: Option<&Bvh>, path: RenderPath) -> Variant {
+    /// one, with the laboratory's changes. `texel_buffer` is the most texels
+    /// the device's buffer textures hold (`StorageLimit::texel_buffer`).
+    pub fn variant(
+        &self,
+        scene: &Scene,
+        bvh: Option<&Bvh>,
+        path: RenderPath,
+        texel_buffer: u64,
+    ) -> Variant {
         let mut v = if self.args.generic {
             Variant::generic(scene.numerics).with_scene_data(scene, bvh)
         } else if self.args.specialize {
@@ -275,6 +282,14 @@ impl Planner {
             && self
                 .api
                 .light_before_walk(bvh.is_some(), path, scene.lights.len());
+        // The GPU's copy of the tree starts with a sentinel node (upload.rs).
+        let fits = bvh.is_some_and(|b| {
+            (b.wide.len() as u64 + 1) * u64::from(WIDE_NODE_TEXELS) <= texel_buffer
+        });
+        v.node_texels = !c.knobs.storage_nodes
+            && !self.args.gl_spirv
+            && fits
+            && self.api.node_texels(bvh.is_some_and(|b| b.width > 2), path);
         v
     }
 }

@@ -73,6 +73,23 @@ impl Api {
         *self == Api::OpenGl && bvh && path == RenderPath::Compute && lights == 1
     }
 
+    /// Whether the tracer reads the wide tree's nodes through a buffer texture
+    /// (`texelFetch` on a `samplerBuffer` over the node buffer) instead of
+    /// its storage block: on OpenGL's BVH walks on the compute path, where the
+    /// tree fits the device's largest buffer texture. NVIDIA's OpenGL guards
+    /// each storage read with a bounds check that clears the registers before
+    /// a predicated load; a texel fetch needs neither. OpenGL's teapot frames
+    /// on an H200 were 2-5 % shorter at every size, its 100k sphere list 2 %,
+    /// and not one pixel moved
+    /// (docs/findings/opengl-compute.md#the-nodes-through-a-buffer-texture-h200).
+    /// Vulkan keeps its storage reads: naga has no texel buffers, and through
+    /// glslang's SPIR-V the same reads cost Vulkan 6-7 % at scale
+    /// (f8d14ba:comparison/results/nvidia-h100/investigation/texel-nodes/vk/tv.txt).
+    /// The fragment path was not measured with it.
+    pub fn node_texels(&self, wide: bool, path: RenderPath) -> bool {
+        *self == Api::OpenGl && wide && path == RenderPath::Compute
+    }
+
     /// Whether a BVH stack of `entries` holds two entries to a `uvec4`
     /// (BVH_STACK_PAIRS in shaders/trace/bvh.glsl), not one to a `uvec2`:
     /// on OpenGL, for trees of at most `PAIRED_STACK_MOST` entries. Vulkan's

@@ -185,6 +185,7 @@ pub(crate) mod tests {
     const SMALL: StorageLimit = StorageLimit {
         bytes: 100 << 20,
         name: "a test device's limit",
+        texel_buffer: 0,
     };
 
     fn scratch(name: &str) -> std::path::PathBuf {
@@ -275,6 +276,7 @@ pub(crate) mod tests {
         let tiny = StorageLimit {
             bytes: 1000 * size_of::<GpuTriangle>() as u64,
             name: "a 1000-triangle limit",
+            texel_buffer: 0,
         };
         let head = "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 1 1 0\n";
         // 499 quads (998 triangles) and two triangles: the limit exactly.

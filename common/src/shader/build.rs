@@ -220,6 +220,12 @@ impl PathShaders {
         })
     }
 
+    /// Whether the tracer reads the wide tree's nodes through a buffer
+    /// texture, which OpenGL must then bind (`Variant::node_texels`).
+    pub fn reads_node_texels(&self) -> bool {
+        matches!(self, PathShaders::Compute(c) if c.variant.node_texels)
+    }
+
     pub fn path(&self) -> RenderPath {
         match self {
             PathShaders::Fragment(_) => RenderPath::Fragment,
@@ -378,6 +384,9 @@ pub fn to_glsl(
     }
     if stage == ShaderStage::Compute && passes.warp_probe {
         out = warp_probe_glsl(&out, crate::gpu::layout::binding::WARP_PROBE)?;
+    }
+    if stage == ShaderStage::Compute && variant.node_texels {
+        out = super::node_texels::node_texels_glsl(&out)?;
     }
     if passes.no_contraction {
         out = precise_float_locals_glsl(&out);

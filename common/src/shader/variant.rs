@@ -44,6 +44,10 @@ pub struct Variant {
     /// The BVH stack as two entries to a `uvec4` (BVH_STACK_PAIRS;
     /// `Api::bvh_stack_pairs` decides), not one to a `uvec2`.
     pub bvh_stack_pairs: bool,
+    /// OpenGL's GLSL reads the wide tree's nodes through a buffer texture
+    /// over the same buffer instead of its storage block (`Api::node_texels`
+    /// decides; `shader::post::node_texels_glsl` rewrites naga's reads).
+    pub node_texels: bool,
     /// The experiments' names, in registry order, for the label.
     pub tags: Vec<String>,
 }
@@ -119,6 +123,9 @@ pub struct ShaderKnobs {
     pub unpaired_bvh_stack: bool,
     /// The BVH stack at most `CAPPED_BVH_STACK` entries, pushes past it dropped.
     pub capped_bvh_stack: bool,
+    /// No node texels where the plan would choose them: OpenGL reads the
+    /// wide tree's nodes from their storage block, as Vulkan does.
+    pub storage_nodes: bool,
     /// Compute: KiB of workgroup memory the tracer does not need.
     pub shared_pad_kib: Option<u32>,
     /// The arithmetic probe (shaders/lab/ulp.glsl) in place of the tracer's
@@ -219,6 +226,7 @@ impl Variant {
             passes: Passes::default(),
             light_before_walk: false,
             bvh_stack_pairs: false,
+            node_texels: false,
             tags: Vec::new(),
         }
     }
@@ -455,9 +463,14 @@ impl Variant {
         } else {
             ""
         };
+        let texels = if self.node_texels {
+            "/node-texels"
+        } else {
+            ""
+        };
         let tags: String = self.tags.iter().map(|t| format!("/{t}")).collect();
         format!(
-            "{}/stack{}/{}{bvh}{spec}{light}{tags}",
+            "{}/stack{}/{}{bvh}{spec}{light}{texels}{tags}",
             parts.join("+"),
             self.ray_stack,
             self.numerics.label()

@@ -9,7 +9,7 @@ use crate::plan::{Planner, RunPlan};
 use crate::report::FrameTime;
 use crate::scene::camera::Orbit;
 use crate::shader::build::PathShaders;
-use crate::shader::variant::Entry;
+use crate::shader::variant::Variant;
 use crate::window::keys::{action_for_key, Action};
 use crate::window::title::{window_title, TitleClock};
 use crate::window::{hooks, Renderer, WindowedRun};
@@ -257,10 +257,9 @@ impl<R: Renderer> Session<R> {
                     RenderPath::Fragment => RenderPath::Compute,
                     RenderPath::Compute => RenderPath::Fragment,
                 };
-                self.plan.variant = self.plan.variant.on(Entry::new(
-                    path,
-                    self.planner.workgroup(self.plan.bvh.as_ref()),
-                ));
+                // Decided afresh: some choices are the path's (the workgroup,
+                // OpenGL's node texels and light order on the compute path).
+                self.plan.variant = self.variant_on(path);
                 self.rebuild()?;
                 self.restart_title();
                 eprintln!("{}: path {path}", self.program);
@@ -276,11 +275,8 @@ impl<R: Renderer> Session<R> {
                 self.rays_stale = true;
                 // The uniform block carries the depth; only a deeper stack or a
                 // feature the current shader compiled out needs a new variant.
-                let plan = &self.plan;
-                let needed = self
-                    .planner
-                    .variant(&plan.scene, plan.bvh.as_ref(), self.path());
-                let rebuilt = !plan.variant.covers(&needed);
+                let needed = self.variant_on(self.path());
+                let rebuilt = !self.plan.variant.covers(&needed);
                 if rebuilt {
                     self.plan.variant = needed;
                     self.rebuild()?;
@@ -301,6 +297,14 @@ impl<R: Renderer> Session<R> {
     }
 
     /// The plan's variant changed (path or depth): its shaders and buffers anew.
+    /// The variant the planner decides for the current scene on `path`.
+    fn variant_on(&self, path: RenderPath) -> Variant {
+        let texels = self.renderer.as_ref().map_or(0, |r| r.storage_limit().texel_buffer);
+        let plan = &self.plan;
+        self.planner
+            .variant(&plan.scene, plan.bvh.as_ref(), path, texels)
+    }
+
     fn rebuild(&mut self) -> anyhow::Result<()> {
         let plan = &mut self.plan;
         plan.shaders = PathShaders::build(&plan.variant)?;

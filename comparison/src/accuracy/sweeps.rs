@@ -273,7 +273,7 @@ pub fn program_of(scene: &str, set: &[String]) -> anyhow::Result<String> {
     );
     let planner = Planner::new(&args, AppApi::Vulkan)?;
     let bvh = args.accel.wants_bvh(&scene).then(|| build_bvh(&scene));
-    let v = planner.variant(&scene, bvh.as_ref(), RenderPath::Fragment);
+    let v = planner.variant(&scene, bvh.as_ref(), RenderPath::Fragment, 0);
     Ok(v.defines()
         .iter()
         .map(|(k, v)| format!("{k}={v}"))
