@@ -87,7 +87,9 @@ impl<'gl> SceneBuffers<'gl> {
     /// reads it (twinray_common::shader::node_texels): the same memory, no copy.
     fn bind_node_texels(&mut self) -> anyhow::Result<()> {
         let gl = self.gl;
-        let slot = binding::STORAGE.iter().position(|&b| b == binding::BVH_NODES);
+        let slot = binding::STORAGE
+            .iter()
+            .position(|&b| b == binding::BVH_NODES);
         let buffer = self.buffers[1 + slot.expect("the nodes are a storage buffer")];
         // SAFETY: a fresh texture on the current context, made a view of a
         // live buffer of whole RGBA32F texels (GpuBvhWideNode is 7 of them);
@@ -105,8 +107,13 @@ impl<'gl> SceneBuffers<'gl> {
         }
         explain::numbered(
             5,
-            &format!("glCreateTextures + glTexBuffer (texture unit {})", binding::BVH_NODES),
-            || "the node buffer again, as an RGBA32F buffer texture: the compute tracer reads the wide tree's nodes with texelFetch, which NVIDIA's OpenGL guards with no bounds check".to_string(),
+            &format!(
+                "glCreateTextures + glTexBuffer (texture unit {})",
+                binding::BVH_NODES
+            ),
+            || {
+                "the node buffer again, as an RGBA32F buffer texture: the compute tracer reads the wide tree's nodes with texelFetch, which NVIDIA's OpenGL guards with no bounds check".to_string()
+            },
         );
         Ok(())
     }

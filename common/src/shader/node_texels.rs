@@ -101,7 +101,10 @@ fn whole_node(before: &str, node: &str, after: &str) -> anyhow::Result<String> {
         .map(str::trim)
         .filter(|_| after.trim() == ";")
         .ok_or_else(|| {
-            anyhow!("node texels: a node read of a form the pass does not know: `{}`", before.trim())
+            anyhow!(
+                "node texels: a node read of a form the pass does not know: `{}`",
+                before.trim()
+            )
         })?;
     let planes = WIDE_NODE_TEXELS - 1;
     let bounds: Vec<String> = (0..planes).map(|k| fetch(node, &format!("{k}u"))).collect();
@@ -134,8 +137,11 @@ mod tests {
         assert!(!out.contains(&format!("{b}.nodes[")), "{out}");
         assert!(out.contains("vec4 _e1 = texelFetch(node_texels, int((_e2) * 7u + (_e3.x)));"));
         assert!(out.contains("BvhWideNode _e4 = BvhWideNode(vec4[6](texelFetch(node_texels, int(((_e5 + 1u)) * 7u + (0u))),"));
-        assert!(out.contains("floatBitsToUint(texelFetch(node_texels, int(((_e5 + 1u)) * 7u + (6u)))));"));
-        let decl = out.find("uniform highp samplerBuffer node_texels;").unwrap();
+        assert!(out
+            .contains("floatBitsToUint(texelFetch(node_texels, int(((_e5 + 1u)) * 7u + (6u)))));"));
+        let decl = out
+            .find("uniform highp samplerBuffer node_texels;")
+            .unwrap();
         assert!(decl > out.find("#version").unwrap() && decl < out.find("buffer B").unwrap());
         assert!(out.starts_with("#version 450 core\nlayout(binding = 6) uniform"));
     }

@@ -463,11 +463,7 @@ impl Variant {
         } else {
             ""
         };
-        let texels = if self.node_texels {
-            "/node-texels"
-        } else {
-            ""
-        };
+        let texels = if self.node_texels { "/node-texels" } else { "" };
         let tags: String = self.tags.iter().map(|t| format!("/{t}")).collect();
         format!(
             "{}/stack{}/{}{bvh}{spec}{light}{texels}{tags}",

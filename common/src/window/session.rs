@@ -299,7 +299,10 @@ impl<R: Renderer> Session<R> {
     /// The plan's variant changed (path or depth): its shaders and buffers anew.
     /// The variant the planner decides for the current scene on `path`.
     fn variant_on(&self, path: RenderPath) -> Variant {
-        let texels = self.renderer.as_ref().map_or(0, |r| r.storage_limit().texel_buffer);
+        let texels = self
+            .renderer
+            .as_ref()
+            .map_or(0, |r| r.storage_limit().texel_buffer);
         let plan = &self.plan;
         self.planner
             .variant(&plan.scene, plan.bvh.as_ref(), path, texels)
