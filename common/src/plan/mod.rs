@@ -354,3 +354,53 @@ impl RunPlan {
         }
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::cli::Size;
+    use crate::plan::requests::Api;
+
+    /// OpenGL's node texels: only its compute walks over a wide tree that
+    /// fits the device's buffer textures, and never under `--gl-spirv` or
+    /// `--experiment storage-nodes`, whose GLSL the pass never sees.
+    #[test]
+    fn only_opengls_compute_walks_over_a_wide_tree_read_node_texels() {
+        let scene = Scene::load("teapot", &[]).unwrap();
+        let binary = build_bvh(&scene);
+        let wide = build_bvh(&scene).widen(4);
+        let texels = (wide.wide.len() as u64 + 1) * u64::from(WIDE_NODE_TEXELS);
+        let args = RenderArgs::headless(
+            "teapot",
+            Size {
+                width: 8,
+                height: 8,
+            },
+        );
+        let reads = |args: &RenderArgs, api, bvh: &Bvh, path, limit| {
+            Planner::new(args, api)
+                .unwrap()
+                .variant(&scene, Some(bvh), path, limit)
+                .node_texels
+        };
+        let (compute, fragment) = (RenderPath::Compute, RenderPath::Fragment);
+        assert!(reads(&args, Api::OpenGl, &wide, compute, texels));
+        assert!(
+            !reads(&args, Api::OpenGl, &wide, compute, texels - 1),
+            "too many texels"
+        );
+        assert!(!reads(&args, Api::Vulkan, &wide, compute, texels));
+        assert!(!reads(&args, Api::OpenGl, &wide, fragment, texels));
+        assert!(!reads(&args, Api::OpenGl, &binary, compute, u64::MAX));
+        let spirv = RenderArgs {
+            gl_spirv: true,
+            ..args.clone()
+        };
+        assert!(!reads(&spirv, Api::OpenGl, &wide, compute, texels));
+        let storage = RenderArgs {
+            experiment: vec![crate::lab::experiment::Experiment::StorageNodes],
+            ..args.clone()
+        };
+        assert!(!reads(&storage, Api::OpenGl, &wide, compute, texels));
+    }
+}

@@ -79,8 +79,8 @@ impl Api {
     /// tree fits the device's largest buffer texture. NVIDIA's OpenGL guards
     /// each storage read with a bounds check that clears the registers before
     /// a predicated load; a texel fetch needs neither. OpenGL's teapot frames
-    /// on an H200 were 2-5 % shorter at every size, its 100k sphere list 2 %,
-    /// and not one pixel moved
+    /// on an H200 were 2-5 % shorter at every size, its 1080p sphere lists
+    /// 1 %, its 300² ones up to 1.6 % longer, and not one pixel moved
     /// (docs/findings/opengl-compute.md#the-nodes-through-a-buffer-texture-h200).
     /// Vulkan keeps its storage reads: naga has no texel buffers, and through
     /// glslang's SPIR-V the same reads cost Vulkan 6-7 % at scale

@@ -296,7 +296,6 @@ impl<R: Renderer> Session<R> {
         Ok(())
     }
 
-    /// The plan's variant changed (path or depth): its shaders and buffers anew.
     /// The variant the planner decides for the current scene on `path`.
     fn variant_on(&self, path: RenderPath) -> Variant {
         let texels = self
@@ -308,6 +307,7 @@ impl<R: Renderer> Session<R> {
             .variant(&plan.scene, plan.bvh.as_ref(), path, texels)
     }
 
+    /// The plan's variant changed (path or depth): its shaders and buffers anew.
     fn rebuild(&mut self) -> anyhow::Result<()> {
         let plan = &mut self.plan;
         plan.shaders = PathShaders::build(&plan.variant)?;
