@@ -191,8 +191,7 @@ fn render_fragment(run: &HeadlessRun, shaders: &Shaders) -> Result<(Rendered, Ve
         Program::new(gl, &shaders.vertex.glsl, &shaders.fragment.glsl)?
     };
     let stats = run.dump_binary(program.raw())?;
-    // The fragment path reads the nodes from their storage block (`Api::node_texels`).
-    let _buffers = SceneBuffers::new(gl, &run.plan.gpu(), false)?;
+    let _buffers = SceneBuffers::new(gl, &run.plan.gpu(), run.plan.variant.node_texels)?;
     let target = Target::new(gl, width, height)?;
     let vao = EmptyVertexArray::new(gl)?;
     let timer = Timer::new(gl, &run.info.device)?;

@@ -83,7 +83,7 @@ impl<'gl> SceneBuffers<'gl> {
     }
 
     /// The node buffer as an RGBA32F buffer texture at texture unit
-    /// `binding::BVH_NODES`, where the compute GLSL's `node_texels` sampler
+    /// `binding::BVH_NODES`, where the tracer's `node_texels` sampler
     /// reads it (twinray_common::shader::node_texels): the same memory, no copy.
     fn bind_node_texels(&mut self) -> anyhow::Result<()> {
         let gl = self.gl;
@@ -112,7 +112,7 @@ impl<'gl> SceneBuffers<'gl> {
                 binding::BVH_NODES
             ),
             || {
-                "the node buffer again, as an RGBA32F buffer texture: the compute tracer reads the wide tree's nodes with texelFetch, which NVIDIA's OpenGL guards with no bounds check".to_string()
+                "the node buffer again, as an RGBA32F buffer texture: the tracer reads the wide tree's nodes with texelFetch, which NVIDIA's OpenGL guards with no bounds check".to_string()
             },
         );
         Ok(())

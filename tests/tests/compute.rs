@@ -125,9 +125,9 @@ fn the_launch_order_moves_the_timing_not_the_image() {
     }
 }
 
-/// OpenGL's compute walks read the wide tree's nodes through a buffer
-/// texture; `--experiment storage-nodes` reads them from their storage
-/// block, as Vulkan does. Through every wide tree (the 4-wide one at two
+/// OpenGL's walks read the wide tree's nodes through a buffer texture;
+/// `--experiment storage-nodes` reads them from their storage block, as
+/// Vulkan does. On both paths, through every wide tree (the 4-wide one at two
 /// depths, the 8-wide one) and with spheres in the leaves, the two forms give
 /// the same bytes, and the label says which form ran.
 #[test]
@@ -140,22 +140,24 @@ fn opengl_reads_the_nodes_through_a_texture_to_the_same_image() {
     ];
     for (scene, extra) in cases {
         let dir = scratch(&format!("compute-texels-{scene}"));
-        let args = [extra, &["--path", "compute"]].concat();
-        let (rt, texels) = render(App::OpenGl, scene, "96x72", &args, &dir.join("texels.png"));
-        let storage_args = [&args[..], &["--experiment", "storage-nodes"]].concat();
-        let (rs, storage) = render(
-            App::OpenGl,
-            scene,
-            "96x72",
-            &storage_args,
-            &dir.join("storage.png"),
-        );
-        let what = format!("{scene} {extra:?} ({} against {})", rt.variant, rs.variant);
-        assert!(rt.variant.contains("/node-texels"), "{what}");
-        assert!(!rs.variant.contains("/node-texels"), "{what}");
-        assert_clean(&rt, &what);
-        assert_clean(&rs, &what);
-        twinray_tests::assert_identical(&texels, &storage, &what);
+        for path in ["fragment", "compute"] {
+            let args = [extra, &["--path", path]].concat();
+            let (rt, texels) = render(App::OpenGl, scene, "64x48", &args, &dir.join("texels.png"));
+            let storage_args = [&args[..], &["--experiment", "storage-nodes"]].concat();
+            let (rs, storage) = render(
+                App::OpenGl,
+                scene,
+                "64x48",
+                &storage_args,
+                &dir.join("storage.png"),
+            );
+            let what = format!("{scene} {args:?} ({} against {})", rt.variant, rs.variant);
+            assert!(rt.variant.contains("/node-texels"), "{what}");
+            assert!(!rs.variant.contains("/node-texels"), "{what}");
+            assert_clean(&rt, &what);
+            assert_clean(&rs, &what);
+            twinray_tests::assert_identical(&texels, &storage, &what);
+        }
         std::fs::remove_dir_all(dir).ok();
     }
 }

@@ -102,7 +102,7 @@ pub const REGISTRY: &[Entry] = &[
     entry(Experiment::WalkThenShade, "OpenGL's BVH walks on the compute path shade a scene's one light after its shadow walk, through the lights' loop, as every scene did, instead of before it with the hit's secondary rays pushed first: the hit's normals, view direction and material then stay live across the walk, and NVIDIA's OpenGL holds 24 warps a multiprocessor on the sphere list instead of 28. Vulkan and brute force shade that way already.", |c| {
         c.knobs.walk_then_shade = true
     }),
-    entry(Experiment::StorageNodes, "OpenGL's BVH walks on the compute path read the wide tree's nodes from their storage block, as Vulkan does and as every walk did, instead of through a buffer texture over the same buffer: NVIDIA's OpenGL then guards each read with a bounds check and clears its registers before the load. Vulkan, brute force, the binary tree and --gl-spirv read them that way already.", |c| {
+    entry(Experiment::StorageNodes, "OpenGL's BVH walks over a wide tree read its nodes from their storage block, as Vulkan does and as every walk did, instead of through a buffer texture over the same buffer: NVIDIA's OpenGL then guards each read with a bounds check and clears its registers before the load. Vulkan, brute force, the binary tree and --gl-spirv read them that way already.", |c| {
         c.knobs.storage_nodes = true
     }),
     entry(Experiment::UniformCounts, "Read the primitive and light counts from the Frame uniform instead of baking them into the shader (what made lavapipe grow per frame).", |c| {

@@ -289,7 +289,7 @@ impl Planner {
         v.node_texels = !c.knobs.storage_nodes
             && !self.args.gl_spirv
             && fits
-            && self.api.node_texels(bvh.is_some_and(|b| b.width > 2), path);
+            && self.api.node_texels(bvh.is_some_and(|b| b.width > 2));
         v
     }
 }
@@ -361,11 +361,11 @@ mod tests {
     use crate::cli::Size;
     use crate::plan::requests::Api;
 
-    /// OpenGL's node texels: only its compute walks over a wide tree that
-    /// fits the device's buffer textures, and never under `--gl-spirv` or
-    /// `--experiment storage-nodes`, whose GLSL the pass never sees.
+    /// OpenGL's node texels: only its walks over a wide tree that fits the
+    /// device's buffer textures, on either path, and never under `--gl-spirv`
+    /// (whose SPIR-V the pass never sees) or `--experiment storage-nodes`.
     #[test]
-    fn only_opengls_compute_walks_over_a_wide_tree_read_node_texels() {
+    fn only_opengls_walks_over_a_wide_tree_read_node_texels() {
         let scene = Scene::load("teapot", &[]).unwrap();
         let binary = build_bvh(&scene);
         let wide = build_bvh(&scene).widen(4);
@@ -390,7 +390,8 @@ mod tests {
             "too many texels"
         );
         assert!(!reads(&args, Api::Vulkan, &wide, compute, texels));
-        assert!(!reads(&args, Api::OpenGl, &wide, fragment, texels));
+        assert!(reads(&args, Api::OpenGl, &wide, fragment, texels));
+        assert!(!reads(&args, Api::Vulkan, &wide, fragment, texels));
         assert!(!reads(&args, Api::OpenGl, &binary, compute, u64::MAX));
         let spirv = RenderArgs {
             gl_spirv: true,

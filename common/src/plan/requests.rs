@@ -75,19 +75,20 @@ impl Api {
 
     /// Whether the tracer reads the wide tree's nodes through a buffer texture
     /// (`texelFetch` on a `samplerBuffer` over the node buffer) instead of
-    /// its storage block: on OpenGL's BVH walks on the compute path, where the
-    /// tree fits the device's largest buffer texture. NVIDIA's OpenGL guards
-    /// each storage read with a bounds check that clears the registers before
-    /// a predicated load; a texel fetch needs neither. OpenGL's teapot frames
-    /// on an H200 were 2-5 % shorter at every size, its 1080p sphere lists
-    /// 1 %, its 300² ones up to 1.6 % longer, and not one pixel moved
-    /// (docs/findings/opengl-compute.md#the-nodes-through-a-buffer-texture-h200).
+    /// its storage block: on OpenGL's BVH walks, on both paths, where the tree
+    /// fits the device's largest buffer texture. NVIDIA's OpenGL guards each
+    /// storage read with a bounds check that clears the registers before a
+    /// predicated load; a texel fetch needs neither. On an H200 OpenGL's
+    /// teapot frames were 2-5 % shorter on the compute path and 6-9 % on the
+    /// fragment path, its 1080p sphere lists 1 % and 5 %, its 300² ones on
+    /// the compute path up to 1.6 % longer; not one pixel moved
+    /// (docs/findings/opengl-compute.md#the-nodes-through-a-buffer-texture-h200,
+    /// docs/findings/fragment-gap.md#the-nodes-through-a-buffer-texture-h200).
     /// Vulkan keeps its storage reads: naga has no texel buffers, and through
     /// glslang's SPIR-V the same reads cost Vulkan 6-7 % at scale
     /// (f8d14ba:comparison/results/nvidia-h100/investigation/texel-nodes/vk/tv.txt).
-    /// The fragment path was not measured with it.
-    pub fn node_texels(&self, wide: bool, path: RenderPath) -> bool {
-        *self == Api::OpenGl && wide && path == RenderPath::Compute
+    pub fn node_texels(&self, wide: bool) -> bool {
+        *self == Api::OpenGl && wide
     }
 
     /// Whether a BVH stack of `entries` holds two entries to a `uvec4`

@@ -223,7 +223,10 @@ impl PathShaders {
     /// Whether the tracer reads the wide tree's nodes through a buffer
     /// texture, which OpenGL must then bind (`Variant::node_texels`).
     pub fn reads_node_texels(&self) -> bool {
-        matches!(self, PathShaders::Compute(c) if c.variant.node_texels)
+        match self {
+            PathShaders::Fragment(s) => s.variant.node_texels,
+            PathShaders::Compute(c) => c.variant.node_texels,
+        }
     }
 
     pub fn path(&self) -> RenderPath {
@@ -385,8 +388,8 @@ pub fn to_glsl(
     if stage == ShaderStage::Compute && passes.warp_probe {
         out = warp_probe_glsl(&out, crate::gpu::layout::binding::WARP_PROBE)?;
     }
-    if stage == ShaderStage::Compute && variant.node_texels {
-        out = super::node_texels::node_texels_glsl(&out)?;
+    if stage != ShaderStage::Vertex && variant.node_texels {
+        out = super::node_texels::node_texels_glsl(&out, stage)?;
     }
     if passes.no_contraction {
         out = precise_float_locals_glsl(&out);

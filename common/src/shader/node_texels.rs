@@ -15,24 +15,31 @@
 
 use crate::gpu::layout::{binding, WIDE_NODE_TEXELS};
 use anyhow::{anyhow, bail};
+use naga::ShaderStage;
 
 /// The sampler's name in the rewritten GLSL.
 const SAMPLER: &str = "node_texels";
 
-/// naga's name for the node block's instance in a compute shader.
-fn block() -> String {
-    format!("_group_0_binding_{}_cs", binding::BVH_NODES)
+/// naga's name for the node block's instance in a `stage` shader.
+fn block(stage: ShaderStage) -> String {
+    let suffix = match stage {
+        ShaderStage::Compute => "cs",
+        ShaderStage::Fragment => "fs",
+        _ => "vs",
+    };
+    format!("_group_0_binding_{}_{suffix}", binding::BVH_NODES)
 }
 
-/// The compute GLSL with every node read a texel fetch, and the sampler
+/// The `stage` GLSL with every node read a texel fetch, and the sampler
 /// declared at texture unit `binding::BVH_NODES` (GL's texture units are a
 /// space of their own, so the number is the node buffer's binding).
-pub fn node_texels_glsl(glsl: &str) -> anyhow::Result<String> {
-    let reads = format!("{}.nodes[", block());
+pub fn node_texels_glsl(glsl: &str, stage: ShaderStage) -> anyhow::Result<String> {
+    let block = block(stage);
+    let reads = format!("{block}.nodes[");
     let mut out = String::with_capacity(glsl.len() + 4096);
     let mut rewritten = 0;
     for line in glsl.lines() {
-        if line.contains(&block()) && !line.contains(&reads) && !line.starts_with('}') {
+        if line.contains(&block) && !line.contains(&reads) && !line.starts_with('}') {
             bail!("node texels: naga's GLSL names the node block in a form the pass does not know: `{}`", line.trim());
         }
         let mut rest = line;
@@ -123,17 +130,17 @@ mod tests {
     fn shader(body: &str) -> String {
         format!(
             "#version 450 core\nlayout(std430, binding = 6) restrict readonly buffer B {{\n    BvhWideNode nodes[];\n}} {};\n\nvoid main() {{\n{body}}}\n",
-            block()
+            block(ShaderStage::Compute)
         )
     }
 
     #[test]
     fn every_node_read_becomes_a_texel_fetch() {
-        let b = block();
+        let b = block(ShaderStage::Compute);
         let glsl = shader(&format!(
             "    vec4 _e1 = {b}.nodes[_e2].bounds[_e3.x];\n    BvhWideNode _e4 = {b}.nodes[(_e5 + 1u)];\n"
         ));
-        let out = node_texels_glsl(&glsl).unwrap();
+        let out = node_texels_glsl(&glsl, ShaderStage::Compute).unwrap();
         assert!(!out.contains(&format!("{b}.nodes[")), "{out}");
         assert!(out.contains("vec4 _e1 = texelFetch(node_texels, int((_e2) * 7u + (_e3.x)));"));
         assert!(out.contains("BvhWideNode _e4 = BvhWideNode(vec4[6](texelFetch(node_texels, int(((_e5 + 1u)) * 7u + (0u))),"));
@@ -148,13 +155,15 @@ mod tests {
 
     #[test]
     fn a_read_the_pass_does_not_know_is_refused() {
-        let b = block();
+        let b = block(ShaderStage::Compute);
         for body in [
             format!("    uvec4 c = {b}.nodes[_e2].child;\n"),
             format!("    uint n = uint({b}.nodes.length());\n"),
             String::new(),
         ] {
-            let err = node_texels_glsl(&shader(&body)).unwrap_err().to_string();
+            let err = node_texels_glsl(&shader(&body), ShaderStage::Compute)
+                .unwrap_err()
+                .to_string();
             assert!(err.starts_with("node texels:"), "{err}");
         }
     }
