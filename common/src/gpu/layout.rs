@@ -147,7 +147,7 @@ pub struct GpuBvhWideNode {
 }
 
 /// The RGBA32F texels of one `GpuBvhWideNode` where OpenGL reads the nodes
-/// through a buffer texture (`shader::post::node_texels_glsl`): the six
+/// through a buffer texture (`shader::node_texels::node_texels_glsl`): the six
 /// bounds, then the children's references as the seventh's bits.
 pub const WIDE_NODE_TEXELS: u32 = (size_of::<GpuBvhWideNode>() / 16) as u32;
 

@@ -282,14 +282,13 @@ impl Planner {
             && self
                 .api
                 .light_before_walk(bvh.is_some(), path, scene.lights.len());
-        // The GPU's copy of the tree starts with a sentinel node (upload.rs).
-        let fits = bvh.is_some_and(|b| {
-            (b.wide.len() as u64 + 1) * u64::from(WIDE_NODE_TEXELS) <= texel_buffer
+        // A wide tree whose GPU copy (a sentinel node first, upload.rs) fits
+        // the device's buffer textures.
+        let wide_fits = bvh.is_some_and(|b| {
+            b.width > 2 && (b.wide.len() as u64 + 1) * u64::from(WIDE_NODE_TEXELS) <= texel_buffer
         });
-        v.node_texels = !c.knobs.storage_nodes
-            && !self.args.gl_spirv
-            && fits
-            && self.api.node_texels(bvh.is_some_and(|b| b.width > 2));
+        v.node_texels =
+            !c.knobs.storage_nodes && !self.args.gl_spirv && self.api.node_texels(wide_fits);
         v
     }
 }

@@ -46,7 +46,7 @@ pub struct Variant {
     pub bvh_stack_pairs: bool,
     /// OpenGL's GLSL reads the wide tree's nodes through a buffer texture
     /// over the same buffer instead of its storage block (`Api::node_texels`
-    /// decides; `shader::post::node_texels_glsl` rewrites naga's reads).
+    /// decides; `shader::node_texels::node_texels_glsl` rewrites naga's reads).
     pub node_texels: bool,
     /// The experiments' names, in registry order, for the label.
     pub tags: Vec<String>,

@@ -258,7 +258,7 @@ impl<R: Renderer> Session<R> {
                     RenderPath::Compute => RenderPath::Fragment,
                 };
                 // Decided afresh: some choices are the path's (the workgroup,
-                // OpenGL's node texels and light order on the compute path).
+                // OpenGL's light order on the compute path).
                 self.plan.variant = self.variant_on(path);
                 self.rebuild()?;
                 self.restart_title();
