@@ -44,6 +44,29 @@ pub(crate) const TEAPOT_BVH_COMPUTE: Gap = Gap {
     path: RenderPath::Compute,
     measure: GapMeasure::Ratio,
 };
+/// The same at the preset's large frame (1080p in the full preset), where
+/// users measure rays per second: a lone frame's end weighs less than at
+/// 1000², Vulkan's workgroup as much.
+pub(crate) const TEAPOT_BVH_LARGE: Gap = Gap {
+    name: "teapot BVH compute large frame",
+    scene: "teapot",
+    set: &[],
+    frame: GapFrame::Large,
+    accel: Accel::Auto,
+    path: RenderPath::Compute,
+    measure: GapMeasure::Ratio,
+};
+/// The same at the preset's largest frame (4K in the full preset), where the
+/// frame's end weighs least.
+pub(crate) const TEAPOT_BVH_LARGEST: Gap = Gap {
+    name: "teapot BVH compute largest frame",
+    scene: "teapot",
+    set: &[],
+    frame: GapFrame::Largest,
+    accel: Accel::Auto,
+    path: RenderPath::Compute,
+    measure: GapMeasure::Ratio,
+};
 /// The teapot at 307k triangles, whose 4-wide tree needs a stack of 37
 /// entries, deeper than any of the study's scenes: NVIDIA's OpenGL runs its
 /// tracer on fewer multiprocessors (110 of an H200's 132).

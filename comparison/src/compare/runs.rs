@@ -141,6 +141,9 @@ pub enum GapFrame {
     Square,
     /// The preset's large frame (1080p in the full preset).
     Large,
+    /// The preset's largest frame (4K in the full preset), where a lone
+    /// frame's start and end weigh least.
+    Largest,
     /// The preset's small square (300² in the full preset): a frame of one
     /// wave of workgroups, which a fixed cost of each dispatch weighs on.
     Small,

@@ -7,7 +7,8 @@
 use crate::apps::{run_json, Api};
 use crate::compare::gaps::{
     floor_file, write_floor_files, BOX_COMPUTE, BOX_FRAGMENT, BOX_IMAGES, SPHERELIST_BVH_COMPUTE,
-    SPHERELIST_BVH_SMALL, TEAPOT_BVH_COMPUTE, TEAPOT_DEEP_BVH_COMPUTE, TEAPOT_FRAGMENT,
+    SPHERELIST_BVH_SMALL, TEAPOT_BVH_COMPUTE, TEAPOT_BVH_LARGE, TEAPOT_BVH_LARGEST,
+    TEAPOT_DEEP_BVH_COMPUTE, TEAPOT_FRAGMENT,
 };
 use crate::compare::runs::{
     baselines, run_label, runs_of, Case, Gap, GapFrame, GapMeasure, Hold, Measured, Run, Why,
@@ -115,6 +116,9 @@ pub const CASES: &[Case] = &[
     second_frame(&TEAPOT_BVH_COMPUTE, None),
     second_frame(&TEAPOT_BVH_COMPUTE, Some((4, 8))),
     opengl(&TEAPOT_BVH_COMPUTE, &[Experiment::StorageNodes]),
+    one_workgroup(&TEAPOT_BVH_LARGE),
+    second_frame(&TEAPOT_BVH_LARGE, Some((4, 8))),
+    one_workgroup(&TEAPOT_BVH_LARGEST),
     both(&TEAPOT_DEEP_BVH_COMPUTE, &[Experiment::CappedBvhStack]),
     opengl(&TEAPOT_DEEP_BVH_COMPUTE, &[Experiment::StorageNodes]),
     one_workgroup(&TEAPOT_DEEP_BVH_COMPUTE),
@@ -144,6 +148,8 @@ pub struct WhyPlan {
     pub teapot_brute_side: u32,
     /// The frame of the gaps measured where users trace large frames.
     pub large_frame: (u32, u32),
+    /// The frame of the gaps measured at the largest frame users trace.
+    pub largest_frame: (u32, u32),
     /// The side of the gaps measured in a frame of one wave.
     pub small_side: u32,
     /// Frames per run at most; each stops once settled (`settle`, per cent).
@@ -206,6 +212,7 @@ pub fn run(out: &Path, plan: &WhyPlan, paths: &[RenderPath], stop: &AtomicBool) 
         let (width, height) = match gap.frame {
             GapFrame::Square => (side, side),
             GapFrame::Large => plan.large_frame,
+            GapFrame::Largest => plan.largest_frame,
             GapFrame::Small => (plan.small_side, plan.small_side),
         };
         let size = Size { width, height };
