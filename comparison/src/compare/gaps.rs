@@ -79,6 +79,18 @@ pub(crate) const TEAPOT_DEEP_BVH_COMPUTE: Gap = Gap {
     path: RenderPath::Compute,
     measure: GapMeasure::Ratio,
 };
+/// The teapot at 4.9M triangles, the deepest of the scaling points: a stack
+/// of 47 entries, on which NVIDIA's OpenGL runs the tracer on 88 of an
+/// H200's 132 multiprocessors.
+pub(crate) const TEAPOT_DEEPEST_BVH_COMPUTE: Gap = Gap {
+    name: "teapot 4.9M BVH compute",
+    scene: "teapot",
+    set: &["tessellation=320x240"],
+    frame: GapFrame::Square,
+    accel: Accel::Auto,
+    path: RenderPath::Compute,
+    measure: GapMeasure::Ratio,
+};
 /// The sphere list at its largest: the deepest tree of the study's scenes.
 pub(crate) const SPHERELIST_BVH_COMPUTE: Gap = Gap {
     name: "sphere list BVH compute",
