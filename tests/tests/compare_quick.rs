@@ -137,6 +137,7 @@ const WHY_ROWS: &[&str] = &[
     "the second of two frames back to back",
     "at workgroup 4x8: the second of two frames back to back",
     "capped-bvh-stack",
+    "capped-bvh-stack+unpaired-bvh-stack",
 ];
 
 fn why_table_has_a_verdict_per_gap_and_experiment(report: &str, out: &std::path::Path) {
