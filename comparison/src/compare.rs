@@ -99,19 +99,7 @@ impl Preset {
                 frames: 8,
                 settle: 2.0,
                 seconds_per_point: 4.0,
-                why: WhyPlan {
-                    box_side: 100,
-                    teapot_side: 16,
-                    teapot_brute_side: 16,
-                    large_frame: (64, 36),
-                    largest_frame: (128, 72),
-                    deepest: false,
-                    small_side: 100,
-                    frames: 8,
-                    settle: 2.0,
-                    seconds_per_point: 2.0,
-                    rounds: 1,
-                },
+                why: WhyPlan::QUICK,
             }
         } else {
             Preset {
@@ -123,23 +111,7 @@ impl Preset {
                 frames: 60,
                 settle: 1.0,
                 seconds_per_point: 30.0,
-                // The brute-force teapot's fragment frame takes seconds at
-                // 1000²: its gap is measured at 400², where its ratio is the
-                // sweep's (report: the teapot table). One round: each run's
-                // interval already says how far its median can be trusted.
-                why: WhyPlan {
-                    box_side: 1000,
-                    teapot_side: 1000,
-                    teapot_brute_side: 400,
-                    large_frame: (1920, 1080),
-                    largest_frame: (3840, 2160),
-                    deepest: true,
-                    small_side: 300,
-                    frames: 60,
-                    settle: 1.0,
-                    seconds_per_point: 30.0,
-                    rounds: 1,
-                },
+                why: WhyPlan::FULL,
             }
         }
     }
