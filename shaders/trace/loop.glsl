@@ -6,7 +6,9 @@
 //
 // Features a scene lacks are compiled out through defines chosen in
 // common's shader module: HAS_SPHERES, HAS_TRIANGLES, HAS_MIRROR, HAS_GLASS,
-// and STACK_SIZE (the ray stack: max_depth + 1 with glass, else 1).
+// and STACK_SIZE (the ray stack: with glass max_depth entries, Features::ray_stack_entries
+// in common/src/scene/mod.rs says why that is enough, and by brute force one more;
+// without glass 1).
 // LIGHT_BEFORE_WALK reorders one light's shading for OpenGL's BVH walks (SHADE).
 //
 // The primitive and light counts are defines too (SPHERE_COUNT, TRIANGLE_COUNT,
@@ -143,7 +145,7 @@ vec3 trace(vec3 origin, vec3 dir) {
     RAY_STACK_DECLARE;
 #ifdef HAS_GLASS
     // Glass pushes two rays per hit: the stack's size bounds the depth.
-    uint max_depth = min(frame.max_depth, uint(STACK_SIZE - 1));
+    uint max_depth = min(frame.max_depth, uint(STACK_SIZE));
 #else
     // A mirror pushes one ray after popping one: one slot serves any depth.
     uint max_depth = frame.max_depth;

@@ -126,6 +126,11 @@ impl Tracer<'_> {
     pub fn trace(&self, origin: DVec3, dir: DVec3) -> DVec3 {
         trace_with(self, origin, dir, &mut RayKinds::default(), &mut |_| {})
     }
+
+    /// The ray stack's entries: the shader's STACK_SIZE for this scene.
+    fn ray_capacity(&self) -> usize {
+        self.scene.features().ray_stack_entries(self.scene.max_depth) as usize
+    }
 }
 
 /// How one glass or mirror hit divides the weight of the ray that arrived
@@ -308,7 +313,7 @@ fn refine(scene: &Scene, hit: &Hit, o: DVec3, d: DVec3, t: f64) -> f64 {
     }
 }
 
-/// One pixel: the shader's `trace`, with its stack capacity of max_depth + 1,
+/// One pixel: the shader's `trace`, with its ray stack's capacity,
 /// adding its rays to `kinds` where the counting variant counts them and
 /// telling `split` how each glass or mirror hit divides its ray's weight.
 fn trace_with(
@@ -318,9 +323,20 @@ fn trace_with(
     kinds: &mut RayKinds,
     split: &mut dyn FnMut(Split),
 ) -> DVec3 {
+    trace_within(tracer, origin, dir, tracer.ray_capacity(), kinds, split)
+}
+
+/// `trace_with` with room for `capacity` pending rays (a test gives it more).
+fn trace_within(
+    tracer: &Tracer,
+    origin: DVec3,
+    dir: DVec3,
+    capacity: usize,
+    kinds: &mut RayKinds,
+    split: &mut dyn FnMut(Split),
+) -> DVec3 {
     kinds.primary += 1;
     let scene = tracer.scene;
-    let capacity = scene.max_depth as usize + 1;
     let mut stack = Vec::with_capacity(capacity);
     stack.push(Ray {
         o: origin,
@@ -442,6 +458,9 @@ pub fn render_truth(scene: &Scene, width: u32, height: u32) -> FloatImage {
     s.epsilon = TRUTH_EPSILON;
     render_with(&s, width, height, &truth_numerics())
 }
+
+#[cfg(test)]
+mod ray_stack_tests;
 
 #[cfg(test)]
 mod tests {

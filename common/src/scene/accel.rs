@@ -21,9 +21,14 @@ pub enum Accel {
 }
 
 /// `--accel auto` builds a BVH for scenes with at least this many primitives.
-/// Below it the brute-force loop is as fast or faster: see the comparison
-/// report's acceleration section for the measurements behind the number.
-pub const AUTO_BVH_MIN_PRIMITIVES: usize = 64;
+/// On an H200 auto's 4-wide tree is faster from the fewest measured (8), in
+/// both APIs and on both paths; on Mesa's llvmpipe brute force is as fast up
+/// to about a dozen and the tree faster from 17 in three of the four app and
+/// path pairs. So the box (32 primitives) takes the tree, a third of its
+/// brute-force time on the GPU (docs/findings/bvh.md#where-the-bvh-starts-to-pay;
+/// `twinray sweep comparison/plans/auto-threshold.toml --out OUT`). It was 64,
+/// from an older traversal.
+pub const AUTO_BVH_MIN_PRIMITIVES: usize = 16;
 
 impl Accel {
     /// Whether a run with this `--accel` traces `scene` through a BVH (none:

@@ -97,6 +97,25 @@ pub struct Features {
     pub glass: bool,
 }
 
+impl Features {
+    /// The ray stack's entries (the shader's STACK_SIZE; the f64 reference
+    /// holds as many). Only glass makes the ray tree branch (reflected and
+    /// refracted rays). A ray of depth d pushes its children only while
+    /// d + 1 < max_depth, and each level's pop and two pushes leave one ray
+    /// more: after a ray of depth d pushed, the stack holds at most d + 2, so
+    /// max_depth at the deepest push (d = max_depth - 2), and no push is ever
+    /// dropped (a brute-force shader declares one entry more:
+    /// `Variant::ray_stack_declared` says why). Without glass a hit pushes at most one ray after popping one, so one
+    /// entry serves every max depth, and every max depth compiles to one shader.
+    pub fn ray_stack_entries(self, max_depth: u32) -> u32 {
+        if self.glass {
+            max_depth.max(1)
+        } else {
+            1
+        }
+    }
+}
+
 #[derive(Debug, Clone, serde::Serialize, serde::Deserialize, PartialEq)]
 pub struct SceneStats {
     pub name: String,

@@ -203,15 +203,7 @@ impl Variant {
     /// refraction code without glass, a ray stack sized to the depth. The
     /// counts are read from the uniform until `with_scene_data` bakes them.
     pub fn from_features(features: Features, max_depth: u32, numerics: Numerics) -> Variant {
-        // Only glass makes the ray tree branch (reflected and refracted rays):
-        // then the depth-first stack holds one pending ray per level. Without
-        // glass a hit pushes at most one ray after popping one, so one slot
-        // serves every max depth, and every max depth compiles to one shader.
-        let ray_stack = if features.glass {
-            max_depth.max(1) + 1
-        } else {
-            1
-        };
+        let ray_stack = features.ray_stack_entries(max_depth);
         Variant {
             features,
             form: Form::Scene,
@@ -267,6 +259,24 @@ impl Variant {
         self.bvh_stack = bvh.map(Bvh::stack_entries);
         self.bvh_width = bvh.map_or(2, |b| b.width.max(2));
         self
+    }
+
+    /// The ray stack's entries as the shader declares them (STACK_SIZE):
+    /// `ray_stack` where the tracer walks a BVH, one more by brute force.
+    /// Beside a BVH stack the spare entry's 32 bytes of local memory took
+    /// NVIDIA's OpenGL box tracer from 240 to 272 B, past the 254 B where
+    /// that driver idles multiprocessors (124 of 132 ran it; its 1080p and
+    /// 4K frames 4-5 % longer). By brute force it is what keeps Vulkan's
+    /// fragment compiler from holding the whole stack in registers: given
+    /// five entries it took 113 registers instead of 95 and the box's frame
+    /// took 7 % longer (docs/findings/bvh.md#the-boxs-tree-and-its-ray-stack-h200).
+    /// A stack of one entry (no glass) has nothing to spare.
+    pub fn ray_stack_declared(&self) -> u32 {
+        if self.ray_stack > 1 && self.bvh_stack.is_none() {
+            self.ray_stack + 1
+        } else {
+            self.ray_stack
+        }
     }
 
     /// The BVH stack's entries as the shader declares them: the tree's, or
@@ -360,7 +370,7 @@ impl Variant {
         for n in self.numerics.defines() {
             flag(true, n);
         }
-        d.insert("STACK_SIZE".into(), self.ray_stack.to_string());
+        d.insert("STACK_SIZE".into(), self.ray_stack_declared().to_string());
         if let (Some(n), Some(declared)) = (self.bvh_stack, self.bvh_stack_declared()) {
             d.insert("BVH_STACK".into(), declared.to_string());
             if declared < n {
@@ -468,7 +478,7 @@ impl Variant {
         format!(
             "{}/stack{}/{}{bvh}{spec}{light}{texels}{tags}",
             parts.join("+"),
-            self.ray_stack,
+            self.ray_stack_declared(),
             self.numerics.label()
         )
     }

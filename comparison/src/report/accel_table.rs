@@ -85,8 +85,9 @@ pub fn section(accel: &[AccelRun], plots: &[String]) -> String {
             s,
             "\n**Where `--accel auto` switches.** `auto` traces through a BVH from {} primitives on \
              (`AUTO_BVH_MIN_PRIMITIVES`, common/src/scene/accel.rs), one threshold for both APIs so that both always run the \
-             same shader. It was set from the sphere-list crossover rows above, measured on an NVIDIA H200 and on Mesa \
-             llvmpipe (comparison/results/). Here:",
+             same shader. It was set from auto's 4-wide tree against brute force on the box and the sphere list, \
+             measured on an NVIDIA H200 and on Mesa llvmpipe (docs/findings/bvh.md). The rows above trace the binary \
+             tree. Here:",
             twinray_common::scene::accel::AUTO_BVH_MIN_PRIMITIVES
         );
         for api in [Api::Vulkan, Api::Opengl] {

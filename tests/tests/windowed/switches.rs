@@ -34,7 +34,7 @@ fn scene_switches_keep_accel_and_the_overrides_that_apply() {
             r.variant
         );
         // The box through a BVH, to the sphere list and back: still a BVH,
-        // and the depth override still applies (glass at depth 2: a 3-slot stack).
+        // and the depth override still applies (glass at depth 2: a 2-slot stack).
         let (r, err) = switched(
             &x,
             app,
@@ -43,7 +43,7 @@ fn scene_switches_keep_accel_and_the_overrides_that_apply() {
         );
         assert_eq!(r.scene.name, "box", "{app:?}: {err}");
         assert!(r.variant.contains("/bvh"), "{app:?}: {}", r.variant);
-        assert!(r.variant.contains("/stack3/"), "{app:?}: {}", r.variant);
+        assert!(r.variant.contains("/stack2/"), "{app:?}: {}", r.variant);
         assert_eq!(r.scene.max_depth, 2, "{app:?}");
         // 50 hidden spheres cannot apply to the box: the switch drops them
         // and says so; back on the sphere list they apply again.
