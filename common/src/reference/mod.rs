@@ -129,7 +129,9 @@ impl Tracer<'_> {
 
     /// The ray stack's entries: the shader's STACK_SIZE for this scene.
     fn ray_capacity(&self) -> usize {
-        self.scene.features().ray_stack_entries(self.scene.max_depth) as usize
+        self.scene
+            .features()
+            .ray_stack_entries(self.scene.max_depth) as usize
     }
 }
 

@@ -16,7 +16,14 @@ fn pixels(scene: &Scene, width: u32, height: u32, capacity: Option<usize>) -> Ve
         .into_par_iter()
         .map(|i| {
             let dir = frame.dir((i % width) as f64, (i / width) as f64);
-            trace_within(&tracer, frame.eye, dir, capacity, &mut RayKinds::default(), &mut |_| {})
+            trace_within(
+                &tracer,
+                frame.eye,
+                dir,
+                capacity,
+                &mut RayKinds::default(),
+                &mut |_| {},
+            )
         })
         .collect()
 }
@@ -30,7 +37,10 @@ fn glass_scenes() -> Vec<(String, Scene)> {
     }
     let mut scenes = Vec::new();
     for p in paths {
-        let deepest = [("max_depth".to_string(), crate::limits::MAX_DEPTH.to_string())];
+        let deepest = [(
+            "max_depth".to_string(),
+            crate::limits::MAX_DEPTH.to_string(),
+        )];
         for set in [&[][..], &deepest[..]] {
             let scene = Scene::load(&p, set).unwrap();
             assert!(scene.features().glass, "{p}: no glass");
@@ -46,7 +56,10 @@ fn the_ray_stack_drops_no_ray() {
         let ample = pixels(&scene, 48, 36, Some(4 * crate::limits::MAX_DEPTH as usize));
         let declared = pixels(&scene, 48, 36, None);
         let differ = ample.iter().zip(&declared).filter(|(a, b)| a != b).count();
-        assert_eq!(differ, 0, "{name}: {differ} pixels lose rays on the declared stack");
+        assert_eq!(
+            differ, 0,
+            "{name}: {differ} pixels lose rays on the declared stack"
+        );
     }
 }
 
@@ -67,5 +80,8 @@ fn one_entry_fewer_drops_rays_through_nested_glass() {
     assert_eq!(declared, ample, "the declared stack drops rays");
     let short = pixels(&scene, 64, 48, Some(entries - 1));
     let differ = declared.iter().zip(&short).filter(|(a, b)| a != b).count();
-    assert!(differ > 0, "nested glass never fills the ray stack: the bound is loose");
+    assert!(
+        differ > 0,
+        "nested glass never fills the ray stack: the bound is loose"
+    );
 }

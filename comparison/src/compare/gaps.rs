@@ -67,6 +67,18 @@ pub(crate) const TEAPOT_BVH_LARGEST: Gap = Gap {
     path: RenderPath::Compute,
     measure: GapMeasure::Ratio,
 };
+/// The box through the tree `auto` gives it (4-wide, 32 primitives): a frame
+/// of a tenth of a millisecond at 1000², where a lone dispatch's start and
+/// end weigh most.
+pub(crate) const BOX_BVH_COMPUTE: Gap = Gap {
+    name: "box BVH compute",
+    scene: "box",
+    set: &[],
+    frame: GapFrame::Square,
+    accel: Accel::Auto,
+    path: RenderPath::Compute,
+    measure: GapMeasure::Ratio,
+};
 /// The teapot at 307k triangles, whose 4-wide tree needs a stack of 37
 /// entries, deeper than any of the study's scenes: NVIDIA's OpenGL runs its
 /// tracer on fewer multiprocessors (110 of an H200's 132).

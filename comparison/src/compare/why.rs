@@ -6,9 +6,9 @@
 
 use crate::apps::{run_json, Api};
 use crate::compare::gaps::{
-    floor_file, write_floor_files, BOX_COMPUTE, BOX_FRAGMENT, BOX_IMAGES, SPHERELIST_BVH_COMPUTE,
-    SPHERELIST_BVH_SMALL, TEAPOT_BVH_COMPUTE, TEAPOT_BVH_LARGE, TEAPOT_BVH_LARGEST,
-    TEAPOT_DEEPEST_BVH_COMPUTE, TEAPOT_DEEP_BVH_COMPUTE, TEAPOT_FRAGMENT,
+    floor_file, write_floor_files, BOX_BVH_COMPUTE, BOX_COMPUTE, BOX_FRAGMENT, BOX_IMAGES,
+    SPHERELIST_BVH_COMPUTE, SPHERELIST_BVH_SMALL, TEAPOT_BVH_COMPUTE, TEAPOT_BVH_LARGE,
+    TEAPOT_BVH_LARGEST, TEAPOT_DEEPEST_BVH_COMPUTE, TEAPOT_DEEP_BVH_COMPUTE, TEAPOT_FRAGMENT,
 };
 use crate::compare::runs::{
     baselines, run_label, runs_of, Case, Gap, GapFrame, GapMeasure, Hold, Measured, Run, Why,
@@ -111,6 +111,8 @@ pub const CASES: &[Case] = &[
     gl_spirv(&BOX_FRAGMENT),
     gl_spirv(&BOX_COMPUTE),
     both(&BOX_COMPUTE, &[Experiment::SplitRayStack]),
+    one_workgroup(&BOX_BVH_COMPUTE),
+    second_frame(&BOX_BVH_COMPUTE, None),
     vulkan(&TEAPOT_FRAGMENT, &[Experiment::Glslang]),
     vulkan(&TEAPOT_FRAGMENT, &[Experiment::NoLoopBounding]),
     gl_spirv(&TEAPOT_FRAGMENT),

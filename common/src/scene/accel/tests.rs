@@ -343,7 +343,10 @@ fn the_study_scenes_stacks_fit_opengls_local_memory_budget() {
         ),
     ] {
         let scene = Scene::load(name, &set).unwrap();
-        assert!(crate::scene::accel::Accel::Auto.wants_bvh(&scene), "{name}: auto takes no tree");
+        assert!(
+            crate::scene::accel::Accel::Auto.wants_bvh(&scene),
+            "{name}: auto takes no tree"
+        );
         let binary = Bvh::build(&scene);
         let depth = binary.depth;
         let wide = binary.widen(4);
@@ -373,7 +376,11 @@ fn the_study_scenes_stacks_fit_opengls_local_memory_budget() {
             closest.push((name, bytes));
         }
     }
-    assert_eq!(closest, [("teapot", 240), ("box", 240)], "the variants closest to 256 B");
+    assert_eq!(
+        closest,
+        [("teapot", 240), ("box", 240)],
+        "the variants closest to 256 B"
+    );
     // --experiment capped-bvh-stack caps deeper trees at the teapot's stack.
     let teapot = Bvh::build(&Scene::load("teapot", &[]).unwrap()).widen(4);
     assert_eq!(
