@@ -106,9 +106,19 @@ const float MIN_DIR = 2.0e-20;
 // four times the 2^-24 that term's rounding can be off by (traverse has why).
 const float ORIGIN_PAD = 2.384185791015625e-7;
 
+// A zero component (+0 or -0) counts as positive. The sign is a select, not
+// sign(dir + 1e-38): that constant is a denormal, which a driver that flushes
+// denormals (Mesa's lavapipe and llvmpipe do) reads as 0, so sign(0) gave an
+// inverse of 0 and every slab of that axis the width 0: the ray missed every
+// box. In a frame of odd width the middle column's primary rays have a zero
+// x component; through the tree the box rendered that column black
+// (tests/tests/accel.rs holds it). A ray that runs exactly along a box's face
+// still leaves that box at t = 0, as if it moved by MIN_DIR: on the seam of
+// two of the box's floor tiles the tree takes the tile whose box it enters
+// and brute force the first in order, two hits at the same point.
 vec3 inverse_dir(vec3 dir) {
     vec3 d = mix(vec3(MIN_DIR), abs(dir), greaterThan(abs(dir), vec3(MIN_DIR)));
-    return sign(dir + vec3(1.0e-38)) / d;
+    return mix(vec3(1.0), vec3(-1.0), lessThan(dir, vec3(0.0))) / d;
 }
 
 // Tests a leaf's primitives against the ray, keeping the closest hit in h.

@@ -287,8 +287,12 @@ impl Planner {
         let wide_fits = bvh.is_some_and(|b| {
             b.width > 2 && (b.wide.len() as u64 + 1) * u64::from(WIDE_NODE_TEXELS) <= texel_buffer
         });
-        v.node_texels =
-            !c.knobs.storage_nodes && !self.args.gl_spirv && self.api.node_texels(wide_fits);
+        // The arithmetic probe (`--experiment ulp`) replaces the tracer and
+        // reads no node: there is no read to rewrite as a texel fetch.
+        v.node_texels = c.knobs.ulp.is_none()
+            && !c.knobs.storage_nodes
+            && !self.args.gl_spirv
+            && self.api.node_texels(wide_fits);
         v
     }
 }

@@ -25,7 +25,7 @@ pub enum Accel {
 /// both APIs and on both paths; on Mesa's llvmpipe brute force is as fast up
 /// to about a dozen and the tree faster from 17 in three of the four app and
 /// path pairs. So the box (32 primitives) takes the tree, a third of its
-/// brute-force time on the GPU (docs/findings/bvh.md#where-the-bvh-starts-to-pay;
+/// brute-force time on the GPU (docs/findings/bvh.md#where-the-bvh-starts-to-pay-h200;
 /// `twinray sweep comparison/plans/auto-threshold.toml --out OUT`). It was 64,
 /// from an older traversal.
 pub const AUTO_BVH_MIN_PRIMITIVES: usize = 16;
