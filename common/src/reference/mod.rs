@@ -127,7 +127,8 @@ impl Tracer<'_> {
         trace_with(self, origin, dir, &mut RayKinds::default(), &mut |_| {})
     }
 
-    /// The ray stack's entries: the shader's STACK_SIZE for this scene.
+    /// The ray stack's entries: the most a trace ever holds, the shader's
+    /// STACK_SIZE where it walks a tree (brute force declares one more).
     fn ray_capacity(&self) -> usize {
         self.scene
             .features()

@@ -105,8 +105,9 @@ impl Features {
     /// more: after a ray of depth d pushed, the stack holds at most d + 2, so
     /// max_depth at the deepest push (d = max_depth - 2), and no push is ever
     /// dropped (a brute-force shader declares one entry more:
-    /// `Variant::ray_stack_declared` says why). Without glass a hit pushes at most one ray after popping one, so one
-    /// entry serves every max depth, and every max depth compiles to one shader.
+    /// `Variant::ray_stack_declared` says why). Without glass a hit pushes at
+    /// most one ray after popping one, so one entry serves every max depth,
+    /// and every max depth compiles to one shader.
     pub fn ray_stack_entries(self, max_depth: u32) -> u32 {
         if self.glass {
             max_depth.max(1)
