@@ -508,7 +508,7 @@ mod tests {
                 "unpaired-bvh-stack",
                 "capped-bvh-stack",
                 "first-of-equals",
-                "optimal-collapse",
+                "greedy-collapse",
                 "walk-then-shade",
                 "storage-nodes",
                 "uniform-counts",

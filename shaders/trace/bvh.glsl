@@ -9,7 +9,7 @@ const uint SPHERE_BIT = 0x80000000u;
 // uvec2(child reference, floatBitsToUint(entry t)). Each API's stack takes
 // the form its driver runs best (Api::bvh_stack_pairs in
 // common/src/plan/requests.rs decides, as it decides the workgroup):
-// - OpenGL on trees of up to 30 entries (BVH_STACK_PAIRS): two entries to a
+// - OpenGL on trees of up to 32 entries (BVH_STACK_PAIRS): two entries to a
 //   uvec4. NVIDIA's OpenGL compiler reports a whole 16-byte slot for every
 //   element of a local array, so two scalar arrays cost it four times the
 //   memory of these pairs (what that was worth:

@@ -108,8 +108,8 @@ fn teapot_bvh_renders_the_default_image_with_each_stack_and_declaration() {
 }
 
 /// `capped-bvh-stack` on a tree deeper than its cap (the 307k-triangle
-/// teapot's stack needs 37 entries; the cap is the default teapot's 30): the
-/// label says the shader declares 30, and no frame here needs more, so the
+/// teapot's stack needs 40 entries; the cap is the default teapot's 31): the
+/// label says the shader declares 31, and no frame here needs more, so the
 /// image is the default's.
 #[test]
 fn a_capped_stack_renders_the_deep_teapots_image() {
@@ -125,7 +125,7 @@ fn a_capped_stack_renders_the_deep_teapots_image() {
     for app in App::BOTH {
         let (report, _) = render(app, "teapot", "8x8", &args, &dir.join("capped.png"));
         assert!(
-            report.variant.contains("/bvh30") && report.variant.ends_with("/capped-bvh-stack"),
+            report.variant.contains("/bvh31") && report.variant.ends_with("/capped-bvh-stack"),
             "{app:?}: {}",
             report.variant
         );

@@ -18,7 +18,7 @@ pub enum Experiment {
     UnpairedBvhStack,
     CappedBvhStack,
     FirstOfEquals,
-    OptimalCollapse,
+    GreedyCollapse,
     WalkThenShade,
     StorageNodes,
     UniformCounts,

@@ -174,8 +174,8 @@ impl Planner {
             let (binary, width) = (build_bvh(&scene), self.args.accel.width());
             let bvh = if self.changes.first_of_equals {
                 binary.widen_first_of_equals(width)
-            } else if self.changes.optimal_collapse {
-                binary.widen_optimal(width)
+            } else if self.changes.greedy_collapse {
+                binary.widen_greedy(width)
             } else {
                 binary.widen(width)
             };

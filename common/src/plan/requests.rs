@@ -19,8 +19,11 @@ pub enum Api {
 }
 
 /// The deepest BVH stack OpenGL keeps in pairs (`Api::bvh_stack_pairs`):
-/// the default teapot's tree (30 entries), 240 B of local memory.
-pub const PAIRED_STACK_MOST: u32 = 30;
+/// the default teapot's tree (31 entries), 256 B of local memory. In one
+/// entry a `uvec2` that tree's tracer reports 496 B and its 1000² and
+/// 1080p frames are 3-4 % shorter (docs/findings/bvh.md#the-trees-top-h200),
+/// but no study scene's OpenGL tracer is to report more than 256 B.
+pub const PAIRED_STACK_MOST: u32 = 32;
 
 impl Api {
     pub fn name(&self) -> &'static str {
@@ -98,10 +101,10 @@ impl Api {
     /// half an entry is in its teapot frames are 2-3 % shorter. NVIDIA's
     /// OpenGL compiler reports 16 bytes for each element of a local array, so
     /// one entry an element reads as twice the local memory (the teapot's
-    /// tracer 240 to 480 B); yet it ran on as many multiprocessors as the
+    /// tracer 256 to 496 B); yet it ran on as many multiprocessors as the
     /// pairs at every tree size, so its real footprint is the same, and it
-    /// held 24 warps a multiprocessor to the pairs' 28. Up to the default
-    /// teapot's 30 entries the pairs were as fast or faster at some points
+    /// held 24 warps a multiprocessor to the pairs' 28. Up to the greedy
+    /// collapse's teapot of 30 entries the pairs were as fast or faster at some points
     /// (4K, the 1080p sphere list); from the 307k-triangle teapot's 37 up the
     /// one-entry form was 4-6 % faster on the compute path and 3-6 % on the
     /// fragment path (docs/findings/bvh.md#the-stacks-form-in-opengl-h200).

@@ -55,7 +55,7 @@ pub struct Variant {
 /// The most entries `--experiment capped-bvh-stack` leaves a BVH stack: the
 /// default teapot's (a test holds the two together), whose stack NVIDIA's
 /// OpenGL runs on every multiprocessor.
-pub const CAPPED_BVH_STACK: u32 = 30;
+pub const CAPPED_BVH_STACK: u32 = 31;
 
 /// Which source the variant compiles.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]

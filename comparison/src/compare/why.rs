@@ -97,7 +97,7 @@ const fn gl_spirv(gap: &'static Gap) -> Case {
     case(gap, &[], &[], Api::OpenglSpirv)
 }
 
-/// The deep teapots' stacks held to the default teapot's 30 entries, in the
+/// The deep teapots' stacks held to the default teapot's 31 entries, in the
 /// form OpenGL takes on deep trees (one entry a `uvec2`): NVIDIA's OpenGL then
 /// runs the tracer on every multiprocessor, with the same warps on each, and
 /// nothing else in the walk changes. `capped-bvh-stack` alone also takes

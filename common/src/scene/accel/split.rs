@@ -10,12 +10,25 @@ use rayon::prelude::*;
 
 /// Primitives per leaf at most; SAH may stop splitting earlier.
 pub const MAX_LEAF: usize = child_ref::MAX_LEAF_COUNT;
-/// Bins per axis. Finer is not better for this greedy top-down build: 8, 32
-/// and 64 gave the teapot's tree a 1.6-4 % higher SAH cost than 16 (19.2k and
-/// 1.2M triangles; `bvh_sah_cost` in `--json`).
+/// Bins per axis, and finer bins for the nodes of at least `FINE_NODE`
+/// primitives: the top of the tree, where a plane's place decides most and
+/// more bins cost the build next to nothing. There 32 bins place the planes
+/// that 16 put a bin's width off; the rays of the teapot's frames walk 4 %
+/// fewer nodes for it (the f64 reference's walk, counted, in six views of
+/// the teapot: fewer in five, 3 % more from straight above), although the
+/// SAH cost says the tree got worse (`bvh_sah_cost` in `--json`: 7.55 ->
+/// 7.85; SAH prices rays spread evenly over the root's box, which the lone
+/// sphere behind the camera makes mostly empty). 64 bins were no better; 32
+/// at every node the same at the teapot and 18 % slower to build 4.9M
+/// triangles (docs/findings/bvh.md#the-trees-top-h200).
 const BINS: usize = 16;
-/// Relative cost of one node visit vs one primitive test, for SAH.
-pub(super) const TRAVERSAL_COST: f64 = 1.0;
+const FINE_BINS: usize = 32;
+const FINE_NODE: usize = 4096;
+/// Relative cost of one node visit vs one primitive test, for SAH. 1.5
+/// makes slightly fuller leaves than 1: with the finer top and the optimal
+/// collapse every teapot frame was 0-5 % shorter in both APIs on the H200,
+/// the box 2-3 %, the sphere lists the same (docs/findings/bvh.md#the-trees-top-h200).
+pub(super) const TRAVERSAL_COST: f64 = 1.5;
 pub(super) const INTERSECT_COST: f64 = 1.0;
 /// A node with at least this many primitives counts its bins in parallel
 /// chunks of `BIN_CHUNK`: below it, the tasks would cost more than they save.
@@ -104,7 +117,7 @@ struct Bin {
     count: u32,
 }
 
-type Bins = [[Bin; BINS]; 3];
+type Bins<const B: usize> = [[Bin; B]; 3];
 
 const EMPTY_BIN: Bin = Bin {
     bounds: Box3::EMPTY,
@@ -112,20 +125,20 @@ const EMPTY_BIN: Bin = Bin {
     count: 0,
 };
 
-/// Where each axis's centroids fall into bins: the same arithmetic counts the
-/// bins and later partitions, so the two always agree.
+/// Where each axis's centroids fall into `B` bins: the same arithmetic counts
+/// the bins and later partitions, so the two always agree.
 #[derive(Clone, Copy)]
-struct Binning {
+struct Binning<const B: usize> {
     min: Vec3A,
     scale: Vec3A,
 }
 
-impl Binning {
-    fn new(centroids: &Box3) -> Binning {
+impl<const B: usize> Binning<B> {
+    fn new(centroids: &Box3) -> Binning<B> {
         let extent = centroids.max - centroids.min;
         // A flat axis puts everything in bin 0, where no plane separates anything.
         let usable = extent.cmpgt(Vec3A::ZERO) & extent.is_finite_mask();
-        let scale = Vec3A::select(usable, BINS as f32 / extent, Vec3A::ZERO);
+        let scale = Vec3A::select(usable, B as f32 / extent, Vec3A::ZERO);
         Binning {
             min: centroids.min,
             scale,
@@ -135,13 +148,13 @@ impl Binning {
     /// The primitive's bin on each axis.
     fn bins(&self, c: Vec3A) -> [usize; 3] {
         let b = ((c - self.min) * self.scale).as_uvec3();
-        b.min(glam::UVec3::splat(BINS as u32 - 1))
+        b.min(glam::UVec3::splat(B as u32 - 1))
             .to_array()
             .map(|x| x as usize)
     }
 
-    fn count(&self, refs: &[PrimRef]) -> Bins {
-        let mut bins = [[EMPTY_BIN; BINS]; 3];
+    fn count(&self, refs: &[PrimRef]) -> Bins<B> {
+        let mut bins = [[EMPTY_BIN; B]; 3];
         for r in refs {
             let b = r.bounds();
             let c = centroid2(&b);
@@ -157,12 +170,12 @@ impl Binning {
 
     /// `count`, in parallel chunks for a large node. Min, max and integer sums
     /// give the same bins whichever way the chunks are merged.
-    fn count_parallel(&self, refs: &[PrimRef]) -> Bins {
+    fn count_parallel(&self, refs: &[PrimRef]) -> Bins<B> {
         if refs.len() < PARALLEL_BINNING {
             return self.count(refs);
         }
         refs.par_chunks(BIN_CHUNK).map(|c| self.count(c)).reduce(
-            || [[EMPTY_BIN; BINS]; 3],
+            || [[EMPTY_BIN; B]; 3],
             |mut a, b| {
                 for (x, y) in a.iter_mut().flatten().zip(b.iter().flatten()) {
                     x.bounds.grow(&y.bounds);
@@ -190,11 +203,20 @@ pub(super) fn boxes(refs: &[PrimRef]) -> (Box3, Box3) {
 /// reorders `refs` so the left half comes first and returns its length and
 /// both halves. None makes the node a leaf.
 pub(super) fn split(refs: &mut [PrimRef], node: &Node) -> Option<(usize, Node, Node)> {
+    if refs.len() >= FINE_NODE {
+        split_in::<FINE_BINS>(refs, node)
+    } else {
+        split_in::<BINS>(refs, node)
+    }
+}
+
+/// `split` with `B` bins per axis.
+fn split_in<const B: usize>(refs: &mut [PrimRef], node: &Node) -> Option<(usize, Node, Node)> {
     let count = refs.len();
     if count <= 1 {
         return None;
     }
-    let binning = Binning::new(&node.centroids);
+    let binning = Binning::<B>::new(&node.centroids);
     let bins = binning.count_parallel(refs);
     let Some((axis, last_left)) = best_plane(&bins, node, count) else {
         if count <= MAX_LEAF {
@@ -235,23 +257,23 @@ pub(super) fn split(refs: &mut [PrimRef], node: &Node) -> Option<(usize, Node, N
     Some((
         mid,
         side(0..last_left + 1, node.first),
-        side(last_left + 1..BINS, node.first + mid),
+        side(last_left + 1..B, node.first + mid),
     ))
 }
 
-/// Binned SAH: the cheapest of BINS-1 planes per axis, as (axis, last bin on
+/// Binned SAH: the cheapest of B-1 planes per axis, as (axis, last bin on
 /// the left), or None when a leaf is cheaper (and allowed) or no plane has
 /// primitives on both sides. Ties go to the first plane found.
-fn best_plane(bins: &Bins, node: &Node, count: usize) -> Option<(usize, usize)> {
+fn best_plane<const B: usize>(bins: &Bins<B>, node: &Node, count: usize) -> Option<(usize, usize)> {
     let leaf_cost = INTERSECT_COST * count as f64;
     let area = node.bounds.area().max(1e-300);
     let mut best: Option<(f64, usize, usize)> = None;
     for (a, axis) in bins.iter().enumerate() {
         // Sweep from the right for the right side's area and count per plane.
-        let mut right = [(0.0, 0u32); BINS];
+        let mut right = [(0.0, 0u32); B];
         let mut acc = Box3::EMPTY;
         let mut side = (0.0, 0);
-        for i in (1..BINS).rev() {
+        for i in (1..B).rev() {
             // An empty bin changes neither side: the plane beside it costs the
             // same, and the first of equal planes wins anyway, so it is skipped.
             if axis[i].count != 0 {
@@ -262,7 +284,7 @@ fn best_plane(bins: &Bins, node: &Node, count: usize) -> Option<(usize, usize)> 
         }
         let mut acc = Box3::EMPTY;
         let mut n = 0;
-        for i in 0..BINS - 1 {
+        for i in 0..B - 1 {
             if axis[i].count == 0 {
                 continue;
             }

@@ -81,8 +81,9 @@ fn builtin_scenes_give_valid_trees() {
     one.triangles.clear();
     let b = check(&one);
     assert_eq!((b.nodes.len(), b.depth, b.stack_entries()), (1, 1, 1));
-    // One visit of the root, then its two children: the same leaf twice.
-    assert_eq!((b.node_count(), b.sah_cost()), (1, 3.0));
+    // One visit of the root (TRAVERSAL_COST 1.5), then its two children:
+    // the same leaf twice.
+    assert_eq!((b.node_count(), b.sah_cost()), (1, 3.5));
 }
 
 #[test]
@@ -117,12 +118,15 @@ fn the_tree_is_the_same_on_any_number_of_threads() {
 }
 
 /// The SAH cost of the teapot's tree at the study's tessellation, against a
-/// bound just above the serial builder this one replaced (7.547): a builder
-/// change that makes the trees worse for rays fails here.
+/// bound just above this builder's (11.21 with TRAVERSAL_COST 1.5; the
+/// serial builder this one replaced had 7.547 with 1, whose sum is not
+/// comparable): a builder change that makes the tree worse by its own
+/// measure fails here. The measure is SAH's, not the frame's: the finer
+/// top raised it by 4 % and the teapot's rays walk 4 % fewer nodes (split.rs).
 #[test]
 fn the_teapot_tree_costs_no_more_than_before() {
     let b = Bvh::build(&Scene::load("teapot", &[]).unwrap());
-    assert!(b.sah_cost() < 7.6, "SAH {}", b.sah_cost());
+    assert!(b.sah_cost() < 11.3, "SAH {}", b.sah_cost());
 }
 
 /// The wide tree of `scene`: every primitive in exactly one leaf, every child
@@ -319,9 +323,10 @@ fn auto_picks_the_width_the_crossover_measured() {
 /// area at every level: opened first-of-equals they made a 4-wide tree of 16
 /// levels (45 entries, 368 B: 90 of 132 multiprocessors on an H200) where 10
 /// do. The box's ray stack with a spare entry made 272 B (124 multiprocessors).
-/// The variants that come closest are the teapot's (30 BVH entries) and the
-/// box's (9 BVH and 5 ray entries): 240 B each, what `--dump-shaders` reports
-/// for their OpenGL tracers.
+/// The variant that comes closest is the teapot's (31 BVH entries): 256 B,
+/// what `--dump-shaders` reports for its OpenGL tracer on the H200; next the
+/// box's (9 BVH and 5 ray entries), 240 B, as the greedy collapse's teapot
+/// (30 entries) had.
 #[test]
 fn the_study_scenes_stacks_fit_opengls_local_memory_budget() {
     use crate::shader::variant::Variant;
@@ -363,9 +368,10 @@ fn the_study_scenes_stacks_fit_opengls_local_memory_budget() {
             "{name} {set:?}: {} BVH and {rays} ray stack entries, {bytes} B",
             wide.stack_entries(),
         );
-        // A 4-wide node spans two binary levels where the areas allow it.
+        // A 4-wide node spans two binary levels where the areas allow it;
+        // the optimal collapse gives up a level where it saves area.
         assert!(
-            wide.depth <= depth / 2 + 2,
+            wide.depth <= depth / 2 + 3,
             "{name} {set:?}: depth {depth} → {}",
             wide.depth
         );
@@ -375,7 +381,7 @@ fn the_study_scenes_stacks_fit_opengls_local_memory_budget() {
     let closest: Vec<_> = all.into_iter().filter(|a| a.1 == most).collect();
     assert_eq!(
         closest,
-        [("teapot", 240), ("box", 240)],
+        [("teapot", 256)],
         "the variants closest to 256 B"
     );
     // --experiment capped-bvh-stack caps deeper trees at the teapot's stack.

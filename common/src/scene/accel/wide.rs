@@ -1,17 +1,21 @@
 //! The wide BVH (`--accel bvh4`, `bvh8`): the binary SAH tree of `build`
 //! collapsed into nodes of four or eight children (`GpuBvhWideNode`, walked
 //! by shaders/trace/bvh.glsl, and by the f64 reference the same way).
-//! A wide node starts from its binary node's two children and keeps opening
-//! the interior child with the largest box, the one a ray is likeliest to
-//! enter, until it has `width` children or only leaves (the greedy collapse
-//! of Embree's wide BVHs). Of boxes of equal area it opens the one fewest
-//! binary levels down, so that equal boxes (the sphere list's identical
-//! spheres) still give a node two binary levels: first-of-equals made that
-//! tree 16 levels deep instead of 10, and its stack too large for OpenGL to
-//! use every multiprocessor (docs/findings/opengl-compute.md). The leaves
-//! are the binary tree's, primitives and order alike, so the leaf primitive
-//! array is shared and only the nodes differ. `--experiment optimal-collapse`
-//! chooses each node's children for the least SAH cost instead (`Optimal`).
+//! Each node's children are those of the wide tree of least SAH cost over
+//! the binary tree's leaves (`Optimal`): with the builder's finer top it
+//! made every teapot frame 2-6 % shorter in both APIs on the H200
+//! (docs/findings/bvh.md#the-trees-top-h200). `--experiment greedy-collapse`
+//! gives the collapse it replaced (`Rule::Largest`): a wide node starts
+//! from its binary node's two children and keeps opening the interior child
+//! with the largest box, the one a ray is likeliest to enter, until it has
+//! `width` children or only leaves (the greedy collapse of Embree's wide
+//! BVHs). Of boxes of equal area it opens the one fewest binary levels down,
+//! so that equal boxes (the sphere list's identical spheres) still give a
+//! node two binary levels: first-of-equals made that tree 16 levels deep
+//! instead of 10, and its stack too large for OpenGL to use every
+//! multiprocessor (docs/findings/opengl-compute.md). The leaves are the
+//! binary tree's, primitives and order alike, so the leaf primitive array
+//! is shared and only the nodes differ.
 //!
 //! Like the builder it depends only on the binary tree, so the wide tree is
 //! as deterministic as the binary one. The top levels are made first, the
@@ -57,11 +61,11 @@ const NO_KIDS: Kids = ([(([0.0; 3], [0.0; 3]), 0); 8], 0);
 /// How a binary subtree becomes a wide node's children.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub(super) enum Rule {
-    /// Open the largest box, the shallowest of equals (`widen`).
+    /// Open the largest box, the shallowest of equals (`--experiment greedy-collapse`).
     Largest,
     /// Open the largest box, the first of equals (`--experiment first-of-equals`).
     FirstOfEquals,
-    /// The children of least SAH cost (`--experiment optimal-collapse`).
+    /// The children of least SAH cost (`widen`).
     Optimal,
 }
 
@@ -242,22 +246,24 @@ fn node_shape(children: usize, below: &[(u32, u32)]) -> (u32, u32) {
 
 impl Bvh {
     /// This tree collapsed to `width` children a node (4 or 8; 2 keeps it
-    /// binary). The binary nodes are dropped: the wide tree replaces them.
+    /// binary), each node's children those of the wide tree of least SAH
+    /// cost over the same leaves (`Optimal`). The binary nodes are dropped:
+    /// the wide tree replaces them.
     pub fn widen(self, width: u32) -> Bvh {
+        self.widen_on(width, PARALLEL_LEVELS, Rule::Optimal)
+    }
+
+    /// `widen` by the greedy rule, opening the largest box until a node is
+    /// full (`--experiment greedy-collapse`).
+    pub fn widen_greedy(self, width: u32) -> Bvh {
         self.widen_on(width, PARALLEL_LEVELS, Rule::Largest)
     }
 
-    /// `widen` opening the first of equal-area boxes instead of the
-    /// shallowest (`--experiment first-of-equals`): the sphere list's tree
-    /// as it was before, 16 levels deep at 100k spheres.
+    /// The greedy collapse opening the first of equal-area boxes instead of
+    /// the shallowest (`--experiment first-of-equals`): the sphere list's
+    /// tree as it was before, 16 levels deep at 100k spheres.
     pub fn widen_first_of_equals(self, width: u32) -> Bvh {
         self.widen_on(width, PARALLEL_LEVELS, Rule::FirstOfEquals)
-    }
-
-    /// `widen` with each node's children those of the wide tree of least SAH
-    /// cost over the same leaves (`--experiment optimal-collapse`, `Optimal`).
-    pub fn widen_optimal(self, width: u32) -> Bvh {
-        self.widen_on(width, PARALLEL_LEVELS, Rule::Optimal)
     }
 
     /// `widen` by `rule`, with the top `levels` levels made first and the subtrees
@@ -419,7 +425,7 @@ const SHARE: u8 = 0xf;
 const OPEN_LEFT: u8 = 0x10;
 const OPEN_RIGHT: u8 = 0x20;
 
-/// The optimal collapse (`--experiment optimal-collapse`): of the wide trees
+/// The optimal collapse (`widen`): of the wide trees
 /// whose leaves are the binary tree's and whose nodes' children are each a
 /// cut of a binary subtree, kept in order, the one of least SAH cost, by
 /// dynamic programming over the binary tree (Ylitie, Karras, Laine and Aila

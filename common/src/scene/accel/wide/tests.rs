@@ -1,4 +1,4 @@
-//! The optimal collapse (`--experiment optimal-collapse`, `Optimal`): a valid
+//! The optimal collapse (`widen`, `Optimal`): a valid
 //! wide tree over the binary tree's leaves, in their order, with a true stack
 //! bound, never costlier than the greedy collapse, and on small trees the
 //! cheapest of every collapse there is, and of those the shallowest.
@@ -120,8 +120,8 @@ fn interior_area(b: &Bvh) -> f64 {
 fn against_greedy(binary: &Bvh, what: &str) {
     let order = leaves(binary);
     for width in [4, 8] {
-        let greedy = binary.clone().widen(width);
-        let optimal = binary.clone().widen_optimal(width);
+        let greedy = binary.clone().widen_greedy(width);
+        let optimal = binary.clone().widen(width);
         for b in [&greedy, &optimal] {
             check_wide_tree(binary, b, width);
             assert!(
@@ -231,8 +231,8 @@ fn the_optimal_collapse_is_the_cheapest_of_every_collapse() {
         for width in [4u32, 8] {
             let all = every_collapse(&tree, width as usize);
             let least = all.iter().map(|c| c.0).fold(f64::INFINITY, f64::min);
-            let optimal = tree.clone().widen_optimal(width);
-            let greedy = tree.clone().widen(width);
+            let optimal = tree.clone().widen(width);
+            let greedy = tree.clone().widen_greedy(width);
             check_wide_tree(&tree, &optimal, width);
             let what = format!("tree {t} ({leaves} leaves, same boxes: {same}) at width {width}");
             let found = interior_area(&optimal);
