@@ -13,14 +13,15 @@ pub const MAX_LEAF: usize = child_ref::MAX_LEAF_COUNT;
 /// Bins per axis, and finer bins for the nodes of at least `FINE_NODE`
 /// primitives: the top of the tree, where a plane's place decides most and
 /// more bins cost the build next to nothing. There 32 bins place the planes
-/// that 16 put a bin's width off; the rays of the teapot's frames walk 4 %
-/// fewer nodes for it (the f64 reference's walk, counted, in six views of
-/// the teapot: fewer in five, 3 % more from straight above), although the
-/// SAH cost says the tree got worse (`bvh_sah_cost` in `--json`: 7.55 ->
-/// 7.85; SAH prices rays spread evenly over the root's box, which the lone
-/// sphere behind the camera makes mostly empty). 64 bins were no better; 32
-/// at every node the same at the teapot and 18 % slower to build 4.9M
-/// triangles (docs/findings/bvh.md#the-trees-top-h200).
+/// that 16 put a bin's width off; the rays of the teapot's frames visit 4 %
+/// fewer nodes for it (the f64 reference's walk, counted: fewer in four of
+/// six views of the teapot, up to 3 % more in two; with the optimal collapse
+/// and TRAVERSAL_COST below, fewer in all six), although SAH calls the tree
+/// worse (32 bins at every node: `bvh_sah_cost` 7.55 -> 7.85 at a node
+/// visit of 1; SAH prices rays spread evenly over the root's box, which the
+/// lone sphere behind the camera makes mostly empty). 64 bins were no
+/// better; 32 at every node the same at the teapot and 18 % slower to build
+/// 4.9M triangles (docs/findings/bvh.md#the-trees-top-h200).
 const BINS: usize = 16;
 const FINE_BINS: usize = 32;
 const FINE_NODE: usize = 4096;

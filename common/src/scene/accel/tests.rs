@@ -379,11 +379,7 @@ fn the_study_scenes_stacks_fit_opengls_local_memory_budget() {
     }
     let most = all.iter().map(|a| a.1).max().unwrap();
     let closest: Vec<_> = all.into_iter().filter(|a| a.1 == most).collect();
-    assert_eq!(
-        closest,
-        [("teapot", 256)],
-        "the variants closest to 256 B"
-    );
+    assert_eq!(closest, [("teapot", 256)], "the variants closest to 256 B");
     // --experiment capped-bvh-stack caps deeper trees at the teapot's stack.
     let teapot = Bvh::build(&Scene::load("teapot", &[]).unwrap()).widen(4);
     assert_eq!(

@@ -2,10 +2,10 @@
 //! collapsed into nodes of four or eight children (`GpuBvhWideNode`, walked
 //! by shaders/trace/bvh.glsl, and by the f64 reference the same way).
 //! Each node's children are those of the wide tree of least SAH cost over
-//! the binary tree's leaves (`Optimal`): with the builder's finer top the
-//! greedy collapse it replaced left the teapot's frames up to 5 % longer
-//! in both APIs on the H200 (docs/findings/bvh.md#the-trees-top-h200). `--experiment greedy-collapse`
-//! gives the collapse it replaced (`Rule::Largest`): a wide node starts
+//! the binary tree's leaves (`Optimal`). `--experiment greedy-collapse`
+//! gives the collapse it replaced, which with the builder's finer top left
+//! the teapot's frames up to 5 % longer in both APIs on the H200
+//! (docs/findings/bvh.md#the-trees-top-h200), `Rule::Largest`: a wide node starts
 //! from its binary node's two children and keeps opening the interior child
 //! with the largest box, the one a ray is likeliest to enter, until it has
 //! `width` children or only leaves (the greedy collapse of Embree's wide
