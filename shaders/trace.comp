@@ -14,10 +14,10 @@
 // Which tile a workgroup traces comes from the launch order (binding 8,
 // common/src/plan/launch.rs): a GPU starts workgroups in about the order of
 // their index, and a frame lasts until its slowest last ones finish, so the
-// costliest tiles are listed first. The frame says which grid of tiles the
-// order was made for: without one (a window, whose camera moves and whose size
-// changes) or for another grid, the tiles go in rows, and no workgroup waits
-// on a load before its first ray.
+// costliest tiles are listed first, and those that see nothing are flagged.
+// The frame says which grid of tiles the order was made for: without one (a
+// window, whose camera moves and whose size changes) or for another grid, the
+// tiles go in rows, and no workgroup waits on a load before its first ray.
 
 #ifndef WG_X
 #define WG_X 8
@@ -34,6 +34,12 @@ layout(rgba32f, set = 0, binding = 5) uniform writeonly image2D out_image;
 layout(std430, set = 0, binding = 8) readonly buffer LaunchOrder {
     uint tiles[];
 } launch_buf;
+
+// A tile flagged in the launch order (common/src/plan/launch.rs, EMPTY_TILE):
+// every pixel's primary ray misses every box of the tree's root's children,
+// so the pixel is the background, which the walk would have returned after
+// its first node step. Its workgroup stores that and is done.
+const uint EMPTY_TILE = 0x80000000u;
 
 #ifdef SHARED_PAD_KIB
 // --shared-pad (a measurement): workgroup memory the tracer does not need. A
@@ -57,8 +63,11 @@ void main() {
 #endif
     uvec2 groups = gl_NumWorkGroups.xy;
     uvec2 tile = gl_WorkGroupID.xy;
+    bool empty = false;
     if (frame.launch_grid == ((groups.x << 16u) | groups.y)) {
         uint t = launch_buf.tiles[tile.y * groups.x + tile.x];
+        empty = (t & EMPTY_TILE) != 0u;
+        t &= ~EMPTY_TILE;
         tile = uvec2(t % groups.x, t / groups.x);
     }
     uvec2 p = tile * uvec2(WG_X, WG_Y) + gl_LocalInvocationID.xy;
@@ -68,6 +77,14 @@ void main() {
 #ifdef COUNT_RAYS
     rays_traced = RayCount(1u, 0u, 0u, 0u, 0u);
 #endif
+    if (empty) {
+        // trace()'s colour for a ray that hits nothing: 0 + 1 * background.
+        imageStore(out_image, ivec2(p), vec4(frame.background, 1.0));
+#ifdef COUNT_RAYS
+        ray_count_buf.pixels[p.y * frame.width + p.x] = rays_traced;
+#endif
+        return;
+    }
     vec3 dir = primary_dir(vec2(p) + 0.5);
     imageStore(out_image, ivec2(p), vec4(trace(frame.eye, dir), 1.0));
 #ifdef COUNT_RAYS

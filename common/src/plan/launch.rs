@@ -12,11 +12,18 @@
 //! launch order, each `y * across + x`; the frame's uniform names the grid it
 //! was made for (`GpuFrame::launch_grid`). A frame without one (a window,
 //! whose camera moves) or of another grid takes the tiles in rows.
+//!
+//! The order also marks the tiles that cannot see the scene (`EMPTY_TILE`):
+//! their workgroups store the background without a walk. That is what a walk
+//! would return for each of their pixels, so no image changes.
 
 use crate::cli::Workgroup;
-use crate::gpu::layout::Bvh;
+use crate::gpu::layout::{Bounds, Bvh};
 use crate::reference::sampled::{sampled_rays, RaySamples};
+use crate::scene::camera::RayFrame;
 use crate::scene::Scene;
+use glam::DVec3;
+use rayon::prelude::*;
 use std::cmp::Reverse;
 
 /// The most pixels that trace their rays for the estimate: every pixel of a
@@ -31,6 +38,22 @@ pub const MOST_SAMPLES: u32 = 1 << 17;
 /// multiprocessors, each holding several workgroups of the tracer), and
 /// reading the order only delays each workgroup's first ray.
 pub const FEWEST_TILES: u32 = 4096;
+
+/// A tile's flag in the launch order (shaders/trace.comp's EMPTY_TILE): the
+/// primary ray of every pixel in it misses every box of the tree's root's
+/// children, so each of its pixels is the background. A walk would find that
+/// after one node step, and at 4K the teapot's rays miss it for five pixels
+/// in six. Storing it without the walk took the H200's 4K teapot frame 5 %
+/// (Vulkan) and 2 % (OpenGL) shorter, the box's 1080p one 8 % in Vulkan
+/// (docs/findings/rays-per-second.md#tiles-that-see-nothing-h200).
+pub const EMPTY_TILE: u32 = 1 << 31;
+
+/// How far past a root child's box a ray must pass to count as missing it:
+/// this share of the box's size plus its farthest corner's distance from the
+/// eye. The GPU's ray is the f32 rounding of the reference's (a few parts in
+/// 10^7 of that distance), and its tests are conservative; the margin is a
+/// hundred times that, so a tile marked empty is empty on the GPU too.
+const MISS_MARGIN: f64 = 1e-4;
 
 /// The side of the square of pixels of which one is sampled at `size`: a
 /// power of two, so that the workgroups' sides (4, 8, 16) hold whole cells.
@@ -73,7 +96,67 @@ pub fn launch_order(
     // Stable: tiles of equal cost keep their rows, and their neighbours
     // their share of the caches.
     tiles.sort_by_key(|&t| Reverse(cost[t as usize]));
+    // A grid of 2^31 tiles or more (never, at the sizes the limits allow with
+    // the workgroups used) would need the flag's bit for its indices.
+    if let Some(bvh) = bvh.filter(|_| grid.0 as u64 * grid.1 as u64 <= EMPTY_TILE as u64) {
+        let empty = empty_tiles(scene, bvh, size, workgroup, grid);
+        for t in &mut tiles {
+            if empty[*t as usize] {
+                *t |= EMPTY_TILE;
+            }
+        }
+    }
     LaunchOrder { grid, tiles }
+}
+
+/// For each tile, whether the primary ray of each of its pixels (in the image)
+/// misses every box of `bvh`'s root's children: rays through the pixels'
+/// centres, as the shader's and the reference's are.
+fn empty_tiles(
+    scene: &Scene,
+    bvh: &Bvh,
+    (width, height): (u32, u32),
+    wg: Workgroup,
+    (across, down): (u32, u32),
+) -> Vec<bool> {
+    let frame = RayFrame::local(scene, &scene.camera, width, height);
+    let root: Vec<Bounds> = if bvh.width > 2 {
+        bvh.wide_children(0).map(|(b, _)| b).collect()
+    } else {
+        bvh.nodes
+            .first()
+            .map(|n| vec![(n.left_min, n.left_max), (n.right_min, n.right_max)])
+            .unwrap_or_default()
+    };
+    let boxes: Vec<(DVec3, DVec3)> = root
+        .iter()
+        .map(|&(lo, hi)| {
+            let (lo, hi) = (
+                DVec3::from(lo.map(f64::from)),
+                DVec3::from(hi.map(f64::from)),
+            );
+            let far = (lo - frame.eye).abs().max((hi - frame.eye).abs()).length();
+            let m = MISS_MARGIN * ((hi - lo).max_element() + far);
+            (lo - m, hi + m)
+        })
+        .collect();
+    let misses = |x: u32, y: u32| {
+        let inv = frame.dir(x as f64, y as f64).recip();
+        boxes.iter().all(|&(lo, hi)| {
+            let (a, b) = ((lo - frame.eye) * inv, (hi - frame.eye) * inv);
+            // A NaN (a zero direction component on a box's plane) fails the
+            // test, so the ray counts as entering: never a tile wrongly empty.
+            a.min(b).max_element().max(0.0) > a.max(b).min_element()
+        })
+    };
+    (0..across * down)
+        .into_par_iter()
+        .map(|t| {
+            let (tx, ty) = (t % across, t / across);
+            let xs = tx * wg.x..((tx + 1) * wg.x).min(width);
+            (ty * wg.y..((ty + 1) * wg.y).min(height)).all(|y| xs.clone().all(|x| misses(x, y)))
+        })
+        .collect()
 }
 
 /// The most rays of one sample in or beside the tile at `(tx, ty)`, then
@@ -129,7 +212,7 @@ mod tests {
                 let order = order(scene, size, wg);
                 let grid = (size.0.div_ceil(wg.0), size.1.div_ceil(wg.1));
                 assert_eq!(order.grid, grid);
-                let mut tiles = order.tiles;
+                let mut tiles: Vec<u32> = order.tiles.iter().map(|t| t & !EMPTY_TILE).collect();
                 tiles.sort_unstable();
                 let all: Vec<u32> = (0..grid.0 * grid.1).collect();
                 assert_eq!(tiles, all, "{scene}, {size:?} in {wg:?}");
@@ -152,7 +235,8 @@ mod tests {
         let costs: Vec<(u32, u32)> = order
             .tiles
             .iter()
-            .map(|&t| tile_cost(&samples, (t % grid_x, t / grid_x), wg))
+            .map(|&t| t & !EMPTY_TILE)
+            .map(|t| tile_cost(&samples, (t % grid_x, t / grid_x), wg))
             .collect();
         assert_eq!(costs[0].0, most);
         assert!(
@@ -160,6 +244,48 @@ mod tests {
             "not costliest first"
         );
         assert_eq!(costs.last().unwrap().0, 1, "the background's tiles last");
+    }
+
+    /// A tile is flagged empty only where brute force finds nothing for the
+    /// primary ray of any of its pixels, in every study scene and through
+    /// either tree; the teapot's and the box's frames have such tiles.
+    #[test]
+    fn a_tile_is_empty_only_where_brute_force_sees_nothing() {
+        let (size, wg) = ((120, 90), Workgroup { x: 4, y: 4 });
+        for scene_name in ["teapot", "box", "spherelist"] {
+            let scene = Scene::load(scene_name, &[]).unwrap();
+            let local = crate::scene::camera::in_local_frame(&scene);
+            let frame = RayFrame::local(&scene, &scene.camera, size.0, size.1);
+            for width in [2, 4] {
+                let bvh = crate::plan::build_bvh(&scene).widen(width);
+                let order = launch_order(&scene, Some(&bvh), size, wg);
+                let empty: Vec<u32> = order
+                    .tiles
+                    .iter()
+                    .filter(|&&t| t & EMPTY_TILE != 0)
+                    .map(|t| t & !EMPTY_TILE)
+                    .collect();
+                if scene_name != "spherelist" {
+                    assert!(
+                        empty.len() > 50,
+                        "{scene_name}, width {width}: {} empty tiles",
+                        empty.len()
+                    );
+                }
+                for t in empty {
+                    let (tx, ty) = (t % order.grid.0, t / order.grid.0);
+                    for y in ty * wg.y..((ty + 1) * wg.y).min(size.1) {
+                        for x in tx * wg.x..((tx + 1) * wg.x).min(size.0) {
+                            let d = frame.dir(x as f64, y as f64);
+                            assert!(
+                                !crate::reference::hits_by_brute_force(&local, frame.eye, d),
+                                "{scene_name}, width {width}: pixel ({x}, {y}) of empty tile {t} sees the scene"
+                            );
+                        }
+                    }
+                }
+            }
+        }
     }
 
     /// The sphere lists' 300² frames fit on an H200 at once (722 workgroups of

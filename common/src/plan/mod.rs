@@ -335,11 +335,12 @@ impl RunPlan {
             launch::launch_order(&self.scene, self.bvh.as_ref(), (width, height), workgroup);
         explain::numbered(0, "Launch order (twinray-common)", || {
             format!(
-                "{} tiles of {}x{}, costliest first by the rays of one pixel in {}; ranked in {:.1} ms",
+                "{} tiles of {}x{}, costliest first by the rays of one pixel in {}, {} seeing nothing; ranked in {:.1} ms",
                 order.tiles.len(),
                 workgroup.x,
                 workgroup.y,
                 launch::sample_step((width, height)).pow(2),
+                order.tiles.iter().filter(|&&t| t & launch::EMPTY_TILE != 0).count(),
                 t0.elapsed().as_secs_f64() * 1e3
             )
         });
