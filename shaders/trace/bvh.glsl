@@ -129,56 +129,40 @@ vec3 inverse_dir(vec3 dir) {
 }
 
 // Tests a leaf's primitives against the ray, keeping the closest hit in h.
-// True when an any-hit query (shadow rays) may stop. A leaf holds spheres or
-// triangles, never both (the builder splits a mixed one:
-// common/src/scene/accel/split.rs), so the kind is tested once a leaf, on its
-// first primitive, and each kind has a loop of its own: with the test once a
-// primitive, the H200's teapot frames were 2-3 % longer in both APIs
-// (docs/findings/rays-per-second.md#one-kind-of-primitive-a-leaf-h200).
+// True when an any-hit query (shadow rays) may stop.
 bool hit_leaf(inout Hit h, vec3 origin, vec3 dir, TriRay ray, uint first, uint count, bool any_hit) {
-#ifdef HAS_SPHERES
-#ifdef HAS_TRIANGLES
-    if ((prim_buf.prims[first].code & SPHERE_BIT) != 0u)
-#endif
-    {
-        for (uint k = 0u; k < count; k++) {
-            BvhPrim p = prim_buf.prims[first + k];
-            // The test takes a whole struct; it reads only the centre and radius.
+    for (uint k = 0u; k < count; k++) {
+        BvhPrim p = prim_buf.prims[first + k];
+        uint prim = p.code;
+        // The tests take whole structs; they read only the positions.
+        if ((prim & SPHERE_BIT) != 0u) {
+            uint i = prim & ~SPHERE_BIT;
             float t = hit_sphere(origin, dir, Sphere(p.a, p.b.x, 0u, 0u, 0u, 0u), 0.0, h.t);
             if (t > 0.0) {
                 h.t = t;
                 h.kind = 1u;
-                h.index = p.code & ~SPHERE_BIT;
-                if (any_hit) {
-                    return true;
-                }
+                h.index = i;
             }
-        }
-        return false;
-    }
-#endif
-#ifdef HAS_TRIANGLES
-    for (uint k = 0u; k < count; k++) {
-        BvhPrim p = prim_buf.prims[first + k];
+        } else {
 #ifdef TRIANGLE_WATERTIGHT
-        Triangle tri = Triangle(p.a, 0u, p.b, 0u, p.c, 0u, vec3(0.0), 0u, vec3(0.0), 0u, vec3(0.0), 0u);
-        vec3 r = hit_triangle(ray, tri, 0.0, h.t);
+            Triangle tri = Triangle(p.a, 0u, p.b, 0u, p.c, 0u, vec3(0.0), 0u, vec3(0.0), 0u, vec3(0.0), 0u);
+            vec3 r = hit_triangle(ray, tri, 0.0, h.t);
 #else
-        // p0 and the two edges (gpu::layout::GpuBvhPrim).
-        vec3 r = moller_trumbore(ray, p.a, p.b, p.c, 0.0, h.t);
+            // p0 and the two edges (gpu::layout::GpuBvhPrim).
+            vec3 r = moller_trumbore(ray, p.a, p.b, p.c, 0.0, h.t);
 #endif
-        if (r.x > 0.0) {
-            h.t = r.x;
-            h.kind = 2u;
-            h.index = p.code;
-            h.u = r.y;
-            h.v = r.z;
-            if (any_hit) {
-                return true;
+            if (r.x > 0.0) {
+                h.t = r.x;
+                h.kind = 2u;
+                h.index = prim;
+                h.u = r.y;
+                h.v = r.z;
             }
         }
+        if (any_hit && h.kind != 0u) {
+            return true;
+        }
     }
-#endif
     return false;
 }
 

@@ -4,7 +4,7 @@
 //! primitives into its two halves (in parallel for a large node, the same
 //! order every run).
 
-use crate::gpu::layout::{child_ref, Bounds, PRIM_SPHERE_BIT};
+use crate::gpu::layout::{child_ref, Bounds};
 use glam::Vec3A;
 use rayon::prelude::*;
 
@@ -219,32 +219,21 @@ fn split_in<const B: usize>(refs: &mut [PrimRef], node: &Node) -> Option<(usize,
     }
     let binning = Binning::<B>::new(&node.centroids);
     let bins = binning.count_parallel(refs);
-    let half = |refs: &[PrimRef], first| {
-        let (bounds, centroids) = boxes(refs);
-        Node {
-            bounds,
-            centroids,
-            first,
-        }
-    };
     let Some((axis, last_left)) = best_plane(&bins, node, count) else {
         if count <= MAX_LEAF {
-            // A leaf holds one kind of primitive, which the shader's leaf
-            // test branches on once (shaders/trace/bvh.glsl, hit_leaf).
-            let sphere = |r: &PrimRef| r.code & PRIM_SPHERE_BIT != 0;
-            if refs.iter().all(sphere) || !refs.iter().any(sphere) {
-                return None;
-            }
-            let mid = partition(refs, sphere);
-            return Some((
-                mid,
-                half(&refs[..mid], node.first),
-                half(&refs[mid..], node.first + mid),
-            ));
+            return None;
         }
         // Too many for a leaf but no plane separates them (identical
         // centroids): split the list in the middle.
         let mid = count / 2;
+        let half = |refs: &[PrimRef], first| {
+            let (bounds, centroids) = boxes(refs);
+            Node {
+                bounds,
+                centroids,
+                first,
+            }
+        };
         return Some((
             mid,
             half(&refs[..mid], node.first),
