@@ -1,4 +1,5 @@
 #!/bin/bash
+# shellcheck disable=SC2164
 # usage: ENV... counts.sh  -> prints per-pixel nodes/prims for 4 sizes + 5 views, plus shadow nodes for study view
 cd /tmp/tw
 run() { target/release/examples/tree_work "$@" 480x270 2>/dev/null | sed -E 's/.*shadow walks [0-9]+ nodes ([0-9.]+)\/walk prims ([0-9.]+)\/walk \| per pixel nodes ([0-9.]+) prims ([0-9.]+).*/\3 \4 (sh \1 \2)/'; }
