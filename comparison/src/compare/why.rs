@@ -6,8 +6,8 @@
 
 use crate::apps::{run_json, Api};
 use crate::compare::gaps::{
-    floor_file, write_floor_files, BOX_BVH_COMPUTE, BOX_COMPUTE, BOX_FRAGMENT, BOX_IMAGES,
-    SPHERELIST_BVH_COMPUTE, SPHERELIST_BVH_SMALL, TEAPOT_BVH_COMPUTE, TEAPOT_BVH_LARGE,
+    floor_file, write_floor_files, BOX_BVH_COMPUTE, BOX_BVH_LARGE, BOX_COMPUTE, BOX_FRAGMENT,
+    BOX_IMAGES, SPHERELIST_BVH_COMPUTE, SPHERELIST_BVH_SMALL, TEAPOT_BVH_COMPUTE, TEAPOT_BVH_LARGE,
     TEAPOT_BVH_LARGEST, TEAPOT_DEEPEST_BVH_COMPUTE, TEAPOT_DEEP_BVH_COMPUTE, TEAPOT_FRAGMENT,
 };
 use crate::compare::runs::{
@@ -113,6 +113,8 @@ pub const CASES: &[Case] = &[
     both(&BOX_COMPUTE, &[Experiment::SplitRayStack]),
     one_workgroup(&BOX_BVH_COMPUTE),
     second_frame(&BOX_BVH_COMPUTE, None),
+    one_workgroup(&BOX_BVH_LARGE),
+    second_frame(&BOX_BVH_LARGE, None),
     vulkan(&TEAPOT_FRAGMENT, &[Experiment::Glslang]),
     vulkan(&TEAPOT_FRAGMENT, &[Experiment::NoLoopBounding]),
     gl_spirv(&TEAPOT_FRAGMENT),
