@@ -278,7 +278,7 @@ mod tests {
                         for x in tx * wg.x..((tx + 1) * wg.x).min(size.0) {
                             let d = frame.dir(x as f64, y as f64);
                             assert!(
-                                !crate::reference::hits_by_brute_force(&local, frame.eye, d),
+                                !crate::reference::sampled::hits_by_brute_force(&local, frame.eye, d),
                                 "{scene_name}, width {width}: pixel ({x}, {y}) of empty tile {t} sees the scene"
                             );
                         }

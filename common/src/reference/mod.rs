@@ -462,13 +462,6 @@ pub fn render_truth(scene: &Scene, width: u32, height: u32) -> FloatImage {
     render_with(&s, width, height, &truth_numerics())
 }
 
-/// Whether the ray from `o` along `d` hits anything in `scene` (in its local
-/// frame), by brute force: what the launch order's empty tiles are held to.
-#[cfg(test)]
-pub(crate) fn hits_by_brute_force(scene: &Scene, o: DVec3, d: DVec3) -> bool {
-    closest_hit(&Tracer::brute_force(scene), o, d).is_some()
-}
-
 #[cfg(test)]
 mod ray_stack_tests;
 

@@ -58,3 +58,10 @@ pub fn sampled_rays(
         rays,
     }
 }
+
+/// Whether the ray from `o` along `d` hits anything in `scene` (in its local
+/// frame), by brute force: what the launch order's empty tiles are held to.
+#[cfg(test)]
+pub(crate) fn hits_by_brute_force(scene: &Scene, o: glam::DVec3, d: glam::DVec3) -> bool {
+    super::intersect::closest_hit(&Tracer::brute_force(scene), o, d).is_some()
+}
