@@ -3,7 +3,7 @@
 
 use std::mem::{offset_of, size_of};
 use twinray_common::gpu::layout::*;
-use twinray_common::shader::build::{fragment_source, parse};
+use twinray_common::shader::build::{compute_source, fragment_source, parse};
 use twinray_common::shader::variant::Variant;
 
 /// (name, offset) of every member, in declaration order.
@@ -356,6 +356,25 @@ fn the_bvh_encodings_match_rust() {
     };
     let (first, _) = child_ref::as_leaf(no_child).expect("NO_CHILD is a leaf reference");
     assert!(first >= twinray_common::limits::MAX_BVH_PRIMITIVES);
+}
+
+/// The compute shader's flag for a tile that sees nothing is the bit the
+/// launch order sets (plan::launch::EMPTY_TILE).
+#[test]
+fn the_empty_tile_flag_matches_rust() {
+    let mut variant = Variant::generic(Default::default());
+    variant.entry =
+        twinray_common::shader::variant::Entry::Compute(twinray_common::cli::Workgroup {
+            x: 8,
+            y: 4,
+        });
+    let module = parse(&compute_source(), naga::ShaderStage::Compute, &variant)
+        .unwrap()
+        .0;
+    assert_eq!(
+        shader_constant(&module, "EMPTY_TILE"),
+        naga::Literal::U32(twinray_common::plan::launch::EMPTY_TILE)
+    );
 }
 
 /// The wide step's per-ray origin term, origin * inverse direction (padded by
