@@ -19,7 +19,7 @@
 
 use crate::cli::Workgroup;
 use crate::gpu::layout::{Bounds, Bvh};
-use crate::reference::sampled::{sampled_rays, RaySamples};
+use crate::reference::sampled::{ray_enters, sampled_rays, RaySamples};
 use crate::scene::camera::RayFrame;
 use crate::scene::Scene;
 use glam::DVec3;
@@ -128,7 +128,8 @@ fn empty_tiles(
             .map(|n| vec![(n.left_min, n.left_max), (n.right_min, n.right_max)])
             .unwrap_or_default()
     };
-    let boxes: Vec<(DVec3, DVec3)> = root
+    // Each box widened by the margin and rounded outwards to f32 again.
+    let boxes: Vec<Bounds> = root
         .iter()
         .map(|&(lo, hi)| {
             let (lo, hi) = (
@@ -137,17 +138,17 @@ fn empty_tiles(
             );
             let far = (lo - frame.eye).abs().max((hi - frame.eye).abs()).length();
             let m = MISS_MARGIN * ((hi - lo).max_element() + far);
-            (lo - m, hi + m)
+            (
+                (lo - m).to_array().map(|v| (v as f32).next_down()),
+                (hi + m).to_array().map(|v| (v as f32).next_up()),
+            )
         })
         .collect();
     let misses = |x: u32, y: u32| {
-        let inv = frame.dir(x as f64, y as f64).recip();
-        boxes.iter().all(|&(lo, hi)| {
-            let (a, b) = ((lo - frame.eye) * inv, (hi - frame.eye) * inv);
-            // A NaN (a zero direction component on a box's plane) fails the
-            // test, so the ray counts as entering: never a tile wrongly empty.
-            a.min(b).max_element().max(0.0) > a.max(b).min_element()
-        })
+        let d = frame.dir(x as f64, y as f64);
+        !boxes
+            .iter()
+            .any(|&(lo, hi)| ray_enters(lo, hi, frame.eye, d))
     };
     (0..across * down)
         .into_par_iter()

@@ -66,7 +66,13 @@ fn order(code: u32) -> u64 {
 /// primitives (rounded outwards), and the pad covers the f64 slab arithmetic and
 /// the intersection tests' own rounding, so no node holding a hit is skipped.
 /// Returns the entry distance, or None for a miss or a box beyond `t_max`.
-fn enter_box(min: [f32; 3], max: [f32; 3], o: DVec3, d: DVec3, t_max: f64) -> Option<f64> {
+pub(super) fn enter_box(
+    min: [f32; 3],
+    max: [f32; 3],
+    o: DVec3,
+    d: DVec3,
+    t_max: f64,
+) -> Option<f64> {
     let (mut t0, mut t1) = (0.0f64, t_max);
     for a in 0..3 {
         let (lo, hi) = (min[a] as f64, max[a] as f64);

@@ -59,6 +59,12 @@ pub fn sampled_rays(
     }
 }
 
+/// Whether the ray from `o` along `d` enters the box, by the reference's own
+/// (padded) test of a node's box: the launch order's test of a tile's rays.
+pub(crate) fn ray_enters(min: [f32; 3], max: [f32; 3], o: glam::DVec3, d: glam::DVec3) -> bool {
+    super::intersect::enter_box(min, max, o, d, f64::INFINITY).is_some()
+}
+
 /// Whether the ray from `o` along `d` hits anything in `scene` (in its local
 /// frame), by brute force: what the launch order's empty tiles are held to.
 #[cfg(test)]
